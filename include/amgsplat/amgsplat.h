@@ -1,0 +1,20 @@
+/*
+ * amgsplat: point-based rendering and extreme simplification by algebraic
+ * multigrid domain primitives (Reniers & Telea 2006; Pajarola et al. 2003;
+ * Schwarz 2004). This header includes the whole public API.
+ */
+#ifndef AMGSPLAT_H
+#define AMGSPLAT_H
+
+#include "core.h"
+#include "cloud.h"
+#include "image.h"
+#include "io.h"
+#include "mesh.h"
+#include "geom.h"
+#include "sample.h"
+#include "eval.h"
+#include "amg.h"
+#include "render.h"
+
+#endif

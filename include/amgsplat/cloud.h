@@ -1,0 +1,135 @@
+/*
+ * asp_cloud: a point set in structure-of-arrays form (STYLE.md section 6).
+ * Positions are float offsets from a double-precision origin so that scans in
+ * large coordinates (UTM, ECEF) keep sub-millimetre precision. Any vertex
+ * property the input carries beyond the standard ones is kept by name and
+ * type, so a PLY read-write round trip loses nothing.
+ */
+#ifndef AMGSPLAT_CLOUD_H
+#define AMGSPLAT_CLOUD_H
+
+#include "core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef uint32_t asp_index; /* point index; a cloud holds at most 2^32-1 points */
+
+/** Scalar types of PLY and of extra properties. */
+typedef enum asp_scalar_type {
+    ASP_SCALAR_NONE = 0,
+    ASP_SCALAR_INT8, ASP_SCALAR_UINT8, ASP_SCALAR_INT16, ASP_SCALAR_UINT16,
+    ASP_SCALAR_INT32, ASP_SCALAR_UINT32, ASP_SCALAR_FLOAT32, ASP_SCALAR_FLOAT64
+} asp_scalar_type;
+
+/** Size in bytes of one value of type t (0 for NONE). */
+size_t asp_scalar_size(asp_scalar_type t);
+/** PLY name of t ("uchar", "float", ...). */
+const char *asp_scalar_name(asp_scalar_type t);
+
+/** An extra per-point scalar property: count values of type, densely packed. */
+typedef struct asp_property {
+    char name[64];
+    asp_scalar_type type;
+    void *data; /* count * asp_scalar_size(type) bytes, owned by the cloud */
+} asp_property;
+
+/** Which optional attributes a cloud holds (bit set). */
+enum asp_cloud_attr {
+    ASP_ATTR_NORMALS = 1 << 0,
+    ASP_ATTR_COLORS = 1 << 1,
+    ASP_ATTR_RADII = 1 << 2,
+    ASP_ATTR_UVS = 1 << 3,
+    ASP_ATTR_LABELS = 1 << 4
+};
+
+/**
+ * The point set. Fields are public for reading and writing the arrays in place;
+ * allocate and resize only through the asp_cloud_* functions. Absent attributes
+ * are NULL. All arrays are 64-byte aligned.
+ */
+typedef struct asp_cloud {
+    size_t count;
+    double origin[3];   /* world position = origin + positions[i] */
+    float *positions;   /* 3 * count, xyz packed */
+    float *normals;     /* 3 * count, unit length, or NULL */
+    uint8_t *colors;    /* 4 * count, RGBA 8-bit sRGB (A = 255 if the input had none), or NULL */
+    float *radii;       /* count, splat radius in world units, or NULL */
+    float *uvs;         /* 2 * count texture coordinates, or NULL */
+    uint32_t *labels;   /* count, e.g. face or part id, or NULL */
+
+    size_t property_count;
+    asp_property *properties; /* extra per-point scalars, in file order */
+
+    /* Triangles when the source had faces (PLY face lists, fan-triangulated): 3 * face_count indices. */
+    size_t face_count;
+    uint32_t *faces;
+
+    /* Source metadata kept for round trips: PLY comments and obj_info lines (NUL-terminated strings). */
+    size_t comment_count;
+    char **comments;
+    size_t obj_info_count;
+    char **obj_info;
+
+    /* How standard attributes were typed in the source file, so a writer can reproduce them. */
+    asp_scalar_type position_type; /* FLOAT32 or FLOAT64 (NONE = float) */
+    asp_scalar_type color_type;    /* UINT8 or FLOAT32 (NONE = uchar) */
+
+    asp_context ctx; /* copy of the context that allocated the arrays */
+} asp_cloud;
+
+/**
+ * Creates a cloud of count points with positions (zeroed) and the attributes in
+ * attrs (ASP_ATTR_* bits, zeroed). ctx may be NULL. Returns 0 or ASP_ENOMEM.
+ * The caller frees the result with asp_cloud_destroy.
+ */
+int asp_cloud_create(size_t count, unsigned attrs, const asp_context *ctx, asp_cloud **out, asp_error *err);
+
+/** Frees the cloud and everything it owns; NULL is accepted. */
+void asp_cloud_destroy(asp_cloud *cloud);
+
+/** Adds the attributes in attrs that are missing (zero-filled). Returns 0 or ASP_ENOMEM. */
+int asp_cloud_add_attrs(asp_cloud *cloud, unsigned attrs, asp_error *err);
+
+/** Bit set of the attributes present. */
+unsigned asp_cloud_attrs(const asp_cloud *cloud);
+
+/**
+ * Adds an extra property of the given type (zero-filled) and returns a pointer
+ * to it in *out (valid until the next add/remove). Fails with ASP_EINVAL if the
+ * name exists or is longer than 63 bytes.
+ */
+int asp_cloud_add_property(asp_cloud *cloud, const char *name, asp_scalar_type type,
+                           asp_property **out, asp_error *err);
+
+/** The property called name, or NULL. */
+asp_property *asp_cloud_find_property(const asp_cloud *cloud, const char *name);
+
+/** Appends a comment (PLY "comment" line, without the keyword). */
+int asp_cloud_add_comment(asp_cloud *cloud, const char *text, asp_error *err);
+/** Appends an obj_info line (without the keyword). */
+int asp_cloud_add_obj_info(asp_cloud *cloud, const char *text, asp_error *err);
+
+/** Sets the face list (copies 3 * face_count indices). Fails with ASP_EFORMAT if an index is >= count. */
+int asp_cloud_set_faces(asp_cloud *cloud, const uint32_t *faces, size_t face_count, asp_error *err);
+
+/** World-space position of point i in double precision. */
+void asp_cloud_world_position(const asp_cloud *cloud, size_t i, double out[3]);
+
+/** Axis-aligned bounds of positions (relative to origin). Returns ASP_EDEGENERATE for an empty cloud. */
+int asp_cloud_bounds(const asp_cloud *cloud, float lo[3], float hi[3], asp_error *err);
+
+/**
+ * Checks that every position (and normal, radius, uv if present) is finite.
+ * On failure names the first bad point: "point 17: coordinate x is NaN".
+ */
+int asp_cloud_validate(const asp_cloud *cloud, asp_error *err);
+
+/** Deep copy. */
+int asp_cloud_clone(const asp_cloud *src, asp_cloud **out, asp_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,78 @@
+/*
+ * Shared CLI plumbing: the environment every subcommand receives, the option
+ * parser, error printing and the terminal progress bar. Only src/cli/ prints.
+ */
+#ifndef ASP_CLI_H
+#define ASP_CLI_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "amgsplat/amgsplat.h"
+
+struct cli_progress_state {
+    double start;
+    double last_draw;
+    char stage[48];
+    int drawn;
+};
+
+struct cli_env {
+    const char *cmd;     /* subcommand name, for messages */
+    asp_context ctx;     /* threads and progress set from the common options */
+    int quiet;           /* --quiet: no progress, no chatter */
+    int json;            /* --json: machine-readable output on stdout */
+    int threads;         /* --threads N (0 = all) */
+    struct cli_progress_state progress;
+};
+
+enum cli_opt_type { CLI_FLAG, CLI_INT, CLI_SIZE, CLI_DOUBLE, CLI_STRING };
+
+/*
+ * One option. value points to: int (FLAG sets 1, INT), size_t (SIZE),
+ * double (DOUBLE), const char * (STRING). Table ends with a zero entry.
+ */
+struct cli_option {
+    const char *name;   /* long name without dashes, e.g. "points" */
+    char short_name;    /* e.g. 'o', or 0 */
+    enum cli_opt_type type;
+    void *value;
+    const char *arg;    /* argument placeholder in help, e.g. "N" */
+    const char *help;
+};
+
+/*
+ * Parses argv (argv[0] is the subcommand name). Every subcommand also gets
+ * -h/--help, -q/--quiet, --json and --threads N. Positional arguments are
+ * compacted to the front of argv; *npos receives their count.
+ * Returns 0 to go on, 1 when help was printed (exit 0), -1 on a usage error
+ * (already printed; exit 2).
+ */
+int cli_parse(int argc, char **argv, const struct cli_option *opts, const char *usage, struct cli_env *env,
+              int *npos);
+
+/* Prints "amgsplat CMD: error: MSG" and returns exit status 1. */
+int cli_fail(const struct cli_env *env, const asp_error *err);
+/* Prints a formatted usage error and returns exit status 2. */
+int cli_usage_error(const struct cli_env *env, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Informational line on stderr unless --quiet. */
+void cli_info(const struct cli_env *env, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Ends a progress bar line if one is drawn (call before printing results). */
+void cli_progress_end(struct cli_env *env);
+
+/* Parses "a,b[,c]" doubles into out (up to max); returns how many, -1 on junk. */
+int cli_parse_doubles(const char *s, double *out, int max);
+/* Parses "WxH"; returns 0 or -1. */
+int cli_parse_size2(const char *s, unsigned *w, unsigned *h);
+/* Writes s as a JSON string literal (quotes and escapes). */
+void cli_json_string(FILE *fp, const char *s);
+
+#endif

@@ -1,0 +1,19 @@
+/*
+ * Subcommands: one file each, src/cli/cmd_<name>.c (STYLE.md section 10).
+ * The return value is the process exit status.
+ */
+#ifndef ASP_CLI_COMMANDS_H
+#define ASP_CLI_COMMANDS_H
+
+struct cli_env;
+
+int cmd_info(int argc, char **argv, struct cli_env *env);
+int cmd_convert(int argc, char **argv, struct cli_env *env);
+int cmd_sample(int argc, char **argv, struct cli_env *env);
+int cmd_synth(int argc, char **argv, struct cli_env *env);
+int cmd_estimate(int argc, char **argv, struct cli_env *env);
+int cmd_render(int argc, char **argv, struct cli_env *env);
+int cmd_imgdiff(int argc, char **argv, struct cli_env *env);
+int cmd_decompose(int argc, char **argv, struct cli_env *env);
+
+#endif

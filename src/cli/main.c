@@ -1,0 +1,94 @@
+/*
+ * amgsplat: git-style dispatcher. The table below is the only list of
+ * subcommands; each lives in src/cli/cmd_<name>.c.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli/cli.h"
+#include "cli/commands.h"
+#include "util/banned.h"
+
+struct cli_command {
+    const char *name;
+    int (*fn)(int argc, char **argv, struct cli_env *env);
+    const char *summary;
+};
+
+static const struct cli_command commands[] = {
+    {"info", cmd_info, "print counts, attributes, bounds and radii of a point or primitive file"},
+    {"convert", cmd_convert, "convert between point formats (PLY ascii/binary, XYZ)"},
+    {"sample", cmd_sample, "sample a mesh (OBJ, PLY, OFF, STL, glTF, 3DS) to points"},
+    {"synth", cmd_synth, "make a synthetic test model (octahedron, cube, sphere, torus, checker-plane)"},
+    {"estimate", cmd_estimate, "estimate normals and radii of a raw scan"},
+    {"render", cmd_render, "render points to PNG headlessly (EGL)"},
+    {"imgdiff", cmd_imgdiff, "compare two images: PSNR, SSIM, silhouette IoU"},
+    {"decompose", cmd_decompose, "multiscale AMG decomposition of a point set into domains"},
+};
+enum { N_COMMANDS = sizeof commands / sizeof commands[0] };
+
+static void print_overview(FILE *fp)
+{
+    fprintf(fp, "usage: amgsplat <command> [options] [args]\n"
+                "       amgsplat help <command>\n\n"
+                "Point-based rendering and AMG domain-primitive simplification (amgsplat %s).\n\n"
+                "commands:\n",
+            ASP_VERSION_STRING);
+    for (size_t i = 0; i < N_COMMANDS; i++)
+        fprintf(fp, "  %-10s %s\n", commands[i].name, commands[i].summary);
+    fprintf(fp, "\nEvery command takes -h, --quiet, --json and --threads N.\n");
+}
+
+static const struct cli_command *find_command(const char *name)
+{
+    for (size_t i = 0; i < N_COMMANDS; i++)
+        if (strcmp(commands[i].name, name) == 0)
+            return &commands[i];
+    return NULL;
+}
+
+static int run(const struct cli_command *c, int argc, char **argv)
+{
+    struct cli_env env;
+    memset(&env, 0, sizeof env);
+    env.cmd = c->name;
+    int status = c->fn(argc, argv, &env);
+    cli_progress_end(&env);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        print_overview(stderr);
+        return 2;
+    }
+    const char *name = argv[1];
+    if (strcmp(name, "-h") == 0 || strcmp(name, "--help") == 0) {
+        print_overview(stdout);
+        return 0;
+    }
+    if (strcmp(name, "--version") == 0 || strcmp(name, "version") == 0) {
+        printf("amgsplat %s\n", ASP_VERSION_STRING);
+        return 0;
+    }
+    if (strcmp(name, "help") == 0) {
+        if (argc < 3) {
+            print_overview(stdout);
+            return 0;
+        }
+        const struct cli_command *c = find_command(argv[2]);
+        if (!c) {
+            fprintf(stderr, "amgsplat: '%s' is not a command; see 'amgsplat help'\n", argv[2]);
+            return 2;
+        }
+        char *help_argv[] = {argv[2], "--help", NULL};
+        return run(c, 2, help_argv);
+    }
+    const struct cli_command *c = find_command(name);
+    if (!c) {
+        fprintf(stderr, "amgsplat: '%s' is not a command; see 'amgsplat help'\n", name);
+        return 2;
+    }
+    return run(c, argc - 1, argv + 1);
+}

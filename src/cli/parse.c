@@ -1,0 +1,290 @@
+/*
+ * Option parsing shared by all subcommands: --name value, --name=value,
+ * -x value, and the common options every command takes.
+ */
+#include <errno.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli/cli.h"
+#include "util/banned.h"
+
+static int progress_cb(void *user, const char *stage, double fraction);
+
+static const char *type_arg(const struct cli_option *o)
+{
+    if (o->arg)
+        return o->arg;
+    switch (o->type) {
+    case CLI_INT: case CLI_SIZE: return "N";
+    case CLI_DOUBLE: return "X";
+    case CLI_STRING: return "S";
+    default: return "";
+    }
+}
+
+static void print_help(const struct cli_option *opts, const char *usage)
+{
+    printf("%s\n", usage);
+    printf("\noptions:\n");
+    for (const struct cli_option *o = opts; o && o->name; o++) {
+        char left[64];
+        if (o->type == CLI_FLAG)
+            snprintf(left, sizeof left, "%s%c%s--%s", o->short_name ? "-" : "", o->short_name ? o->short_name : ' ',
+                     o->short_name ? ", " : "  ", o->name);
+        else
+            snprintf(left, sizeof left, "%s%c%s--%s %s", o->short_name ? "-" : "",
+                     o->short_name ? o->short_name : ' ', o->short_name ? ", " : "  ", o->name, type_arg(o));
+        printf("  %-26s %s\n", left + (o->short_name ? 0 : 1), o->help ? o->help : "");
+    }
+    printf("  %-26s %s\n", "-q, --quiet", "no progress bar or informational messages");
+    printf("  %-26s %s\n", "    --json", "machine-readable output on stdout");
+    printf("  %-26s %s\n", "    --threads N", "worker threads (default: all cores)");
+    printf("  %-26s %s\n", "-h, --help", "show this help");
+}
+
+static int set_value(struct cli_env *env, const struct cli_option *o, const char *v)
+{
+    char *end = NULL;
+    errno = 0;
+    switch (o->type) {
+    case CLI_FLAG:
+        *(int *)o->value = 1;
+        return 0;
+    case CLI_INT: {
+        long x = strtol(v, &end, 10);
+        if (errno || end == v || *end || x < INT_MIN || x > INT_MAX)
+            return cli_usage_error(env, "--%s expects an integer, got '%s'", o->name, v);
+        *(int *)o->value = (int)x;
+        return 0;
+    }
+    case CLI_SIZE: {
+        if (*v == '-')
+            return cli_usage_error(env, "--%s expects a non-negative integer, got '%s'", o->name, v);
+        /* accept 2e6 / 200k / 1M for point counts */
+        double d = strtod(v, &end);
+        if (end != v && (*end == 'k' || *end == 'K')) d *= 1e3, end++;
+        else if (end != v && (*end == 'm' || *end == 'M')) d *= 1e6, end++;
+        if (errno || end == v || *end || d < 0 || d > 1e15 || d != (double)(size_t)d)
+            return cli_usage_error(env, "--%s expects a non-negative integer, got '%s'", o->name, v);
+        *(size_t *)o->value = (size_t)d;
+        return 0;
+    }
+    case CLI_DOUBLE: {
+        double d = strtod(v, &end);
+        if (errno || end == v || *end || d != d)
+            return cli_usage_error(env, "--%s expects a number, got '%s'", o->name, v);
+        *(double *)o->value = d;
+        return 0;
+    }
+    case CLI_STRING:
+        *(const char **)o->value = v;
+        return 0;
+    }
+    return 2;
+}
+
+int cli_parse(int argc, char **argv, const struct cli_option *opts, const char *usage, struct cli_env *env,
+              int *npos)
+{
+    int n = 0;
+    int only_positional = 0;
+    for (int i = 1; i < argc; i++) {
+        char *a = argv[i];
+        if (only_positional || a[0] != '-' || a[1] == '\0') {
+            argv[n++] = a;
+            continue;
+        }
+        if (strcmp(a, "--") == 0) {
+            only_positional = 1;
+            continue;
+        }
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            print_help(opts, usage);
+            return 1;
+        }
+        if (strcmp(a, "-q") == 0 || strcmp(a, "--quiet") == 0) {
+            env->quiet = 1;
+            continue;
+        }
+        if (strcmp(a, "--json") == 0) {
+            env->json = 1;
+            continue;
+        }
+        const struct cli_option *o = NULL;
+        const char *inline_value = NULL;
+        char name[64];
+        if (a[1] == '-') {
+            const char *eq = strchr(a + 2, '=');
+            size_t len = eq ? (size_t)(eq - (a + 2)) : strlen(a + 2);
+            if (len >= sizeof name)
+                len = sizeof name - 1;
+            memcpy(name, a + 2, len);
+            name[len] = '\0';
+            inline_value = eq ? eq + 1 : NULL;
+            if (strcmp(name, "threads") == 0) {
+                const char *v = inline_value ? inline_value : (i + 1 < argc ? argv[++i] : NULL);
+                char *end;
+                long t = v ? strtol(v, &end, 10) : -1;
+                if (!v || *end || t < 0 || t > 4096)
+                    return cli_usage_error(env, "--threads expects a count from 0 to 4096"), -1;
+                env->threads = (int)t;
+                continue;
+            }
+            for (const struct cli_option *p = opts; p && p->name; p++)
+                if (strcmp(p->name, name) == 0)
+                    o = p;
+        } else if (a[2] == '\0') {
+            for (const struct cli_option *p = opts; p && p->name; p++)
+                if (p->short_name == a[1])
+                    o = p;
+            snprintf(name, sizeof name, "%c", a[1]);
+        } else {
+            snprintf(name, sizeof name, "%s", a + 1);
+        }
+        if (!o) {
+            cli_usage_error(env, "unknown option '%s'; see 'amgsplat %s -h'", a, env->cmd);
+            return -1;
+        }
+        const char *v = inline_value;
+        if (o->type != CLI_FLAG && !v) {
+            if (i + 1 >= argc) {
+                cli_usage_error(env, "option '%s' needs a value", a);
+                return -1;
+            }
+            v = argv[++i];
+        }
+        if (o->type == CLI_FLAG && inline_value) {
+            cli_usage_error(env, "option '--%s' takes no value", o->name);
+            return -1;
+        }
+        if (set_value(env, o, v))
+            return -1;
+    }
+    *npos = n;
+    env->ctx.threads = env->threads;
+    if (!env->quiet && isatty(STDERR_FILENO)) {
+        env->ctx.progress = progress_cb;
+        env->ctx.progress_user = env;
+    }
+    return 0;
+}
+
+int cli_fail(const struct cli_env *env, const asp_error *err)
+{
+    fprintf(stderr, "amgsplat %s: error: %s\n", env->cmd, err && err->msg[0] ? err->msg : "failed");
+    return 1;
+}
+
+int cli_usage_error(const struct cli_env *env, const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, "amgsplat %s: ", env->cmd);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    return 2;
+}
+
+void cli_info(const struct cli_env *env, const char *fmt, ...)
+{
+    if (env->quiet)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+}
+
+/* Progress bar with ETA, redrawn at most 10 times a second, only on a terminal. */
+static int progress_cb(void *user, const char *stage, double fraction)
+{
+    struct cli_env *env = user;
+    struct cli_progress_state *p = &env->progress;
+    double now = asp_time_now();
+    if (strncmp(p->stage, stage, sizeof p->stage - 1) != 0) {
+        snprintf(p->stage, sizeof p->stage, "%s", stage);
+        p->start = now;
+        p->last_draw = 0;
+    }
+    if (fraction < 1.0 && now - p->last_draw < 0.1)
+        return 0;
+    p->last_draw = now;
+    if (fraction < 0) fraction = 0;
+    if (fraction > 1) fraction = 1;
+    int width = 30, fill = (int)(fraction * width + 0.5);
+    char bar[32];
+    for (int i = 0; i < width; i++)
+        bar[i] = i < fill ? '#' : '.';
+    bar[width] = '\0';
+    double elapsed = now - p->start;
+    char eta[32] = "";
+    if (fraction > 0.02 && fraction < 1.0)
+        snprintf(eta, sizeof eta, " ETA %.0fs", elapsed * (1.0 - fraction) / fraction);
+    fprintf(stderr, "\r%-12s [%s] %3.0f%%%-12s", p->stage, bar, 100.0 * fraction, eta);
+    p->drawn = 1;
+    return 0;
+}
+
+void cli_progress_end(struct cli_env *env)
+{
+    if (env->progress.drawn) {
+        fputs("\r\033[K", stderr);
+        env->progress.drawn = 0;
+    }
+}
+
+int cli_parse_doubles(const char *s, double *out, int max)
+{
+    int n = 0;
+    const char *p = s;
+    while (*p) {
+        char *end;
+        errno = 0;
+        double d = strtod(p, &end);
+        if (end == p || errno || d != d || n >= max)
+            return -1;
+        out[n++] = d;
+        p = end;
+        if (*p == ',')
+            p++;
+        else if (*p)
+            return -1;
+    }
+    return n;
+}
+
+int cli_parse_size2(const char *s, unsigned *w, unsigned *h)
+{
+    char *end;
+    unsigned long a = strtoul(s, &end, 10);
+    if (end == s || (*end != 'x' && *end != 'X'))
+        return -1;
+    const char *q = end + 1;
+    unsigned long b = strtoul(q, &end, 10);
+    if (end == q || *end || a == 0 || b == 0 || a > 16384 || b > 16384)
+        return -1;
+    *w = (unsigned)a;
+    *h = (unsigned)b;
+    return 0;
+}
+
+void cli_json_string(FILE *fp, const char *s)
+{
+    fputc('"', fp);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(fp, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(fp, "\\u%04x", c);
+        else
+            fputc(c, fp);
+    }
+    fputc('"', fp);
+}

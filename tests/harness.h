@@ -1,0 +1,84 @@
+/*
+ * Minimal unit-test harness (STYLE.md section 11): CHECK macros that stay on
+ * whatever NDEBUG says, a per-file list of tests, and a summary line that
+ * ctest's log and a human can read. A failing CHECK records the failure and
+ * continues, so one run reports every broken invariant.
+ */
+#ifndef ASP_TESTS_HARNESS_H
+#define ASP_TESTS_HARNESS_H
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int asp_test_failures;
+static int asp_test_checks;
+
+#define CHECK(cond)                                                                  \
+    do {                                                                             \
+        asp_test_checks++;                                                           \
+        if (!(cond)) {                                                               \
+            asp_test_failures++;                                                     \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); \
+        }                                                                            \
+    } while (0)
+
+#define CHECK_MSG(cond, ...)                                                         \
+    do {                                                                             \
+        asp_test_checks++;                                                           \
+        if (!(cond)) {                                                               \
+            asp_test_failures++;                                                     \
+            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #cond); \
+            fprintf(stderr, __VA_ARGS__);                                            \
+            fputc('\n', stderr);                                                     \
+        }                                                                            \
+    } while (0)
+
+#define CHECK_NEAR(a, b, tol)                                                                   \
+    do {                                                                                        \
+        double asp_a_ = (double)(a), asp_b_ = (double)(b);                                      \
+        asp_test_checks++;                                                                      \
+        if (!(fabs(asp_a_ - asp_b_) <= (tol))) {                                                \
+            asp_test_failures++;                                                                \
+            fprintf(stderr, "%s:%d: CHECK_NEAR failed: %s = %.9g, %s = %.9g, tol %.3g\n",       \
+                    __FILE__, __LINE__, #a, asp_a_, #b, asp_b_, (double)(tol));                 \
+        }                                                                                       \
+    } while (0)
+
+/* Asserts a library call succeeded; prints its message otherwise. */
+#define CHECK_OK(call, errp)                                                                  \
+    do {                                                                                      \
+        int asp_rc_ = (call);                                                                 \
+        asp_test_checks++;                                                                    \
+        if (asp_rc_ != 0) {                                                                   \
+            asp_test_failures++;                                                              \
+            fprintf(stderr, "%s:%d: %s returned %d: %s\n", __FILE__, __LINE__, #call, asp_rc_, \
+                    (errp) ? (errp)->msg : "");                                               \
+        }                                                                                     \
+    } while (0)
+
+typedef void (*asp_test_fn)(void);
+typedef struct { const char *name; asp_test_fn fn; } asp_test_case;
+
+#define TEST_CASE(fn) { #fn, fn }
+
+static inline int asp_test_run(const char *file, const asp_test_case *cases, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        int before = asp_test_failures;
+        cases[i].fn();
+        fprintf(stderr, "%s %s\n", asp_test_failures == before ? "ok  " : "FAIL", cases[i].name);
+    }
+    fprintf(stderr, "%s: %d checks, %d failed\n", file, asp_test_checks, asp_test_failures);
+    return asp_test_failures == 0 ? 0 : 1;
+}
+
+#define TEST_MAIN(...)                                                                 \
+    int main(void)                                                                     \
+    {                                                                                  \
+        static const asp_test_case cases_[] = {__VA_ARGS__};                           \
+        return asp_test_run(__FILE__, cases_, sizeof cases_ / sizeof cases_[0]);       \
+    }
+
+#endif
