@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs every build, test and demo dependency from Debian packages (apt-get
+# only). Idempotent: installs nothing when everything is already present.
+# Usage: scripts/bootstrap.sh [--fuzz]   (--fuzz adds clang for the libFuzzer targets)
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libhypre-dev libopenmpi-dev      # BoomerAMG (hypre) on MPI
+  libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri   # OpenGL 4.5 core via EGL (Mesa llvmpipe headless)
+  libglfw3-dev                     # viewer windows
+  libassimp-dev                    # mesh formats
+  libstb-dev                       # PNG/JPEG read and write
+  libflann-dev                     # k-NN baseline for bench/bench_knn.c
+  xvfb xauth                       # viewer test under a virtual display
+  glmark2-data                     # ships the Stanford bunny (demo model)
+)
+if [[ "${1:-}" == "--fuzz" ]]; then
+  packages+=(clang libclang-rt-14-dev)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then
+  SUDO="sudo"
+fi
+echo "bootstrap: installing ${missing[*]}" >&2
+$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
