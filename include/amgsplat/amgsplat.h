@@ -14,6 +14,7 @@
 #include "geom.h"
 #include "sample.h"
 #include "eval.h"
+#include "hier.h"
 #include "amg.h"
 #include "render.h"
 

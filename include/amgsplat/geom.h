@@ -20,9 +20,14 @@ typedef struct asp_kdtree asp_kdtree;
 
 /**
  * Builds a kd-tree over count points read from positions with stride_bytes
- * between consecutive points (12 for packed xyz). The positions are copied, so
- * the array may be freed afterwards. Returns 0, ASP_ENOMEM, or ASP_EINVAL for
- * count == 0 or count >= 2^32.
+ * between consecutive points (12 for packed xyz; a multiple of 4). The
+ * positions are copied into leaf order (about 40 bytes per point in all), so
+ * the array may be freed afterwards. Median splits on the widest axis, leaves
+ * of at most 12 points; all-equal subsets become one leaf, so duplicates cost
+ * no extra depth (depth <= log2(count) + 1). O(n log n), serial. On success
+ * *out owns the tree (free with asp_kdtree_destroy). Returns 0; ASP_ENOMEM;
+ * ASP_EINVAL for count == 0, count >= 2^32 - 1, a bad stride, NULL arrays or
+ * a non-finite coordinate ("point 17: coordinate y is not finite").
  */
 int asp_kdtree_create(const float *positions, size_t count, size_t stride_bytes,
                       const asp_context *ctx, asp_kdtree **out, asp_error *err);
@@ -34,15 +39,23 @@ size_t asp_kdtree_count(const asp_kdtree *tree);
 /**
  * Exact k nearest neighbours of query q: writes min(k, count) indices to idx and
  * squared distances to dist2 (may be NULL), nearest first, ties broken by
- * smaller index. Returns the number written. Thread-safe on a shared tree.
+ * smaller index, so the result equals a brute-force sort of the float squared
+ * distances (dx*dx + dy*dy + dz*dz). Returns the number written (0 for k == 0
+ * or NULL arguments). k > 128 allocates a scratch buffer through the context
+ * the tree was built with; if that fails the function returns 0. Thread-safe
+ * on a shared tree.
  */
 size_t asp_kdtree_knn(const asp_kdtree *tree, const float q[3], size_t k,
                       asp_index *idx, float *dist2);
 
 /**
- * All points within distance radius of q (inclusive), nearest first. Writes at
- * most capacity results and returns the total number found (which may exceed
- * capacity: call again with a larger buffer). Thread-safe.
+ * All points within distance radius of q (inclusive: squared distance <=
+ * radius * radius in float), nearest first with ties by smaller index. Writes
+ * the nearest min(total, capacity) results to idx and dist2 (may be NULL) and
+ * returns the total number found (which may exceed capacity: call again with a
+ * larger buffer; capacity 0 just counts). A negative or NaN radius gives 0.
+ * With dist2 NULL and capacity > 128 a scratch buffer is allocated through the
+ * tree's context; if that fails the function returns 0. Thread-safe.
  */
 size_t asp_kdtree_radius(const asp_kdtree *tree, const float q[3], float radius,
                          asp_index *idx, float *dist2, size_t capacity);
@@ -50,12 +63,153 @@ size_t asp_kdtree_radius(const asp_kdtree *tree, const float q[3], float radius,
 /**
  * k nearest neighbours of every indexed point, in parallel. Row i of idx
  * (count * k entries, count = asp_kdtree_count) lists point i's neighbours,
- * nearest first, excluding i itself; dist2 (may be NULL) likewise. k must be
- * < count. Deterministic for any thread count. Returns 0, ASP_EINVAL,
- * ASP_ECANCELED.
+ * nearest first, excluding i itself, ties by smaller index; dist2 (may be
+ * NULL) likewise. 1 <= k < count. Queries run in the tree's leaf order for
+ * locality; each writes only its own row, so results are bit-identical for
+ * any thread count. Reports progress as stage "knn". Returns 0; ASP_EINVAL;
+ * ASP_ENOMEM (per-thread scratch of about 16 k + 96 bytes); ASP_ECANCELED,
+ * with the rows partially written.
  */
 int asp_knn_all(const asp_kdtree *tree, size_t k, asp_index *idx, float *dist2,
                 const asp_context *ctx, asp_error *err);
+
+/* ---- PCA (src/geom/eigen3.c) ---- */
+
+/**
+ * Eigen-decomposition of the symmetric 3x3 matrix m = {xx, xy, xz, yy, yz, zz}
+ * by cyclic Jacobi rotations in double precision. Writes evals in descending
+ * order and evecs as a row-major 3x3 matrix whose column k (evecs[3*r + k],
+ * r = 0..2) is the unit eigenvector of evals[k]; the columns are orthonormal
+ * and right-handed (column 2 = column 0 x column 1), and columns 0 and 1 have
+ * their largest-magnitude component positive. Accurate to a few ulps of the
+ * largest |entry| for any scale, including repeated eigenvalues, rank-1 and
+ * zero matrices (zero gives evals 0 and the identity). A non-finite entry gives
+ * NaN evals and the identity. Never fails; thread-safe; no allocation.
+ */
+void asp_eigen_sym3(const double m[6], double evals[3], double evecs[9]);
+
+/**
+ * Centroid and covariance (divided by n) of n points, accumulated in double
+ * with the centroid subtracted first. The points are positions[idx[j]] for
+ * j < n, or the first n points when idx is NULL; stride_bytes separates
+ * consecutive points (12 for packed xyz). cov is {xx, xy, xz, yy, yz, zz},
+ * ready for asp_eigen_sym3. n == 0 gives zeros. Thread-safe; no allocation.
+ */
+void asp_covariance_sym3(const float *positions, size_t stride_bytes, const asp_index *idx, size_t n,
+                         double centroid[3], double cov[6]);
+
+/* ---- normals (src/geom/normals.c) ---- */
+
+/** How estimated normals are given a consistent sign. */
+typedef enum asp_orient {
+    /*
+     * Hoppe et al. 1992: propagate along a minimum spanning tree of the
+     * symmetric k-NN graph with weights 1 - |n_i . n_j|. Each connected
+     * component starts from its highest point (largest z, then smallest index),
+     * whose normal is turned to +z (or away from the component centroid when
+     * it is nearly horizontal). Closed surfaces come out pointing outwards.
+     */
+    ASP_ORIENT_MST = 0,
+    ASP_ORIENT_VIEWPOINT = 1, /* every normal faces desc.viewpoint: n . (viewpoint - p) >= 0 */
+    ASP_ORIENT_EXISTING = 2,  /* keep the sign of the normals passed in the output array */
+    ASP_ORIENT_NONE = 3       /* raw PCA sign (deterministic, not consistent) */
+} asp_orient;
+
+/** Normal estimation options; the zero value means k = 16 and MST orientation. */
+typedef struct asp_normals_desc {
+    size_t k;           /* neighbours besides the point itself; 0 = ASP_NORMALS_DEFAULT_K */
+    asp_orient orient;
+    float viewpoint[3]; /* for ASP_ORIENT_VIEWPOINT, in the positions' coordinates */
+} asp_normals_desc;
+
+#define ASP_NORMALS_DEFAULT_K 16
+
+/**
+ * Estimates unit normals by PCA of each point together with its k nearest
+ * neighbours (the eigenvector of the smallest covariance eigenvalue, thesis
+ * 3.3.1), then orients them per desc->orient. desc may be NULL (defaults); k is
+ * clamped to count - 1. positions: count points, stride_bytes apart. normals:
+ * 3 * count floats, written packed; for ASP_ORIENT_EXISTING it holds the
+ * reference normals on entry. Points whose neighbours are all equal get
+ * (0, 0, 1) before orientation. Returns 0; ASP_EINVAL (NULL arrays, stride,
+ * non-finite coordinate, named by point); ASP_EDEGENERATE (fewer than 3
+ * points, or all points equal); ASP_ENOMEM; ASP_ECANCELED. On failure normals
+ * is unchanged. Uses asp_context_threads(ctx) threads for the kNN and PCA;
+ * the MST pass is serial. Results do not depend on the thread count.
+ */
+int asp_estimate_normals(const float *positions, size_t count, size_t stride_bytes, const asp_normals_desc *desc,
+                         float *restrict normals, const asp_context *ctx, asp_error *err);
+
+/**
+ * As asp_estimate_normals, on a precomputed k-NN graph: knn has count rows of
+ * k indices (as written by asp_knn_all, the point itself excluded); desc->k is
+ * ignored. Returns ASP_EINVAL when an index is >= count (naming row and
+ * column), otherwise as asp_estimate_normals.
+ */
+int asp_normals_from_knn(const float *positions, size_t count, size_t stride_bytes, const asp_index *knn,
+                         size_t k, const asp_normals_desc *desc, float *restrict normals, const asp_context *ctx,
+                         asp_error *err);
+
+/* ---- splat radii (src/geom/radii.c) ---- */
+
+/**
+ * Radius options; the zero value means r_i = 1.0 * (distance from point i to
+ * its 16th nearest neighbour). With that choice, discs of radius r_i cover
+ * every point of a uniformly (even randomly) sampled surface: the largest
+ * empty circle among n random samples has area about ln(n) / density, while
+ * the 16th-neighbour disc has area about 16 / density, and a hole only makes
+ * the radii of the samples around it larger (tests/unit/test_geom_radii.c).
+ */
+typedef struct asp_radii_desc {
+    size_t k;     /* which neighbour's distance; 0 = ASP_RADII_DEFAULT_K */
+    float factor; /* multiplier; 0 = 1 */
+} asp_radii_desc;
+
+#define ASP_RADII_DEFAULT_K 16
+
+/**
+ * Writes count radii (see asp_radii_desc) to radii. desc may be NULL; k is
+ * clamped to count - 1. Returns 0, ASP_EINVAL (NULL arrays, bad stride,
+ * non-finite coordinate, negative or non-finite factor), ASP_EDEGENERATE
+ * (fewer than 2 points, or all points equal), ASP_ENOMEM, ASP_ECANCELED. On
+ * failure radii is unchanged. A point with k duplicates of itself gets the
+ * smallest positive radius of the set, so no splat has zero size. Parallel,
+ * deterministic.
+ */
+int asp_estimate_radii(const float *positions, size_t count, size_t stride_bytes, const asp_radii_desc *desc,
+                       float *restrict radii, const asp_context *ctx, asp_error *err);
+
+/**
+ * As asp_estimate_radii from precomputed squared neighbour distances: dist2
+ * has count rows of k_stride values, ascending (as written by asp_knn_all).
+ * desc->k must be <= k_stride (0 means min(16, k_stride)). Returns 0,
+ * ASP_EINVAL, ASP_EDEGENERATE (every distance is zero).
+ */
+int asp_radii_from_knn(const float *dist2, size_t count, size_t k_stride, const asp_radii_desc *desc,
+                       float *restrict radii, const asp_context *ctx, asp_error *err);
+
+/* ---- cloud-level convenience (src/geom/normals.c) ---- */
+
+/** What asp_cloud_estimate computes; zero fields take the defaults above. */
+typedef struct asp_estimate_desc {
+    size_t k;            /* neighbours for normals; 0 = ASP_NORMALS_DEFAULT_K */
+    int normals;         /* estimate normals (when missing, or always with force) */
+    int radii;           /* estimate radii (when missing, or always with force) */
+    int force;           /* recompute attributes the cloud already has */
+    asp_orient orient;   /* ASP_ORIENT_EXISTING with force keeps the old normals' signs */
+    float viewpoint[3];  /* for ASP_ORIENT_VIEWPOINT, relative to cloud->origin */
+    size_t radius_k;     /* 0 = ASP_RADII_DEFAULT_K */
+    float radius_factor; /* 0 = 1 */
+} asp_estimate_desc;
+
+/**
+ * Adds normals and/or radii to cloud, sharing one k-NN pass, using cloud->ctx
+ * for threads and memory. Attributes already present are left alone unless
+ * desc->force. Returns 0 or the errors of asp_estimate_normals /
+ * asp_estimate_radii; on failure the cloud is unchanged. Not thread-safe on
+ * the same cloud.
+ */
+int asp_cloud_estimate(asp_cloud *cloud, const asp_estimate_desc *desc, asp_error *err);
 
 #ifdef __cplusplus
 }

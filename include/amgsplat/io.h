@@ -1,6 +1,154 @@
-/* amgsplat io module (placeholder, being written). */
+/*
+ * amgsplat io: point files. PLY (ascii, binary little and big endian, every
+ * scalar type, list properties, faces) and plain-text XYZ/PTS, plus load/save
+ * by extension. The point set is the input of every later stage (journal
+ * Sect. 1, Fig. 2 pipeline; Schwarz 2004 1.4: samples carry position, normal,
+ * colour, and uv as in 3.1.6-3.1.7).
+ */
 #ifndef AMGSPLAT_IO_H
 #define AMGSPLAT_IO_H
+
 #include "cloud.h"
 #include "image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** PLY body encoding for writing; 0 means binary little endian. */
+typedef enum asp_ply_encoding {
+    ASP_PLY_DEFAULT = 0,      /* binary_little_endian */
+    ASP_PLY_BINARY_LE = 1,
+    ASP_PLY_BINARY_BE = 2,
+    ASP_PLY_ASCII = 3
+} asp_ply_encoding;
+
+/** Options for writing point files; the zero value means defaults. */
+typedef struct asp_save_desc {
+    asp_ply_encoding encoding; /* PLY only; ignored by the text formats */
+} asp_save_desc;
+
+/**
+ * Reads a PLY file into a new cloud (*out; free with asp_cloud_destroy).
+ *
+ * Accepted: "format ascii|binary_little_endian|binary_big_endian 1.0", every
+ * scalar type and alias (char/int8 ... double/float64), list properties in any
+ * element, elements in any order, CRLF or LF header lines. The 'vertex'
+ * element gives the points:
+ *  - x, y, z of any numeric type (required). float32 (and 8/16-bit integer)
+ *    coordinates are stored exactly with origin 0. double and 32-bit integer
+ *    coordinates set origin[k] to the first point's coordinate rounded to an
+ *    integer and store float offsets from it; position_type becomes FLOAT64.
+ *  - colours red/green/blue[/alpha], r/g/b[/a] or diffuse_red/... as uchar,
+ *    or as float/double in 0..1 (color_type records which; alpha is 255 when
+ *    absent). The three (four) must share one type.
+ *  - normals nx/ny/nz or normal_x/normal_y/normal_z (float or double);
+ *    radius, psz or point_size (float or double); uvs u/v, s/t or
+ *    texture_u/texture_v (float or double); label (uint) into labels.
+ *  - every other scalar vertex property is kept as an asp_property with its
+ *    name and type, in file order; list properties of the vertex are skipped.
+ * The 'face' element's vertex_indices (or vertex_index) list becomes
+ * triangles (polygons fan-triangulated, fewer than 3 indices dropped); other
+ * elements and lists (tristrips, edges, material ...) are skipped. comment
+ * and obj_info lines are kept in order.
+ *
+ * Errors: ASP_EIO (cannot open or read), ASP_EUNSUPPORTED (more than 2^32-1
+ * points), ASP_ENOMEM, ASP_ECANCELED (progress callback), ASP_EFORMAT for
+ * anything malformed: bad magic, unknown format or type, missing x/y/z,
+ * duplicate property, empty vertex element, NaN/Inf coordinate, truncation,
+ * a count the file cannot hold (checked against the file size before any
+ * allocation), an out-of-range face index. Messages read
+ * "cannot read 'F': line N: ..." for the header and ascii bodies, and
+ * "cannot read 'F': element 'vertex' N of M, byte B: ..." for binary bodies,
+ * N counting records from 1 and B being the file offset. On failure *out is
+ * unchanged and nothing leaks. Reentrant; ctx may be NULL.
+ */
+int asp_ply_read(const char *path, const asp_context *ctx, asp_cloud **out, asp_error *err);
+
+/**
+ * As asp_ply_read, from size bytes at data (borrowed for the call); name is
+ * used in messages (NULL gives "<memory>"). Safe on arbitrary bytes (fuzzed).
+ */
+int asp_ply_read_memory(const void *data, size_t size, const char *name, const asp_context *ctx, asp_cloud **out,
+                        asp_error *err);
+
+/**
+ * Writes cloud as PLY (desc may be NULL: binary little endian). Positions are
+ * float, or double world coordinates (origin + offset) when position_type is
+ * FLOAT64 or the origin is non-zero; normals, radius ("radius"), uvs
+ * ("texture_u", "texture_v") and labels ("label", uint) as written by
+ * asp_ply_read; colours as uchar or float 0..1 per color_type ("alpha" only
+ * when some alpha is not 255); every extra property with its own type; faces
+ * as "face" with "list uchar int vertex_indices" (uint when an index exceeds
+ * 2^31-1); comments and obj_info (newlines inside them become spaces).
+ * The file appears atomically (temporary file + rename).
+ * Errors: ASP_EINVAL (an extra property's name clashes with a written
+ * standard property), ASP_EIO, ASP_ENOMEM; on failure no file is left.
+ * Reentrant; the cloud is only read.
+ */
+int asp_ply_write(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err);
+
+/**
+ * Reads a plain-text point file: one point per line, values separated by
+ * spaces, tabs, commas or semicolons; blank lines and lines starting with '#'
+ * or "//" are skipped; a first data line holding a single integer is a point
+ * count (as in .pts) and is skipped. The first data line fixes the column
+ * count, every other line must match:
+ *   3: x y z            4: x y z intensity       7: x y z intensity r g b
+ *   6: x y z nx ny nz  or  x y z r g b           9: x y z nx ny nz r g b
+ * Six columns mean colours when, on every line, the last three values are
+ * integers in 0..255 and not every triple has unit length (so "0 0 1" is a
+ * normal); otherwise normals. Colour columns hold integers 0..255, or values
+ * in 0..1 (color_type FLOAT32). intensity becomes the float property
+ * "intensity". When the coordinates are far from zero (|x| > 65536) the
+ * origin is the bounding-box centre rounded to an integer and positions are
+ * float offsets from it. Values are parsed as doubles.
+ * Errors: ASP_EIO, ASP_ENOMEM, ASP_EFORMAT "cannot read 'F': line N: ..."
+ * (wrong value count, not a number, colour out of range, no points).
+ * On failure *out is unchanged. Reentrant.
+ */
+int asp_xyz_read(const char *path, const asp_context *ctx, asp_cloud **out, asp_error *err);
+
+/** As asp_xyz_read from memory (data borrowed; name for messages, NULL = "<memory>"). */
+int asp_xyz_read_memory(const void *data, size_t size, const char *name, const asp_context *ctx, asp_cloud **out,
+                        asp_error *err);
+
+/**
+ * Writes "x y z [nx ny nz] [r g b]" lines with world coordinates (shortest
+ * text that reads back to the same float, or 17 digits when the origin is
+ * non-zero). With no normals, an extra property "intensity" is written as the
+ * fourth column (4 or 7 columns, Leica PTS layout). Radius, uvs, labels,
+ * alpha, other extra properties, faces and comments are not written. When
+ * the path ends in ".pts" a first line holds the point count. desc is
+ * ignored (may be NULL). Atomic; errors ASP_EIO, ASP_ENOMEM. Reentrant.
+ */
+int asp_xyz_write(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err);
+
+/**
+ * Loads a point file by extension (case-insensitive): .ply through
+ * asp_ply_read, .xyz/.pts/.txt through asp_xyz_read. Then rejects non-finite
+ * values (asp_cloud_validate) and an empty cloud, with ASP_EFORMAT
+ * "cannot read 'F': ...". A cloud whose points are all equal loads fine.
+ * Unknown extension: ASP_EUNSUPPORTED "cannot read 'f.abc': unknown point
+ * format '.abc' (expected .ply, .xyz, .pts, .txt)". On failure *out is
+ * unchanged. Reentrant; ctx may be NULL.
+ */
+int asp_cloud_load(const char *path, const asp_context *ctx, asp_cloud **out, asp_error *err);
+
+/**
+ * Saves by extension: .ply through asp_ply_write (desc->encoding applies),
+ * .xyz/.pts/.txt through asp_xyz_write. Unknown extension: ASP_EUNSUPPORTED
+ * "cannot write 'f.abc': unknown point format ...". Atomic. Reentrant.
+ */
+int asp_cloud_save(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err);
+
+/**
+ * Point format of a path by its extension: "ply", "xyz" (for .xyz, .pts,
+ * .txt) or NULL when unknown. Pure; never fails.
+ */
+const char *asp_cloud_format_of(const char *path);
+
+#ifdef __cplusplus
+}
+#endif
 #endif

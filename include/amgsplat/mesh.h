@@ -1,6 +1,114 @@
-/* amgsplat mesh module (placeholder, being written). */
+/*
+ * asp_mesh: a triangle mesh in structure-of-arrays form, the input of the
+ * mesh-to-point samplers (Schwarz 2004 section 3.1 starts from "a polygon-based
+ * object"). Files are read through assimp's C API; the node hierarchy is
+ * flattened (transforms applied) and all meshes are merged into one.
+ */
 #ifndef AMGSPLAT_MESH_H
 #define AMGSPLAT_MESH_H
+
 #include "cloud.h"
 #include "image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** A material: diffuse colour and an optional diffuse texture. */
+typedef struct asp_material {
+    char name[64];          /* material name from the file ("DefaultMaterial" when assimp made one up) */
+    float diffuse[4];       /* RGBA in 0..1 */
+    int has_color;          /* 1 when the colour came from the file, 0 for assimp's default material */
+    asp_image texture;      /* pixels == NULL when the material has no texture */
+    char texture_path[512]; /* where the texture came from ("*0" = embedded), "" when none */
+} asp_material;
+
+/**
+ * The mesh. Fields are public for reading; allocate only through asp_mesh_create
+ * or asp_mesh_load. Arrays are 64-byte aligned and owned by the mesh.
+ */
+typedef struct asp_mesh {
+    size_t vertex_count;
+    size_t triangle_count;
+    double origin[3];       /* world position = origin + positions[i] (bounding-box centre after loading) */
+    float *positions;       /* 3 * vertex_count */
+    float *normals;         /* 3 * vertex_count, unit length (from the file, else area-weighted) */
+    float *uvs;             /* 2 * vertex_count, or NULL (GL convention: v = 0 is the image bottom) */
+    uint8_t *colors;        /* 4 * vertex_count RGBA sRGB, or NULL (only when the file has vertex colours) */
+    uint32_t *triangles;    /* 3 * triangle_count vertex indices, counter-clockwise seen from outside */
+    uint32_t *material_ids; /* triangle_count indices into materials */
+    size_t material_count;  /* >= 1 */
+    asp_material *materials;
+    asp_context ctx;        /* copy of the context that allocated the arrays */
+} asp_mesh;
+
+/** Bits for asp_mesh_create: which optional vertex arrays to allocate. */
+enum asp_mesh_attr {
+    ASP_MESH_UVS = 1 << 0,
+    ASP_MESH_COLORS = 1 << 1
+};
+
+/**
+ * Creates a mesh with vertex_count vertices and triangle_count triangles:
+ * positions, normals, triangles and material_ids zeroed, uvs/colors when asked
+ * in attrs (ASP_MESH_* bits), and one material (grey 0.6, no texture, has_color
+ * 0). For building meshes in code (tests, generators). ctx may be NULL.
+ * Returns 0, ASP_EINVAL (counts >= 2^32) or ASP_ENOMEM. Free with asp_mesh_destroy.
+ */
+int asp_mesh_create(size_t vertex_count, size_t triangle_count, unsigned attrs, const asp_context *ctx,
+                    asp_mesh **out, asp_error *err);
+
+/** Frees the mesh, its materials and their textures; NULL is accepted. */
+void asp_mesh_destroy(asp_mesh *mesh);
+
+/** Options for asp_mesh_load; the zero value means defaults. */
+typedef struct asp_mesh_load_desc {
+    /*
+     * Image file used as the diffuse texture of every material that names no
+     * texture, or whose texture file cannot be found. Needs UVs in the mesh.
+     */
+    const char *texture_override;
+    int ignore_file_normals; /* 1: recompute area-weighted normals even if the file has some */
+} asp_mesh_load_desc;
+
+/**
+ * Loads a triangle mesh (OBJ+MTL, PLY with faces, OFF, STL, glTF/GLB, 3DS and
+ * whatever else the installed assimp reads). Polygons are triangulated, the
+ * node transforms applied, all meshes merged; points and lines are dropped.
+ * Texture paths resolve relative to the model file; embedded textures ("*0")
+ * are decoded. Normals come from the file when every mesh has them, else they
+ * are computed area-weighted over triangles sharing a position (so UV seams do
+ * not show). desc may be NULL.
+ * Errors: ASP_EIO (unreadable file or a named texture that cannot be read: the
+ * message names the texture path and the material and suggests --texture),
+ * ASP_EFORMAT (assimp's message; a non-finite coordinate), ASP_EDEGENERATE (no
+ * triangles; zero surface area), ASP_EINVAL (texture_override without UVs),
+ * ASP_EUNSUPPORTED (more than 2^32-1 vertices), ASP_ENOMEM. On failure *out is
+ * unchanged. Thread safety: not safe to call from two threads at once, because
+ * assimp's C API keeps its last error message in a process-wide string.
+ */
+int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_context *ctx, asp_mesh **out,
+                  asp_error *err);
+
+/**
+ * Recomputes normals: area-weighted sums of triangle normals over all vertices
+ * at the same position (exactly equal coordinates), normalised; a vertex whose
+ * sum vanishes gets (0,0,1). Returns 0 or ASP_ENOMEM (scratch).
+ */
+int asp_mesh_compute_normals(asp_mesh *mesh, asp_error *err);
+
+/** Total triangle area in world units squared (summed in double). */
+double asp_mesh_area(const asp_mesh *mesh);
+
+/**
+ * Checks a mesh before sampling: triangle indices in range, finite positions,
+ * uvs and normals, material ids in range, non-zero area. name is used in the
+ * messages ("mesh 'x.obj' has zero surface area"). Returns 0, ASP_EFORMAT or
+ * ASP_EDEGENERATE.
+ */
+int asp_mesh_validate(const asp_mesh *mesh, const char *name, asp_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 #endif

@@ -1,6 +1,290 @@
-/* amgsplat render module (placeholder, being written). */
+/*
+ * amgsplat render module: OpenGL 4.5 core rendering of point sets as opaque
+ * oriented discs (journal section 1: "simple point primitives, such as flat
+ * discs ... position, radius, color, and normal"; Pajarola et al. 2003 section
+ * 5: surfels drawn as polygons in their tangent plane, shaped per fragment).
+ * Headless through EGL (Mesa llvmpipe or a GPU), windowed through GLFW.
+ *
+ * Threading: a GL context belongs to one thread at a time. Every function that
+ * takes an asp_gl_context (or an asp_renderer made from one) must be called
+ * from the thread that created it; different contexts may be used from
+ * different threads concurrently. The camera functions are pure math and
+ * thread safe.
+ */
 #ifndef AMGSPLAT_RENDER_H
 #define AMGSPLAT_RENDER_H
+
 #include "cloud.h"
 #include "image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------ */
+/* GL context                                                               */
+/* ------------------------------------------------------------------------ */
+
+/** An OpenGL 4.5 core context, headless (EGL) or in a window (GLFW). Opaque. */
+typedef struct asp_gl_context asp_gl_context;
+
+/** Flags for asp_gl_context_desc.flags; 0 is the safe default. */
+enum asp_gl_context_flags {
+    /* Ask for a debug context: the driver validates more and reports more
+     * through KHR_debug, at some speed cost. Errors are collected either way. */
+    ASP_GL_CONTEXT_DEBUG = 1 << 0,
+    /* Headless only: prefer Mesa's software rasteriser (llvmpipe) even when a
+     * GPU is present, e.g. for reproducible images across machines. */
+    ASP_GL_CONTEXT_SOFTWARE = 1 << 1
+};
+
+/** Options for creating a GL context; the zero value means defaults. */
+typedef struct asp_gl_context_desc {
+    unsigned flags;           /* asp_gl_context_flags */
+    uint32_t width, height;   /* window only: client area in screen units; 0 = 1280 x 800 */
+    const char *title;        /* window only: title; NULL = "amgsplat" */
+    const asp_context *ctx;   /* allocator for the context's CPU-side memory; NULL = C library */
+} asp_gl_context_desc;
+
+/**
+ * Creates a headless OpenGL 4.5 core context without any window or pbuffer
+ * (EGL_KHR_surfaceless_context; renders go to an offscreen framebuffer) and
+ * makes it current on the calling thread. Displays are tried in this order:
+ * EGL devices that are not software (EGL_EXT_platform_device; the GPU on an
+ * NVIDIA machine), Mesa's surfaceless platform (llvmpipe when there is no GPU),
+ * software EGL devices, and eglGetDisplay(EGL_DEFAULT_DISPLAY); with
+ * ASP_GL_CONTEXT_SOFTWARE, software displays come first. desc may be NULL.
+ *
+ * On success *out owns the context (free with asp_gl_context_destroy). On
+ * failure returns ASP_EGL with "no OpenGL 4.5 context: ..." naming each display
+ * tried and its EGL error (e.g. EGL_NOT_INITIALIZED), or ASP_ENOMEM; *out is
+ * unchanged. Nothing process-wide is changed (no environment variables).
+ */
+int asp_gl_context_create_headless(const asp_gl_context_desc *desc, asp_gl_context **out, asp_error *err);
+
+/**
+ * Creates a window of desc->width x desc->height with an OpenGL 4.5 core
+ * context through GLFW and makes it current. GLFW keeps process-wide state:
+ * call from the main thread and keep at most one window context alive at a time
+ * (destroying it terminates GLFW). Returns 0, ASP_EGL ("no OpenGL 4.5 window:
+ * ..." with GLFW's reason, e.g. no display) or ASP_ENOMEM; *out is unchanged on
+ * failure.
+ */
+int asp_gl_context_create_window(const asp_gl_context_desc *desc, asp_gl_context **out, asp_error *err);
+
+/**
+ * Destroys the context and every GL object it still owns (the offscreen
+ * framebuffer); renderers made from it must be destroyed first. NULL is
+ * accepted. The EGL display is left initialised: it is shared by every
+ * context of the process, and eglTerminate would invalidate the others.
+ */
+void asp_gl_context_destroy(asp_gl_context *gl);
+
+/** Makes gl current on the calling thread. Returns 0 or ASP_EGL. */
+int asp_gl_context_make_current(asp_gl_context *gl, asp_error *err);
+
+/**
+ * Reports GL errors collected since the last check: KHR_debug messages of type
+ * error (the first message is kept, with a count) and glGetError codes.
+ * Returns 0, or ASP_EGL with "cannot render: GL_INVALID_ENUM: <driver message>"
+ * and clears the collected errors. Only for callers issuing their own GL calls:
+ * every library function checks after its own GL work.
+ */
+int asp_gl_context_check(asp_gl_context *gl, asp_error *err);
+
+/** GL_RENDERER of the context, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"; valid until destroy. */
+const char *asp_gl_context_renderer(const asp_gl_context *gl);
+/** GL_VERSION of the context, e.g. "4.5 (Core Profile) Mesa 22.3.6"; valid until destroy. */
+const char *asp_gl_context_version(const asp_gl_context *gl);
+/** How the context was made: "egl-device", "egl-surfaceless", "egl-default" or "glfw". */
+const char *asp_gl_context_backend(const asp_gl_context *gl);
+
+/** Window contexts: swaps the front and back buffers. No-op for headless contexts. */
+void asp_gl_context_swap_buffers(asp_gl_context *gl);
+/** Window contexts: processes pending window events. No-op for headless contexts. */
+void asp_gl_context_poll_events(asp_gl_context *gl);
+/** Window contexts: 1 once the user asked to close the window; always 0 for headless contexts. */
+int asp_gl_context_should_close(const asp_gl_context *gl);
+/** Window contexts: framebuffer size in pixels; 0 x 0 for headless contexts. */
+void asp_gl_context_framebuffer_size(const asp_gl_context *gl, uint32_t *width, uint32_t *height);
+
+/* ------------------------------------------------------------------------ */
+/* Orbit camera (no GL; thread safe)                                        */
+/* ------------------------------------------------------------------------ */
+
+/**
+ * Orbit camera around target, y up. The eye sits at
+ *   target + distance * (cos(el) sin(az), sin(el), cos(el) cos(az))
+ * so azimuth 0, elevation 0 looks from +z towards -z with +x to the right;
+ * azimuth turns counter-clockwise seen from +y (90 looks from +x), elevation is
+ * the angle above the horizon (90 looks straight down; the image "up" then
+ * points away from the azimuth direction, so no singularity). Perspective
+ * projection with vertical field of view fov_y. Caller-owned plain struct.
+ */
+typedef struct asp_camera {
+    float target[3];
+    float azimuth;    /* degrees */
+    float elevation;  /* degrees, -90..90 */
+    float distance;   /* eye to target, world units, > 0 */
+    float fov_y;      /* vertical field of view, degrees, in (0, 180) */
+    float aspect;     /* viewport width / height, > 0 */
+    float z_near, z_far;
+} asp_camera;
+
+/** Defaults: target 0, azimuth 0, elevation 0, distance 3, fov_y 40, aspect 1, near 0.01, far 100. */
+void asp_camera_init(asp_camera *cam);
+
+/**
+ * Points the camera at a bounding sphere (center, radius > 0) and sets distance
+ * so the sphere exactly fills the view: its silhouette cone touches the nearer
+ * pair of frustum sides (top/bottom when aspect >= 1). Keeps azimuth,
+ * elevation and fov_y, sets aspect, and sets near/far with
+ * asp_camera_clip_to_sphere. To move closer or further afterwards, change
+ * distance and call asp_camera_clip_to_sphere again.
+ */
+void asp_camera_fit(asp_camera *cam, const float center[3], float radius, float aspect);
+
+/** The distance asp_camera_fit would choose for radius with cam's fov_y and aspect. */
+float asp_camera_fit_distance(const asp_camera *cam, float radius);
+
+/**
+ * Sets z_near/z_far so the sphere (center, radius) lies between them from the
+ * current eye, with 1% slack; if the eye is inside, z_near = 0.001 * (distance
+ * to center + radius) so the 24-bit depth buffer keeps its precision.
+ */
+void asp_camera_clip_to_sphere(asp_camera *cam, const float center[3], float radius);
+
+/** Eye position in world units. */
+void asp_camera_eye(const asp_camera *cam, float eye[3]);
+
+/** View matrix (world to eye; eye looks down -z), column-major: m[col * 4 + row]. */
+void asp_camera_view_matrix(const asp_camera *cam, float m[16]);
+
+/** OpenGL perspective matrix (eye to clip, NDC z in -1..1), column-major. */
+void asp_camera_projection_matrix(const asp_camera *cam, float m[16]);
+
+/**
+ * Projects world point p into a width x height image: out[0] = x in pixels
+ * from the left edge, out[1] = y in pixels from the top edge (pixel (i, j)
+ * covers [i, i+1) x [j, j+1), matching asp_image rows), out[2] = window depth
+ * in 0..1 (0 on the near plane). Returns 1 if p is in front of the eye (then
+ * out is filled, even when outside the image), else 0 and out is unchanged.
+ */
+int asp_camera_project(const asp_camera *cam, const float p[3], uint32_t width, uint32_t height, float out[3]);
+
+/* ------------------------------------------------------------------------ */
+/* Renderers                                                                */
+/* ------------------------------------------------------------------------ */
+
+/**
+ * A point set uploaded to GL with a way of drawing it (discs today; splats,
+ * squares and domain primitives later). Opaque; drawn with
+ * asp_render_to_image. Keeps a reference to the asp_gl_context it was created
+ * with, which must outlive it.
+ */
+typedef struct asp_renderer asp_renderer;
+
+/** Options of the disc renderer; the zero value means defaults. */
+typedef struct asp_disc_renderer_desc {
+    float radius_scale;        /* multiplies every disc radius; 0 = 1 */
+    uint8_t default_color[4];  /* sRGB colour of points when the cloud has none; all 0 = light grey 200,200,200 */
+} asp_disc_renderer_desc;
+
+/**
+ * Uploads cloud to GL buffers and returns a renderer drawing each point as an
+ * opaque disc of its radius in its tangent plane: one triangle around the disc
+ * in object space (so depth is exact and discs occlude correctly), with the
+ * fragments outside the disc discarded. Missing attributes:
+ *  - normals: each disc faces the eye;
+ *  - radii: one radius for all, asp_render_default_radius(cloud);
+ *  - colours: desc->default_color (light grey).
+ * Positions are used relative to cloud->origin (the renderer works in the
+ * cloud's local frame; put the camera there too). cloud is only read during
+ * the call. Makes gl current.
+ * Returns 0; ASP_EDEGENERATE for an empty cloud or when radii are missing and
+ * cannot be estimated (all points equal); ASP_EFORMAT if a position, normal or
+ * radius is not finite (names the point); ASP_EUNSUPPORTED for more than
+ * 2^31-1 points; ASP_EGL (out of GPU memory, shader failure); ASP_ENOMEM.
+ * *out is unchanged on failure; free the result with asp_renderer_destroy.
+ */
+int asp_disc_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_disc_renderer_desc *desc,
+                             asp_renderer **out, asp_error *err);
+
+/** Frees the renderer's GL buffers and memory (makes its context current). NULL is accepted. */
+void asp_renderer_destroy(asp_renderer *r);
+
+/** Short name of the renderer kind ("disc"). */
+const char *asp_renderer_name(const asp_renderer *r);
+
+/** Number of points (primitives) the renderer draws. */
+size_t asp_renderer_count(const asp_renderer *r);
+
+/** Flags for asp_render_desc.flags. */
+enum asp_render_flags {
+    ASP_RENDER_UNLIT = 1 << 0, /* output the point colours without shading */
+    ASP_RENDER_WAIT = 1 << 1   /* asp_render_frame: wait until the GPU has finished (glFinish), for timing */
+};
+
+/** How to render one image; the zero value means defaults. */
+typedef struct asp_render_desc {
+    uint32_t width, height;     /* pixels; 0 = 512 */
+    uint8_t background[4];      /* sRGB RGBA, straight alpha; zero = transparent black */
+    uint32_t samples;           /* multisampling per pixel; 0 or 1 = none; capped at GL_MAX_SAMPLES */
+    float light_azimuth;        /* degrees, light direction relative to the view: 0, 0 = headlight */
+    float light_elevation;      /* degrees; positive = light from above the view direction */
+    unsigned flags;             /* asp_render_flags */
+} asp_render_desc;
+
+/**
+ * Renders r seen by cam into *out (width x height RGBA8, rows top first, sRGB,
+ * straight alpha). Shading is in linear light: colour * (0.25 + 0.75 |n . l|)
+ * with a directional light l fixed to the camera (two-sided Lambert; 0.25 is
+ * the ambient term), stored to an sRGB framebuffer, so a surface facing the
+ * light shows exactly its colour. Pixels no disc covers get the background.
+ * cam->aspect is used as given; set it to width / height to avoid stretching.
+ *
+ * out must be zeroed or released; on success it is initialised here (release
+ * with asp_image_release); on failure it is unchanged. gl must be the context
+ * r was created with. Returns 0, ASP_EINVAL (size over 16384, or the GL limit),
+ * ASP_EGL (GL errors, framebuffer incomplete) or ASP_ENOMEM.
+ */
+int asp_render_to_image(asp_gl_context *gl, asp_renderer *r, const asp_camera *cam, const asp_render_desc *desc,
+                        asp_image *out, asp_error *err);
+
+/**
+ * Draws r seen by cam without reading anything back: into the window's back
+ * buffer for a window context (desc->width/height 0 = the framebuffer size;
+ * show it with asp_gl_context_swap_buffers), or into the headless context's
+ * offscreen target (then asp_render_to_image is what you want, except for
+ * timing the drawing alone with ASP_RENDER_WAIT). Same shading, background and
+ * errors as asp_render_to_image. A window framebuffer that is not sRGB-capable
+ * shows linear colours (darker mid-tones).
+ */
+int asp_render_frame(asp_gl_context *gl, asp_renderer *r, const asp_camera *cam, const asp_render_desc *desc,
+                     asp_error *err);
+
+/**
+ * The disc radius used when a cloud has no radii: 2 * sqrt(A / (pi n)) where
+ * A = xy + yz + zx of the bounding box sides (half the box's surface area:
+ * exact for a plane, 0.95 of a sphere's area) and n the point count. Discs of
+ * radius sqrt(A / (pi n)) would have the surface's total area; the factor 2
+ * closes the gaps of irregular (random) sampling. If A is 0 (colinear points)
+ * the longest side / n is used. Returns 0 for an empty cloud or all points
+ * equal.
+ */
+float asp_render_default_radius(const asp_cloud *cloud);
+
+/**
+ * Bounding sphere of what a disc renderer draws, in the cloud's local frame:
+ * center = middle of the position bounds, radius = the largest distance from
+ * it plus the largest disc radius (the cloud's radii, or
+ * asp_render_default_radius). Returns 0, or ASP_EDEGENERATE (empty cloud, or a
+ * zero radius: all points equal without radii) or ASP_EFORMAT (non-finite
+ * values); outputs are unchanged on failure.
+ */
+int asp_render_bounding_sphere(const asp_cloud *cloud, float center[3], float *radius, asp_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 #endif

@@ -1,10 +1,252 @@
-/* PLACEHOLDER: replaced by the real subcommand. */
+/*
+ * amgsplat decompose: multiscale AMG decomposition of a point set into
+ * quasi-flat domains (Reniers & Telea 2006, section 2; thesis chapter 2).
+ */
+#include <stdio.h>
+#include <string.h>
+
 #include "cli/cli.h"
 #include "cli/commands.h"
+#include "util/banned.h"
+
+static const char usage[] =
+    "usage: amgsplat decompose IN.ply -o OUT.amg [--k N] [--k-max N] [--epsilon X] [--fan-k N]\n"
+    "                          [--classifier variation|moment] [--alpha X] [--beta X]\n"
+    "                          [--coarsen rs|falgout|cljp|pmis|hmis] [--interp classical|direct|standard|ext+i]\n"
+    "                          [--strong X] [--trunc X] [--max-levels N] [--max-coarse N] [--weak-cut X]\n"
+    "                          [--drop X] [--stats] [--tau X] [--json]\n"
+    "                          [--export-colors classifier|domains|strict --level L-3 --colors-out X.ply]\n"
+    "       amgsplat decompose IN.amg --stats | --export-colors ...\n"
+    "\n"
+    "Classifies every point's neighbourhood (surface variation or the journal's moment\n"
+    "classifier), builds a stiffness matrix on local Delaunay fans and coarsens it with\n"
+    "hypre BoomerAMG into levels of basis functions (a partition of unity) whose domains\n"
+    "stop at creases. Level names: L is the coarsest, L-5 five levels finer, or an index.\n"
+    "--stats prints per level: unknowns, domains (Psi > tau), mean and max domain size,\n"
+    "mean domains per point and time. An existing .amg file can be inspected or coloured.";
+
+struct name_code {
+    const char *name;
+    int code;
+};
+
+static const struct name_code classifiers[] = {
+    {"variation", ASP_AMG_CLASSIFIER_VARIATION}, {"moment", ASP_AMG_CLASSIFIER_MOMENT}, {0, 0}};
+static const struct name_code coarsenings[] = {{"rs", ASP_AMG_COARSEN_RS},     {"falgout", ASP_AMG_COARSEN_FALGOUT},
+                                               {"cljp", ASP_AMG_COARSEN_CLJP}, {"pmis", ASP_AMG_COARSEN_PMIS},
+                                               {"hmis", ASP_AMG_COARSEN_HMIS}, {0, 0}};
+static const struct name_code interps[] = {{"classical", ASP_AMG_INTERP_CLASSICAL},
+                                           {"direct", ASP_AMG_INTERP_DIRECT},
+                                           {"standard", ASP_AMG_INTERP_STANDARD},
+                                           {"ext+i", ASP_AMG_INTERP_EXTENDED_I},
+                                           {0, 0}};
+static const struct name_code color_modes[] = {
+    {"classifier", ASP_AMG_COLOR_CLASSIFIER}, {"domains", ASP_AMG_COLOR_DOMAINS}, {"strict", ASP_AMG_COLOR_STRICT}, {0, 0}};
+
+static int lookup(const struct name_code *t, const char *name, int *out)
+{
+    for (; t->name; t++)
+        if (strcmp(t->name, name) == 0) {
+            *out = t->code;
+            return 0;
+        }
+    return -1;
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), m = strlen(suffix);
+    return n >= m && strcmp(s + n - m, suffix) == 0;
+}
+
+static void print_info_json(const asp_amg *amg)
+{
+    const asp_amg_info *in = asp_amg_get_info(amg);
+    printf("\"points\": %zu, \"levels\": %zu, \"level_sizes\": [", asp_amg_cloud(amg)->count, asp_amg_level_count(amg));
+    for (size_t l = 0; l < asp_amg_level_count(amg); l++)
+        printf("%s%zu", l ? ", " : "", asp_amg_level_size(amg, l));
+    printf("], \"epsilon\": %.9g, \"k_min\": %zu, \"k_max\": %zu, \"fan_k\": %zu, \"mean_neighbourhood\": %.4g, "
+           "\"mean_fan\": %.4g, \"matrix_nnz\": %zu, \"positive_offdiag_clamped\": %zu, \"isolated_points\": %zu, "
+           "\"repaired_rows\": %zu, \"seconds\": {\"neighbours\": %.4f, \"classifier\": %.4f, \"fans\": %.4f, "
+           "\"assembly\": %.4f, \"amg\": %.4f}",
+           in->epsilon, in->k_min, in->k_max, in->fan_k, in->mean_neighbourhood, in->mean_fan, in->matrix_nnz,
+           in->positive_offdiag, in->isolated_points, in->repaired_rows, in->t_neighbours, in->t_classifier, in->t_fans,
+           in->t_assembly, in->t_amg);
+}
+
+static int print_stats(struct cli_env *env, const asp_amg *amg, double tau, asp_error *err)
+{
+    size_t nl = asp_amg_level_count(amg);
+    asp_amg_level_stats *st = asp_calloc(&env->ctx, nl, sizeof *st);
+    if (!st)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for the level statistics");
+    int rc = asp_amg_level_stats_all(amg, tau, &env->ctx, st, err);
+    cli_progress_end(env);
+    if (!rc && env->json) {
+        printf(", \"tau\": %g, \"level_stats\": [", tau);
+        for (size_t l = 0; l < nl; l++)
+            printf("%s{\"level\": %zu, \"name\": \"L-%zu\", \"unknowns\": %zu, \"domains\": %zu, "
+                   "\"mean_domain_size\": %.6g, \"max_domain_size\": %zu, \"mean_domains_per_point\": %.6g, "
+                   "\"reduction\": %.4g, \"max_pou_error\": %.3g, \"seconds\": %.4f}",
+                   l ? ", " : "", l, nl - 1 - l, st[l].unknowns, st[l].domains, st[l].mean_domain_size,
+                   st[l].max_domain_size, st[l].mean_domains_per_point,
+                   l ? (double)st[l - 1].unknowns / (double)st[l].unknowns : 1.0, st[l].max_pou_error, st[l].seconds);
+        printf("]");
+    } else if (!rc) {
+        printf("level  name   unknowns  reduction   domains  mean size   max size  domains/pt   seconds\n");
+        for (size_t l = 0; l < nl; l++) {
+            char name[32];
+            snprintf(name, sizeof name, "L-%zu", nl - 1 - l);
+            printf("%5zu  %-5s %9zu  %9.2f %9zu  %9.1f  %9zu  %10.2f  %8.3f\n", l, l == nl - 1 ? "L" : name,
+                   st[l].unknowns, l ? (double)st[l - 1].unknowns / (double)st[l].unknowns : 1.0, st[l].domains,
+                   st[l].mean_domain_size, st[l].max_domain_size, st[l].mean_domains_per_point, st[l].seconds);
+        }
+    }
+    asp_free(&env->ctx, st);
+    return rc;
+}
+
+static int export_colors(struct cli_env *env, const asp_amg *amg, int mode, const char *level_name, const char *out,
+                         asp_error *err)
+{
+    size_t level = 0;
+    if (mode != ASP_AMG_COLOR_CLASSIFIER) {
+        int rc = asp_amg_level_parse(amg, level_name, &level, err);
+        if (rc)
+            return rc;
+    }
+    asp_cloud *c = NULL;
+    int rc = asp_cloud_clone(asp_amg_cloud(amg), &c, err);
+    if (!rc)
+        rc = asp_cloud_add_attrs(c, ASP_ATTR_COLORS, err);
+    if (!rc)
+        rc = asp_amg_colorize(amg, (asp_amg_color_mode)mode, level, &env->ctx, c->colors, err);
+    if (!rc)
+        rc = asp_cloud_save(c, out, NULL, err);
+    asp_cloud_destroy(c);
+    return rc;
+}
 
 int cmd_decompose(int argc, char **argv, struct cli_env *env)
 {
-    (void)argc;
-    (void)argv;
-    return cli_usage_error(env, "not implemented yet");
+    const char *output = NULL, *classifier = "variation", *coarsen = "rs", *interp = "classical";
+    const char *export_mode = NULL, *level_name = "L-3", *colors_out = NULL;
+    size_t k = 0, k_max = 0, fan_k = 0, max_levels = 0, max_coarse = 0;
+    double epsilon = 0, alpha = 0, beta = 0, strong = 0, trunc = 0, weak = 0, drop = 0, tau = 0.05;
+    int stats = 0;
+    const struct cli_option opts[] = {
+        {"output", 'o', CLI_STRING, &output, "FILE", "output decomposition (.amg)"},
+        {"k", 'k', CLI_SIZE, &k, "N", "minimum neighbourhood size k_min (default 24)"},
+        {"k-max", 0, CLI_SIZE, &k_max, "N", "cap with the epsilon-ball extension (default 2 k_min)"},
+        {"epsilon", 0, CLI_DOUBLE, &epsilon, "X", "neighbourhood radius (default: median k_min-th distance)"},
+        {"fan-k", 0, CLI_SIZE, &fan_k, "N", "nearest neighbours projected for the fan (default 16)"},
+        {"classifier", 0, CLI_STRING, &classifier, "C", "variation (default, thesis 2.3) or moment (journal eq. 3)"},
+        {"alpha", 0, CLI_DOUBLE, &alpha, "X", "G(s) = 1/(alpha + beta s^2): alpha (default 0.01)"},
+        {"beta", 0, CLI_DOUBLE, &beta, "X", "beta (default 100)"},
+        {"coarsen", 0, CLI_STRING, &coarsen, "M", "BoomerAMG coarsening: rs (default), falgout, cljp, pmis, hmis"},
+        {"interp", 0, CLI_STRING, &interp, "M", "interpolation: classical (default), direct, standard, ext+i"},
+        {"strong", 0, CLI_DOUBLE, &strong, "X", "strength threshold (default 0.9)"},
+        {"trunc", 0, CLI_DOUBLE, &trunc, "X", "interpolation truncation factor (default 0: none)"},
+        {"max-levels", 0, CLI_SIZE, &max_levels, "N", "at most N levels (default 25)"},
+        {"max-coarse", 0, CLI_SIZE, &max_coarse, "N", "stop at N unknowns (default 4)"},
+        {"weak-cut", 0, CLI_DOUBLE, &weak, "X", "cut coarse couplings below X times the median (default 0: off)"},
+        {"drop", 0, CLI_DOUBLE, &drop, "X", "drop basis values below X, renormalised (default 1e-4)"},
+        {"stats", 0, CLI_FLAG, &stats, NULL, "print per-level statistics"},
+        {"tau", 0, CLI_DOUBLE, &tau, "X", "domain threshold for --stats (default 0.05; thesis K = 0.01)"},
+        {"export-colors", 0, CLI_STRING, &export_mode, "M", "write a coloured point file: classifier, domains, strict"},
+        {"level", 'l', CLI_STRING, &level_name, "L", "level for --export-colors domains|strict (default L-3)"},
+        {"colors-out", 0, CLI_STRING, &colors_out, "FILE", "point file for --export-colors (.ply)"},
+        {0},
+    };
+    int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
+    if (rc)
+        return rc > 0 ? 0 : 2;
+    if (npos != 1)
+        return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat decompose -h'", npos);
+    const char *input = argv[0];
+    int from_amg = ends_with(input, ".amg");
+    int color_mode = 0;
+    asp_amg_desc desc = {.k_min = k, .k_max = k_max, .epsilon = epsilon, .fan_k = fan_k, .alpha = alpha,
+                         .beta = beta, .strong_threshold = strong, .trunc_factor = trunc, .max_levels = max_levels,
+                         .max_coarse = max_coarse, .weak_coupling = weak, .drop_tol = drop};
+    int code;
+    if (lookup(classifiers, classifier, &code))
+        return cli_usage_error(env, "--classifier must be variation or moment, got '%s'", classifier);
+    desc.classifier = (asp_amg_classifier_kind)code;
+    if (lookup(coarsenings, coarsen, &code))
+        return cli_usage_error(env, "--coarsen must be rs, falgout, cljp, pmis or hmis, got '%s'", coarsen);
+    desc.coarsen = (asp_amg_coarsen)code;
+    if (lookup(interps, interp, &code))
+        return cli_usage_error(env, "--interp must be classical, direct, standard or ext+i, got '%s'", interp);
+    desc.interp = (asp_amg_interp)code;
+    if (export_mode && lookup(color_modes, export_mode, &color_mode))
+        return cli_usage_error(env, "--export-colors must be classifier, domains or strict, got '%s'", export_mode);
+    if (export_mode && !colors_out)
+        return cli_usage_error(env, "--export-colors needs --colors-out FILE.ply");
+    if (!(tau >= 0 && tau < 1))
+        return cli_usage_error(env, "--tau must be in [0, 1), got %g", tau);
+    if (!from_amg && !output && !stats && !export_mode)
+        return cli_usage_error(env, "missing -o OUT.amg (or --stats / --export-colors)");
+    if (from_amg && output)
+        return cli_usage_error(env, "'%s' is already a decomposition; -o applies to point input", input);
+
+    asp_error err = {0};
+    asp_amg *amg = NULL;
+    double t0 = asp_time_now();
+    if (from_amg) {
+        if (asp_amg_load(input, &env->ctx, &amg, &err))
+            return cli_fail(env, &err);
+    } else {
+        asp_cloud *cloud = NULL;
+        if (asp_cloud_load(input, &env->ctx, &cloud, &err))
+            return cli_fail(env, &err);
+        rc = asp_amg_decompose(cloud, &desc, &env->ctx, &amg, &err);
+        asp_cloud_destroy(cloud);
+        if (rc) {
+            asp_amg_shutdown();
+            return cli_fail(env, &err);
+        }
+        if (output && asp_amg_save(amg, output, &err)) {
+            asp_amg_destroy(amg);
+            asp_amg_shutdown();
+            return cli_fail(env, &err);
+        }
+    }
+    double t_total = asp_time_now() - t0;
+    rc = 0;
+    if (export_mode)
+        rc = export_colors(env, amg, color_mode, level_name, colors_out, &err);
+    cli_progress_end(env);
+    if (!rc && env->json) {
+        printf("{\"input\": ");
+        cli_json_string(stdout, input);
+        printf(", \"output\": ");
+        if (output)
+            cli_json_string(stdout, output);
+        else
+            printf("null");
+        printf(", ");
+        print_info_json(amg);
+        if (stats)
+            rc = print_stats(env, amg, tau, &err);
+        printf(", \"total_seconds\": %.4f}\n", t_total);
+    } else if (!rc) {
+        size_t nl = asp_amg_level_count(amg);
+        if (!env->quiet) {
+            const asp_amg_info *in = asp_amg_get_info(amg);
+            printf("%s: %zu points, %zu levels (L = %zu, coarsest %zu unknowns)", output ? output : input,
+                   asp_amg_cloud(amg)->count, nl, nl - 1, asp_amg_level_size(amg, nl - 1));
+            if (!from_amg)
+                printf(", epsilon %.4g, %zu positive couplings clamped, %.2f s", in->epsilon, in->positive_offdiag,
+                       t_total);
+            printf("\n");
+        }
+        if (stats)
+            rc = print_stats(env, amg, tau, &err);
+    }
+    asp_amg_destroy(amg);
+    asp_amg_shutdown();
+    if (rc)
+        return cli_fail(env, &err);
+    return 0;
 }

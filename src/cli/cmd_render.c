@@ -1,10 +1,274 @@
-/* PLACEHOLDER: replaced by the real subcommand. */
+/*
+ * amgsplat render: draw a point file headlessly (EGL) to PNG, one view or a
+ * contact sheet of views around the object. Glue only: loading, framing and
+ * drawing are library calls (io.h, render.h); see docs/cli/render.md.
+ */
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
 #include "cli/cli.h"
 #include "cli/commands.h"
+#include "util/banned.h"
+
+static const char usage[] =
+    "usage: amgsplat render IN.ply -o OUT.png [--size WxH] [--view AZ,EL[,DIST]] [--views N]\n"
+    "                      [--renderer disc] [--background R,G,B[,A] | --transparent] [--light AZ,EL]\n"
+    "\n"
+    "Renders a point set (PLY, XYZ) headlessly through EGL (a GPU, or Mesa llvmpipe without one)\n"
+    "to a PNG. Points are opaque discs in their tangent planes, Lambert-shaded by a light fixed to\n"
+    "the camera. AZ turns around +y (0 looks from +z), EL is the angle above the horizon, both in\n"
+    "degrees; DIST is the eye distance in bounding-sphere radii (default: the sphere fills the view).\n"
+    "--views N renders N views at azimuths AZ + 360 i / N, elevation alternating +EL and -EL,\n"
+    "into one contact sheet.";
+
+enum { MAX_VIEWS = 256, MAX_SIDE = 16384 };
+
+struct render_opts {
+    const char *output;
+    const char *size;
+    const char *view;
+    const char *renderer;
+    const char *background;
+    const char *light;
+    size_t views;
+    size_t samples;
+    int transparent;
+    double fov;
+    double radius_scale;
+    /* parsed */
+    unsigned width, height;
+    double az, el, dist; /* dist 0 = fit */
+    double light_az, light_el;
+    uint8_t bg[4];
+};
+
+/* What was loaded from IN. Later inputs (.amg, .dps domain primitives) add their members here. */
+struct scene {
+    asp_cloud *cloud;
+    float center[3];
+    float radius;
+    size_t count;
+};
+
+static int load_scene(const char *path, const struct cli_env *env, struct scene *s, asp_error *err)
+{
+    int rc = asp_cloud_load(path, &env->ctx, &s->cloud, err);
+    if (rc)
+        return rc;
+    s->count = s->cloud->count;
+    return asp_render_bounding_sphere(s->cloud, s->center, &s->radius, err);
+}
+
+static void scene_release(struct scene *s)
+{
+    asp_cloud_destroy(s->cloud);
+    memset(s, 0, sizeof *s);
+}
+
+static int make_disc(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
+                     asp_error *err)
+{
+    asp_disc_renderer_desc desc = {.radius_scale = (float)o->radius_scale};
+    return asp_disc_renderer_create(gl, s->cloud, &desc, r, err);
+}
+
+/* --renderer values; splat and square renderers get a row each. */
+static const struct {
+    const char *name;
+    int (*make)(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
+                asp_error *err);
+} renderers[] = {
+    {"disc", make_disc},
+};
+enum { N_RENDERERS = sizeof renderers / sizeof renderers[0] };
+
+static int ends_with_png(const char *path)
+{
+    size_t n = strlen(path);
+    if (n < 4)
+        return 0;
+    const char *e = path + n - 4;
+    return e[0] == '.' && tolower((unsigned char)e[1]) == 'p' && tolower((unsigned char)e[2]) == 'n' &&
+           tolower((unsigned char)e[3]) == 'g';
+}
+
+static int parse_colour(struct cli_env *env, const char *s, uint8_t out[4])
+{
+    double v[4] = {0, 0, 0, 255};
+    int n = cli_parse_doubles(s, v, 4);
+    if (n < 3)
+        return cli_usage_error(env, "--background expects R,G,B or R,G,B,A in 0..255, got '%s'", s);
+    for (int i = 0; i < 4; i++) {
+        if (!(v[i] >= 0 && v[i] <= 255) || v[i] != floor(v[i]))
+            return cli_usage_error(env, "--background expects integers in 0..255, got '%s'", s);
+        out[i] = (uint8_t)v[i];
+    }
+    return 0;
+}
+
+static int parse_options(struct cli_env *env, struct render_opts *o)
+{
+    if (!o->output)
+        return cli_usage_error(env, "missing -o OUT.png");
+    if (!ends_with_png(o->output))
+        return cli_usage_error(env, "output '%s' must end in .png", o->output);
+    if (o->size && (cli_parse_size2(o->size, &o->width, &o->height) != 0 || o->width == 0 || o->height == 0 ||
+                    o->width > MAX_SIDE || o->height > MAX_SIDE))
+        return cli_usage_error(env, "--size expects WxH with sides in 1..%d, got '%s'", MAX_SIDE, o->size);
+    if (o->view) {
+        double v[3] = {0, 0, 0};
+        int n = cli_parse_doubles(o->view, v, 3);
+        if (n < 2 || !(v[1] >= -90 && v[1] <= 90) || (n == 3 && !(v[2] > 0)) || !isfinite(v[0]))
+            return cli_usage_error(env,
+                                   "--view expects AZ,EL[,DIST] with EL in -90..90 and DIST > 0 (radii), got '%s'",
+                                   o->view);
+        o->az = v[0];
+        o->el = v[1];
+        o->dist = n == 3 ? v[2] : 0;
+    }
+    if (o->views < 1 || o->views > MAX_VIEWS)
+        return cli_usage_error(env, "--views expects 1..%d, got %zu", MAX_VIEWS, o->views);
+    if (o->samples > 64)
+        return cli_usage_error(env, "--samples expects 0..64, got %zu", o->samples);
+    if (o->transparent && o->background)
+        return cli_usage_error(env, "--background and --transparent exclude each other");
+    if (o->background && parse_colour(env, o->background, o->bg))
+        return 2;
+    if (o->transparent)
+        memset(o->bg, 0, 4);
+    if (o->light) {
+        double v[2] = {0, 0};
+        if (cli_parse_doubles(o->light, v, 2) != 2 || !(v[1] >= -90 && v[1] <= 90) || !isfinite(v[0]))
+            return cli_usage_error(env, "--light expects AZ,EL in degrees with EL in -90..90, got '%s'", o->light);
+        o->light_az = v[0];
+        o->light_el = v[1];
+    }
+    if (!(o->fov > 0 && o->fov < 180))
+        return cli_usage_error(env, "--fov expects degrees in (0, 180), got %g", o->fov);
+    if (!(o->radius_scale > 0) || !isfinite(o->radius_scale))
+        return cli_usage_error(env, "--radius-scale expects a positive number, got %g", o->radius_scale);
+    return 0;
+}
+
+/* Renders the views into tiles[0 .. views-1]. */
+static int render_views(asp_gl_context *gl, asp_renderer *r, const struct scene *s, const struct render_opts *o,
+                        const struct cli_env *env, asp_image *tiles, asp_error *err)
+{
+    asp_render_desc desc = {.width = o->width, .height = o->height, .samples = (uint32_t)o->samples,
+                            .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el};
+    memcpy(desc.background, o->bg, 4);
+    for (size_t i = 0; i < o->views; i++) {
+        asp_camera cam;
+        asp_camera_init(&cam);
+        cam.fov_y = (float)o->fov;
+        cam.azimuth = (float)(o->az + 360.0 * (double)i / (double)o->views);
+        cam.elevation = (float)(i % 2 ? -o->el : o->el);
+        asp_camera_fit(&cam, s->center, s->radius, (float)o->width / (float)o->height);
+        if (o->dist > 0) {
+            cam.distance = (float)(o->dist * s->radius);
+            asp_camera_clip_to_sphere(&cam, s->center, s->radius);
+        }
+        int rc = asp_render_to_image(gl, r, &cam, &desc, &tiles[i], err);
+        if (rc)
+            return rc;
+        rc = asp_progress(&env->ctx, "render", (double)(i + 1) / (double)o->views);
+        if (rc)
+            return asp_error_set(err, rc, "rendering canceled");
+    }
+    return 0;
+}
+
+static void print_json(const struct render_opts *o, const struct scene *s, asp_gl_context *gl, const char *renderer,
+                       const asp_image *img, double seconds)
+{
+    printf("{\"output\": ");
+    cli_json_string(stdout, o->output);
+    printf(", \"width\": %u, \"height\": %u, \"tile_width\": %u, \"tile_height\": %u, \"views\": %zu, "
+           "\"points\": %zu, \"renderer\": ",
+           img->width, img->height, o->width, o->height, o->views, s->count);
+    cli_json_string(stdout, renderer);
+    printf(", \"gl_renderer\": ");
+    cli_json_string(stdout, asp_gl_context_renderer(gl));
+    printf(", \"gl_backend\": ");
+    cli_json_string(stdout, asp_gl_context_backend(gl));
+    printf(", \"seconds\": %.3f}\n", seconds);
+}
 
 int cmd_render(int argc, char **argv, struct cli_env *env)
 {
-    (void)argc;
-    (void)argv;
-    return cli_usage_error(env, "not implemented yet");
+    struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .renderer = "disc",
+                            .width = 512, .height = 512, .az = 30.0, .el = 20.0,
+                            .bg = {255, 255, 255, 255}};
+    const struct cli_option opts[] = {
+        {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
+        {"size", 0, CLI_STRING, &o.size, "WxH", "image size of one view (default 512x512)"},
+        {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "camera azimuth, elevation (degrees), distance in radii (default 30,20)"},
+        {"views", 0, CLI_SIZE, &o.views, "N", "N views around the object in a contact sheet (default 1)"},
+        {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "how points are drawn: disc (default)"},
+        {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
+        {"transparent", 0, CLI_FLAG, &o.transparent, NULL, "transparent background"},
+        {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
+        {"samples", 0, CLI_SIZE, &o.samples, "N", "multisamples per pixel, 0..64 (default 4)"},
+        {"fov", 0, CLI_DOUBLE, &o.fov, "DEG", "vertical field of view (default 40)"},
+        {"radius-scale", 0, CLI_DOUBLE, &o.radius_scale, "X", "multiply every disc radius by X (default 1)"},
+        {0},
+    };
+    int npos = 0;
+    int prc = cli_parse(argc, argv, opts, usage, env, &npos);
+    if (prc)
+        return prc > 0 ? 0 : 2;
+    if (npos != 1)
+        return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat render -h'", npos);
+    if (parse_options(env, &o))
+        return 2;
+    size_t kind = N_RENDERERS;
+    for (size_t i = 0; i < N_RENDERERS; i++)
+        if (strcmp(renderers[i].name, o.renderer) == 0)
+            kind = i;
+    if (kind == N_RENDERERS)
+        return cli_usage_error(env, "unknown renderer '%s' (expected disc)", o.renderer);
+
+    double t0 = asp_time_now();
+    asp_error err = {0, ""};
+    struct scene s;
+    memset(&s, 0, sizeof s);
+    asp_gl_context *gl = NULL;
+    asp_renderer *r = NULL;
+    asp_image tiles[MAX_VIEWS];
+    asp_image sheet = {0, 0, NULL};
+    memset(tiles, 0, sizeof tiles);
+    int rc = load_scene(argv[0], env, &s, &err);
+    if (!rc)
+        rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.ctx = &env->ctx}, &gl, &err);
+    if (!rc)
+        rc = renderers[kind].make(gl, &s, &o, &r, &err);
+    if (!rc)
+        rc = render_views(gl, r, &s, &o, env, tiles, &err);
+    if (!rc && o.views > 1)
+        rc = asp_image_contact_sheet(tiles, o.views, 0, &sheet, &err);
+    const asp_image *result = o.views > 1 ? &sheet : &tiles[0];
+    if (!rc)
+        rc = asp_image_save_png(result, o.output, &err);
+    double seconds = asp_time_now() - t0;
+    int status = 0;
+    if (rc) {
+        status = cli_fail(env, &err);
+    } else {
+        cli_progress_end(env);
+        if (env->json)
+            print_json(&o, &s, gl, renderers[kind].name, result, seconds);
+        else
+            cli_info(env, "rendered %zu view%s of %zu points (%s, %s) to '%s' (%ux%u) in %.2f s\n", o.views,
+                     o.views > 1 ? "s" : "", s.count, renderers[kind].name, asp_gl_context_renderer(gl), o.output,
+                     result->width, result->height, seconds);
+    }
+    asp_image_release(&sheet);
+    for (size_t i = 0; i < o.views; i++)
+        asp_image_release(&tiles[i]);
+    asp_renderer_destroy(r);
+    asp_gl_context_destroy(gl);
+    scene_release(&s);
+    return status;
 }

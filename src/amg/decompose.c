@@ -1,0 +1,221 @@
+/*
+ * The decomposition pipeline (journal 2, Fig. 2): neighbourhoods, classifier
+ * (2.1), triangle fans and stiffness matrix (2.2), BoomerAMG hierarchy (2.3);
+ * plus the accessors of the asp_amg object and level naming (L, L-5, journal
+ * Table 2).
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amg/internal.h"
+#include "util/banned.h"
+
+int asp__amg_alloc(const asp_context *ctx, asp_amg **out, asp_error *err)
+{
+    asp_amg *a = asp_calloc(ctx, 1, sizeof *a);
+    if (!a)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for the decomposition");
+    if (ctx)
+        a->ctx = *ctx;
+    *out = a;
+    return 0;
+}
+
+void asp_amg_destroy(asp_amg *amg)
+{
+    if (!amg)
+        return;
+    asp_context ctx = amg->ctx;
+    asp_cloud_destroy(amg->cloud);
+    asp_free(&ctx, amg->classifier);
+    asp_amg_csr_destroy(amg->matrix);
+    if (amg->prolong)
+        for (size_t l = 0; l < amg->nlevels; l++)
+            asp_amg_csr_destroy(amg->prolong[l]);
+    asp_free(&ctx, amg->prolong);
+    asp_free(&ctx, amg->level_size);
+    asp_free(&ctx, amg);
+}
+
+const asp_cloud *asp_amg_cloud(const asp_amg *amg) { return amg->cloud; }
+const float *asp_amg_classifier(const asp_amg *amg) { return amg->classifier; }
+const asp_amg_info *asp_amg_get_info(const asp_amg *amg) { return &amg->info; }
+const asp_amg_csr *asp_amg_matrix(const asp_amg *amg) { return amg->matrix; }
+size_t asp_amg_level_count(const asp_amg *amg) { return amg->nlevels; }
+
+size_t asp_amg_level_size(const asp_amg *amg, size_t level)
+{
+    return level < amg->nlevels ? amg->level_size[level] : 0;
+}
+
+const asp_amg_csr *asp_amg_prolongation(const asp_amg *amg, size_t level)
+{
+    return level >= 1 && level < amg->nlevels ? amg->prolong[level] : NULL;
+}
+
+int asp_amg_level_parse(const asp_amg *amg, const char *text, size_t *level, asp_error *err)
+{
+    const size_t top = amg->nlevels - 1;
+    const char *s = text;
+    int relative = 0;
+    if (s[0] == 'L' || s[0] == 'l') {
+        relative = 1;
+        s++;
+        if (*s == 0) {
+            *level = top;
+            return 0;
+        }
+        if (*s != '-')
+            goto bad;
+        s++;
+    }
+    if (*s < '0' || *s > '9')
+        goto bad;
+    char *end;
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (errno || *end)
+        goto bad;
+    if (v > top)
+        return asp_error_set(err, ASP_EINVAL, "no level '%s': the decomposition has levels 0..%zu (L = %zu)", text,
+                             top, top);
+    *level = relative ? top - (size_t)v : (size_t)v;
+    return 0;
+bad:
+    return asp_error_set(err, ASP_EINVAL, "invalid level '%s': expected L, L-N or an index 0..%zu", text, top);
+}
+
+/* Rejects what has no surface: fewer than 3 points, or every point equal. */
+static int check_cloud(const asp_cloud *cloud, asp_error *err)
+{
+    if (cloud->count < 3)
+        return asp_error_set(err, ASP_EDEGENERATE, "cannot decompose %zu points: need at least 3 to span a surface",
+                             cloud->count);
+    if (cloud->count > (size_t)INT32_MAX - 1)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot decompose %zu points: at most 2^31-2 are supported",
+                             cloud->count);
+    int rc = asp_cloud_validate(cloud, err);
+    if (rc)
+        return rc;
+    float lo[3], hi[3];
+    rc = asp_cloud_bounds(cloud, lo, hi, err);
+    if (rc)
+        return rc;
+    if (lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2])
+        return asp_error_set(err, ASP_EDEGENERATE, "cannot decompose: all %zu points are equal", cloud->count);
+    return 0;
+}
+
+static int stage(const asp_context *ctx, const char *name, double f, asp_error *err)
+{
+    int rc = asp_progress(ctx, name, f);
+    if (rc)
+        asp_error_set(err, rc, "decomposition canceled during %s", name);
+    return rc;
+}
+
+int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out,
+                      asp_error *err)
+{
+    int rc = check_cloud(cloud, err);
+    if (rc)
+        return rc;
+    asp_amg_desc d;
+    rc = asp__amg_resolve_desc(desc, cloud->count, &d, err);
+    if (rc)
+        return rc;
+#ifndef ASP_HAVE_HYPRE
+    (void)ctx;
+    (void)out;
+    return asp_error_set(err, ASP_EUNSUPPORTED, "cannot decompose: this build has no hypre (ASP_WITH_HYPRE=OFF)");
+#else
+    const size_t n = cloud->count;
+    asp_amg *a = NULL;
+    asp__amg_nbhd nb = {0, 0, NULL, NULL};
+    asp__amg_fans fans = {0, 0, NULL, NULL};
+    asp_amg_csr **p = NULL;
+    size_t nlevels = 0;
+    if ((rc = asp__amg_alloc(ctx, &a, err)) != 0)
+        return rc;
+    if ((rc = asp_cloud_create(n, ASP_ATTR_NORMALS, ctx, &a->cloud, err)) != 0)
+        goto fail;
+    memcpy(a->cloud->positions, cloud->positions, 3 * n * sizeof(float));
+    memcpy(a->cloud->origin, cloud->origin, sizeof cloud->origin);
+    a->classifier = asp_alloc(ctx, n * sizeof *a->classifier);
+    if (!a->classifier) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the classifier of %zu points", n);
+        goto fail;
+    }
+    const float *pos = a->cloud->positions;
+
+    double t = asp_time_now(), t1;
+    if ((rc = stage(ctx, "neighbours", 0, err)) != 0)
+        goto fail;
+    rc = asp__amg_neighbourhoods(pos, n, &d, ctx, &nb, &a->info.mean_neighbourhood, err);
+    if (rc)
+        goto fail;
+    t1 = asp_time_now();
+    a->info.t_neighbours = t1 - t;
+    t = t1;
+    if ((rc = stage(ctx, "classifier", 0, err)) != 0)
+        goto fail;
+    rc = asp__amg_classify(pos, &nb, &d, ctx, a->classifier, a->cloud->normals, err);
+    if (rc)
+        goto fail;
+    t1 = asp_time_now();
+    a->info.t_classifier = t1 - t;
+    t = t1;
+    if ((rc = stage(ctx, "fans", 0, err)) != 0)
+        goto fail;
+    rc = asp__amg_build_fans(pos, a->cloud->normals, &nb, d.fan_k, ctx, &fans, err);
+    if (rc)
+        goto fail;
+    asp__amg_nbhd_release(ctx, &nb);
+    size_t tri_total = 0;
+    for (size_t i = 0; i < n; i++)
+        tri_total += fans.ntri[i];
+    a->info.mean_fan = (double)tri_total / (double)n;
+    t1 = asp_time_now();
+    a->info.t_fans = t1 - t;
+    t = t1;
+    if ((rc = stage(ctx, "assembly", 0, err)) != 0)
+        goto fail;
+    rc = asp__amg_assemble(pos, a->classifier, &fans, ctx, &a->matrix, &a->info.positive_offdiag, err);
+    if (rc)
+        goto fail;
+    asp__amg_fans_release(ctx, &fans);
+    a->info.matrix_nnz = a->matrix->row_ptr[n];
+    for (size_t i = 0; i < n; i++)
+        a->info.isolated_points += a->matrix->row_ptr[i + 1] - a->matrix->row_ptr[i] == 1;
+    if (a->info.isolated_points == n) {
+        rc = asp_error_set(err, ASP_EDEGENERATE,
+                           "cannot decompose %zu points: no point has a triangle fan (colinear or too sparse points)", n);
+        goto fail;
+    }
+    t1 = asp_time_now();
+    a->info.t_assembly = t1 - t;
+    t = t1;
+    if ((rc = stage(ctx, "amg", 0, err)) != 0)
+        goto fail;
+    rc = asp__amg_build_hierarchy(a->matrix, &d, ctx, &nlevels, &p, &a->level_size, &a->info.repaired_rows, err);
+    if (rc)
+        goto fail;
+    a->prolong = p;
+    a->nlevels = nlevels;
+    a->info.t_amg = asp_time_now() - t;
+    a->info.epsilon = d.epsilon;
+    a->info.k_min = d.k_min;
+    a->info.k_max = d.k_max;
+    a->info.fan_k = d.fan_k;
+    a->desc = d;
+    *out = a;
+    return 0;
+fail:
+    asp__amg_nbhd_release(ctx, &nb);
+    asp__amg_fans_release(ctx, &fans);
+    asp_amg_destroy(a);
+    return rc;
+#endif
+}

@@ -1,0 +1,67 @@
+/*
+ * Private to src/amg: the decomposition object and the stages of the
+ * pipeline (journal 2.1-2.3), each in its own file. Not public API.
+ */
+#ifndef ASP_AMG_INTERNAL_H
+#define ASP_AMG_INTERNAL_H
+
+#include "amgsplat/amg.h"
+
+struct asp_amg {
+    asp_context ctx;
+    asp_cloud *cloud;      /* positions, origin, tangent normals */
+    float *classifier;     /* count */
+    asp_amg_csr *matrix;   /* A^0; NULL after load */
+    size_t nlevels;        /* L + 1 */
+    size_t *level_size;    /* nlevels */
+    asp_amg_csr **prolong; /* nlevels entries; [0] is NULL */
+    asp_amg_desc desc;     /* resolved options */
+    asp_amg_info info;
+};
+
+/* Neighbourhoods N(x) of journal 2.1: row i of nbr (stride kmax) holds nn[i] indices, nearest first. */
+typedef struct asp__amg_nbhd {
+    size_t n, kmax;
+    asp_index *nbr; /* n * kmax */
+    uint16_t *nn;   /* n */
+} asp__amg_nbhd;
+
+/* Local triangle fans (journal 2.2): point i's triangles are (i, tri[2(i*stride+t)], tri[2(i*stride+t)+1]), t < ntri[i]. */
+typedef struct asp__amg_fans {
+    size_t n, stride;
+    asp_index *tri;  /* 2 * n * stride */
+    uint16_t *ntri;  /* n */
+} asp__amg_fans;
+
+int asp__amg_resolve_desc(const asp_amg_desc *in, size_t count, asp_amg_desc *out, asp_error *err);
+
+int asp__amg_neighbourhoods(const float *pos, size_t n, asp_amg_desc *desc, const asp_context *ctx,
+                            asp__amg_nbhd *out, double *mean_size, asp_error *err);
+void asp__amg_nbhd_release(const asp_context *ctx, asp__amg_nbhd *nb);
+
+int asp__amg_classify(const float *pos, const asp__amg_nbhd *nb, const asp_amg_desc *desc, const asp_context *ctx,
+                      float *classifier, float *normals, asp_error *err);
+
+int asp__amg_build_fans(const float *pos, const float *normals, const asp__amg_nbhd *nb, size_t fan_k,
+                        const asp_context *ctx, asp__amg_fans *out, asp_error *err);
+void asp__amg_fans_release(const asp_context *ctx, asp__amg_fans *f);
+
+int asp__amg_assemble(const float *pos, const float *classifier, const asp__amg_fans *fans, const asp_context *ctx,
+                      asp_amg_csr **out, size_t *positive, asp_error *err);
+
+/* One BoomerAMG setup level on a: copies P (a->rows x nc) and A^1 = P^T a P; *p = NULL when hypre did not coarsen. */
+int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
+                           asp_amg_csr **p, asp_amg_csr **ac, asp_error *err);
+
+/* The hierarchy level by level (hierarchy.c): p[1..nlevels-1], sizes[0..nlevels-1]; arrays sized max_levels. */
+int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_desc *desc, const asp_context *ctx,
+                             size_t *nlevels, asp_amg_csr ***p, size_t **sizes, size_t *repaired, asp_error *err);
+
+/* Sparse product c = a * b with entries < drop dropped and rows renormalised to sum 1. */
+int asp__amg_spgemm_pou(const asp_amg_csr *a, const asp_amg_csr *b, double drop, const asp_context *ctx,
+                        asp_amg_csr **out, asp_error *err);
+
+/* Allocates an empty asp_amg owning nothing yet. */
+int asp__amg_alloc(const asp_context *ctx, asp_amg **out, asp_error *err);
+
+#endif

@@ -1,0 +1,65 @@
+/*
+ * Private layout of the kd-tree shared by kdtree.c (build, single queries)
+ * and knn.c (all-points queries). Not part of the public API.
+ */
+#ifndef ASP_GEOM_KDTREE_INTERNAL_H
+#define ASP_GEOM_KDTREE_INTERNAL_H
+
+#include "amgsplat/geom.h"
+
+/*
+ * A node splits at the median along its widest axis; leaves hold at most
+ * ASP__KD_LEAF_MAX points unless all their points are equal, in which case
+ * they are "flat" leaves of any size, sorted by original index.
+ */
+enum { ASP__KD_LEAF_MAX = 12, ASP__KD_LEAF = 3, ASP__KD_FLAT = 4 };
+
+/* Candidate keys a k-NN search needs as scratch. */
+#define ASP__KD_SCRATCH(k) (2 * (size_t)(k) + ASP__KD_LEAF_MAX)
+
+typedef struct asp__kd_node {
+    float split;        /* inner: left child coords <= split <= right child coords */
+    uint32_t right;     /* inner: index of the right child (left child is this + 1) */
+    uint32_t begin;     /* slots [begin, end) of the subtree in leaf order */
+    uint32_t end;
+    uint32_t min_index; /* smallest original index in the subtree, for exact tie pruning */
+    uint32_t axis;      /* 0..2 for inner nodes, ASP__KD_LEAF or ASP__KD_FLAT */
+} asp__kd_node;
+
+struct asp_kdtree {
+    asp_context ctx;
+    size_t count;
+    float *xyz;          /* 3 * count, in leaf order (slot order) */
+    asp_index *perm;     /* slot -> original index */
+    asp__kd_node *nodes; /* preorder, root at 0 */
+    size_t node_count;
+};
+
+/*
+ * Exact k nearest neighbours of q, skipping slot exclude (UINT32_MAX for none).
+ * bound2 is INFINITY or a squared distance known to hold at least k candidates
+ * (it only speeds up pruning). scratch holds ASP__KD_SCRATCH(k) keys; on return scratch[0]
+ * ... scratch[m-1] are the sorted result keys (distance bits << 32 | index).
+ * Writes m = min(k, available) results to idx (original indices) and d
+ * (squared distances; may be NULL), ascending by (distance, index).
+ */
+size_t asp__kdtree_search(const asp_kdtree *tree, const float q[3], size_t k, uint32_t exclude, float bound2,
+                          uint64_t *scratch, float *d, asp_index *idx);
+
+/*
+ * Shared by the estimators: checks positions, stride and finiteness ("cannot
+ * estimate WHAT: point 3: coordinate y is not finite"); returns 0 or ASP_EINVAL.
+ */
+int asp__check_positions(const float *positions, size_t count, size_t stride_bytes, const char *what,
+                         asp_error *err);
+/* ASP_EDEGENERATE when all count >= 1 points are equal, else 0. */
+int asp__check_spread(const float *positions, size_t count, size_t stride_bytes, const char *what, asp_error *err);
+/*
+ * Builds a kd-tree and the k-NN graph of all points (1 <= k < count): *idx gets
+ * count * k indices and, when dist2 is not NULL, *dist2 the squared distances,
+ * both from asp_alloc(ctx). On failure nothing is allocated.
+ */
+int asp__knn_graph(const float *positions, size_t count, size_t stride_bytes, size_t k, asp_index **idx,
+                   float **dist2, const asp_context *ctx, asp_error *err);
+
+#endif

@@ -1,0 +1,497 @@
+/*
+ * Mesh input through assimp's C API: every format assimp reads (OBJ+MTL, PLY,
+ * OFF, STL, glTF/GLB, 3DS ...) becomes one merged triangle mesh with the node
+ * transforms applied, per-vertex UVs/colours and per-triangle materials with
+ * their diffuse textures, the "polygon-based object" Schwarz 2004 3.1 samples.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <assimp/cimport.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <stb/stb_image.h>
+
+#include "amgsplat/mesh.h"
+#include "util/banned.h"
+
+enum { MAX_NODE_DEPTH = 256 };
+
+/* Accumulates counts (fill == 0) or writes vertices and triangles (fill == 1) while walking the node tree. */
+struct walk {
+    const struct aiScene *scene;
+    const char *path;
+    int fill;
+    size_t nv, nt;        /* running totals */
+    asp_mesh *mesh;       /* fill: destination (triangles, uvs, colours, material ids) */
+    double *world;        /* fill: 3 * nv world positions */
+    float *file_normals;  /* fill: 3 * nv transformed file normals, or NULL */
+    asp_error *err;
+};
+
+typedef struct { double m[4][4]; } mat4;
+
+static mat4 mat4_from_ai(const struct aiMatrix4x4 *a)
+{
+    mat4 r = {{{a->a1, a->a2, a->a3, a->a4}, {a->b1, a->b2, a->b3, a->b4},
+               {a->c1, a->c2, a->c3, a->c4}, {a->d1, a->d2, a->d3, a->d4}}};
+    return r;
+}
+
+static mat4 mat4_mul(const mat4 *a, const mat4 *b)
+{
+    mat4 r;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            r.m[i][j] = a->m[i][0] * b->m[0][j] + a->m[i][1] * b->m[1][j] + a->m[i][2] * b->m[2][j] +
+                        a->m[i][3] * b->m[3][j];
+    return r;
+}
+
+/* Cofactor matrix of the upper 3x3: proportional to the inverse transpose, which carries normals. */
+static void normal_matrix(const mat4 *t, double n[3][3], double *det)
+{
+    const double(*m)[4] = t->m;
+    n[0][0] = m[1][1] * m[2][2] - m[1][2] * m[2][1];
+    n[0][1] = m[1][2] * m[2][0] - m[1][0] * m[2][2];
+    n[0][2] = m[1][0] * m[2][1] - m[1][1] * m[2][0];
+    n[1][0] = m[0][2] * m[2][1] - m[0][1] * m[2][2];
+    n[1][1] = m[0][0] * m[2][2] - m[0][2] * m[2][0];
+    n[1][2] = m[0][1] * m[2][0] - m[0][0] * m[2][1];
+    n[2][0] = m[0][1] * m[1][2] - m[0][2] * m[1][1];
+    n[2][1] = m[0][2] * m[1][0] - m[0][0] * m[1][2];
+    n[2][2] = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    *det = m[0][0] * n[0][0] + m[0][1] * n[0][1] + m[0][2] * n[0][2];
+}
+
+/* Bounded copy that always terminates; truncation of a name or path in a message is acceptable. */
+static void copy_str(char *dst, size_t cap, const char *src)
+{
+    size_t len = strlen(src);
+    if (len >= cap)
+        len = cap - 1;
+    memcpy(dst, src, len);
+    dst[len] = '\0';
+}
+
+static uint8_t unit_to_u8(float x)
+{
+    if (!(x > 0.0f))
+        return 0;
+    if (x >= 1.0f)
+        return 255;
+    return (uint8_t)lrintf(x * 255.0f);
+}
+
+static size_t mesh_triangles(const struct aiMesh *am)
+{
+    if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
+        return 0;
+    size_t n = 0;
+    for (unsigned f = 0; f < am->mNumFaces; f++)
+        n += am->mFaces[f].mNumIndices == 3;
+    return n;
+}
+
+static int fill_mesh(struct walk *w, const struct aiMesh *am, unsigned mesh_index, const mat4 *t)
+{
+    asp_mesh *m = w->mesh;
+    size_t base = w->nv;
+    double nm[3][3], det;
+    normal_matrix(t, nm, &det);
+    for (unsigned v = 0; v < am->mNumVertices; v++) {
+        const struct aiVector3D *p = &am->mVertices[v];
+        double *o = w->world + 3 * (base + v);
+        for (int r = 0; r < 3; r++)
+            o[r] = t->m[r][0] * p->x + t->m[r][1] * p->y + t->m[r][2] * p->z + t->m[r][3];
+        if (!isfinite(o[0]) || !isfinite(o[1]) || !isfinite(o[2]))
+            return asp_error_set(w->err, ASP_EFORMAT, "cannot read '%s': mesh %u vertex %u has a non-finite coordinate",
+                                 w->path, mesh_index, v);
+        if (w->file_normals) {
+            const struct aiVector3D *n = &am->mNormals[v];
+            float *d = w->file_normals + 3 * (base + v);
+            for (int r = 0; r < 3; r++)
+                d[r] = (float)(nm[r][0] * n->x + nm[r][1] * n->y + nm[r][2] * n->z);
+        }
+        if (m->uvs) {
+            const struct aiVector3D *uv = am->mTextureCoords[0] ? &am->mTextureCoords[0][v] : NULL;
+            m->uvs[2 * (base + v)] = uv ? uv->x : 0.0f;
+            m->uvs[2 * (base + v) + 1] = uv ? uv->y : 0.0f;
+        }
+        if (m->colors) {
+            uint8_t *c = m->colors + 4 * (base + v);
+            if (am->mColors[0]) {
+                const struct aiColor4D *s = &am->mColors[0][v];
+                c[0] = unit_to_u8(s->r), c[1] = unit_to_u8(s->g), c[2] = unit_to_u8(s->b), c[3] = unit_to_u8(s->a);
+            } else {
+                /* meshes without vertex colours show their material colour (filled in after materials load) */
+                c[0] = c[1] = c[2] = c[3] = 0;
+            }
+        }
+    }
+    /* a mirroring transform flips the winding; swap to keep triangles counter-clockwise from outside */
+    int flip = det < 0.0;
+    for (unsigned f = 0; f < am->mNumFaces; f++) {
+        const struct aiFace *face = &am->mFaces[f];
+        if (face->mNumIndices != 3)
+            continue;
+        uint32_t *tri = m->triangles + 3 * w->nt;
+        for (int k = 0; k < 3; k++) {
+            unsigned idx = face->mIndices[flip && k ? 3 - k : k];
+            if (idx >= am->mNumVertices)
+                return asp_error_set(w->err, ASP_EFORMAT, "cannot read '%s': mesh %u face %u uses vertex %u of %u",
+                                     w->path, mesh_index, f, idx, am->mNumVertices);
+            tri[k] = (uint32_t)(base + idx);
+        }
+        m->material_ids[w->nt] = am->mMaterialIndex < m->material_count ? am->mMaterialIndex : 0;
+        w->nt++;
+    }
+    return 0;
+}
+
+static int walk_node(struct walk *w, const struct aiNode *node, const mat4 *parent, int depth)
+{
+    if (depth > MAX_NODE_DEPTH)
+        return asp_error_set(w->err, ASP_EFORMAT, "cannot read '%s': node hierarchy deeper than %d", w->path,
+                             MAX_NODE_DEPTH);
+    mat4 local = mat4_from_ai(&node->mTransformation);
+    mat4 t = mat4_mul(parent, &local);
+    for (unsigned i = 0; i < node->mNumMeshes; i++) {
+        unsigned mi = node->mMeshes[i];
+        if (mi >= w->scene->mNumMeshes)
+            return asp_error_set(w->err, ASP_EFORMAT, "cannot read '%s': node '%s' names mesh %u of %u", w->path,
+                                 node->mName.data, mi, w->scene->mNumMeshes);
+        const struct aiMesh *am = w->scene->mMeshes[mi];
+        size_t nt = mesh_triangles(am);
+        if (nt == 0)
+            continue;
+        if (w->fill) {
+            int rc = fill_mesh(w, am, mi, &t);
+            if (rc)
+                return rc;
+        } else {
+            w->nt += nt;
+        }
+        w->nv += am->mNumVertices;
+        if (w->nv >= UINT32_MAX || w->nt >= UINT32_MAX)
+            return asp_error_set(w->err, ASP_EUNSUPPORTED, "cannot read '%s': more than 2^32-1 vertices or triangles",
+                                 w->path);
+    }
+    for (unsigned c = 0; c < node->mNumChildren; c++) {
+        int rc = walk_node(w, node->mChildren[c], &t, depth + 1);
+        if (rc)
+            return rc;
+    }
+    return 0;
+}
+
+/* Which meshes the walk reaches, to decide which optional arrays the merged mesh needs. */
+static void scan_attrs(const struct aiScene *s, const struct aiNode *node, int depth, int *uvs, int *colors,
+                       int *all_normals)
+{
+    if (depth > MAX_NODE_DEPTH)
+        return;
+    for (unsigned i = 0; i < node->mNumMeshes; i++) {
+        if (node->mMeshes[i] >= s->mNumMeshes)
+            continue;
+        const struct aiMesh *am = s->mMeshes[node->mMeshes[i]];
+        if (mesh_triangles(am) == 0)
+            continue;
+        *uvs |= am->mTextureCoords[0] != NULL;
+        *colors |= am->mColors[0] != NULL;
+        *all_normals &= am->mNormals != NULL;
+    }
+    for (unsigned c = 0; c < node->mNumChildren; c++)
+        scan_attrs(s, node->mChildren[c], depth + 1, uvs, colors, all_normals);
+}
+
+static int image_from_rgba(asp_image *img, const uint8_t *rgba, uint32_t w, uint32_t h, asp_error *err)
+{
+    int rc = asp_image_init(img, w, h, err);
+    if (rc)
+        return rc;
+    memcpy(img->pixels, rgba, (size_t)w * h * 4);
+    return 0;
+}
+
+static int load_embedded(const struct aiScene *scene, const char *ref, const char *path, const char *material,
+                         asp_image *img, asp_error *err)
+{
+    const struct aiTexture *tex = NULL;
+    if (ref[0] == '*') {
+        char *end;
+        long i = strtol(ref + 1, &end, 10);
+        if (*end == '\0' && i >= 0 && (unsigned long)i < scene->mNumTextures)
+            tex = scene->mTextures[i];
+    } else {
+        for (unsigned i = 0; i < scene->mNumTextures; i++)
+            if (strcmp(scene->mTextures[i]->mFilename.data, ref) == 0)
+                tex = scene->mTextures[i];
+    }
+    if (!tex)
+        return ASP_EIO; /* not embedded: caller looks for a file */
+    if (tex->mHeight == 0) {
+        int w, h, comp;
+        if (tex->mWidth > INT32_MAX)
+            return asp_error_set(err, ASP_EFORMAT, "cannot decode embedded texture '%s' of material '%s' in '%s'", ref,
+                                 material, path);
+        stbi_uc *data = stbi_load_from_memory((const stbi_uc *)tex->pcData, (int)tex->mWidth, &w, &h, &comp, 4);
+        if (!data)
+            return asp_error_set(err, ASP_EFORMAT, "cannot decode embedded texture '%s' of material '%s' in '%s': %s",
+                                 ref, material, path, stbi_failure_reason());
+        int rc = image_from_rgba(img, data, (uint32_t)w, (uint32_t)h, err);
+        stbi_image_free(data);
+        return rc;
+    }
+    if ((uint64_t)tex->mWidth * tex->mHeight > (uint64_t)16384 * 16384)
+        return asp_error_set(err, ASP_EFORMAT, "embedded texture '%s' of material '%s' in '%s' is %ux%u", ref, material,
+                             path, tex->mWidth, tex->mHeight);
+    int rc = asp_image_init(img, tex->mWidth, tex->mHeight, err);
+    if (rc)
+        return rc;
+    /* aiTexel is stored b, g, r, a */
+    for (size_t i = 0; i < (size_t)tex->mWidth * tex->mHeight; i++) {
+        img->pixels[4 * i + 0] = tex->pcData[i].r;
+        img->pixels[4 * i + 1] = tex->pcData[i].g;
+        img->pixels[4 * i + 2] = tex->pcData[i].b;
+        img->pixels[4 * i + 3] = tex->pcData[i].a;
+    }
+    return 0;
+}
+
+static int readable(const char *p)
+{
+    FILE *fp = fopen(p, "rb");
+    if (!fp)
+        return 0;
+    fclose(fp);
+    return 1;
+}
+
+/* Texture references are relative to the model file; exporters often write Windows separators or stale folders. */
+static int resolve_texture(const char *model, const char *ref, char *out, size_t cap)
+{
+    char clean[1024];
+    copy_str(clean, sizeof clean, ref);
+    for (char *c = clean; *c; c++)
+        if (*c == '\\')
+            *c = '/';
+    const char *slash = strrchr(model, '/');
+    int dir_len = slash ? (int)(slash - model) : 0;
+    if (clean[0] == '/')
+        copy_str(out, cap, clean);
+    else if (slash)
+        snprintf(out, cap, "%.*s/%s", dir_len, model, clean);
+    else
+        copy_str(out, cap, clean);
+    if (readable(out))
+        return 1;
+    const char *base = strrchr(clean, '/');
+    if (base) {
+        char alt[1024];
+        if (slash)
+            snprintf(alt, sizeof alt, "%.*s/%s", dir_len, model, base + 1);
+        else
+            copy_str(alt, sizeof alt, base + 1);
+        if (readable(alt)) {
+            copy_str(out, cap, alt);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static int load_override(const char *override, const char *material, asp_material *mat, asp_error *err)
+{
+    asp_error e = {0};
+    if (!readable(override))
+        return asp_error_set(err, ASP_EIO, "cannot open texture '%s': %s", override, strerror(errno));
+    int rc = asp_image_load(&mat->texture, override, &e);
+    if (rc)
+        return asp_error_set(err, rc, "%s (texture for material '%s')", e.msg, material);
+    copy_str(mat->texture_path, sizeof mat->texture_path, override);
+    return 0;
+}
+
+static int load_materials(const struct aiScene *scene, const char *path, const asp_mesh_load_desc *desc,
+                          asp_mesh *m, asp_error *err)
+{
+    for (size_t i = 0; i < m->material_count; i++) {
+        asp_material *mat = &m->materials[i];
+        const struct aiMaterial *am = scene->mMaterials[i];
+        struct aiString s;
+        if (aiGetMaterialString(am, AI_MATKEY_NAME, &s) == aiReturn_SUCCESS)
+            copy_str(mat->name, sizeof mat->name, s.data);
+        else
+            snprintf(mat->name, sizeof mat->name, "material %zu", i);
+        struct aiColor4D c;
+        if (aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &c) == aiReturn_SUCCESS) {
+            mat->diffuse[0] = c.r, mat->diffuse[1] = c.g, mat->diffuse[2] = c.b, mat->diffuse[3] = c.a;
+            mat->has_color = strcmp(mat->name, AI_DEFAULT_MATERIAL_NAME) != 0;
+        } else {
+            mat->diffuse[0] = mat->diffuse[1] = mat->diffuse[2] = 0.6f, mat->diffuse[3] = 1.0f;
+        }
+        enum aiTextureType type = aiTextureType_DIFFUSE;
+        if (aiGetMaterialTextureCount(am, type) == 0)
+            type = aiTextureType_BASE_COLOR;
+        int rc = 0;
+        if (aiGetMaterialTextureCount(am, type) > 0 &&
+            aiGetMaterialTexture(am, type, 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS &&
+            s.length > 0) {
+            rc = load_embedded(scene, s.data, path, mat->name, &mat->texture, err);
+            if (rc == 0) {
+                copy_str(mat->texture_path, sizeof mat->texture_path, s.data);
+                continue;
+            }
+            if (rc != ASP_EIO)
+                return rc;
+            char file[1024];
+            if (resolve_texture(path, s.data, file, sizeof file)) {
+                asp_error e = {0};
+                rc = asp_image_load(&mat->texture, file, &e);
+                if (rc)
+                    return asp_error_set(err, rc, "%s (texture of material '%s')", e.msg, mat->name);
+                copy_str(mat->texture_path, sizeof mat->texture_path, file);
+                continue;
+            }
+            if (!desc->texture_override)
+                return asp_error_set(err, ASP_EIO,
+                                     "cannot open texture '%s' of material '%s' in '%s': No such file; "
+                                     "pass --texture FILE to use another image",
+                                     file, mat->name, path);
+        }
+        if (desc->texture_override) {
+            rc = load_override(desc->texture_override, mat->name, mat, err);
+            if (rc)
+                return rc;
+        }
+    }
+    return 0;
+}
+
+/* Vertices without their own colour take their triangle's material colour, so every vertex colour is meaningful. */
+static void fill_material_colors(asp_mesh *m)
+{
+    for (size_t t = 0; t < m->triangle_count; t++) {
+        const float *d = m->materials[m->material_ids[t]].diffuse;
+        for (int k = 0; k < 3; k++) {
+            uint8_t *c = m->colors + 4 * (size_t)m->triangles[3 * t + k];
+            if (c[0] == 0 && c[1] == 0 && c[2] == 0 && c[3] == 0)
+                c[0] = unit_to_u8(d[0]), c[1] = unit_to_u8(d[1]), c[2] = unit_to_u8(d[2]), c[3] = 255;
+        }
+    }
+}
+
+static int build(const struct aiScene *scene, const char *path, const asp_mesh_load_desc *desc,
+                 const asp_context *ctx, asp_mesh **out, asp_error *err)
+{
+    if (!scene->mRootNode)
+        return asp_error_set(err, ASP_EDEGENERATE, "'%s' has no triangles", path);
+    struct walk w = {.scene = scene, .path = path, .err = err};
+    mat4 id = {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
+    int rc = walk_node(&w, scene->mRootNode, &id, 0);
+    if (rc)
+        return rc;
+    if (w.nt == 0)
+        return asp_error_set(err, ASP_EDEGENERATE, "'%s' has no triangles", path);
+    int has_uvs = 0, has_colors = 0, all_normals = 1;
+    scan_attrs(scene, scene->mRootNode, 0, &has_uvs, &has_colors, &all_normals);
+    if (desc->texture_override && !has_uvs)
+        return asp_error_set(err, ASP_EINVAL, "'%s' has no texture coordinates, so texture '%s' cannot be applied",
+                             path, desc->texture_override);
+    asp_mesh *m = NULL;
+    rc = asp_mesh_create(w.nv, w.nt, (has_uvs ? ASP_MESH_UVS : 0) | (has_colors ? ASP_MESH_COLORS : 0), ctx, &m, err);
+    if (rc)
+        return rc;
+    if (scene->mNumMaterials > 0) {
+        asp_material *mats = asp_calloc(ctx, scene->mNumMaterials, sizeof *mats);
+        if (!mats) {
+            asp_mesh_destroy(m);
+            return asp_error_set(err, ASP_ENOMEM, "out of memory for %u materials", scene->mNumMaterials);
+        }
+        asp_free(ctx, m->materials);
+        m->materials = mats;
+        m->material_count = scene->mNumMaterials;
+    }
+    int use_file_normals = all_normals && !desc->ignore_file_normals;
+    w.fill = 1;
+    w.nv = w.nt = 0;
+    w.mesh = m;
+    w.world = asp_alloc(ctx, 3 * m->vertex_count * sizeof(double) + 1);
+    w.file_normals = use_file_normals ? m->normals : NULL;
+    if (!w.world) {
+        asp_mesh_destroy(m);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", path);
+    }
+    rc = walk_node(&w, scene->mRootNode, &id, 0);
+    if (rc == 0)
+        rc = load_materials(scene, path, desc, m, err);
+    if (rc) {
+        asp_free(ctx, w.world);
+        asp_mesh_destroy(m);
+        return rc;
+    }
+    /* positions become floats around the bounding-box centre: float keeps ~7 digits of the extent, not of UTM offsets */
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t v = 0; v < m->vertex_count; v++)
+        for (int c = 0; c < 3; c++)
+            lo[c] = fmin(lo[c], w.world[3 * v + c]), hi[c] = fmax(hi[c], w.world[3 * v + c]);
+    for (int c = 0; c < 3; c++)
+        m->origin[c] = 0.5 * (lo[c] + hi[c]);
+    for (size_t v = 0; v < m->vertex_count; v++)
+        for (int c = 0; c < 3; c++)
+            m->positions[3 * v + c] = (float)(w.world[3 * v + c] - m->origin[c]);
+    asp_free(ctx, w.world);
+    if (m->colors)
+        fill_material_colors(m);
+    int need_normals = !use_file_normals;
+    for (size_t v = 0; use_file_normals && v < m->vertex_count; v++) {
+        float *n = m->normals + 3 * v;
+        double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        if (!(len > 0.0) || !isfinite(len)) {
+            need_normals = 1; /* one broken file normal: trust none of them */
+            break;
+        }
+        for (int c = 0; c < 3; c++)
+            n[c] = (float)(n[c] / len);
+    }
+    if (need_normals)
+        rc = asp_mesh_compute_normals(m, err);
+    if (rc == 0)
+        rc = asp_mesh_validate(m, path, err);
+    if (rc) {
+        asp_mesh_destroy(m);
+        return rc;
+    }
+    *out = m;
+    return 0;
+}
+
+int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_context *ctx, asp_mesh **out,
+                  asp_error *err)
+{
+    asp_mesh_load_desc d = desc ? *desc : (asp_mesh_load_desc){0};
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+    fclose(fp);
+    /*
+     * JoinIdenticalVertices welds the per-corner vertices OBJ/STL importers
+     * emit; SortByPType puts points and lines into meshes of their own so the
+     * walk can skip them.
+     */
+    unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
+                     aiProcess_ValidateDataStructure;
+    const struct aiScene *scene = aiImportFile(path, flags);
+    if (!scene) {
+        const char *why = aiGetErrorString();
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': %s", path, why && *why ? why : "unknown format");
+    }
+    int rc = build(scene, path, &d, ctx, out, err);
+    aiReleaseImport(scene);
+    return rc;
+}

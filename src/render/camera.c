@@ -1,0 +1,130 @@
+/*
+ * Orbit camera: y-up azimuth/elevation around a target, perspective
+ * projection, and fitting a bounding sphere to the view. Pure math, no GL, so
+ * it is unit-tested without a context. Matrices follow OpenGL conventions
+ * (column-major, eye looks down -z, NDC z in -1..1).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "render/internal.h"
+#include "util/banned.h"
+
+static const double deg = 3.14159265358979323846 / 180.0;
+
+void asp_camera_init(asp_camera *cam)
+{
+    memset(cam, 0, sizeof *cam);
+    cam->distance = 3.0f;
+    cam->fov_y = 40.0f;
+    cam->aspect = 1.0f;
+    cam->z_near = 0.01f;
+    cam->z_far = 100.0f;
+}
+
+/* Unit vector from target to eye, and the image "up" vector (d/d elevation of it). */
+static void orbit_axes(const asp_camera *cam, double back[3], double up[3])
+{
+    double az = cam->azimuth * deg, el = cam->elevation * deg;
+    back[0] = cos(el) * sin(az);
+    back[1] = sin(el);
+    back[2] = cos(el) * cos(az);
+    // the derivative stays defined at el = +-90, where y-up lookAt breaks down
+    up[0] = -sin(el) * sin(az);
+    up[1] = cos(el);
+    up[2] = -sin(el) * cos(az);
+}
+
+void asp_camera_eye(const asp_camera *cam, float eye[3])
+{
+    double back[3], up[3];
+    orbit_axes(cam, back, up);
+    for (int i = 0; i < 3; i++)
+        eye[i] = (float)(cam->target[i] + cam->distance * back[i]);
+}
+
+float asp_camera_fit_distance(const asp_camera *cam, float radius)
+{
+    /*
+     * A sphere at distance d subtends a cone of half-angle asin(r / d); it
+     * touches the frustum sides when that equals the smaller half field of view.
+     */
+    double half_y = 0.5 * cam->fov_y * deg;
+    double half_x = atan(tan(half_y) * (cam->aspect > 0 ? cam->aspect : 1.0));
+    double half = half_x < half_y ? half_x : half_y;
+    return (float)(radius / sin(half));
+}
+
+void asp_camera_clip_to_sphere(asp_camera *cam, const float center[3], float radius)
+{
+    float eye[3];
+    asp_camera_eye(cam, eye);
+    double dx = eye[0] - center[0], dy = eye[1] - center[1], dz = eye[2] - center[2];
+    double d = sqrt(dx * dx + dy * dy + dz * dz);
+    double r = radius > 0 ? radius : 0;
+    double near_min = 1e-3 * (d + r); // keeps far / near <= 1000 for the 24-bit depth buffer
+    double zn = 0.99 * (d - r);
+    cam->z_near = (float)(zn > near_min ? zn : near_min);
+    cam->z_far = (float)(1.01 * (d + r));
+    if (!(cam->z_far > cam->z_near))
+        cam->z_far = cam->z_near * 2.0f;
+}
+
+void asp_camera_fit(asp_camera *cam, const float center[3], float radius, float aspect)
+{
+    memcpy(cam->target, center, sizeof cam->target);
+    cam->aspect = aspect > 0 ? aspect : 1.0f;
+    cam->distance = asp_camera_fit_distance(cam, radius);
+    asp_camera_clip_to_sphere(cam, center, radius);
+}
+
+void asp_camera_view_matrix(const asp_camera *cam, float m[16])
+{
+    double back[3], up[3];
+    orbit_axes(cam, back, up);
+    // right = up x back completes a right-handed eye frame (x right, y up, z towards the viewer)
+    double right[3] = {up[1] * back[2] - up[2] * back[1], up[2] * back[0] - up[0] * back[2],
+                       up[0] * back[1] - up[1] * back[0]};
+    double eye[3];
+    for (int i = 0; i < 3; i++)
+        eye[i] = cam->target[i] + cam->distance * back[i];
+    const double *rows[3] = {right, up, back};
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++)
+            m[c * 4 + r] = (float)rows[r][c];
+        m[12 + r] = (float)-(rows[r][0] * eye[0] + rows[r][1] * eye[1] + rows[r][2] * eye[2]);
+        m[r * 4 + 3] = 0.0f;
+    }
+    m[15] = 1.0f;
+}
+
+void asp_camera_projection_matrix(const asp_camera *cam, float m[16])
+{
+    double f = 1.0 / tan(0.5 * cam->fov_y * deg);
+    double n = cam->z_near, fa = cam->z_far;
+    memset(m, 0, 16 * sizeof *m);
+    m[0] = (float)(f / cam->aspect);
+    m[5] = (float)f;
+    m[10] = (float)((fa + n) / (n - fa));
+    m[11] = -1.0f;
+    m[14] = (float)(2.0 * fa * n / (n - fa));
+}
+
+int asp_camera_project(const asp_camera *cam, const float p[3], uint32_t width, uint32_t height, float out[3])
+{
+    float v[16], pr[16];
+    asp_camera_view_matrix(cam, v);
+    asp_camera_projection_matrix(cam, pr);
+    double e[4], c[4];
+    for (int r = 0; r < 4; r++)
+        e[r] = (double)v[r] * p[0] + (double)v[4 + r] * p[1] + (double)v[8 + r] * p[2] + v[12 + r];
+    for (int r = 0; r < 4; r++)
+        c[r] = pr[r] * e[0] + pr[4 + r] * e[1] + pr[8 + r] * e[2] + pr[12 + r] * e[3];
+    if (!(c[3] > 0))
+        return 0;
+    double x = c[0] / c[3], y = c[1] / c[3], z = c[2] / c[3];
+    out[0] = (float)((x * 0.5 + 0.5) * width);
+    out[1] = (float)((0.5 - y * 0.5) * height); // image rows run top to bottom, NDC y bottom to top
+    out[2] = (float)(z * 0.5 + 0.5);
+    return 1;
+}

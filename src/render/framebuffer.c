@@ -1,0 +1,70 @@
+/*
+ * The offscreen render target of a headless context: an sRGB colour buffer
+ * (so shading happens in linear light and is encoded on store) and a 24-bit
+ * depth buffer, multisampled on request with a single-sample resolve copy.
+ * Kept in the context and reused while the size and sample count stay.
+ */
+#include "render/internal.h"
+#include "util/banned.h"
+
+void asp__gl_target_release(asp__gl_target *t)
+{
+    GLuint fbos[2] = {t->fbo.id, t->resolve_fbo.id};
+    GLuint rbs[3] = {t->color.id, t->depth.id, t->resolve_color.id};
+    for (int i = 0; i < 2; i++)
+        if (fbos[i])
+            glDeleteFramebuffers(1, &fbos[i]);
+    for (int i = 0; i < 3; i++)
+        if (rbs[i])
+            glDeleteRenderbuffers(1, &rbs[i]);
+    t->fbo.id = t->resolve_fbo.id = 0;
+    t->color.id = t->depth.id = t->resolve_color.id = 0;
+    t->width = t->height = t->samples = 0;
+}
+
+static int check_complete(GLuint fbo, const char *which, asp_error *err)
+{
+    GLenum status = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER);
+    if (status == GL_FRAMEBUFFER_COMPLETE)
+        return 0;
+    return asp_error_set(err, ASP_EGL, "cannot create the %s framebuffer: status 0x%04x", which, (unsigned)status);
+}
+
+int asp__gl_target_ensure(asp_gl_context *gl, uint32_t width, uint32_t height, uint32_t samples, asp_error *err)
+{
+    asp__gl_target *t = &gl->target;
+    if (t->fbo.id && t->width == width && t->height == height && t->samples == samples)
+        return 0;
+    asp__gl_target_release(t);
+    asp__gl_clear_errors(gl);
+    // samples == 1 would still make a multisampled buffer on some drivers; 0 means a plain one
+    GLsizei s = samples > 1 ? (GLsizei)samples : 0;
+    glCreateRenderbuffers(1, &t->color.id);
+    glNamedRenderbufferStorageMultisample(t->color.id, s, GL_SRGB8_ALPHA8, (GLsizei)width, (GLsizei)height);
+    glCreateRenderbuffers(1, &t->depth.id);
+    glNamedRenderbufferStorageMultisample(t->depth.id, s, GL_DEPTH_COMPONENT24, (GLsizei)width, (GLsizei)height);
+    glCreateFramebuffers(1, &t->fbo.id);
+    glNamedFramebufferRenderbuffer(t->fbo.id, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t->color.id);
+    glNamedFramebufferRenderbuffer(t->fbo.id, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t->depth.id);
+    int rc = asp__gl_check(gl, "create the offscreen framebuffer", err);
+    if (!rc)
+        rc = check_complete(t->fbo.id, "offscreen", err);
+    if (!rc && s > 0) {
+        glCreateRenderbuffers(1, &t->resolve_color.id);
+        glNamedRenderbufferStorage(t->resolve_color.id, GL_SRGB8_ALPHA8, (GLsizei)width, (GLsizei)height);
+        glCreateFramebuffers(1, &t->resolve_fbo.id);
+        glNamedFramebufferRenderbuffer(t->resolve_fbo.id, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                                       t->resolve_color.id);
+        rc = asp__gl_check(gl, "create the resolve framebuffer", err);
+        if (!rc)
+            rc = check_complete(t->resolve_fbo.id, "resolve", err);
+    }
+    if (rc) {
+        asp__gl_target_release(t);
+        return rc;
+    }
+    t->width = width;
+    t->height = height;
+    t->samples = samples;
+    return 0;
+}

@@ -1,0 +1,103 @@
+/*
+ * Private to src/render/: the asp_gl_context layout shared by the EGL and GLFW
+ * backends, typed GL object handles (STYLE.md section 9), error collection,
+ * shader building, the offscreen target and the renderer interface.
+ */
+#ifndef ASP_RENDER_INTERNAL_H
+#define ASP_RENDER_INTERNAL_H
+
+#include <epoxy/gl.h>
+
+#include "amgsplat/render.h"
+
+/* Typed handles so a buffer can never be passed where a program is expected. */
+typedef struct asp__gl_buffer { GLuint id; } asp__gl_buffer;
+typedef struct asp__gl_program { GLuint id; } asp__gl_program;
+typedef struct asp__gl_vertex_array { GLuint id; } asp__gl_vertex_array;
+typedef struct asp__gl_framebuffer { GLuint id; } asp__gl_framebuffer;
+typedef struct asp__gl_renderbuffer { GLuint id; } asp__gl_renderbuffer;
+
+/* Offscreen render target, reused between renders of the same size. */
+typedef struct asp__gl_target {
+    uint32_t width, height, samples;
+    asp__gl_framebuffer fbo;          /* draw target, multisampled when samples > 1 */
+    asp__gl_renderbuffer color, depth;
+    asp__gl_framebuffer resolve_fbo;  /* single-sample copy read back when samples > 1 */
+    asp__gl_renderbuffer resolve_color;
+} asp__gl_target;
+
+enum asp__gl_backend { ASP__GL_EGL = 1, ASP__GL_GLFW = 2 };
+
+struct asp_gl_context {
+    asp_context actx;          /* allocator this struct came from */
+    enum asp__gl_backend backend;
+    void *egl_display;         /* EGLDisplay (EGL backend) */
+    void *egl_context;         /* EGLContext (EGL backend) */
+    void *window;              /* GLFWwindow * (GLFW backend) */
+    char backend_name[32];
+    char renderer[128];
+    char version[128];
+    GLint max_samples, max_size;
+    /* KHR_debug errors collected by the callback, reported by asp__gl_check */
+    unsigned debug_errors;
+    char debug_msg[200];
+    asp__gl_target target;
+};
+
+/* Queries strings and limits, checks GL >= 4.5 core, installs the debug callback. */
+int asp__gl_context_setup(asp_gl_context *gl, asp_error *err);
+/* Makes gl current if it is not. */
+int asp__gl_ensure_current(asp_gl_context *gl, asp_error *err);
+/* Backends' make-current. */
+int asp__gl_egl_make_current(asp_gl_context *gl, asp_error *err);
+int asp__gl_glfw_make_current(asp_gl_context *gl, asp_error *err);
+void asp__gl_egl_destroy(asp_gl_context *gl);
+void asp__gl_glfw_destroy(asp_gl_context *gl);
+
+/* Installs the KHR_debug callback that collects errors into gl. */
+void asp__gl_debug_install(asp_gl_context *gl);
+/* Reports collected errors as "cannot <what>: GL error ..." (ASP_EGL) and clears them. */
+int asp__gl_check(asp_gl_context *gl, const char *what, asp_error *err);
+/* Discards collected errors (before an operation whose errors we want to attribute). */
+void asp__gl_clear_errors(asp_gl_context *gl);
+/* "GL_INVALID_ENUM" for a glGetError code. */
+const char *asp__gl_error_name(GLenum code);
+
+/* Compiles and links a program from vertex and fragment sources; name appears in errors. */
+int asp__gl_program_create(asp_gl_context *gl, const char *name, const char *vs, const char *fs,
+                           asp__gl_program *out, asp_error *err);
+void asp__gl_program_destroy(asp__gl_program *p);
+
+/* Makes sure gl->target is width x height with samples (reallocating if needed). */
+int asp__gl_target_ensure(asp_gl_context *gl, uint32_t width, uint32_t height, uint32_t samples,
+                          asp_error *err);
+void asp__gl_target_release(asp__gl_target *t);
+
+/* Per-frame values every renderer needs; matrices column-major. */
+typedef struct asp__frame {
+    float view[16], proj[16];
+    float eye[3];          /* eye position in the renderer's (cloud-local) frame */
+    float light_eye[3];    /* unit direction towards the light, eye coordinates */
+    unsigned flags;        /* asp_render_flags */
+    uint32_t width, height;
+} asp__frame;
+
+/* The renderer interface: each kind fills the function table. */
+typedef struct asp__renderer_vtable {
+    const char *name;
+    int (*draw)(asp_renderer *r, const asp__frame *frame, asp_error *err);
+    void (*destroy)(asp_renderer *r);
+} asp__renderer_vtable;
+
+struct asp_renderer {
+    const asp__renderer_vtable *vt;
+    asp_gl_context *gl;
+    size_t count;
+};
+
+/* sRGB 8-bit to linear light (IEC 61966-2-1). */
+float asp__srgb_to_linear(uint8_t v);
+/* Linear light in 0..1 to sRGB 8-bit, rounded to nearest. */
+uint8_t asp__linear_to_srgb(float v);
+
+#endif

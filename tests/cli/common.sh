@@ -1,0 +1,18 @@
+# Sourced by tests/cli/*.sh: strict mode, a scratch directory, and assertions.
+set -euo pipefail
+: "${AMGSPLAT:?AMGSPLAT must name the amgsplat binary}"
+name=$(basename "${BASH_SOURCE[1]}" .sh)
+T="${ASP_TEST_TMP:-/tmp/amgsplat-test}/$name"
+rm -rf "$T"
+mkdir -p "$T"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# expect_fail STATUS SUBSTRING cmd...: the command must exit with STATUS and print SUBSTRING on stderr.
+expect_fail() {
+  local want=$1 text=$2; shift 2
+  local st=0
+  "$@" >"$T/out" 2>"$T/err" || st=$?
+  [[ $st -eq $want ]] || fail "'$*' exited $st, expected $want; stderr: $(cat "$T/err")"
+  grep -qF -- "$text" "$T/err" || fail "'$*' stderr lacks '$text': $(cat "$T/err")"
+}

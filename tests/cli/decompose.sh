@@ -1,0 +1,87 @@
+#!/usr/bin/env bash
+# amgsplat decompose: .amg output, --stats/--json, colour export, re-reading
+# an .amg, and the error cases (exit 1 for bad input, 2 for usage).
+set -euo pipefail
+T="$ASP_TEST_TMP/decompose"
+rm -rf "$T" && mkdir -p "$T"
+A="$AMGSPLAT"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+expect_exit() { # code, command...
+    local want=$1; shift
+    set +e; "$@" >"$T/out" 2>"$T/err"; local got=$?; set -e
+    [ "$got" = "$want" ] || { cat "$T/err" >&2; fail "'$*' exited $got, expected $want"; }
+}
+
+"$A" decompose -h | grep -q "usage: amgsplat decompose" || fail "help"
+"$A" synth octahedron -o "$T/oct.ply" -q
+
+# decomposition + stats as JSON: 8 unknowns on some level, partition of unity on all
+"$A" decompose "$T/oct.ply" -o "$T/oct.amg" --stats --json > "$T/oct.json"
+[ -s "$T/oct.amg" ] || fail "no .amg written"
+python3 - "$T/oct.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+st = d["level_stats"]
+assert d["points"] == 16000, d["points"]
+assert len(st) == d["levels"] >= 6, len(st)
+assert st[0]["unknowns"] == 16000 and st[-1]["unknowns"] <= 8
+assert any(s["unknowns"] == 8 for s in st), [s["unknowns"] for s in st]
+for a, b in zip(st, st[1:]):
+    assert b["unknowns"] < a["unknowns"]
+    assert 1.5 <= a["unknowns"] / b["unknowns"] <= 4.5, (a["unknowns"], b["unknowns"])
+for s in st:
+    assert s["max_pou_error"] < 1e-6, s
+    assert s["domains"] <= s["unknowns"] and s["mean_domains_per_point"] >= 1
+assert st[-1]["name"] == "L-0"
+assert set(d["seconds"]) == {"neighbours", "classifier", "fans", "assembly", "amg"}
+PY
+
+# text stats from the saved file, with the thesis threshold
+"$A" decompose "$T/oct.amg" --stats --tau 0.01 > "$T/stats.txt"
+grep -q "^level  name" "$T/stats.txt" || fail "stats header"
+grep -Eq "^ +[0-9]+  L +[0-9]+" "$T/stats.txt" || fail "coarsest level L missing"
+
+# colour export: domains of L-1 and the classifier, as PLY with colours
+"$A" decompose "$T/oct.amg" --export-colors domains --level L-1 --colors-out "$T/dom.ply" -q
+"$A" decompose "$T/oct.amg" --export-colors classifier --colors-out "$T/cls.ply" -q
+head -c 400 "$T/dom.ply" | grep -q "property uchar red" || fail "no colours in export"
+"$A" info "$T/dom.ply" > /dev/null
+
+# options reach the library: a coarser strength threshold changes the hierarchy
+"$A" decompose "$T/oct.ply" -o "$T/oct2.amg" --strong 0.25 --coarsen falgout --classifier moment --k 16 --json > "$T/o2.json"
+python3 -c "import json,sys; a=json.load(open('$T/oct.json')); b=json.load(open('$T/o2.json')); assert b['k_min']==16 and a['level_sizes']!=b['level_sizes']"
+
+# degenerate inputs: clear messages, exit 1, no output file
+printf 'ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n' > "$T/two.ply"
+expect_exit 1 "$A" decompose "$T/two.ply" -o "$T/two.amg"
+grep -q "at least 3" "$T/err" || fail "two points: $(cat "$T/err")"
+[ ! -e "$T/two.amg" ] || fail "output written on failure"
+python3 -c "
+print('ply\nformat ascii 1.0\nelement vertex 200\nproperty float x\nproperty float y\nproperty float z\nend_header')
+for i in range(200): print(i * 0.1, i * 0.2, 0)" > "$T/line.ply"
+expect_exit 1 "$A" decompose "$T/line.ply" -o "$T/line.amg"
+grep -q "colinear" "$T/err" || fail "colinear: $(cat "$T/err")"
+"$A" synth checker-plane --grid 40 -o "$T/plane.ply" -q
+"$A" decompose "$T/plane.ply" -o "$T/plane.amg" -q
+
+# damaged .amg files
+head -c 1000 "$T/oct.amg" > "$T/cut.amg"
+expect_exit 1 "$A" decompose "$T/cut.amg" --stats
+grep -q "truncated" "$T/err" || fail "truncated: $(cat "$T/err")"
+cp "$T/oct.amg" "$T/flip.amg"
+printf '\x7f' | dd of="$T/flip.amg" bs=1 seek=5000 conv=notrunc status=none
+expect_exit 1 "$A" decompose "$T/flip.amg" --stats
+grep -q "checksum" "$T/err" || fail "corrupted: $(cat "$T/err")"
+expect_exit 1 "$A" decompose "$T/oct.ply.missing.ply" -o "$T/x.amg"
+
+# usage errors: exit 2
+expect_exit 2 "$A" decompose
+expect_exit 2 "$A" decompose "$T/oct.ply"
+expect_exit 2 "$A" decompose "$T/oct.ply" -o "$T/x.amg" --coarsen nope
+expect_exit 2 "$A" decompose "$T/oct.ply" -o "$T/x.amg" --classifier nope
+expect_exit 2 "$A" decompose "$T/oct.amg" --export-colors domains
+expect_exit 2 "$A" decompose "$T/oct.amg" --stats --tau 1.5
+expect_exit 1 "$A" decompose "$T/oct.amg" --export-colors domains --level L-99 --colors-out "$T/x.ply"
+grep -q "L-99" "$T/err" || fail "bad level: $(cat "$T/err")"
+expect_exit 1 "$A" decompose "$T/oct.ply" -o "$T/x.amg" --strong 1.5
+echo "decompose: ok"

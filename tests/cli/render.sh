@@ -1,0 +1,115 @@
+# amgsplat render: sizes, framing, views, colours and backgrounds checked on decoded pixels; usage and input errors.
+source "$(dirname "$0")/common.sh"
+
+# A Fibonacci sphere of 3000 points (radius 1, colour = normal mapped to 0..255, hole-closing radii)
+# and a PLY with no vertices.
+python3 - "$T" <<'PY'
+import math, sys
+d = sys.argv[1]
+n = 3000
+r = 1.2 * math.sqrt(4 * math.pi / n)
+with open(d + '/sphere.ply', 'w') as f:
+    f.write('ply\nformat ascii 1.0\nelement vertex %d\n' % n)
+    for p in ('x', 'y', 'z', 'nx', 'ny', 'nz'):
+        f.write('property float %s\n' % p)
+    f.write('property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float radius\nend_header\n')
+    for i in range(n):
+        y = 1 - 2 * (i + 0.5) / n; rho = math.sqrt(1 - y * y); phi = i * 2.399963229728653
+        x, z = rho * math.cos(phi), rho * math.sin(phi)
+        c = [int(round(127.5 + 127.5 * v)) for v in (x, y, z)]
+        f.write('%.6f %.6f %.6f %.6f %.6f %.6f %d %d %d %.6f\n' % (x, y, z, x, y, z, c[0], c[1], c[2], r))
+with open(d + '/empty.ply', 'w') as f:
+    f.write('ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n')
+PY
+
+# png.py FILE EXPR: decodes an 8-bit RGBA PNG (any row filter) and evaluates EXPR with w, h, px(x, y) -> (r,g,b,a).
+cat >"$T/png.py" <<'PY'
+import struct, sys, zlib
+data = open(sys.argv[1], 'rb').read()
+assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
+pos, idat = 8, b''
+while pos < len(data):
+    n, t = struct.unpack('>I4s', data[pos:pos + 8])
+    body = data[pos + 8:pos + 8 + n]
+    if t == b'IHDR':
+        w, h, depth, ctype = struct.unpack('>IIBB', body[:10])
+        assert depth == 8 and ctype == 6, 'expected 8-bit RGBA'
+    elif t == b'IDAT':
+        idat += body
+    pos += 12 + n
+raw, stride, rows, prev = zlib.decompress(idat), 4 * w, [], bytearray(4 * w)
+for y in range(h):
+    f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+    for i in range(stride):
+        a = line[i - 4] if i >= 4 else 0
+        b = prev[i]
+        c = prev[i - 4] if i >= 4 else 0
+        if f == 1: line[i] = (line[i] + a) & 255
+        elif f == 2: line[i] = (line[i] + b) & 255
+        elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
+        elif f == 4:
+            p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+            line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+    rows.append(line); prev = line
+px = lambda x, y: tuple(rows[y][4 * x:4 * x + 4])
+if not eval(sys.argv[2]):
+    sys.exit('assertion failed: %s (w=%d h=%d, centre %s, corner %s)' % (sys.argv[2], w, h, px(w // 2, h // 2), px(0, 0)))
+PY
+check() { python3 "$T/png.py" "$1" "$2" || fail "$1: $2"; }
+
+# One view from +z: the bounding sphere (radius R = 1 + disc radius 0.0777) fills the 64x64 view, so the
+# unit sphere's outline has radius 32 tan(asin(1 / d)) / tan(20 deg) = 29.4 px with d = R / sin(20 deg):
+# 66.3% of the pixels
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/front.png" --size 64x64 --view 0,0 --transparent --samples 0 -q
+check "$T/front.png" "w == 64 and h == 64"
+check "$T/front.png" "px(0, 0)[3] == 0 and px(63, 63)[3] == 0 and px(32, 32)[3] == 255"
+check "$T/front.png" "0.64 < sum(px(x, y)[3] == 255 for x in range(w) for y in range(h)) / (w * h) < 0.69"
+# the centre faces +z (blue high, red mid); from +x (azimuth 90) red dominates
+check "$T/front.png" "px(32, 32)[2] > 230 and px(32, 32)[2] > px(32, 32)[0] + 60"
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/side.png" --size 64x64 --view 90,0 -q
+check "$T/side.png" "px(32, 32)[0] > 230 and px(32, 32)[0] > px(32, 32)[2] + 60"
+# the top of the image is +y (green high)
+check "$T/front.png" "px(32, 8)[1] > px(32, 56)[1] + 60"
+# default background is opaque white; --background sets it exactly
+check "$T/side.png" "px(0, 0) == (255, 255, 255, 255)"
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/bg.png" --size 48x32 --background 10,20,30 -q
+check "$T/bg.png" "w == 48 and h == 32 and px(0, 0) == (10, 20, 30, 255) and px(47, 31) == (10, 20, 30, 255)"
+# DIST 5.8476 radii (twice the fitted 1 / sin(20 deg)): outline radius 14.1 px, 15.3% of the pixels
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/far.png" --size 64x64 --view 0,0,5.8476 --transparent --samples 0 -q
+check "$T/far.png" "0.14 < sum(px(x, y)[3] == 255 for x in range(w) for y in range(h)) / (w * h) < 0.17"
+
+# --views: contact sheet of 2x2 tiles, deterministic
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/sheet.png" --size 32x24 --views 4 -q
+check "$T/sheet.png" "w == 64 and h == 48"
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/sheet2.png" --size 32x24 --views 4 -q
+cmp -s "$T/sheet.png" "$T/sheet2.png" || fail "two identical renders differ"
+
+# --json
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/j.png" --size 40x30 --views 3 --json >"$T/json"
+python3 -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d['points'] == 3000 and d['views'] == 3 and d['renderer'] == 'disc', d
+assert d['tile_width'] == 40 and d['tile_height'] == 30 and d['width'] == 80 and d['height'] == 60, d
+assert d['gl_renderer'] and d['seconds'] >= 0, d
+" "$T/json" || fail "json output: $(cat "$T/json")"
+
+# usage errors: exit 2, nothing written
+"$AMGSPLAT" render -h | grep -q "usage: amgsplat render" || fail "-h"
+expect_fail 2 "missing -o" "$AMGSPLAT" render "$T/sphere.ply"
+expect_fail 2 "must end in .png" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.jpg"
+expect_fail 2 "--size expects WxH" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --size 0x10
+expect_fail 2 "--view expects AZ,EL" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --view 10,95
+expect_fail 2 "--view expects AZ,EL" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --view 10
+expect_fail 2 "--views expects 1..256" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --views 0
+expect_fail 2 "exclude each other" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --transparent --background 1,2,3
+expect_fail 2 "--background expects" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --background 1,2,300
+expect_fail 2 "unknown renderer 'splat'" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --renderer splat
+expect_fail 2 "expected one input file" "$AMGSPLAT" render -o "$T/x.png"
+[[ ! -e "$T/x.png" && ! -e "$T/x.jpg" ]] || fail "a failed render left an output file"
+
+# input errors: exit 1, the file named
+expect_fail 1 "$T/nope.ply" "$AMGSPLAT" render "$T/nope.ply" -o "$T/x.png"
+expect_fail 1 "empty" "$AMGSPLAT" render "$T/empty.ply" -o "$T/x.png"
+[[ ! -e "$T/x.png" ]] || fail "a failed render left an output file"
+echo "render: ok"

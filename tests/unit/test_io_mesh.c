@@ -1,0 +1,321 @@
+/*
+ * Mesh input through assimp: each format from tiny files written here, node
+ * transforms, textures (relative, embedded, missing, override), normals, and
+ * the error cases; then the real models when ASP_TEST_DATA is present.
+ */
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "amgsplat/amgsplat.h"
+#include "harness.h"
+
+static char dir[256];
+
+static const char *path_in(const char *name)
+{
+    static char buf[4][512];
+    static int k;
+    k = (k + 1) % 4;
+    snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name);
+    return buf[k];
+}
+
+static void write_file(const char *name, const char *text)
+{
+    FILE *fp = fopen(path_in(name), "wb");
+    if (!fp)
+        return;
+    fputs(text, fp);
+    fclose(fp);
+}
+
+static void write_texture(const char *name)
+{
+    asp_image img = {0};
+    asp_image_init(&img, 4, 4, NULL);
+    for (int i = 0; i < 16; i++) {
+        uint8_t *p = img.pixels + 4 * i;
+        p[0] = (i % 4) < 2 ? 255 : 0, p[1] = 0, p[2] = (i % 4) < 2 ? 0 : 255, p[3] = 255;
+    }
+    asp_image_save_png(&img, path_in(name), NULL);
+    asp_image_release(&img);
+}
+
+static const char quad_obj[] = "mtllib quad.mtl\n"
+                               "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                               "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                               "usemtl checker\nf 1/1 2/2 3/3 4/4\n";
+
+static void test_obj_with_texture(void)
+{
+    asp_error err_ = {0}, *err = &err_;
+    write_texture("quad.png");
+    write_file("quad.mtl", "newmtl checker\nKd 0.8 0.8 0.8\nmap_Kd quad.png\n");
+    write_file("quad.obj", quad_obj);
+    asp_mesh *m = NULL;
+    CHECK_OK(asp_mesh_load(path_in("quad.obj"), NULL, NULL, &m, err), err);
+    if (!m)
+        return;
+    CHECK(m->vertex_count == 4);
+    CHECK(m->triangle_count == 2);
+    CHECK(m->uvs != NULL);
+    CHECK_NEAR(asp_mesh_area(m), 1.0, 1e-6);
+    const asp_material *mat = &m->materials[m->material_ids[0]];
+    CHECK(strcmp(mat->name, "checker") == 0);
+    CHECK(mat->texture.pixels && mat->texture.width == 4 && mat->texture.height == 4);
+    CHECK(mat->has_color);
+    /* computed normals face +z (counter-clockwise quad) */
+    for (size_t v = 0; v < m->vertex_count; v++)
+        CHECK(m->normals[3 * v + 2] == 1.0f);
+    /* world positions: origin + relative */
+    double lo = 1e9, hi = -1e9;
+    for (size_t v = 0; v < m->vertex_count; v++) {
+        double x = m->origin[0] + m->positions[3 * v];
+        lo = fmin(lo, x), hi = fmax(hi, x);
+    }
+    CHECK_NEAR(lo, 0.0, 1e-7);
+    CHECK_NEAR(hi, 1.0, 1e-7);
+    /* sampled points take the texture's colour by half */
+    asp_cloud *c = NULL;
+    CHECK_OK(asp_sample_mesh(m, &(asp_sample_desc){.points = 4000}, NULL, &c, NULL, err), err);
+    size_t bad = 0;
+    for (size_t i = 0; c && c->colors && i < c->count; i++) {
+        double x = m->origin[0] + c->positions[3 * i];
+        const uint8_t *col = c->colors + 4 * i;
+        if (x > 0.13 && x < 0.37)
+            bad += col[0] != 255 || col[2] != 0;
+        if (x > 0.63 && x < 0.87)
+            bad += col[0] != 0 || col[2] != 255;
+    }
+    CHECK(c && c->colors && bad == 0);
+    asp_cloud_destroy(c);
+    asp_mesh_destroy(m);
+}
+
+static void test_missing_texture(void)
+{
+    asp_error err_ = {0}, *err = &err_;
+    write_file("lost.mtl", "newmtl stone\nKd 0.5 0.5 0.5\nmap_Kd textures/gone.png\n");
+    char obj[sizeof quad_obj + 16];
+    snprintf(obj, sizeof obj, "mtllib lost.mtl\n%s", strchr(quad_obj, '\n') + 1);
+    for (char *p = strstr(obj, "checker"); p; p = NULL)
+        memcpy(p, "stone  ", 7);
+    write_file("lost.obj", obj);
+    asp_mesh *m = NULL;
+    CHECK(asp_mesh_load(path_in("lost.obj"), NULL, NULL, &m, err) == ASP_EIO);
+    CHECK_MSG(strstr(err->msg, "gone.png") && strstr(err->msg, "stone") && strstr(err->msg, "--texture"), "%s",
+              err->msg);
+    CHECK(m == NULL);
+    /* an override stands in for the missing file */
+    write_texture("other.png");
+    CHECK_OK(asp_mesh_load(path_in("lost.obj"), &(asp_mesh_load_desc){.texture_override = path_in("other.png")},
+                           NULL, &m, err),
+             err);
+    CHECK(m && m->materials[m->material_ids[0]].texture.width == 4);
+    asp_mesh_destroy(m);
+    m = NULL;
+    /* an override that does not exist is reported by name */
+    CHECK(asp_mesh_load(path_in("lost.obj"), &(asp_mesh_load_desc){.texture_override = path_in("nope.png")}, NULL,
+                        &m, err) == ASP_EIO);
+    CHECK(strstr(err->msg, "nope.png") != NULL);
+}
+
+static void test_simple_formats(void)
+{
+    asp_error err_ = {0}, *err = &err_;
+    /* a unit cube in OFF: 6 quads -> 12 triangles, area 6, outward normals */
+    write_file("cube.off", "OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+                           "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 2 3 7 6\n4 1 2 6 5\n4 0 4 7 3\n");
+    write_file("tri.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 2 0 0\nvertex 0 2 0\n"
+                          "endloop\nendfacet\nendsolid t\n");
+    write_file("quad.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                           "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+                           "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                           "0 0 0 255 0 0\n3 0 0 255 0 0\n3 1 0 255 0 0\n0 1 0 255 0 0\n4 0 1 2 3\n");
+    struct {
+        const char *name;
+        size_t tris;
+        double area;
+    } cases[] = {{"cube.off", 12, 6.0}, {"tri.stl", 1, 2.0}, {"quad.ply", 2, 3.0}};
+    for (size_t i = 0; i < 3; i++) {
+        asp_mesh *m = NULL;
+        CHECK_OK(asp_mesh_load(path_in(cases[i].name), NULL, NULL, &m, err), err);
+        if (!m)
+            continue;
+        CHECK_MSG(m->triangle_count == cases[i].tris, "%s: %zu triangles", cases[i].name, m->triangle_count);
+        CHECK_NEAR(asp_mesh_area(m), cases[i].area, 1e-5);
+        if (i == 0) {
+            /* outward: the normal points away from the centre (0.5,0.5,0.5) */
+            int out = 1;
+            for (size_t v = 0; v < m->vertex_count; v++) {
+                double d = 0;
+                for (int k = 0; k < 3; k++)
+                    d += (m->origin[k] + m->positions[3 * v + k] - 0.5) * m->normals[3 * v + k];
+                out &= d > 0;
+            }
+            CHECK(out);
+        }
+        if (i == 2) {
+            CHECK(m->colors && m->colors[0] == 255 && m->colors[1] == 0);
+            asp_cloud *c = NULL;
+            CHECK_OK(asp_sample_mesh(m, &(asp_sample_desc){.points = 100}, NULL, &c, NULL, err), err);
+            CHECK(c && c->colors && c->colors[0] == 255 && c->colors[2] == 0);
+            asp_cloud_destroy(c);
+        }
+        asp_mesh_destroy(m);
+    }
+}
+
+static void b64(const uint8_t *in, size_t n, char *out)
+{
+    static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    size_t o = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
+        out[o++] = t[v >> 18 & 63], out[o++] = t[v >> 12 & 63];
+        out[o++] = i + 1 < n ? t[v >> 6 & 63] : '=';
+        out[o++] = i + 2 < n ? t[v & 63] : '=';
+    }
+    out[o] = '\0';
+}
+
+/* glTF with a node hierarchy (translate 10 then scale 2) and a data-URI PNG texture (assimp: embedded "*0"). */
+static void test_gltf_transform_embedded(void)
+{
+    asp_error err_ = {0}, *err = &err_;
+    write_texture("emb.png");
+    FILE *fp = fopen(path_in("emb.png"), "rb");
+    uint8_t png[4096];
+    size_t npng = fp ? fread(png, 1, sizeof png, fp) : 0;
+    if (fp)
+        fclose(fp);
+    uint8_t buf[68] = {0};
+    float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0, 1};
+    uint16_t idx[3] = {0, 1, 2};
+    memcpy(buf, pos, 36), memcpy(buf + 36, uv, 24), memcpy(buf + 60, idx, 6);
+    static char b_png[8192], b_buf[256], json[16384];
+    b64(png, npng, b_png);
+    b64(buf, sizeof buf, b_buf);
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+             "\"nodes\":[{\"children\":[1],\"translation\":[10,0,0]},{\"mesh\":0,\"scale\":[2,2,2]}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
+             "\"material\":0}]}],"
+             "\"materials\":[{\"name\":\"emb\",\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],"
+             "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
+             "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36},"
+             "{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+             "\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+             "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
+             b_png, b_buf);
+    write_file("tri.gltf", json);
+    asp_mesh *m = NULL;
+    CHECK_OK(asp_mesh_load(path_in("tri.gltf"), NULL, NULL, &m, err), err);
+    if (!m)
+        return;
+    CHECK(m->triangle_count == 1);
+    CHECK_NEAR(asp_mesh_area(m), 2.0, 1e-5);
+    double lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
+    for (size_t v = 0; v < m->vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            double x = m->origin[k] + m->positions[3 * v + k];
+            lo[k] = fmin(lo[k], x), hi[k] = fmax(hi[k], x);
+        }
+    CHECK_NEAR(lo[0], 10.0, 1e-5);
+    CHECK_NEAR(hi[0], 12.0, 1e-5);
+    CHECK_NEAR(hi[1], 2.0, 1e-5);
+    const asp_material *mat = &m->materials[m->material_ids[0]];
+    CHECK_MSG(mat->texture.pixels && mat->texture.width == 4, "texture '%s'", mat->texture_path);
+    CHECK(mat->texture.pixels && mat->texture.pixels[0] == 255 && mat->texture.pixels[4 * 3 + 2] == 255);
+    asp_mesh_destroy(m);
+}
+
+static void test_errors(void)
+{
+    asp_error err_ = {0}, *err = &err_;
+    asp_mesh *m = NULL;
+    CHECK(asp_mesh_load(path_in("absent.obj"), NULL, NULL, &m, err) == ASP_EIO);
+    CHECK(strstr(err->msg, "absent.obj") != NULL);
+    write_file("flat.obj", "v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n");
+    CHECK(asp_mesh_load(path_in("flat.obj"), NULL, NULL, &m, err) == ASP_EDEGENERATE);
+    CHECK_MSG(strstr(err->msg, "zero surface area") && strstr(err->msg, "flat.obj"), "%s", err->msg);
+    write_file("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\np 1 2 3\n");
+    CHECK(asp_mesh_load(path_in("points.obj"), NULL, NULL, &m, err) < 0);
+    CHECK_MSG(strstr(err->msg, "points.obj") != NULL, "%s", err->msg);
+    write_file("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+    CHECK(asp_mesh_load(path_in("nan.obj"), NULL, NULL, &m, err) == ASP_EFORMAT);
+    CHECK_MSG(strstr(err->msg, "nan.obj") != NULL, "%s", err->msg);
+    write_file("junk.stl", "\x01\x02 this is not a mesh");
+    CHECK(asp_mesh_load(path_in("junk.stl"), NULL, NULL, &m, err) < 0);
+    CHECK(strstr(err->msg, "junk.stl") != NULL);
+    /* a texture override needs UVs */
+    write_texture("t.png");
+    write_file("nouv.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    CHECK(asp_mesh_load(path_in("nouv.obj"), &(asp_mesh_load_desc){.texture_override = path_in("t.png")}, NULL, &m,
+                        err) == ASP_EINVAL);
+    CHECK(strstr(err->msg, "texture coordinates") != NULL);
+    CHECK(m == NULL);
+}
+
+static void test_real_models(void)
+{
+    char p[1024], t[1024];
+    snprintf(p, sizeof p, "%s/spot_triangulated.obj", ASP_TEST_DATA);
+    snprintf(t, sizeof t, "%s/spot_texture.png", ASP_TEST_DATA);
+    if (access(p, R_OK) != 0) {
+        fprintf(stderr, "skipping real models: %s not found\n", p);
+        return;
+    }
+    asp_error err_ = {0}, *err = &err_;
+    asp_mesh *m = NULL;
+    CHECK_OK(asp_mesh_load(p, &(asp_mesh_load_desc){.texture_override = t}, NULL, &m, err), err);
+    if (m) {
+        CHECK(m->triangle_count == 5856);
+        asp_cloud *c = NULL;
+        CHECK_OK(asp_sample_mesh(m, &(asp_sample_desc){.points = 200000}, NULL, &c, NULL, err), err);
+        /* Spot's texture: pale pink skin (red above blue) with dark patches; a grey fallback has neither */
+        size_t pink = 0, dark = 0;
+        for (size_t i = 0; c && c->colors && i < c->count; i++) {
+            const uint8_t *q = c->colors + 4 * i;
+            pink += q[0] > q[2] + 15;
+            dark += q[0] < 110 && q[1] < 110 && q[2] < 110;
+        }
+        CHECK_MSG(c && c->count == 200000 && pink > c->count / 2 && dark > c->count / 50,
+                  "%zu pink and %zu dark of 200000 points", pink, dark);
+        asp_cloud_destroy(c);
+        asp_mesh_destroy(m);
+    }
+    snprintf(p, sizeof p, "%s/stanford-bunny.obj", ASP_TEST_DATA);
+    m = NULL;
+    CHECK_OK(asp_mesh_load(p, NULL, NULL, &m, err), err);
+    if (m) {
+        CHECK(m->triangle_count == 69451);
+        CHECK(m->vertex_count >= 34000 && m->vertex_count <= 35947);
+        CHECK(m->uvs == NULL && m->colors == NULL);
+    }
+    asp_mesh_destroy(m);
+}
+
+static void setup(void)
+{
+    snprintf(dir, sizeof dir, "/tmp/asp_test_mesh_XXXXXX");
+    if (!mkdtemp(dir))
+        snprintf(dir, sizeof dir, "/tmp");
+}
+
+static void teardown(void)
+{
+    const char *names[] = {"quad.png", "quad.mtl", "quad.obj", "lost.mtl", "lost.obj", "other.png", "cube.off",
+                           "tri.stl", "quad.ply", "emb.png", "tri.gltf", "flat.obj", "points.obj", "nan.obj",
+                           "junk.stl", "t.png", "nouv.obj"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        remove(path_in(names[i]));
+    rmdir(dir);
+}
+
+TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_obj_with_texture), TEST_CASE(test_missing_texture),
+          TEST_CASE(test_simple_formats), TEST_CASE(test_gltf_transform_embedded), TEST_CASE(test_errors),
+          TEST_CASE(test_real_models), TEST_CASE(teardown))

@@ -1,0 +1,198 @@
+/*
+ * Orbit camera math (render/camera.c): view frame conventions, projection of
+ * known points to known pixels, and asp_camera_fit keeping a bounding sphere
+ * inside the frustum while touching its nearer sides.
+ */
+#include <math.h>
+
+#include "amgsplat/render.h"
+#include "harness.h"
+
+static const double deg = 3.14159265358979323846 / 180.0;
+
+static void mul_point(const float m[16], const float p[3], double out[4])
+{
+    for (int r = 0; r < 4; r++)
+        out[r] = (double)m[r] * p[0] + (double)m[4 + r] * p[1] + (double)m[8 + r] * p[2] + m[12 + r];
+}
+
+static void test_defaults(void)
+{
+    asp_camera cam;
+    asp_camera_init(&cam);
+    CHECK_NEAR(cam.fov_y, 40.0, 0);
+    CHECK_NEAR(cam.aspect, 1.0, 0);
+    CHECK(cam.distance > 0 && cam.z_near > 0 && cam.z_far > cam.z_near);
+    float eye[3];
+    asp_camera_eye(&cam, eye);
+    // azimuth 0, elevation 0 looks from +z
+    CHECK_NEAR(eye[0], 0, 1e-6);
+    CHECK_NEAR(eye[1], 0, 1e-6);
+    CHECK_NEAR(eye[2], cam.distance, 1e-6);
+}
+
+/* The view matrix is rigid, sends the eye to the origin and the target to (0, 0, -distance). */
+static void test_view_frame(void)
+{
+    static const float angles[][2] = {{0, 0}, {90, 0}, {-30, 20}, {200, -45}, {10, 90}, {75, -90}};
+    for (size_t a = 0; a < sizeof angles / sizeof angles[0]; a++) {
+        asp_camera cam;
+        asp_camera_init(&cam);
+        cam.target[0] = 1.5f, cam.target[1] = -2.0f, cam.target[2] = 0.25f;
+        cam.azimuth = angles[a][0];
+        cam.elevation = angles[a][1];
+        cam.distance = 4.0f;
+        float m[16], eye[3];
+        asp_camera_view_matrix(&cam, m);
+        asp_camera_eye(&cam, eye);
+        double e[4], t[4];
+        mul_point(m, eye, e);
+        mul_point(m, cam.target, t);
+        for (int k = 0; k < 3; k++)
+            CHECK_NEAR(e[k], 0, 1e-5);
+        CHECK_NEAR(t[0], 0, 1e-5);
+        CHECK_NEAR(t[1], 0, 1e-5);
+        CHECK_NEAR(t[2], -4.0, 1e-5);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                double dot = 0;
+                for (int k = 0; k < 3; k++)
+                    dot += (double)m[k * 4 + i] * m[k * 4 + j];
+                CHECK_NEAR(dot, i == j ? 1.0 : 0.0, 1e-6);
+            }
+        // elevation: the eye is above the target by distance * sin(el)
+        CHECK_NEAR(eye[1] - cam.target[1], 4.0 * sin(angles[a][1] * deg), 1e-5);
+    }
+    // azimuth 90 looks from +x; world +y stays image up at elevation 0, and -z is to the right
+    asp_camera cam;
+    asp_camera_init(&cam);
+    cam.azimuth = 90;
+    float eye[3], m[16];
+    asp_camera_eye(&cam, eye);
+    CHECK_NEAR(eye[0], cam.distance, 1e-5);
+    asp_camera_view_matrix(&cam, m);
+    float minus_z[3] = {0, 0, -1}, plus_y[3] = {0, 1, 0};
+    double r[4], u[4];
+    mul_point(m, minus_z, r);
+    mul_point(m, plus_y, u);
+    CHECK(r[0] > 0.99 && u[1] > 0.99);
+}
+
+static void test_project_known_points(void)
+{
+    asp_camera cam;
+    asp_camera_init(&cam);
+    cam.distance = 5.0f;
+    cam.aspect = 2.0f;
+    cam.z_near = 1.0f;
+    cam.z_far = 10.0f;
+    const uint32_t w = 200, h = 100;
+    float out[3];
+    float origin[3] = {0, 0, 0};
+    CHECK(asp_camera_project(&cam, origin, w, h, out) == 1);
+    CHECK_NEAR(out[0], 100.0, 1e-3);
+    CHECK_NEAR(out[1], 50.0, 1e-3);
+    // perspective depth of eye distance 5 with near 1, far 10
+    double z_ndc = (10.0 + 1.0) / (10.0 - 1.0) - 2.0 * 10.0 * 1.0 / ((10.0 - 1.0) * 5.0);
+    CHECK_NEAR(out[2], 0.5 * z_ndc + 0.5, 1e-5);
+    // the top edge of the frustum at the target's depth is y = 5 tan(20 deg): pixel row 0
+    float top[3] = {0, (float)(5.0 * tan(20 * deg)), 0};
+    CHECK(asp_camera_project(&cam, top, w, h, out) == 1);
+    CHECK_NEAR(out[0], 100.0, 1e-3);
+    CHECK_NEAR(out[1], 0.0, 1e-3);
+    // the right edge: x = aspect * 5 tan(20 deg) is column w; a quarter of the way is column 125
+    float right[3] = {(float)(0.25 * 2.0 * 5.0 * tan(20 * deg)), 0, 0};
+    CHECK(asp_camera_project(&cam, right, w, h, out) == 1);
+    CHECK_NEAR(out[0], 125.0, 1e-3);
+    CHECK_NEAR(out[1], 50.0, 1e-3);
+    // on the near plane the window depth is 0, on the far plane 1
+    float on_near[3] = {0, 0, 4.0f}, on_far[3] = {0, 0, -5.0f};
+    CHECK(asp_camera_project(&cam, on_near, w, h, out) == 1);
+    CHECK_NEAR(out[2], 0.0, 1e-5);
+    CHECK(asp_camera_project(&cam, on_far, w, h, out) == 1);
+    CHECK_NEAR(out[2], 1.0, 1e-5);
+    // behind the eye: refused, out untouched
+    float behind[3] = {0, 0, 6.0f};
+    out[0] = -7.0f;
+    CHECK(asp_camera_project(&cam, behind, w, h, out) == 0);
+    CHECK(out[0] == -7.0f);
+}
+
+/* Samples the sphere densely; returns the largest distance of a projection from the image centre per axis. */
+static void sphere_extent(const asp_camera *cam, const float c[3], float r, uint32_t w, uint32_t h, double *max_dx,
+                          double *max_dy, int *inside)
+{
+    *max_dx = *max_dy = 0;
+    *inside = 1;
+    const int n = 20000;
+    for (int i = 0; i < n; i++) {
+        double y = 1.0 - 2.0 * (i + 0.5) / n, rho = sqrt(1.0 - y * y), phi = i * 2.399963229728653;
+        float p[3] = {(float)(c[0] + r * rho * cos(phi)), (float)(c[1] + r * y), (float)(c[2] + r * rho * sin(phi))};
+        float o[3];
+        if (!asp_camera_project(cam, p, w, h, o)) {
+            *inside = 0;
+            continue;
+        }
+        if (o[0] < -1e-3 || o[0] > w + 1e-3 || o[1] < -1e-3 || o[1] > h + 1e-3 || o[2] <= 0 || o[2] >= 1)
+            *inside = 0;
+        *max_dx = fmax(*max_dx, fabs(o[0] - 0.5 * w));
+        *max_dy = fmax(*max_dy, fabs(o[1] - 0.5 * h));
+    }
+}
+
+static void test_fit_sphere_in_frustum(void)
+{
+    static const float cases[][3] = {{0, 0, 1}, {30, 20, 1}, {-120, -60, 2}, {45, 89, 0.5f}, {10, 10, 0.75f}};
+    const float center[3] = {10.0f, -3.0f, 2.5f};
+    const float radius = 2.0f;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        asp_camera cam;
+        asp_camera_init(&cam);
+        cam.azimuth = cases[k][0];
+        cam.elevation = cases[k][1];
+        float aspect = cases[k][2];
+        asp_camera_fit(&cam, center, radius, aspect);
+        CHECK_NEAR(cam.aspect, aspect, 0);
+        CHECK_NEAR(cam.target[0], center[0], 0);
+        uint32_t h = 300, w = (uint32_t)lround(300 * aspect);
+        double dx, dy;
+        int inside;
+        sphere_extent(&cam, center, radius, w, h, &dx, &dy, &inside);
+        CHECK_MSG(inside, "case %zu: sphere leaves the frustum", k);
+        // the nearer pair of sides is touched (within the sampling density)
+        double fill = aspect >= 1 ? dy / (0.5 * h) : dx / (0.5 * w);
+        CHECK_MSG(fill > 0.99 && fill < 1.0 + 1e-4, "case %zu: sphere fills %.4f of the view", k, fill);
+        CHECK_NEAR(cam.distance, asp_camera_fit_distance(&cam, radius), 1e-4);
+    }
+    // twice the distance: half the angular size, still inside
+    asp_camera cam;
+    asp_camera_init(&cam);
+    asp_camera_fit(&cam, center, radius, 1.0f);
+    double d0 = cam.distance;
+    cam.distance *= 2.0f;
+    asp_camera_clip_to_sphere(&cam, center, radius);
+    double dx, dy;
+    int inside;
+    sphere_extent(&cam, center, radius, 100, 100, &dx, &dy, &inside);
+    CHECK(inside);
+    double expect = 50.0 * tan(asin(radius / (2 * d0))) / tan(20 * deg);
+    CHECK_NEAR(dy, expect, 0.05);
+}
+
+static void test_clip_inside_sphere(void)
+{
+    asp_camera cam;
+    asp_camera_init(&cam);
+    const float c[3] = {0, 0, 0};
+    cam.distance = 0.5f;
+    asp_camera_clip_to_sphere(&cam, c, 2.0f);
+    CHECK_NEAR(cam.z_near, 1e-3 * 2.5, 1e-7);
+    CHECK_NEAR(cam.z_far, 1.01 * 2.5, 1e-6);
+    cam.distance = 10.0f;
+    asp_camera_clip_to_sphere(&cam, c, 2.0f);
+    CHECK_NEAR(cam.z_near, 0.99 * 8.0, 1e-5);
+    CHECK_NEAR(cam.z_far, 1.01 * 12.0, 1e-5);
+}
+
+TEST_MAIN(TEST_CASE(test_defaults), TEST_CASE(test_view_frame), TEST_CASE(test_project_known_points),
+          TEST_CASE(test_fit_sphere_in_frustum), TEST_CASE(test_clip_inside_sphere))
