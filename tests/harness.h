@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amgsplat/core.h"
+
 static int asp_test_failures;
 static int asp_test_checks;
 
@@ -46,6 +48,12 @@ static int asp_test_checks;
         }                                                                                       \
     } while (0)
 
+/* The message of an optional error (a function, so &err does not trip -Waddress). */
+static inline const char *asp_test_error_text(const asp_error *e)
+{
+    return e ? e->msg : "";
+}
+
 /* Asserts a library call succeeded; prints its message otherwise. */
 #define CHECK_OK(call, errp)                                                                  \
     do {                                                                                      \
@@ -54,7 +62,7 @@ static int asp_test_checks;
         if (asp_rc_ != 0) {                                                                   \
             asp_test_failures++;                                                              \
             fprintf(stderr, "%s:%d: %s returned %d: %s\n", __FILE__, __LINE__, #call, asp_rc_, \
-                    (errp) ? (errp)->msg : "");                                               \
+                    asp_test_error_text(errp));                                               \
         }                                                                                     \
     } while (0)
 

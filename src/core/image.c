@@ -134,14 +134,23 @@ int asp_image_contact_sheet(const asp_image *tiles, size_t n, uint32_t cols, asp
         if (tiles[i].width != w || tiles[i].height != h)
             return asp_error_set(err, ASP_EINVAL, "contact sheet image %zu is %ux%u, expected %ux%u", i,
                                  tiles[i].width, tiles[i].height, w, h);
-    if (cols == 0)
+    if (cols == 0) {
+        /* near-square, preferring a column count that leaves no empty tile (8 views: 4x2, not 3x3) */
         cols = (uint32_t)ceil(sqrt((double)n));
+        for (uint32_t c = cols; (double)c <= ceil(sqrt(2.0 * (double)n)); c++)
+            if (n % c == 0) {
+                cols = c;
+                break;
+            }
+    }
     if (cols > n)
         cols = (uint32_t)n;
     uint32_t rows = (uint32_t)((n + cols - 1) / cols);
     int rc = asp_image_init(dst, w * cols, h * rows, err);
     if (rc)
         return rc;
+    /* empty tiles take the first tile's corner colour, which is its background */
+    asp_image_fill(dst, tiles[0].pixels);
     for (size_t i = 0; i < n; i++) {
         uint32_t ox = (uint32_t)(i % cols) * w, oy = (uint32_t)(i / cols) * h;
         for (uint32_t y = 0; y < h; y++)

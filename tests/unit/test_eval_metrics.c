@@ -122,8 +122,20 @@ static void test_contact_sheet_and_png(void)
     for (int i = 0; i < 3; i++)
         make_pattern(&tiles[i], 10, 6, i);
     CHECK_OK(asp_image_contact_sheet(tiles, 3, 0, &sheet, NULL), (asp_error *)NULL);
-    CHECK(sheet.width == 20 && sheet.height == 12);
-    CHECK(memcmp(sheet.pixels + 4 * (6 * 20 + 0), tiles[2].pixels, 40) == 0); /* third tile starts row 2 */
+    CHECK(sheet.width == 30 && sheet.height == 6); /* 3 tiles: one row, no empty tile */
+    CHECK(memcmp(sheet.pixels + 4 * 20, tiles[2].pixels, 40) == 0);
+    asp_image eight;
+    asp_image many[8];
+    for (int i = 0; i < 8; i++)
+        many[i] = tiles[i % 3];
+    CHECK_OK(asp_image_contact_sheet(many, 8, 0, &eight, NULL), (asp_error *)NULL);
+    CHECK(eight.width == 40 && eight.height == 12); /* 8 views: 4x2 */
+    asp_image_release(&eight);
+    asp_image five;
+    CHECK_OK(asp_image_contact_sheet(many, 5, 0, &five, NULL), (asp_error *)NULL);
+    CHECK(five.width == 30 && five.height == 12); /* 3x2 with one empty tile in the background colour */
+    CHECK(memcmp(five.pixels + 4 * (6 * 30 + 29), tiles[0].pixels, 4) == 0);
+    asp_image_release(&five);
     char path[256];
     snprintf(path, sizeof path, "/tmp/asp_test_sheet_%d.png", (int)getpid());
     CHECK_OK(asp_image_save_png(&sheet, path, NULL), (asp_error *)NULL);
