@@ -1,8 +1,10 @@
 /*
  * k-NN benchmark: our kd-tree (build + asp_knn_all) against FLANN's exact
  * single kd-tree (KDTreeSingleIndex through the C API) on the same points:
- * a uniform cube, a sphere surface and the Stanford bunny surface.
- * usage: bench_knn [points=1000000] [k=64] [threads=0] [runs=3]
+ * a uniform cube, a sphere surface and the Stanford bunny surface. Also times
+ * the per-query tree search alone (the fallback path) as an in-run baseline.
+ * usage: bench_knn [points=1000000] [k=64] [threads=0] [runs=3] [--no-flann]
+ *        [--no-baseline] [--sets=cube,sphere,bunny]
  */
 #include <math.h>
 #include <stdint.h>
@@ -11,6 +13,7 @@
 #include <string.h>
 
 #include "amgsplat/geom.h"
+#include "geom/kdtree_internal.h"
 
 #ifdef ASP_HAVE_FLANN
 #include <flann/flann.h>
@@ -123,14 +126,19 @@ static double median(double *t, int n)
 
 enum { MAX_RUNS = 9 };
 
-static void bench_set(const char *name, const float *p, size_t n, size_t k, int threads, int runs)
+typedef struct bench_opts {
+    size_t k;
+    int threads, runs, flann, baseline;
+} bench_opts;
+
+/* Median build and knn_all times of our tree; tuning NULL is the library default (asp_knn_all). */
+static void time_ours(const float *p, size_t n, const bench_opts *o, const asp__knn_tuning *tuning, asp_index *idx,
+                      float *d2, double *build_s, double *query_s)
 {
-    asp_context ctx = {.threads = threads};
-    asp_index *idx = malloc(n * k * sizeof(asp_index));
-    float *d2 = malloc(n * k * sizeof(float));
+    asp_context ctx = {.threads = o->threads};
     double tb[MAX_RUNS], tq[MAX_RUNS];
     asp_error err;
-    for (int r = 0; r < runs; r++) {
+    for (int r = 0; r < o->runs; r++) {
         asp_kdtree *t = NULL;
         double t0 = asp_time_now();
         if (asp_kdtree_create(p, n, 12, &ctx, &t, &err)) {
@@ -138,7 +146,9 @@ static void bench_set(const char *name, const float *p, size_t n, size_t k, int 
             exit(1);
         }
         double t1 = asp_time_now();
-        if (asp_knn_all(t, k, idx, d2, &ctx, &err)) {
+        int rc = tuning ? asp__knn_all_tuned(t, o->k, idx, d2, tuning, &ctx, &err)
+                        : asp_knn_all(t, o->k, idx, d2, &ctx, &err);
+        if (rc) {
             fprintf(stderr, "bench_knn: %s\n", err.msg);
             exit(1);
         }
@@ -147,46 +157,79 @@ static void bench_set(const char *name, const float *p, size_t n, size_t k, int 
         tq[r] = t2 - t1;
         asp_kdtree_destroy(t);
     }
-    double ob = median(tb, runs), oq = median(tq, runs);
-    printf("%-8s %9zu %4zu | ours  build %7.3f s  knn_all %7.3f s  total %7.3f s", name, n, k, ob, oq, ob + oq);
-#ifdef ASP_HAVE_FLANN
-    struct FLANNParameters fp = DEFAULT_FLANN_PARAMETERS;
-    fp.algorithm = FLANN_INDEX_KDTREE_SINGLE;
-    fp.leaf_max_size = 10;
-    fp.checks = FLANN_CHECKS_UNLIMITED;
-    fp.eps = 0.0f;
-    fp.cores = threads > 0 ? threads : asp_context_threads(NULL);
-    fp.log_level = FLANN_LOG_NONE;
-    size_t kf = k + 1; /* FLANN returns the query point itself first */
-    int *fi = malloc(n * kf * sizeof(int));
-    float *fd = malloc(n * kf * sizeof(float));
-    float *pm = malloc(n * 3 * sizeof(float));
-    memcpy(pm, p, n * 3 * sizeof(float));
-    for (int r = 0; r < runs; r++) {
-        float speedup = 0;
-        double t0 = asp_time_now();
-        flann_index_t fx = flann_build_index(pm, (int)n, 3, &speedup, &fp);
-        double t1 = asp_time_now();
-        flann_find_nearest_neighbors_index(fx, pm, (int)n, fi, fd, (int)kf, &fp);
-        double t2 = asp_time_now();
-        tb[r] = t1 - t0;
-        tq[r] = t2 - t1;
-        flann_free_index(fx, &fp);
+    *build_s = median(tb, o->runs);
+    *query_s = median(tq, o->runs);
+}
+
+static void print_row(const char *set, const char *impl, double b, double q, double ref_total, const char *note)
+{
+    printf("%-7s %-22s %8.3f %8.3f %8.3f", set, impl, b, q, b + q);
+    if (ref_total > 0)
+        printf(" %7.2fx", ref_total / (b + q));
+    else
+        printf(" %8s", "1.00x");
+    printf("  %s\n", note);
+}
+
+static void bench_set(const char *name, const float *p, size_t n, const bench_opts *o)
+{
+    const size_t k = o->k;
+    asp_index *idx = malloc(n * k * sizeof(asp_index));
+    float *d2 = malloc(n * k * sizeof(float));
+    double ob, oq;
+    time_ours(p, n, o, NULL, idx, d2, &ob, &oq);
+    print_row(name, "ours (grouped)", ob, oq, 0, "");
+    if (o->baseline) {
+        /* the per-query tree search alone: the previous algorithm, kept as the fallback path */
+        asp_index *bi = malloc(n * k * sizeof(asp_index));
+        float *bd = malloc(n * k * sizeof(float));
+        double bb, bq;
+        time_ours(p, n, o, &(asp__knn_tuning){.tree_only = 1}, bi, bd, &bb, &bq);
+        int same = memcmp(bi, idx, n * k * sizeof(asp_index)) == 0 && memcmp(bd, d2, n * k * sizeof(float)) == 0;
+        print_row(name, "ours (per-query tree)", bb, bq, ob + oq, same ? "identical output" : "OUTPUT DIFFERS");
+        free(bi);
+        free(bd);
     }
-    double fb = median(tb, runs), fq = median(tq, runs);
-    /* agreement: the sorted distance lists must match (indices may differ on ties) */
-    size_t bad = 0;
-    for (size_t i = 0; i < n; i += 97)
-        for (size_t j = 0; j < k; j++)
-            if (fabsf(fd[i * kf + j + 1] - d2[i * k + j]) > 1e-6f * (1.0f + d2[i * k + j]))
-                bad++;
-    printf(" | flann build %7.3f s  query %7.3f s  total %7.3f s | mismatching rows %zu\n", fb, fq, fb + fq,
-           bad);
-    free(fi);
-    free(fd);
-    free(pm);
-#else
-    printf(" | flann: not built\n");
+#ifdef ASP_HAVE_FLANN
+    if (o->flann) {
+        double tb[MAX_RUNS], tq[MAX_RUNS];
+        struct FLANNParameters fp = DEFAULT_FLANN_PARAMETERS;
+        fp.algorithm = FLANN_INDEX_KDTREE_SINGLE;
+        fp.leaf_max_size = 10;
+        fp.checks = FLANN_CHECKS_UNLIMITED;
+        fp.eps = 0.0f;
+        fp.cores = asp_context_threads(&(asp_context){.threads = o->threads});
+        fp.log_level = FLANN_LOG_NONE;
+        size_t kf = k + 1; /* FLANN returns the query point itself first */
+        int *fi = malloc(n * kf * sizeof(int));
+        float *fd = malloc(n * kf * sizeof(float));
+        float *pm = malloc(n * 3 * sizeof(float));
+        memcpy(pm, p, n * 3 * sizeof(float));
+        for (int r = 0; r < o->runs; r++) {
+            float speedup = 0;
+            double t0 = asp_time_now();
+            flann_index_t fx = flann_build_index(pm, (int)n, 3, &speedup, &fp);
+            double t1 = asp_time_now();
+            flann_find_nearest_neighbors_index(fx, pm, (int)n, fi, fd, (int)kf, &fp);
+            double t2 = asp_time_now();
+            tb[r] = t1 - t0;
+            tq[r] = t2 - t1;
+            flann_free_index(fx, &fp);
+        }
+        double fb = median(tb, o->runs), fq = median(tq, o->runs);
+        /* agreement: the sorted distance lists must match (indices may differ on ties) */
+        size_t bad = 0;
+        for (size_t i = 0; i < n; i += 97)
+            for (size_t j = 0; j < k; j++)
+                if (fabsf(fd[i * kf + j + 1] - d2[i * k + j]) > 1e-6f * (1.0f + d2[i * k + j]))
+                    bad++;
+        char note[64];
+        snprintf(note, sizeof note, "distances differ in %zu sampled entries", bad);
+        print_row(name, "FLANN kdtree_single", fb, fq, ob + oq, note);
+        free(fi);
+        free(fd);
+        free(pm);
+    }
 #endif
     fflush(stdout);
     free(idx);
@@ -195,24 +238,57 @@ static void bench_set(const char *name, const float *p, size_t n, size_t k, int 
 
 int main(int argc, char **argv)
 {
-    size_t n = argc > 1 ? strtoull(argv[1], NULL, 10) : 1000000;
-    size_t k = argc > 2 ? strtoull(argv[2], NULL, 10) : 64;
-    int threads = argc > 3 ? atoi(argv[3]) : 0;
-    int runs = argc > 4 ? atoi(argv[4]) : 3;
-    if (runs < 1 || runs > MAX_RUNS || n < 2 || k < 1 || k >= n) {
-        fprintf(stderr, "usage: bench_knn [points>=2] [1<=k<points] [threads] [runs 1..%d]\n", MAX_RUNS);
+    bench_opts o = {64, 0, 3, 1, 1};
+    size_t n = 1000000;
+    const char *sets = "cube,sphere,bunny";
+    int pos = 0;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--no-flann") == 0)
+            o.flann = 0;
+        else if (strcmp(argv[i], "--no-baseline") == 0)
+            o.baseline = 0;
+        else if (strncmp(argv[i], "--sets=", 7) == 0)
+            sets = argv[i] + 7;
+        else if (pos == 0 && ++pos)
+            n = strtoull(argv[i], NULL, 10);
+        else if (pos == 1 && ++pos)
+            o.k = strtoull(argv[i], NULL, 10);
+        else if (pos == 2 && ++pos)
+            o.threads = atoi(argv[i]);
+        else if (pos == 3 && ++pos)
+            o.runs = atoi(argv[i]);
+        else
+            o.runs = 0;
+    }
+    if (o.runs < 1 || o.runs > MAX_RUNS || n < 2 || o.k < 1 || o.k >= n) {
+        fprintf(stderr,
+                "usage: bench_knn [points>=2] [1<=k<points] [threads] [runs 1..%d] [--no-flann] [--no-baseline] "
+                "[--sets=cube,sphere,bunny]\n",
+                MAX_RUNS);
         return 2;
     }
-    printf("bench_knn: %zu points, k = %zu, %d threads, median of %d runs\n", n, k, asp_context_threads(&(asp_context){.threads = threads}), runs);
+    printf("bench_knn: %zu points, k = %zu, %d threads, median of %d runs (seconds; speed-up = ours total / row "
+           "total)\n",
+           n, o.k, asp_context_threads(&(asp_context){.threads = o.threads}), o.runs);
+#ifndef ASP_HAVE_FLANN
+    printf("FLANN: not found at build time, comparison skipped\n");
+#endif
+    printf("%-7s %-22s %8s %8s %8s %8s\n", "set", "implementation", "build", "query", "total", "speed-up");
     float *p = malloc(3 * n * sizeof(float));
-    make_cube(p, n);
-    bench_set("cube", p, n, k, threads, runs);
-    make_sphere(p, n);
-    bench_set("sphere", p, n, k, threads, runs);
-    if (make_obj_surface(ASP_TEST_DATA "/stanford-bunny.obj", p, n))
-        bench_set("bunny", p, n, k, threads, runs);
-    else
-        printf("bunny: %s not found, skipped\n", ASP_TEST_DATA "/stanford-bunny.obj");
+    if (strstr(sets, "cube")) {
+        make_cube(p, n);
+        bench_set("cube", p, n, &o);
+    }
+    if (strstr(sets, "sphere")) {
+        make_sphere(p, n);
+        bench_set("sphere", p, n, &o);
+    }
+    if (strstr(sets, "bunny")) {
+        if (make_obj_surface(ASP_TEST_DATA "/stanford-bunny.obj", p, n))
+            bench_set("bunny", p, n, &o);
+        else
+            printf("bunny: %s not found, skipped\n", ASP_TEST_DATA "/stanford-bunny.obj");
+    }
     free(p);
     return 0;
 }

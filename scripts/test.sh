@@ -12,8 +12,8 @@ cmake --build build -j "$jobs"
 
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DASP_SANITIZE=ON -DASP_BUILD_BENCH=OFF >/dev/null
 cmake --build build-asan -j "$jobs"
-# full unwinding on malloc so the OpenMPI suppressions in tests/lsan.supp match
-export ASAN_OPTIONS="detect_leaks=1:fast_unwind_on_malloc=0:strict_string_checks=1"
+# tests that start MPI get full unwinding from CMakeLists.txt (see there)
+export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
 (cd build-asan && ctest --output-on-failure -j "$jobs")

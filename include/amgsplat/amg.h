@@ -140,6 +140,8 @@ typedef struct asp_amg_desc {
     size_t max_coarse;       /* stop coarsening at this many unknowns (0 = 4) */
     double weak_coupling;    /* cut coarse couplings weaker than this times the median fine coupling (0 = off; see hierarchy.c) */
     double drop_tol;         /* basis entries below this are dropped and rows renormalised (0 = 1e-4, < 0 keeps all) */
+    double crease_cut;       /* cut coarse couplings whose interface classifier is below this times the smaller
+                                interior classifier of the two unknowns (0 = 0.25, < 0 = off; hierarchy.c) */
 } asp_amg_desc;
 
 /** Opaque decomposition: points, classifier and the AMG hierarchy. */
@@ -176,8 +178,23 @@ void asp_amg_destroy(asp_amg *amg);
 /** Finalises hypre and MPI if asp_amg_decompose initialised them; call once at exit. Idempotent. */
 void asp_amg_shutdown(void);
 
-/** The points (positions, origin, and normals = tangent-plane normals); valid until asp_amg_destroy. */
+/**
+ * The input point set, kept whole so that domain primitives can be built from
+ * a decomposition or an .amg file alone (thesis 2.6): positions with origin,
+ * normals, and the colours, radii, uvs and labels the input had (NULL when it
+ * had none). normals is never NULL: the input's normals when it had them
+ * (asp_amg_has_input_normals), else the unoriented tangent-plane normals.
+ * Extra properties, faces and comments are not kept. Valid until asp_amg_destroy.
+ */
 const asp_cloud *asp_amg_cloud(const asp_amg *amg);
+/**
+ * Tangent-plane normal per point (3 * count floats, unit, unoriented): the
+ * eigenvector of the smallest eigenvalue of the neighbourhood's M1 (journal
+ * 2.1), used for the fans. Valid until asp_amg_destroy.
+ */
+const float *asp_amg_tangent_normals(const asp_amg *amg);
+/** 1 if asp_amg_cloud(amg)->normals are the input's normals, 0 if they are the tangent-plane normals. */
+int asp_amg_has_input_normals(const asp_amg *amg);
 /** Classifier value per point (asp_amg_cloud(amg)->count); valid until asp_amg_destroy. */
 const float *asp_amg_classifier(const asp_amg *amg);
 /** Run statistics; the timings are zero for a loaded file. */
@@ -249,13 +266,17 @@ int asp_amg_level_stats_all(const asp_amg *amg, double tau, const asp_context *c
 
 /**
  * Writes the decomposition to path (atomically) in the versioned binary .amg
- * format (docs/cli/decompose.md): points, normals, classifier and the
- * prolongations, with a CRC-32. Returns 0, ASP_EIO.
+ * format, version 2 (docs/cli/decompose.md): the whole point set (positions,
+ * origin, normals, colours, radii, uvs, labels as present), tangent normals,
+ * classifier and the prolongations, with a CRC-32. Returns 0, ASP_EIO,
+ * ASP_EUNSUPPORTED (big-endian host).
  */
 int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err);
 
 /**
- * Reads a .amg file. Returns 0, ASP_EIO (cannot open/read), ASP_EFORMAT
+ * Reads a .amg file (version 2; version 1 files, which lack the point
+ * attributes, are refused with a message to decompose again). Returns 0,
+ * ASP_EIO (cannot open/read), ASP_EFORMAT
  * (not an .amg file, unsupported version, truncated, checksum mismatch,
  * inconsistent counts: the message names the file and what was expected),
  * ASP_ENOMEM. The caller frees *out with asp_amg_destroy.

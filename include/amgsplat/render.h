@@ -15,6 +15,7 @@
 #define AMGSPLAT_RENDER_H
 
 #include "cloud.h"
+#include "hier.h"
 #include "image.h"
 
 #ifdef __cplusplus
@@ -283,6 +284,243 @@ float asp_render_default_radius(const asp_cloud *cloud);
  * values); outputs are unchanged on failure.
  */
 int asp_render_bounding_sphere(const asp_cloud *cloud, float center[3], float *radius, asp_error *err);
+
+/* ------------------------------------------------------------------------ */
+/* Interactive viewer (GLFW window; amgsplat view)                          */
+/* ------------------------------------------------------------------------ */
+
+/** Flags for asp_viewer_desc.flags; 0 is the default. */
+enum asp_viewer_flags {
+    ASP_VIEWER_UNLIT = 1 << 0,  /* start with lighting off (the l key toggles it) */
+    ASP_VIEWER_VERBOSE = 1 << 1 /* log frame time and primitive count about once a second */
+};
+
+/**
+ * Receives one line of viewer output (no trailing newline): screenshot names,
+ * key help, the current view, renderer switches that failed, and with
+ * ASP_VIEWER_VERBOSE the frame statistics. Called on the viewer's thread.
+ */
+typedef void (*asp_viewer_log_fn)(void *user, const char *line);
+
+/** Options of asp_viewer_run; the zero value means defaults. */
+typedef struct asp_viewer_desc {
+    uint32_t width, height;  /* window client area, 1..16384; 0 = 1280 x 800 */
+    const char *renderer;    /* first renderer: a name of asp_viewer_renderer_name; NULL = "disc" */
+    float tolerance;         /* screen tolerance tau in pixels for renderers that take one, >= 0 */
+    int set_view;            /* nonzero: start at azimuth/elevation/distance below, else 30, 20, fitted */
+    float azimuth;           /* degrees (asp_camera conventions) */
+    float elevation;         /* degrees, -90..90 */
+    float distance;          /* eye distance in bounding-sphere radii; 0 = the sphere fills the view */
+    unsigned amg_color;      /* .amg input: first colour mode, an asp_amg_color_mode (amg.h; 0 = classifier),
+                                or 3 = the points' own colours (refused when they have none) */
+    const char *amg_level;   /* .amg input: first level, "L", "L-2" or an index; NULL = "L" */
+    uint8_t background[4];   /* sRGB; alpha 0 = default opaque white */
+    size_t frames;           /* 0 = interactive until closed; N = scripted: draw N frames, then return */
+    const char *screenshot;  /* scripted: PNG written from the last frame's back buffer; may be NULL */
+    const char *keys;        /* keys pressed one per frame from the first frame on, e.g. "]]l" (see docs/cli/view.md) */
+    unsigned flags;          /* asp_viewer_flags */
+    asp_viewer_log_fn log;   /* NULL = lines are dropped */
+    void *log_user;
+    const asp_context *ctx;  /* allocator and threads for loading and colouring; NULL = defaults */
+} asp_viewer_desc;
+
+/** What a viewer run did, for scripts (amgsplat view --json). */
+typedef struct asp_viewer_stats {
+    size_t frames;            /* frames drawn */
+    double mean_frame_ms;     /* mean time of asp_render_frame with ASP_RENDER_WAIT (drawing finished) */
+    double last_frame_ms;
+    size_t count;             /* primitives the renderer drew in the last frame */
+    char renderer[32];        /* renderer of the last frame */
+    uint32_t width, height;   /* framebuffer size of the last frame, pixels */
+    size_t screenshots;       /* PNG files written (the s key and desc->screenshot) */
+    char gl_renderer[128];    /* GL_RENDERER of the window's context */
+} asp_viewer_stats;
+
+/**
+ * Name of renderer kind i of the viewer ("disc", then "splat", "square" ...
+ * in the order the 1..9 keys pick them), or NULL when i is past the end. Every
+ * name listed is built in; a kind may still fail to draw a given input, in
+ * which case the viewer skips it. Thread safe.
+ */
+const char *asp_viewer_renderer_name(size_t i);
+
+/**
+ * Checks desc without opening anything: sizes, renderer name, tolerance,
+ * view, colour mode, keys (each must be a viewer key), and that screenshot
+ * ends in .png and is given only with frames > 0. Returns 0 or ASP_EINVAL
+ * naming the bad value, e.g. "unknown renderer 'x' (expected disc, splat)".
+ * Thread safe.
+ */
+int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err);
+
+/**
+ * Opens a window on path (.ply/.xyz/.pts/.txt points, or an .amg
+ * decomposition coloured by classifier or domains) and runs the viewer:
+ * orbit with the left mouse button, zoom with the wheel or the right button,
+ * pan with the middle button or shift + left; keys switch renderers, the
+ * tolerance, lighting, colour mode and level (docs/cli/view.md lists them).
+ * The window title shows the renderer, the primitive count and the frame time.
+ * Interactive (desc->frames == 0) it returns when the window is closed or q /
+ * Esc is pressed; scripted it draws desc->frames frames, pressing desc->keys
+ * one per frame, writes desc->screenshot from the last frame and returns.
+ *
+ * The file is loaded before the window opens, so a bad file fails without a
+ * display. Must run on the main thread; opens and closes GLFW itself (no other
+ * window context may be alive). stats may be NULL; it is filled on success.
+ * Returns 0; ASP_EINVAL (desc, as asp_viewer_desc_check; a level out of
+ * range); the loader's ASP_EIO / ASP_EFORMAT / ASP_EUNSUPPORTED naming the
+ * file; ASP_EDEGENERATE (nothing to frame); ASP_EGL (no display or no OpenGL
+ * 4.5: "no OpenGL 4.5 window: ..."); ASP_EIO (screenshot not written);
+ * ASP_ENOMEM. Everything is freed on return.
+ */
+int asp_viewer_run(const char *path, const asp_viewer_desc *desc, asp_viewer_stats *stats, asp_error *err);
+
+/* ------------------------------------------------------------------------ */
+/* Splat and square renderers on the point hierarchy (hier.h)               */
+/* ------------------------------------------------------------------------ */
+
+/** How the splat renderer lights its splats (asp_splat_renderer_desc.lighting). */
+typedef enum asp_splat_lighting {
+    /* Seed 001 section 5.2, Fig. 14: each splat triangle is lit at its three
+     * corners, whose normals are the splat normal tilted outwards by the
+     * node's normal-cone semi-angle (at most 60 degrees; 0 for input points),
+     * and the shade is interpolated across it (Gouraud). */
+    ASP_SPLAT_LIGHT_GOURAUD = 0,
+    /* The same corner normals interpolated per fragment, blended with the
+     * kernel like the colours, normalised and lit per pixel in the resolve
+     * pass (smooth across splats, one extra float target). */
+    ASP_SPLAT_LIGHT_PIXEL = 1,
+    /* One shade per splat from its normal. */
+    ASP_SPLAT_LIGHT_FLAT = 2
+} asp_splat_lighting;
+
+/** How splats are combined (asp_splat_renderer_desc.mode). */
+typedef enum asp_splat_mode {
+    /* Seed 001 section 5: epsilon-z-buffer visibility pass, additive blending
+     * of (psi * colour, psi), per-pixel normalisation. */
+    ASP_SPLAT_BLEND = 0,
+    /* Opaque ellipses with an exact depth test, no blending (QSplat-like, the
+     * cheap mode: one pass). */
+    ASP_SPLAT_OPAQUE = 1
+} asp_splat_mode;
+
+/** Flags for asp_splat_renderer_desc.flags and asp_square_renderer_desc.flags. */
+enum asp_splat_renderer_flags {
+    /* Drop subtrees whose normal cone faces away from the eye (seed 004
+     * 3.2.2). Off by default: points whose normal faces slightly away can
+     * still cover silhouette pixels. Ignored for unoriented hierarchies. */
+    ASP_SPLAT_CULL_BACKFACES = 1 << 0
+};
+
+/**
+ * Options of the splat renderer; the zero value means defaults.
+ *
+ * Kernel (seed 001 eq. 12): psi_E(r) = exp(-a (r / b)^n) where r is the
+ * position in the splat's ellipse in units of its semi-axes (r = 1 on the
+ * ellipse e_i, Fig. 11 with the axes as unit), cut off at r = min(b, 1): the
+ * ellipse is the splat's support (section 4.1) and b the kernel's own support
+ * radius as in Fig. 10. Deviation: Fig. 11 maps the ellipse rim to r = b, where
+ * b cancels out; b = 1 gives exactly that kernel, exp(-a r^n). With the
+ * defaults a = 6, b = 1.5, n = 3 (Fig. 18 b) the weight is 1 at the centre,
+ * 0.5 at r = 0.73 and 0.17 on the rim.
+ */
+typedef struct asp_splat_renderer_desc {
+    float kernel_a;          /* width: larger = narrower kernel; 0 = 6; else > 0 */
+    float kernel_b;          /* support radius in ellipse units; 0 = 1.5; else > 0 */
+    float kernel_n;          /* drop-off sharpness; 0 = 3; else > 0 */
+    float epsilon;           /* depth offset of the visibility pass (section 5.3, Fig. 15), along each
+                                eye ray, in units of each splat's major semi-axis; 0 = 1; < 0 = none */
+    float tolerance;         /* tau in pixels (asp_hier_view.tau): splats whose projected ellipse is smaller
+                                are drawn instead of their children; 0 = every visible input point */
+    float radius_scale;      /* multiplies every ellipse; 0 = 1 */
+    asp_splat_lighting lighting;
+    asp_splat_mode mode;
+    unsigned flags;          /* asp_splat_renderer_flags */
+    uint8_t default_color[4]; /* sRGB colour when the cloud has no colours; all 0 = light grey 200,200,200 */
+    asp_hier_desc hier;      /* hierarchy build options for asp_splat_renderer_create */
+    const asp_context *ctx;  /* threads and allocator of the hierarchy build; NULL = defaults */
+} asp_splat_renderer_desc;
+
+/**
+ * Builds the point hierarchy of cloud (asp_hier_build with desc->hier; the
+ * renderer owns it) and returns a renderer drawing, per frame, the
+ * view-dependent cut of the hierarchy for tau = desc->tolerance pixels (seed
+ * 001 section 5.1 step 1) as elliptical splats blended with the kernel
+ * psi_E (see asp_splat_renderer_desc): pass 1 writes the depth of the splats
+ * pushed back by epsilon along the eye rays, pass 2 adds (psi * colour, psi)
+ * of every splat within epsilon of the front surface into a float target,
+ * pass 3 divides by the weight (section 5.4) and writes the sRGB colour, with
+ * the background where no splat lies. Shading as asp_render_to_image (colour
+ * * (0.25 + 0.75 |n . l|), ASP_RENDER_UNLIT), with desc->lighting. Positions
+ * are in the cloud's local frame, as for the disc renderer; cloud is only read
+ * during the call. asp_renderer_count gives the splats drawn in the last
+ * frame (before the first frame: the number of input points). Makes gl current.
+ * Returns 0; ASP_EINVAL (a negative or non-finite option); the errors of
+ * asp_hier_build (ASP_EDEGENERATE for an empty cloud, ASP_EINVAL for
+ * non-finite values); ASP_EUNSUPPORTED (more than 2^31 - 1 splats); ASP_EGL;
+ * ASP_ENOMEM. *out is unchanged on failure; free it with asp_renderer_destroy.
+ */
+int asp_splat_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_splat_renderer_desc *desc,
+                              asp_renderer **out, asp_error *err);
+
+/**
+ * Like asp_splat_renderer_create on an existing hierarchy, which the renderer
+ * keeps a reference to: hier must outlive it (desc->hier and desc->ctx are
+ * not used). Colours come from the splats when the hierarchy has them
+ * (ASP_HIER_HAS_COLORS), else desc->default_color.
+ */
+int asp_splat_renderer_create_hier(asp_gl_context *gl, const asp_hier *hier, const asp_splat_renderer_desc *desc,
+                                   asp_renderer **out, asp_error *err);
+
+/** Options of the square renderer; the zero value means defaults. */
+typedef struct asp_square_renderer_desc {
+    float point_size;        /* side of every square in pixels; 0 = each splat's projected ellipse diameter
+                                (2 a, so the square covers the ellipse); at most the GL point size limit */
+    float tolerance;         /* tau in pixels, as asp_splat_renderer_desc.tolerance */
+    float radius_scale;      /* multiplies the projected size; 0 = 1 */
+    unsigned flags;          /* asp_splat_renderer_flags */
+    uint8_t default_color[4]; /* as asp_splat_renderer_desc */
+    asp_hier_desc hier;      /* hierarchy build options for asp_square_renderer_create */
+    const asp_context *ctx;  /* threads and allocator of the hierarchy build; NULL = defaults */
+} asp_square_renderer_desc;
+
+/**
+ * Builds the hierarchy of cloud (owned by the renderer) and returns a renderer
+ * drawing each splat of the per-frame cut as one opaque, depth-tested,
+ * screen-aligned square of the GL point primitive (seed 004 3.2.6, the
+ * "rectangular point-representations used by graphics hardware"), flat-shaded
+ * by the splat normal, sized by its projected ellipse (seed 004 3.2.3) or
+ * desc->point_size. The cheapest mode: one vertex per splat, no per-fragment
+ * work. Same frame, count and errors as asp_splat_renderer_create.
+ */
+int asp_square_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_square_renderer_desc *desc,
+                               asp_renderer **out, asp_error *err);
+
+/** Like asp_square_renderer_create on an existing hierarchy, which must outlive the renderer. */
+int asp_square_renderer_create_hier(asp_gl_context *gl, const asp_hier *hier, const asp_square_renderer_desc *desc,
+                                    asp_renderer **out, asp_error *err);
+
+/**
+ * Sets the screen tolerance tau (pixels, >= 0) and the depth limit (0 = none;
+ * see asp_hier_view.depth_limit) of a splat or square renderer for the
+ * following frames, e.g. from asp_hier_adapt. Returns 0; ASP_EINVAL for a
+ * negative or NaN tau; ASP_EUNSUPPORTED for a renderer without a hierarchy
+ * (disc), naming it. No GL calls; same thread rules as the renderer.
+ */
+int asp_renderer_set_lod(asp_renderer *r, float tolerance, uint32_t depth_limit, asp_error *err);
+
+/** Figures of a renderer's last frame (asp_renderer_stats). */
+typedef struct asp_renderer_stats {
+    size_t count;          /* primitives drawn in the last frame (= asp_renderer_count) */
+    size_t points;         /* input points (the leaves' points) */
+    size_t nodes;          /* hierarchy nodes; 0 for renderers without one */
+    float tolerance;       /* tau of the last frame; 0 without a hierarchy */
+    uint32_t depth_limit;  /* depth limit of the last frame; 0 = none */
+    double select_seconds; /* CPU time of the last cut (asp_hier_select) and its upload */
+} asp_renderer_stats;
+
+/** Fills *out for any renderer (disc: count = points, the rest 0). Thread rules of the renderer. */
+void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out);
 
 #ifdef __cplusplus
 }

@@ -1,8 +1,9 @@
 /*
- * The .amg file (docs/cli/decompose.md): points, tangent normals, classifier
- * (journal 2.1) and the prolongations P^l of the hierarchy (journal 2.3), from
- * which any level's basis is one chain of sparse products. Versioned,
- * little-endian, with a CRC-32 over everything before it.
+ * The .amg file (docs/cli/decompose.md): the whole input point set, tangent
+ * normals, classifier (journal 2.1) and the prolongations P^l of the hierarchy
+ * (journal 2.3), from which any level's basis is one chain of sparse products
+ * (the thesis stores the AMG output and constructs only the chosen basis, 2.6).
+ * Versioned, little-endian, with a CRC-32 over everything before it.
  */
 #include <errno.h>
 #include <math.h>
@@ -14,7 +15,25 @@
 #include "util/banned.h"
 
 #define AMG_MAGIC "ASPAMG\r\n"
-enum { AMG_VERSION = 1, AMG_HEADER = 64, AMG_OPTIONS = 128 };
+enum { AMG_VERSION = 2, AMG_HEADER = 64, AMG_OPTIONS = 128 };
+/* point attributes a version-2 file may carry after the classifier */
+static const unsigned amg_attrs = ASP_ATTR_NORMALS | ASP_ATTR_COLORS | ASP_ATTR_RADII | ASP_ATTR_UVS | ASP_ATTR_LABELS;
+
+/* Bytes per point of the optional attributes in attrs. */
+static uint64_t attr_bytes(unsigned attrs)
+{
+    return (attrs & ASP_ATTR_NORMALS ? 12u : 0u) + (attrs & ASP_ATTR_COLORS ? 4u : 0u) +
+           (attrs & ASP_ATTR_RADII ? 4u : 0u) + (attrs & ASP_ATTR_UVS ? 8u : 0u) + (attrs & ASP_ATTR_LABELS ? 4u : 0u);
+}
+
+/* Attributes the file stores: the input's normals only when they differ from the tangent normals. */
+static unsigned stored_attrs(const asp_amg *amg)
+{
+    unsigned a = asp_cloud_attrs(amg->cloud) & amg_attrs;
+    if (!amg->input_normals)
+        a &= ~(unsigned)ASP_ATTR_NORMALS;
+    return a;
+}
 
 /* CRC-32 (IEEE 802.3, reflected 0xEDB88320); the table lives on the caller's stack, no global state. */
 static void crc_table(uint32_t t[256])
@@ -64,7 +83,8 @@ static void put_f64(writer *w, double v) { put(w, &v, 8); }
 
 static uint64_t payload_size(const asp_amg *amg)
 {
-    uint64_t n = amg->cloud->count, s = 7 * 4 * n + AMG_OPTIONS + 8 * (uint64_t)amg->nlevels;
+    uint64_t n = amg->cloud->count;
+    uint64_t s = 7 * 4 * n + 8 + attr_bytes(stored_attrs(amg)) * n + AMG_OPTIONS + 8 * (uint64_t)amg->nlevels;
     for (size_t l = 1; l < amg->nlevels; l++) {
         const asp_amg_csr *p = amg->prolong[l];
         s += 8 + 8 * ((uint64_t)p->rows + 1) + 12 * (uint64_t)p->row_ptr[p->rows];
@@ -93,8 +113,23 @@ int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err)
     for (int a = 0; a < 3; a++)
         put_f64(&w, amg->cloud->origin[a]);
     put(&w, amg->cloud->positions, 3 * n * sizeof(float));
-    put(&w, amg->cloud->normals, 3 * n * sizeof(float));
+    put(&w, amg->tangent, 3 * n * sizeof(float));
     put(&w, amg->classifier, n * sizeof(float));
+    /* the input's attributes (version 2): a bit set, then one array per bit in this order */
+    const unsigned attrs = stored_attrs(amg);
+    const asp_cloud *c = amg->cloud;
+    put_u32(&w, attrs);
+    put_u32(&w, 0);
+    if (attrs & ASP_ATTR_NORMALS)
+        put(&w, c->normals, 3 * n * sizeof(float));
+    if (attrs & ASP_ATTR_COLORS)
+        put(&w, c->colors, 4 * n);
+    if (attrs & ASP_ATTR_RADII)
+        put(&w, c->radii, n * sizeof(float));
+    if (attrs & ASP_ATTR_UVS)
+        put(&w, c->uvs, 2 * n * sizeof(float));
+    if (attrs & ASP_ATTR_LABELS)
+        put(&w, c->labels, n * sizeof(uint32_t));
     /* options block: 128 bytes, what produced the hierarchy */
     const asp_amg_desc *d = &amg->desc;
     put_f64(&w, d->epsilon);
@@ -113,8 +148,8 @@ int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err)
     put_u64(&w, d->max_levels);
     put_u64(&w, d->max_coarse);
     put_f64(&w, d->weak_coupling);
+    put_f64(&w, d->crease_cut);
     put_u64(&w, 0); /* reserved */
-    put_u64(&w, 0);
     for (size_t l = 0; l < amg->nlevels; l++)
         put_u64(&w, amg->level_size[l]);
     for (size_t l = 1; l < amg->nlevels; l++) {
@@ -203,6 +238,10 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': not an .amg file (bad magic)", r->path);
     take(r, &version, 4, "the header");
     take(r, &header, 4, "the header");
+    if (version == 1)
+        return asp_error_set(r->err, ASP_EFORMAT,
+                             "cannot read '%s': .amg version 1 lacks the point attributes; decompose the input again "
+                             "(version %d)", r->path, AMG_VERSION);
     if (version != AMG_VERSION)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': .amg version %u, expected %d", r->path,
                              (unsigned)version, AMG_VERSION);
@@ -226,23 +265,55 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
         return bad(r, "point count does not fit the file");
     if (nlevels < 1 || nlevels > 100)
         return bad(r, "level count outside 1..100");
-    if ((rc = asp_cloud_create((size_t)n, ASP_ATTR_NORMALS, ctx, &a->cloud, r->err)) != 0)
+    /* the attribute bit set sits after the fixed per-point arrays; read it first to size the cloud */
+    uint32_t attrs = 0;
+    r->at = AMG_HEADER + 28 * (size_t)n;
+    if ((rc = take(r, &attrs, 4, "the attribute set")) != 0)
+        return rc;
+    if (attrs & ~(uint32_t)amg_attrs)
+        return bad(r, "unknown point attribute bits");
+    if (payload < 28 * n + 8 + attr_bytes(attrs) * n)
+        return bad(r, "point attributes do not fit the file");
+    r->at = AMG_HEADER;
+    if ((rc = asp_cloud_create((size_t)n, ASP_ATTR_NORMALS | attrs, ctx, &a->cloud, r->err)) != 0)
         return rc;
     memcpy(a->cloud->origin, origin, sizeof origin);
+    a->input_normals = (attrs & ASP_ATTR_NORMALS) != 0;
     a->classifier = asp_alloc(ctx, (size_t)n * sizeof(float));
+    a->tangent = asp_alloc(ctx, 12 * (size_t)n);
     a->level_size = asp_calloc(ctx, (size_t)nlevels, sizeof *a->level_size);
     a->prolong = asp_calloc(ctx, (size_t)nlevels, sizeof *a->prolong);
     a->nlevels = (size_t)nlevels;
-    if (!a->classifier || !a->level_size || !a->prolong)
+    if (!a->classifier || !a->tangent || !a->level_size || !a->prolong)
         return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory", r->path);
-    if ((rc = take(r, a->cloud->positions, 12 * (size_t)n, "positions")) ||
-        (rc = take(r, a->cloud->normals, 12 * (size_t)n, "normals")) ||
-        (rc = take(r, a->classifier, 4 * (size_t)n, "classifier values")))
+    asp_cloud *c = a->cloud;
+    if ((rc = take(r, c->positions, 12 * (size_t)n, "positions")) ||
+        (rc = take(r, a->tangent, 12 * (size_t)n, "tangent normals")) ||
+        (rc = take(r, a->classifier, 4 * (size_t)n, "classifier values")) ||
+        (rc = take(r, u32, 8, "the attribute set")))
         return rc;
-    for (size_t i = 0; i < 3 * (size_t)n; i++)
-        if (!isfinite(a->cloud->positions[i]))
-            return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': point %zu: non-finite coordinate", r->path,
-                                 i / 3);
+    if (attrs & ASP_ATTR_NORMALS)
+        rc = take(r, c->normals, 12 * (size_t)n, "normals");
+    else
+        memcpy(c->normals, a->tangent, 12 * (size_t)n);
+    if (!rc && (attrs & ASP_ATTR_COLORS))
+        rc = take(r, c->colors, 4 * (size_t)n, "colors");
+    if (!rc && (attrs & ASP_ATTR_RADII))
+        rc = take(r, c->radii, 4 * (size_t)n, "radii");
+    if (!rc && (attrs & ASP_ATTR_UVS))
+        rc = take(r, c->uvs, 8 * (size_t)n, "uvs");
+    if (!rc && (attrs & ASP_ATTR_LABELS))
+        rc = take(r, c->labels, 4 * (size_t)n, "labels");
+    if (rc)
+        return rc;
+    asp_error verr;
+    if (asp_cloud_validate(c, &verr) != 0)
+        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': %s", r->path, verr.msg);
+    for (size_t i = 0; i < (size_t)n; i++)
+        if (!isfinite(a->tangent[3 * i]) || !isfinite(a->tangent[3 * i + 1]) || !isfinite(a->tangent[3 * i + 2]) ||
+            !isfinite(a->classifier[i]))
+            return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': point %zu: non-finite tangent normal or classifier",
+                                 r->path, i);
     asp_amg_desc *d = &a->desc;
     take(r, &d->epsilon, 8, "options");
     take(r, &u64, 8, "options");
@@ -266,7 +337,7 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
     d->max_levels = (size_t)u64;
     take(r, &u64, 8, "options");
     d->max_coarse = (size_t)u64;
-    if ((rc = take(r, &d->weak_coupling, 8, "options")) || (rc = take(r, &u64, 8, "options")) ||
+    if ((rc = take(r, &d->weak_coupling, 8, "options")) || (rc = take(r, &d->crease_cut, 8, "options")) ||
         (rc = take(r, &u64, 8, "options")))
         return rc;
     if (!(d->drop_tol < 0.01))

@@ -30,6 +30,7 @@ void asp_amg_destroy(asp_amg *amg)
     asp_context ctx = amg->ctx;
     asp_cloud_destroy(amg->cloud);
     asp_free(&ctx, amg->classifier);
+    asp_free(&ctx, amg->tangent);
     asp_amg_csr_destroy(amg->matrix);
     if (amg->prolong)
         for (size_t l = 0; l < amg->nlevels; l++)
@@ -41,6 +42,8 @@ void asp_amg_destroy(asp_amg *amg)
 
 const asp_cloud *asp_amg_cloud(const asp_amg *amg) { return amg->cloud; }
 const float *asp_amg_classifier(const asp_amg *amg) { return amg->classifier; }
+const float *asp_amg_tangent_normals(const asp_amg *amg) { return amg->tangent; }
+int asp_amg_has_input_normals(const asp_amg *amg) { return amg->input_normals; }
 const asp_amg_info *asp_amg_get_info(const asp_amg *amg) { return &amg->info; }
 const asp_amg_csr *asp_amg_matrix(const asp_amg *amg) { return amg->matrix; }
 size_t asp_amg_level_count(const asp_amg *amg) { return amg->nlevels; }
@@ -108,6 +111,38 @@ static int check_cloud(const asp_cloud *cloud, asp_error *err)
     return 0;
 }
 
+/*
+ * The decomposition keeps the whole input point set, so domain primitives can
+ * be built from an .amg alone (thesis 2.6: the AMG output is stored and only
+ * the chosen basis is constructed). Extra properties, faces and comments are
+ * not kept: they do not take part in the primitives.
+ */
+static int copy_points(const asp_cloud *in, const asp_context *ctx, asp_cloud **out, asp_error *err)
+{
+    const unsigned keep = ASP_ATTR_COLORS | ASP_ATTR_RADII | ASP_ATTR_UVS | ASP_ATTR_LABELS;
+    const size_t n = in->count;
+    asp_cloud *c;
+    int rc = asp_cloud_create(n, ASP_ATTR_NORMALS | (asp_cloud_attrs(in) & keep), ctx, &c, err);
+    if (rc)
+        return rc;
+    memcpy(c->origin, in->origin, sizeof in->origin);
+    memcpy(c->positions, in->positions, 3 * n * sizeof(float));
+    if (in->normals)
+        memcpy(c->normals, in->normals, 3 * n * sizeof(float));
+    if (in->colors)
+        memcpy(c->colors, in->colors, 4 * n);
+    if (in->radii)
+        memcpy(c->radii, in->radii, n * sizeof(float));
+    if (in->uvs)
+        memcpy(c->uvs, in->uvs, 2 * n * sizeof(float));
+    if (in->labels)
+        memcpy(c->labels, in->labels, n * sizeof(uint32_t));
+    c->position_type = in->position_type;
+    c->color_type = in->color_type;
+    *out = c;
+    return 0;
+}
+
 static int stage(const asp_context *ctx, const char *name, double f, asp_error *err)
 {
     int rc = asp_progress(ctx, name, f);
@@ -135,16 +170,16 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
     asp_amg *a = NULL;
     asp__amg_nbhd nb = {0, 0, NULL, NULL};
     asp__amg_fans fans = {0, 0, NULL, NULL};
-    asp_amg_csr **p = NULL;
+    asp_amg_csr **p = NULL, *flat = NULL;
     size_t nlevels = 0;
     if ((rc = asp__amg_alloc(ctx, &a, err)) != 0)
         return rc;
-    if ((rc = asp_cloud_create(n, ASP_ATTR_NORMALS, ctx, &a->cloud, err)) != 0)
+    if ((rc = copy_points(cloud, ctx, &a->cloud, err)) != 0)
         goto fail;
-    memcpy(a->cloud->positions, cloud->positions, 3 * n * sizeof(float));
-    memcpy(a->cloud->origin, cloud->origin, sizeof cloud->origin);
+    a->input_normals = cloud->normals != NULL;
     a->classifier = asp_alloc(ctx, n * sizeof *a->classifier);
-    if (!a->classifier) {
+    a->tangent = asp_alloc(ctx, 3 * n * sizeof *a->tangent);
+    if (!a->classifier || !a->tangent) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the classifier of %zu points", n);
         goto fail;
     }
@@ -161,15 +196,17 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
     t = t1;
     if ((rc = stage(ctx, "classifier", 0, err)) != 0)
         goto fail;
-    rc = asp__amg_classify(pos, &nb, &d, ctx, a->classifier, a->cloud->normals, err);
+    rc = asp__amg_classify(pos, &nb, &d, ctx, a->classifier, a->tangent, err);
     if (rc)
         goto fail;
+    if (!a->input_normals)
+        memcpy(a->cloud->normals, a->tangent, 3 * n * sizeof *a->tangent);
     t1 = asp_time_now();
     a->info.t_classifier = t1 - t;
     t = t1;
     if ((rc = stage(ctx, "fans", 0, err)) != 0)
         goto fail;
-    rc = asp__amg_build_fans(pos, a->cloud->normals, &nb, d.fan_k, ctx, &fans, err);
+    rc = asp__amg_build_fans(pos, a->tangent, &nb, d.fan_k, ctx, &fans, err);
     if (rc)
         goto fail;
     asp__amg_nbhd_release(ctx, &nb);
@@ -185,6 +222,21 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
     rc = asp__amg_assemble(pos, a->classifier, &fans, ctx, &a->matrix, &a->info.positive_offdiag, err);
     if (rc)
         goto fail;
+    if (d.crease_cut > 0) {
+        /* the same fans with C = 1: the reference the crease test compares coarse couplings with (hierarchy.c) */
+        float *ones = asp_alloc(ctx, n * sizeof *ones);
+        size_t unused = 0;
+        if (!ones) {
+            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the stiffness matrix of %zu points", n);
+            goto fail;
+        }
+        for (size_t i = 0; i < n; i++)
+            ones[i] = 1.0f;
+        rc = asp__amg_assemble(pos, ones, &fans, ctx, &flat, &unused, err);
+        asp_free(ctx, ones);
+        if (rc)
+            goto fail;
+    }
     asp__amg_fans_release(ctx, &fans);
     a->info.matrix_nnz = a->matrix->row_ptr[n];
     for (size_t i = 0; i < n; i++)
@@ -199,7 +251,10 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
     t = t1;
     if ((rc = stage(ctx, "amg", 0, err)) != 0)
         goto fail;
-    rc = asp__amg_build_hierarchy(a->matrix, &d, ctx, &nlevels, &p, &a->level_size, &a->info.repaired_rows, err);
+    rc = asp__amg_build_hierarchy(a->matrix, flat, a->classifier, &d, ctx, &nlevels, &p, &a->level_size,
+                                  &a->info.repaired_rows, err);
+    asp_amg_csr_destroy(flat);
+    flat = NULL;
     if (rc)
         goto fail;
     a->prolong = p;
@@ -213,6 +268,7 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
     *out = a;
     return 0;
 fail:
+    asp_amg_csr_destroy(flat);
     asp__amg_nbhd_release(ctx, &nb);
     asp__amg_fans_release(ctx, &fans);
     asp_amg_destroy(a);

@@ -9,7 +9,9 @@
 
 struct asp_amg {
     asp_context ctx;
-    asp_cloud *cloud;      /* positions, origin, tangent normals */
+    asp_cloud *cloud;      /* the input points: positions, origin, normals (input's, else tangent), colors, radii, uvs, labels */
+    float *tangent;        /* 3 * count tangent-plane normals (journal 2.1, Fig. 3a) */
+    int input_normals;     /* cloud->normals came from the input (else they alias the tangent normals' values) */
     float *classifier;     /* count */
     asp_amg_csr *matrix;   /* A^0; NULL after load */
     size_t nlevels;        /* L + 1 */
@@ -54,8 +56,17 @@ int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const
                            asp_amg_csr **p, asp_amg_csr **ac, asp_error *err);
 
 /* The hierarchy level by level (hierarchy.c): p[1..nlevels-1], sizes[0..nlevels-1]; arrays sized max_levels. */
-int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_desc *desc, const asp_context *ctx,
-                             size_t *nlevels, asp_amg_csr ***p, size_t **sizes, size_t *repaired, asp_error *err);
+/*
+ * f0 (may be NULL) is the stiffness matrix of the same fans with C = 1 and cls the classifier: with
+ * desc->crease_cut > 0 they drive the crease test that keeps coarse unknowns from merging across creases.
+ */
+int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const float *cls,
+                             const asp_amg_desc *desc, const asp_context *ctx, size_t *nlevels, asp_amg_csr ***p,
+                             size_t **sizes, size_t *repaired, asp_error *err);
+
+/* Galerkin product P^T F P (p: n x nc, f: n x n), rows sorted by column. */
+int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_context *ctx, asp_amg_csr **out,
+                      asp_error *err);
 
 /* Sparse product c = a * b with entries < drop dropped and rows renormalised to sum 1. */
 int asp__amg_spgemm_pou(const asp_amg_csr *a, const asp_amg_csr *b, double drop, const asp_context *ctx,

@@ -45,6 +45,10 @@ int asp__amg_resolve_desc(const asp_amg_desc *in, size_t count, asp_amg_desc *ou
         d.max_coarse = 4;
     if (d.drop_tol == 0)
         d.drop_tol = 1e-4;
+    if (d.crease_cut == 0)
+        d.crease_cut = 0.25; /* by experiment, docs/cli/decompose.md */
+    else if (d.crease_cut < 0)
+        d.crease_cut = -1; /* off */
     if (d.k_min < 3 || d.k_max < d.k_min || d.k_max > 1024)
         return asp_error_set(err, ASP_EINVAL, "invalid neighbourhood sizes k_min %zu, k_max %zu: expected 3 <= k_min <= k_max <= 1024",
                              d.k_min, d.k_max);
@@ -69,6 +73,9 @@ int asp__amg_resolve_desc(const asp_amg_desc *in, size_t count, asp_amg_desc *ou
     if (!(d.weak_coupling >= 0 && d.weak_coupling < 1))
         return asp_error_set(err, ASP_EINVAL, "invalid weak-coupling cut %g: expected a value in [0, 1)",
                              d.weak_coupling);
+    if (!(d.crease_cut <= 1) || !isfinite(d.crease_cut))
+        return asp_error_set(err, ASP_EINVAL, "invalid crease cut %g: expected a value <= 1 (negative: off)",
+                             d.crease_cut);
     if (!(d.drop_tol < 0.01) || d.drop_tol != d.drop_tol)
         return asp_error_set(err, ASP_EINVAL, "invalid drop tolerance %g: expected a value below 0.01", d.drop_tol);
     /* small clouds: every other point is a neighbour */

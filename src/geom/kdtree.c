@@ -21,6 +21,7 @@ typedef struct kd_item {
 typedef struct kd_build {
     kd_item *items;
     asp__kd_node *nodes;
+    float *box;
     size_t node_count;
     size_t node_cap;
 } kd_build;
@@ -111,6 +112,8 @@ static uint32_t build_node(kd_build *b, uint32_t begin, uint32_t end)
             axis = a;
         }
     }
+    memcpy(b->box + 6 * (size_t)id, lo, sizeof lo);
+    memcpy(b->box + 6 * (size_t)id + 3, hi, sizeof hi);
     nd->begin = begin;
     nd->end = end;
     nd->min_index = min_index;
@@ -168,7 +171,9 @@ int asp_kdtree_create(const float *positions, size_t count, size_t stride_bytes,
     asp__kd_node *nodes = asp_calloc(&c, cap, sizeof(asp__kd_node));
     float *xyz = asp_calloc(&c, count, 3 * sizeof(float));
     asp_index *perm = asp_calloc(&c, count, sizeof(asp_index));
-    if (!t || !items || !nodes || !xyz || !perm) {
+    float *box = asp_alloc(&c, cap * 6 * sizeof(float));
+    if (!t || !items || !nodes || !xyz || !perm || !box) {
+        asp_free(&c, box);
         asp_free(&c, t);
         asp_free(&c, items);
         asp_free(&c, nodes);
@@ -180,7 +185,7 @@ int asp_kdtree_create(const float *positions, size_t count, size_t stride_bytes,
         const float *p = positions + i * stride;
         items[i] = (kd_item){{p[0], p[1], p[2]}, (uint32_t)i};
     }
-    kd_build b = {items, nodes, 0, cap};
+    kd_build b = {items, nodes, box, 0, cap};
     build_node(&b, 0, (uint32_t)count);
     for (size_t i = 0; i < count; i++) {
         memcpy(xyz + 3 * i, items[i].p, 3 * sizeof(float));
@@ -193,6 +198,7 @@ int asp_kdtree_create(const float *positions, size_t count, size_t stride_bytes,
     t->xyz = xyz;
     t->perm = perm;
     t->nodes = nodes;
+    t->box = box;
     t->node_count = b.node_count;
     *out = t;
     return 0;
@@ -206,6 +212,7 @@ void asp_kdtree_destroy(asp_kdtree *tree)
     asp_free(&c, tree->xyz);
     asp_free(&c, tree->perm);
     asp_free(&c, tree->nodes);
+    asp_free(&c, tree->box);
     asp_free(&c, tree);
 }
 
@@ -330,9 +337,7 @@ typedef struct kn_search {
 
 static inline uint64_t make_key(float d, asp_index i)
 {
-    uint32_t bits;
-    memcpy(&bits, &d, sizeof bits);
-    return (uint64_t)bits << 32 | i;
+    return asp__kd_key(d, i);
 }
 
 static inline void swap_keys(uint64_t *a, uint64_t *b)
@@ -347,7 +352,7 @@ static inline void swap_keys(uint64_t *a, uint64_t *b)
  * sorted position with smaller keys before it (keys are distinct). Candidate
  * distances are random, so a branchy partition mispredicts half its compares.
  */
-static void select_keys(uint64_t *v, size_t n, size_t nth)
+void asp__kd_select_keys(uint64_t *v, size_t n, size_t nth)
 {
     size_t lo = 0, hi = n; /* [lo, hi) */
     while (hi - lo > 1) {
@@ -374,13 +379,13 @@ static void select_keys(uint64_t *v, size_t n, size_t nth)
     }
 }
 
-static void sort_keys(uint64_t *v, size_t n)
+void asp__kd_sort_keys(uint64_t *v, size_t n)
 {
     while (n > 16) {
         size_t m = n / 2;
-        select_keys(v, n, m);
+        asp__kd_select_keys(v, n, m);
         /* recurse into the smaller half, loop on the larger */
-        sort_keys(v, m);
+        asp__kd_sort_keys(v, m);
         v += m + 1;
         n -= m + 1;
     }
@@ -404,7 +409,7 @@ static void kn_settle(kn_search *s)
         s->bound = mx + 1;
     }
     if (s->n >= 2 * s->k) {
-        select_keys(s->buf, s->n, s->k - 1);
+        asp__kd_select_keys(s->buf, s->n, s->k - 1);
         s->n = s->k;
         s->bound = s->buf[s->k - 1];
     }
@@ -478,10 +483,10 @@ size_t asp__kdtree_search(const asp_kdtree *tree, const float q[3], size_t k, ui
     kn_rec(&s, 0, off);
     size_t m = s.n;
     if (m > k) {
-        select_keys(scratch, m, k - 1);
+        asp__kd_select_keys(scratch, m, k - 1);
         m = k;
     }
-    sort_keys(scratch, m);
+    asp__kd_sort_keys(scratch, m);
     for (size_t j = 0; j < m; j++) {
         idx[j] = (asp_index)(scratch[j] & 0xffffffffu);
         if (d) {

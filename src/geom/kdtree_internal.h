@@ -5,6 +5,8 @@
 #ifndef ASP_GEOM_KDTREE_INTERNAL_H
 #define ASP_GEOM_KDTREE_INTERNAL_H
 
+#include <string.h>
+
 #include "amgsplat/geom.h"
 
 /*
@@ -32,8 +34,22 @@ struct asp_kdtree {
     float *xyz;          /* 3 * count, in leaf order (slot order) */
     asp_index *perm;     /* slot -> original index */
     asp__kd_node *nodes; /* preorder, root at 0 */
+    float *box;          /* 6 per node: tight bounding box lo[3], hi[3] of the subtree's points */
     size_t node_count;
 };
+
+/* Candidate key: squared distance bits << 32 | original index (see kdtree.c). */
+static inline uint64_t asp__kd_key(float d, asp_index i)
+{
+    uint32_t bits;
+    memcpy(&bits, &d, sizeof bits);
+    return (uint64_t)bits << 32 | i;
+}
+
+/* Partial sort of distinct keys: afterwards v[nth] is in sorted position, smaller keys before it. */
+void asp__kd_select_keys(uint64_t *v, size_t n, size_t nth);
+/* Ascending sort of distinct keys. */
+void asp__kd_sort_keys(uint64_t *v, size_t n);
 
 /*
  * Exact k nearest neighbours of q, skipping slot exclude (UINT32_MAX for none).
@@ -61,5 +77,21 @@ int asp__check_spread(const float *positions, size_t count, size_t stride_bytes,
  */
 int asp__knn_graph(const float *positions, size_t count, size_t stride_bytes, size_t k, asp_index **idx,
                    float **dist2, const asp_context *ctx, asp_error *err);
+
+/*
+ * Tuning of asp_knn_all, exposed so tests can force every code path; the zero
+ * value means the defaults. group_max: queries answered together share one
+ * candidate list (subtrees of at most this many points). cand_max: candidate
+ * points a group may gather before it falls back to one tree search per query
+ * (1 forces the fallback). tree_only: skip the grouped path entirely.
+ */
+typedef struct asp__knn_tuning {
+    size_t group_max;
+    size_t cand_max;
+    int tree_only;
+} asp__knn_tuning;
+
+int asp__knn_all_tuned(const asp_kdtree *tree, size_t k, asp_index *idx, float *dist2, const asp__knn_tuning *tuning,
+                       const asp_context *ctx, asp_error *err);
 
 #endif

@@ -1,6 +1,6 @@
 # Every subcommand answers -h and 'amgsplat help CMD' with its usage; unknown commands fail with 2.
 source "$(dirname "$0")/common.sh"
-cmds=$("$AMGSPLAT" help | awk '/^commands:/{f=1;next} f&&NF>1{print $1}')
+cmds=$("$AMGSPLAT" help | awk '/^commands:/{f=1;next} f&&/^ /{print $1} f&&/^$/{exit}')
 [[ -n "$cmds" ]] || fail "no commands listed"
 for c in $cmds; do
   "$AMGSPLAT" "$c" -h >"$T/h" || fail "$c -h exited non-zero"

@@ -56,4 +56,10 @@ if [[ -r "${ASP_TEST_DATA:-}/spot_triangulated.obj" ]]; then
 else
   echo "skipping spot: ASP_TEST_DATA not found"
 fi
+# 3DS through assimp: glmark2-data (a declared dependency, scripts/bootstrap.sh) ships a horse
+horse=/usr/share/glmark2/models/horse.3ds
+[[ -r $horse ]] || fail "$horse missing: run scripts/bootstrap.sh"
+"$AMGSPLAT" sample "$horse" -n 5000 -o "$T/horse.ply" --json >"$T/horse.json"
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['points']==5000 and d['area']>0, d" "$T/horse.json" \
+  || fail "3ds: $(cat "$T/horse.json")"
 echo "sample: ok"

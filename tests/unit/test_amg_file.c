@@ -1,7 +1,8 @@
 /*
- * The .amg file: a save/load round trip keeps points, classifier and every
- * level's P exactly; truncated, corrupted, foreign and missing files give a
- * clear error and no crash.
+ * The .amg file: a save/load round trip keeps the whole point set (positions,
+ * origin, normals, colours, radii, uvs, labels), tangent normals, classifier
+ * and every level's P exactly; truncated, corrupted, foreign, old-version and
+ * missing files give a clear error and no crash.
  */
 #include <unistd.h>
 
@@ -51,8 +52,18 @@ static void test_round_trip_and_damage(void)
     asp_amg *amg = NULL, *back = NULL;
     snprintf(path, sizeof path, "/tmp/asp_test_amg_%ld.amg", (long)getpid());
     CHECK_OK(asp_synth(ASP_SYNTH_OCTAHEDRON, &(asp_synth_desc){.points = 3000}, NULL, &c, err), err);
-    if (c)
+    if (c) {
+        /* every attribute the file must keep, with a far origin (UTM-like) and uvs the synth does not make */
+        CHECK_OK(asp_cloud_add_attrs(c, ASP_ATTR_UVS, err), err);
+        for (size_t i = 0; i < c->count; i++) {
+            c->uvs[2 * i] = (float)i / 7.0f;
+            c->uvs[2 * i + 1] = -(float)i / 3.0f;
+        }
+        c->origin[0] = 512345.25;
+        c->origin[1] = -5.5e6;
+        c->origin[2] = 0.125;
         CHECK_OK(asp_amg_decompose(c, NULL, NULL, &amg, err), err);
+    }
     if (!amg) {
         asp_cloud_destroy(c);
         return;
@@ -62,8 +73,19 @@ static void test_round_trip_and_damage(void)
     if (back) {
         size_t n = c->count;
         CHECK(asp_amg_cloud(back)->count == n);
-        CHECK(memcmp(asp_amg_cloud(back)->positions, asp_amg_cloud(amg)->positions, 12 * n) == 0);
-        CHECK(memcmp(asp_amg_cloud(back)->normals, asp_amg_cloud(amg)->normals, 12 * n) == 0);
+        const asp_cloud *b = asp_amg_cloud(back);
+        CHECK(memcmp(b->origin, c->origin, sizeof c->origin) == 0);
+        CHECK(memcmp(b->positions, c->positions, 12 * n) == 0);
+        /* the input had normals: they are kept, not replaced by the unoriented tangent normals */
+        CHECK(asp_amg_has_input_normals(amg) && asp_amg_has_input_normals(back));
+        CHECK(memcmp(asp_amg_cloud(amg)->normals, c->normals, 12 * n) == 0);
+        CHECK(b->normals && memcmp(b->normals, c->normals, 12 * n) == 0);
+        CHECK(b->colors && memcmp(b->colors, c->colors, 4 * n) == 0);
+        CHECK(b->radii && memcmp(b->radii, c->radii, 4 * n) == 0);
+        CHECK(b->uvs && memcmp(b->uvs, c->uvs, 8 * n) == 0);
+        CHECK(b->labels && memcmp(b->labels, c->labels, 4 * n) == 0);
+        CHECK(asp_cloud_attrs(b) == asp_cloud_attrs(asp_amg_cloud(amg)));
+        CHECK(memcmp(asp_amg_tangent_normals(back), asp_amg_tangent_normals(amg), 12 * n) == 0);
         CHECK(memcmp(asp_amg_classifier(back), asp_amg_classifier(amg), 4 * n) == 0);
         CHECK(asp_amg_level_count(back) == asp_amg_level_count(amg));
         CHECK(asp_amg_matrix(back) == NULL);
@@ -120,8 +142,13 @@ static void test_round_trip_and_damage(void)
     spit(bad, bytes, size);
     CHECK(asp_amg_load(bad, NULL, &back, err) == ASP_EFORMAT);
     CHECK(strstr(err->msg, "version 9") != NULL);
-    /* a huge count in the header is refused before anything is allocated */
+    /* version 1 (no point attributes) names the remedy */
     bytes[8] = 1;
+    spit(bad, bytes, size);
+    CHECK(asp_amg_load(bad, NULL, &back, err) == ASP_EFORMAT);
+    CHECK_MSG(strstr(err->msg, "version 1") != NULL && strstr(err->msg, "decompose") != NULL, "%s", err->msg);
+    /* a huge count in the header is refused before anything is allocated */
+    bytes[8] = 2;
     memset(bytes + 16, 0xFF, 8);
     spit(bad, bytes, size);
     CHECK(asp_amg_load(bad, NULL, &back, err) == ASP_EFORMAT);
@@ -133,7 +160,53 @@ static void test_round_trip_and_damage(void)
     remove(path);
     asp_amg_destroy(amg);
     asp_cloud_destroy(c);
-    asp_amg_shutdown();
 }
 
-TEST_MAIN(TEST_CASE(test_round_trip_and_damage))
+/* An input without normals or colours: the file stays small and the normals are the tangent ones. */
+static void test_bare_positions(void)
+{
+    asp_error errbuf, *err = &errbuf;
+    asp_cloud *full = NULL, *c = NULL;
+    asp_amg *amg = NULL, *back = NULL;
+    char p2[600];
+    snprintf(p2, sizeof p2, "/tmp/asp_test_amg_bare_%ld.amg", (long)getpid());
+    CHECK_OK(asp_synth(ASP_SYNTH_CUBE, &(asp_synth_desc){.points = 1200}, NULL, &full, err), err);
+    if (!full)
+        return;
+    CHECK_OK(asp_cloud_create(full->count, 0, NULL, &c, err), err);
+    if (c) {
+        memcpy(c->positions, full->positions, 12 * full->count);
+        CHECK_OK(asp_amg_decompose(c, NULL, NULL, &amg, err), err);
+    }
+    if (amg) {
+        const size_t n = c->count;
+        CHECK(!asp_amg_has_input_normals(amg));
+        CHECK(asp_cloud_attrs(asp_amg_cloud(amg)) == ASP_ATTR_NORMALS);
+        CHECK(memcmp(asp_amg_cloud(amg)->normals, asp_amg_tangent_normals(amg), 12 * n) == 0);
+        CHECK_OK(asp_amg_save(amg, p2, err), err);
+        CHECK_OK(asp_amg_load(p2, NULL, &back, err), err);
+        if (back) {
+            const asp_cloud *b = asp_amg_cloud(back);
+            CHECK(!asp_amg_has_input_normals(back));
+            CHECK(asp_cloud_attrs(b) == ASP_ATTR_NORMALS);
+            CHECK(!b->colors && !b->radii && !b->uvs && !b->labels);
+            CHECK(memcmp(b->positions, c->positions, 12 * n) == 0);
+            CHECK(memcmp(b->normals, asp_amg_tangent_normals(amg), 12 * n) == 0);
+            /* no attribute arrays: header, 7 floats per point, the attribute set, options, levels, P, CRC */
+            size_t expect = 64 + 28 * n + 8 + 128 + 8 * asp_amg_level_count(amg) + 4;
+            for (size_t l = 1; l < asp_amg_level_count(amg); l++) {
+                const asp_amg_csr *p = asp_amg_prolongation(amg, l);
+                expect += 8 + 8 * (p->rows + 1) + 12 * p->row_ptr[p->rows];
+            }
+            CHECK_MSG(file_size(p2) == expect, "size %zu, expected %zu", file_size(p2), expect);
+            asp_amg_destroy(back);
+        }
+    }
+    remove(p2);
+    asp_amg_destroy(amg);
+    asp_cloud_destroy(c);
+    asp_cloud_destroy(full);
+    asp_amg_shutdown(); /* last test: MPI cannot start again in this process */
+}
+
+TEST_MAIN(TEST_CASE(test_round_trip_and_damage), TEST_CASE(test_bare_positions))

@@ -1,0 +1,241 @@
+/*
+ * Domain primitives (journal section 3, thesis chapter 3): every domain of an
+ * AMG level becomes one planar rectangle (PCA support polygon, thesis 3.1)
+ * with a texture whose colour holds the points' colours and whose alpha holds
+ * the domain's basis function (thesis 3.3); neighbour lists for rendering
+ * (journal section 4); and the .dps file that stores several levels.
+ */
+#ifndef AMGSPLAT_PRIM_H
+#define AMGSPLAT_PRIM_H
+
+#include "amg.h"
+#include "cloud.h"
+#include "image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- options ---- */
+
+/** Texture construction method (thesis 3.3). */
+typedef enum asp_prim_method {
+    ASP_PRIM_AFFINE = 0, /* linear affine: 2D Delaunay + barycentric, radial linear outside (3.3.3); default */
+    ASP_PRIM_RADIAL = 1  /* radial basis functions summed per texel (3.3.2) */
+} asp_prim_method;
+
+/** Radial basis-function shape (thesis 3.3.2); d = texel distance, R = w r. */
+typedef enum asp_prim_shape {
+    ASP_PRIM_LINEAR = 0,   /* 1 - d/R inside R; default */
+    ASP_PRIM_CONSTANT = 1, /* 1 inside R */
+    ASP_PRIM_GAUSSIAN = 2  /* exp(-d^2 / 2 sigma^2), sigma = R/3, cut at R (value 0.011) */
+} asp_prim_shape;
+
+/** Per-texel normalisation criterion of the radial sum f(t) = sum phi_p(t) (thesis eq. 3.3 / 3.4). */
+typedef enum asp_prim_normalise {
+    ASP_PRIM_NORM_POSITIVE = 0, /* divide by f where f > 0 (eq. 3.4); default */
+    ASP_PRIM_NORM_GE1 = 1       /* divide by f only where f >= 1 (eq. 3.3): alpha fades at the border */
+} asp_prim_normalise;
+
+/**
+ * Build options; the zero value means the documented defaults, so
+ * `&(asp_prim_desc){ .texel_size = 2 }` works.
+ */
+typedef struct asp_prim_desc {
+    double tau;              /* domain threshold: points with Psi > tau (0 = 0.05, journal eq. 8) */
+    double texel_size;       /* texel edge = texel_size x mean point radius (0 = 1, thesis 5.2.1) */
+    uint32_t max_texture;    /* cap on a primitive's texture side in texels (0 = 512); the texel grows */
+    asp_prim_method method;
+    asp_prim_shape shape;    /* radial only */
+    double width;            /* radial width factor w (0 = 1) */
+    asp_prim_normalise normalise; /* radial only */
+    int unweighted;          /* 1: plain PCA instead of PCA weighted by Psi */
+    int project_radii;       /* 1: radius r |n_p . n_plane| (thesis 3.1) */
+    int no_extend_color;     /* 1: leave texels without coverage black (thesis 3.3.4 off) */
+    int normal_map;          /* 1: also build a per-texel normal atlas (journal section 6) */
+    double neighbour_fraction; /* neighbours share more than this fraction of either's points (0 = 0.05) */
+    int merge;               /* 1: greedy domain merging (thesis 3.4) */
+    double merge_flatness;   /* merge while l_min / sum l of both and the union is below this (0 = 0.01) */
+    double merge_angle;      /* and their normals differ by less than this, degrees (0 = 15) */
+    uint32_t padding;        /* atlas padding around each texture, texels (0 = 2) */
+} asp_prim_desc;
+
+/* ---- one primitive ---- */
+
+/**
+ * A textured support rectangle. The rectangle is centre + s axis_u + t axis_v,
+ * |s| <= half_u, |t| <= half_v; its texture is the atlas rectangle
+ * [tex_x, tex_x + tex_w) x [tex_y, tex_y + tex_h), where atlas row tex_y + j
+ * and column tex_x + i hold (s, t) = (-half_u + (i + 0.5) texel,
+ * -half_v + (j + 0.5) texel). So tex_w texel = 2 half_u, tex_h texel = 2 half_v.
+ */
+typedef struct asp_prim {
+    double centre[3];         /* world coordinates */
+    float axis_u[3], axis_v[3]; /* unit, in-plane PCA axes; axis_u x axis_v = normal */
+    float normal[3];          /* unit; faces the weighted mean of the point normals */
+    float half_u, half_v;     /* half extents, world units, margin included */
+    float texel;              /* texel edge, world units */
+    float error;              /* mean |distance| of the domain's points to the plane (thesis 3.2) */
+    float error_norm;         /* error / mean point radius of the cloud */
+    float curvature;          /* l_min / (l0 + l1 + l2) of the (weighted) PCA (thesis 3.2, 3.4) */
+    uint32_t points;          /* points in the domain (Psi > tau) */
+    uint32_t basis;           /* index of the basis function (the first one when merged) */
+    uint32_t merged;          /* basis functions summed into this one (1 unless merged) */
+    uint32_t flags;           /* ASP_PRIM_FLAG_* */
+    uint32_t tex_x, tex_y, tex_w, tex_h; /* texture rectangle in the level's atlas */
+    uint32_t neighbour_first, neighbour_count; /* range in the level's neighbour array */
+} asp_prim;
+
+enum asp_prim_flags {
+    ASP_PRIM_FLAG_DEGENERATE = 1 << 0, /* 1 or 2 points, or colinear: plane from the point normals */
+    ASP_PRIM_FLAG_CAPPED = 1 << 1      /* max_texture was reached; texel is larger than asked */
+};
+
+/* ---- a built file ---- */
+
+/** One level of a .dps: primitives, neighbour lists, atlases and the Table 5.2 figures. */
+typedef struct asp_dps_level {
+    uint32_t level;           /* AMG level index (0 = points) */
+    uint32_t basis_count;     /* basis functions of the level (before skipping and merging) */
+    size_t prim_count;
+    asp_prim *prims;
+    size_t neighbour_total;   /* entries of neighbours (each pair appears twice) */
+    uint32_t *neighbours;     /* prim indices, sorted within each primitive's range */
+    asp_image atlas;          /* RGBA8: colour (sRGB, straight) + alpha = basis function */
+    asp_image normal_atlas;   /* RGB = world normal * 0.5 + 0.5, A = alpha; width 0 when absent */
+    uint64_t texels;          /* sum of tex_w * tex_h */
+    double error, error_norm; /* mean over all domain points (thesis Table 5.2 "error", "normalized") */
+    double t_basis;           /* seconds to get Psi and the domains ("cb") */
+    double t_construct;       /* seconds for planes, textures, atlas, neighbours ("dpc") */
+    uint32_t skipped;         /* basis functions without a point above tau */
+    uint32_t degenerate;      /* primitives flagged DEGENERATE */
+    uint32_t capped;          /* primitives flagged CAPPED */
+    uint32_t merges;          /* merge operations performed */
+} asp_dps_level;
+
+/** A set of levels; create with asp_prim_build or asp_dps_load, free with asp_dps_destroy. */
+typedef struct asp_dps {
+    size_t level_count;
+    asp_dps_level *levels;    /* finest first */
+    uint32_t amg_levels;      /* level count of the decomposition (to name levels "L-k") */
+    uint64_t source_points;
+    double mean_radius;       /* mean point radius, world units */
+    asp_prim_desc desc;       /* parameters used, defaults resolved */
+    char source[256];         /* the input file's name (may be empty) */
+    asp_context ctx;
+} asp_dps;
+
+/* ---- building ---- */
+
+/**
+ * Builds the primitives of levels[0 .. nlevels-1] of amg (indices as given by
+ * asp_amg_level_parse; nlevels >= 1, each < asp_amg_level_count) into a new
+ * asp_dps (*out, levels stored finest first, duplicates removed). Colours and
+ * radii come from attrs when it is not NULL (it must have the amg's point
+ * count), else from asp_amg_cloud(amg); missing colours are light grey,
+ * missing radii are estimated (16th neighbour). source names the input in the
+ * file (NULL = ""). desc may be NULL (defaults). Runs with
+ * asp_context_threads(ctx) threads; the result is identical for any count.
+ * Errors: ASP_EINVAL (bad option, level out of range, attrs of another size),
+ * ASP_EDEGENERATE (every domain of a level is empty), ASP_ENOMEM,
+ * ASP_EUNSUPPORTED (an atlas would exceed 16384 texels a side: raise
+ * texel_size), ASP_ECANCELED. On failure *out is unchanged. Reports progress
+ * as stage "primitives". Thread-safe on a shared amg.
+ */
+int asp_prim_build(const asp_amg *amg, const asp_cloud *attrs, const size_t *levels, size_t nlevels,
+                   const asp_prim_desc *desc, const char *source, const asp_context *ctx, asp_dps **out,
+                   asp_error *err);
+
+/**
+ * Picks the finest level with at most max_prims basis functions (the budget
+ * --primitives N); when even the coarsest has more, the coarsest. Returns 0,
+ * or ASP_EINVAL for max_prims == 0.
+ */
+int asp_prim_level_for_budget(const asp_amg *amg, size_t max_prims, size_t *level, asp_error *err);
+
+/** Frees a dps and everything it owns; NULL is accepted. */
+void asp_dps_destroy(asp_dps *dps);
+
+/* ---- kernels (usable and testable alone) ---- */
+
+/**
+ * 2D Delaunay triangulation of n points (xy packed, finite) by incremental
+ * insertion along a Hilbert curve with Lawson flips, on coordinates snapped to
+ * a 2^20 grid over their bounding box so that the orientation and in-circle
+ * predicates are exact in integer arithmetic. Points that snap to the same
+ * grid node count once (the first in index order). Writes triangles as vertex
+ * index triples, counter-clockwise, to tri (capacity 3 * asp_delaunay2d_bound(n))
+ * and returns their number (0 for fewer than 3 distinct or all colinear
+ * points). Every triangle's circumcircle holds no other input point (exact on
+ * the snapped coordinates); hull slivers flatter than about 1/256 of the
+ * extent may be missing. scratch holds asp_delaunay2d_scratch_size(n) bytes.
+ * Thread-safe; no allocation.
+ */
+size_t asp_delaunay2d(const double *xy, size_t n, uint32_t *tri, void *scratch);
+/** Most triangles asp_delaunay2d can write for n points (2n). */
+size_t asp_delaunay2d_bound(size_t n);
+/** Scratch bytes asp_delaunay2d needs for n points. */
+size_t asp_delaunay2d_scratch_size(size_t n);
+
+/**
+ * Domain neighbours (journal section 4): domains a and b (rows of dom, as
+ * written by asp_amg_domains, column indices sorted) are neighbours when their
+ * common points exceed fraction (in (0,1)) times the point count of a or of b.
+ * Writes, per row a, its neighbours in increasing order: first[a] .. first[a+1]
+ * in *list (first holds dom->rows + 1 entries; *list is allocated here through
+ * ctx, free with asp_free; *total = first[rows]). Parallel, deterministic.
+ * Returns 0, ASP_EINVAL, ASP_ENOMEM.
+ */
+int asp_prim_neighbours(const asp_amg_csr *dom, double fraction, const asp_context *ctx, size_t *first,
+                        uint32_t **list, size_t *total, asp_error *err);
+
+/* ---- the .dps file ---- */
+
+/**
+ * Writes dps to path atomically in the versioned, little-endian .dps format
+ * (docs/cli/build.md): parameters, source name and per level the primitives,
+ * neighbour lists and atlases, with a CRC-32 trailer. Returns 0, ASP_EIO,
+ * ASP_ENOMEM.
+ */
+int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err);
+
+/**
+ * Reads a .dps file into a new asp_dps (*out). Returns 0, ASP_EIO, ASP_ENOMEM,
+ * ASP_EFORMAT for anything damaged (wrong magic or version, truncated, checksum
+ * mismatch, counts the file cannot hold, a texture rectangle outside its atlas,
+ * a neighbour index out of range, a non-finite value), with a message naming
+ * the file, the level and primitive, and what was expected. Sizes are checked
+ * against the file length before any allocation. On failure *out is unchanged.
+ */
+int asp_dps_load(const char *path, const asp_context *ctx, asp_dps **out, asp_error *err);
+
+/** One row of the thesis Table 5.2 for a level (what `amgsplat info X.dps` prints). */
+typedef struct asp_dps_summary {
+    uint32_t level;           /* AMG level index */
+    char name[16];            /* "L", "L-3" */
+    size_t primitives;
+    uint64_t texels;
+    double error, error_norm;
+    double t_basis, t_construct;
+    uint32_t skipped, degenerate, capped, merges;
+    uint32_t atlas_width, atlas_height;
+    size_t neighbour_pairs;   /* neighbour_total / 2 */
+    int normal_map;
+} asp_dps_summary;
+
+/** Fills rows[0 .. dps->level_count-1]; prints nothing. Thread-safe. */
+void asp_dps_summarize(const asp_dps *dps, asp_dps_summary *rows);
+
+/** Option names: "affine"/"radial", "linear"/"constant"/"gaussian", "positive"/"ge1". 0 or ASP_EINVAL. */
+int asp_prim_method_parse(const char *name, asp_prim_method *out, asp_error *err);
+int asp_prim_shape_parse(const char *name, asp_prim_shape *out, asp_error *err);
+int asp_prim_normalise_parse(const char *name, asp_prim_normalise *out, asp_error *err);
+/** Names of the enums above ("affine"). */
+const char *asp_prim_method_name(asp_prim_method m);
+const char *asp_prim_shape_name(asp_prim_shape s);
+const char *asp_prim_normalise_name(asp_prim_normalise n);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

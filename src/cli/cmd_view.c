@@ -1,0 +1,166 @@
+/*
+ * amgsplat view: the interactive viewer in a window (GLFW), and its scripted
+ * mode for tests and screenshots. Glue only: options go into an
+ * asp_viewer_desc and asp_viewer_run does the rest; see docs/cli/view.md.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cli/cli.h"
+#include "cli/commands.h"
+#include "util/banned.h"
+
+static const char usage[] =
+    "usage: amgsplat view FILE [--size WxH] [--view AZ,EL[,DIST]] [--renderer NAME] [--tau PX]\n"
+    "                     [--color MODE] [--level L] [--unlit] [--background R,G,B] [--verbose]\n"
+    "       amgsplat view FILE --frames N [--screenshot OUT.png] [--keys KEYS] [options above]\n"
+    "\n"
+    "Opens a window on a point file (.ply, .xyz, .pts, .txt) or an AMG decomposition (.amg,\n"
+    "coloured by classifier or domains). Left drag orbits, the wheel or right drag zooms, middle\n"
+    "drag or shift + left drag pans; press h in the window for the keys (docs/cli/view.md).\n"
+    "With --frames N the viewer draws N frames, pressing KEYS one per frame, saves the last\n"
+    "frame to OUT.png and exits (needs a display: run under xvfb-run without one).";
+
+static const char *const color_modes[] = {"classifier", "domains", "strict", "input"};
+
+struct view_opts {
+    const char *size;
+    const char *view;
+    const char *renderer;
+    const char *color;
+    const char *level;
+    const char *background;
+    const char *screenshot;
+    const char *keys;
+    size_t frames;
+    double tau;
+    int unlit;
+    int verbose;
+};
+
+static void log_line(void *user, const char *line)
+{
+    const struct cli_env *env = user;
+    if (!env->quiet)
+        fprintf(stderr, "%s\n", line);
+}
+
+static int parse_into(struct cli_env *env, const struct view_opts *o, asp_viewer_desc *d)
+{
+    if (o->size && (cli_parse_size2(o->size, &d->width, &d->height) != 0 || d->width == 0 || d->height == 0 ||
+                    d->width > 16384 || d->height > 16384))
+        return cli_usage_error(env, "--size expects WxH with sides in 1..16384, got '%s'", o->size);
+    if (o->view) {
+        double v[3] = {0, 0, 0};
+        int n = cli_parse_doubles(o->view, v, 3);
+        if (n < 2 || !isfinite(v[0]) || !(v[1] >= -90 && v[1] <= 90) || (n == 3 && !(v[2] > 0 && isfinite(v[2]))))
+            return cli_usage_error(env, "--view expects AZ,EL[,DIST] with EL in -90..90 and DIST > 0 (radii), got '%s'",
+                                   o->view);
+        d->set_view = 1;
+        d->azimuth = (float)v[0];
+        d->elevation = (float)v[1];
+        d->distance = (float)v[2];
+    }
+    if (!(o->tau >= 0) || !isfinite(o->tau))
+        return cli_usage_error(env, "--tau expects pixels >= 0, got %g", o->tau);
+    d->tolerance = (float)o->tau;
+    if (o->color) {
+        size_t m = sizeof color_modes / sizeof color_modes[0];
+        d->amg_color = (unsigned)m;
+        for (size_t i = 0; i < m; i++)
+            if (strcmp(o->color, color_modes[i]) == 0)
+                d->amg_color = (unsigned)i;
+        if (d->amg_color == m)
+            return cli_usage_error(env, "--color expects classifier, domains, strict or input, got '%s'", o->color);
+    }
+    if (o->background) {
+        double c[3];
+        if (cli_parse_doubles(o->background, c, 3) != 3)
+            return cli_usage_error(env, "--background expects R,G,B in 0..255, got '%s'", o->background);
+        for (int i = 0; i < 3; i++) {
+            if (!(c[i] >= 0 && c[i] <= 255) || c[i] != floor(c[i]))
+                return cli_usage_error(env, "--background expects integers in 0..255, got '%s'", o->background);
+            d->background[i] = (uint8_t)c[i];
+        }
+        d->background[3] = 255;
+    }
+    d->renderer = o->renderer;
+    d->amg_level = o->level;
+    d->frames = o->frames;
+    d->screenshot = o->screenshot;
+    d->keys = o->keys;
+    d->flags = (o->unlit ? ASP_VIEWER_UNLIT : 0u) | (o->verbose ? ASP_VIEWER_VERBOSE : 0u);
+    // what the library would refuse is a usage error too (renderer names, keys, screenshot)
+    asp_error err = {0, ""};
+    if (asp_viewer_desc_check(d, &err))
+        return cli_usage_error(env, "%s", err.msg);
+    return 0;
+}
+
+static void print_json(const char *path, const asp_viewer_desc *d, const asp_viewer_stats *s)
+{
+    printf("{\"input\": ");
+    cli_json_string(stdout, path);
+    printf(", \"frames\": %zu, \"mean_frame_ms\": %.3f, \"last_frame_ms\": %.3f, \"count\": %zu, \"renderer\": ",
+           s->frames, s->mean_frame_ms, s->last_frame_ms, s->count);
+    cli_json_string(stdout, s->renderer);
+    printf(", \"width\": %u, \"height\": %u, \"screenshots\": %zu, \"screenshot\": ", s->width, s->height,
+           s->screenshots);
+    if (d->screenshot)
+        cli_json_string(stdout, d->screenshot);
+    else
+        printf("null");
+    printf(", \"gl_renderer\": ");
+    cli_json_string(stdout, s->gl_renderer);
+    printf("}\n");
+}
+
+#ifndef ASP_HAVE_GL
+int cmd_view(int argc, char **argv, struct cli_env *env)
+{
+    (void)argc;
+    (void)argv;
+    asp_error err = {ASP_EUNSUPPORTED, "this amgsplat was built without OpenGL (ASP_WITH_GL=OFF)"};
+    return cli_fail(env, &err);
+}
+#else
+int cmd_view(int argc, char **argv, struct cli_env *env)
+{
+    struct view_opts o = {0};
+    const struct cli_option opts[] = {
+        {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
+        {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "first view as in 'amgsplat render' (default 30,20)"},
+        {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "first renderer (default disc; 'h' in the window lists them)"},
+        {"tau", 0, CLI_DOUBLE, &o.tau, "PX", "screen tolerance of the hierarchy renderers in pixels (default 0)"},
+        {"color", 0, CLI_STRING, &o.color, "MODE", ".amg: classifier (default), domains, strict or input"},
+        {"level", 0, CLI_STRING, &o.level, "L", ".amg: level for domain colours: L, L-2 or an index (default L)"},
+        {"unlit", 0, CLI_FLAG, &o.unlit, NULL, "start with lighting off"},
+        {"background", 0, CLI_STRING, &o.background, "R,G,B", "background colour, 0..255 (default 255,255,255)"},
+        {"verbose", 'v', CLI_FLAG, &o.verbose, NULL, "print frame time and primitive count once a second"},
+        {"frames", 0, CLI_SIZE, &o.frames, "N", "scripted: draw N frames, then exit"},
+        {"screenshot", 0, CLI_STRING, &o.screenshot, "OUT.png", "scripted: save the last frame"},
+        {"keys", 0, CLI_STRING, &o.keys, "KEYS", "press these keys, one per frame, from the first frame on"},
+        {0},
+    };
+    int npos = 0;
+    int prc = cli_parse(argc, argv, opts, usage, env, &npos);
+    if (prc)
+        return prc > 0 ? 0 : 2;
+    if (npos != 1)
+        return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat view -h'", npos);
+    asp_viewer_desc desc = {.log = log_line, .log_user = env, .ctx = &env->ctx};
+    if (parse_into(env, &o, &desc))
+        return 2;
+    asp_error err = {0, ""};
+    asp_viewer_stats stats;
+    if (asp_viewer_run(argv[0], &desc, &stats, &err))
+        return cli_fail(env, &err);
+    if (env->json)
+        print_json(argv[0], &desc, &stats);
+    else
+        cli_info(env, "drew %zu frames of '%s' (%s, %zu %s, %.2f ms per frame)\n", stats.frames, argv[0],
+                 stats.renderer, stats.count, "primitives", stats.mean_frame_ms);
+    return 0;
+}
+#endif

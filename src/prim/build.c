@@ -1,0 +1,478 @@
+/*
+ * Domain-primitive construction for whole levels (journal section 3, thesis
+ * chapter 3 and Table 5.2): basis and thresholded domains of a level, optional
+ * merging (3.4), one support plane and texture per domain (3.1-3.3), the
+ * level's atlas and the neighbour lists (journal section 4).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "amgsplat/geom.h"
+#include "prim/internal.h"
+#include "util/banned.h"
+
+enum { ATLAS_MAX = 16384 };
+
+/* Per-point inputs shared by all levels. */
+typedef struct build_src {
+    const asp_cloud *cloud;   /* positions, normals, origin */
+    const uint8_t *colors;    /* 4n, or NULL (grey) */
+    const float *radii;       /* n */
+    double mean_radius;
+} build_src;
+
+/* Per-primitive layout decided in pass 1. */
+typedef struct layout {
+    asp__plane pl;
+    size_t row;           /* domain row */
+    double texel, s0, t0; /* texel size and the texture grid's origin in plane coordinates */
+    double foot;          /* footprint factor: 1 (affine) or w (radial) */
+    uint32_t w, h;
+    int capped;
+} layout;
+
+static void resolve_desc(const asp_prim_desc *in, asp_prim_desc *d)
+{
+    *d = in ? *in : (asp_prim_desc){0};
+    if (d->tau == 0)
+        d->tau = 0.05;
+    if (d->texel_size == 0)
+        d->texel_size = 1;
+    if (d->max_texture == 0)
+        d->max_texture = 512;
+    if (d->width == 0)
+        d->width = 1;
+    if (d->neighbour_fraction == 0)
+        d->neighbour_fraction = 0.05;
+    if (d->merge_flatness == 0)
+        d->merge_flatness = 0.01;
+    if (d->merge_angle == 0)
+        d->merge_angle = 15;
+    if (d->padding == 0)
+        d->padding = 2;
+}
+
+static int check_desc(const asp_prim_desc *d, asp_error *err)
+{
+    if (!(d->tau >= 0 && d->tau < 1))
+        return asp_error_set(err, ASP_EINVAL, "domain threshold tau must be in [0, 1), got %g", d->tau);
+    if (!(d->texel_size > 0 && d->texel_size < 1e6))
+        return asp_error_set(err, ASP_EINVAL, "texel size must be positive, got %g", d->texel_size);
+    if (d->max_texture > ATLAS_MAX / 2)
+        return asp_error_set(err, ASP_EINVAL, "texture cap must be at most %d texels, got %u", ATLAS_MAX / 2,
+                             d->max_texture);
+    if (!(d->width > 0 && d->width <= 16))
+        return asp_error_set(err, ASP_EINVAL, "radial width factor must be in (0, 16], got %g", d->width);
+    if (!(d->neighbour_fraction > 0 && d->neighbour_fraction < 1))
+        return asp_error_set(err, ASP_EINVAL, "neighbour fraction must be in (0, 1), got %g", d->neighbour_fraction);
+    if (!(d->merge_flatness > 0 && d->merge_flatness <= 1.0 / 3))
+        return asp_error_set(err, ASP_EINVAL, "merge flatness must be in (0, 1/3], got %g", d->merge_flatness);
+    if (!(d->merge_angle > 0 && d->merge_angle <= 180))
+        return asp_error_set(err, ASP_EINVAL, "merge angle must be in (0, 180] degrees, got %g", d->merge_angle);
+    if (d->padding > 64)
+        return asp_error_set(err, ASP_EINVAL, "atlas padding must be at most 64 texels, got %u", d->padding);
+    if ((unsigned)d->method > ASP_PRIM_RADIAL || (unsigned)d->shape > ASP_PRIM_GAUSSIAN ||
+        (unsigned)d->normalise > ASP_PRIM_NORM_GE1)
+        return asp_error_set(err, ASP_EINVAL, "unknown texture method, shape or normalisation");
+    return 0;
+}
+
+static double point_radius(const build_src *src, const asp__plane *pl, const asp_prim_desc *d, size_t p)
+{
+    double r = src->radii[p];
+    if (d->project_radii && src->cloud->normals) {
+        const float *n = &src->cloud->normals[3 * p];
+        /* thesis 3.1: r |n_p . n|; a floor keeps edge-on points from vanishing entirely */
+        r *= fmax(fabs(n[0] * pl->n[0] + n[1] * pl->n[1] + n[2] * pl->n[2]), 0.05);
+    }
+    return r;
+}
+
+/* Pass 1 for one domain: plane, rectangle with margin, texel grid. */
+static void plan_one(const build_src *src, const asp_amg_csr *dom, const asp_prim_desc *d, layout *L)
+{
+    size_t a = dom->row_ptr[L->row], n = dom->row_ptr[L->row + 1] - a;
+    const asp_cloud *c = src->cloud;
+    asp__prim_plane(c->positions, c->normals, &dom->col[a], &dom->val[a], n, d->unweighted, &L->pl);
+    L->foot = d->method == ASP_PRIM_RADIAL ? d->width : 1.0;
+    double rmax = 0, rsum = 0;
+    for (size_t k = 0; k < n; k++) {
+        double r = point_radius(src, &L->pl, d, dom->col[a + k]);
+        rmax = fmax(rmax, r);
+        rsum += r;
+    }
+    /* margin: the largest footprint, but at most 3x the domain's mean, so one outlier radius cannot bloat it */
+    double margin = L->foot * fmin(rmax, 3 * rsum / (double)n);
+    double ew = L->pl.smax - L->pl.smin + 2 * margin, eh = L->pl.tmax - L->pl.tmin + 2 * margin;
+    double T = d->texel_size * src->mean_radius;
+    double wf = ceil(ew / T), hf = ceil(eh / T);
+    L->capped = 0;
+    if (wf > d->max_texture || hf > d->max_texture) {
+        T = fmax(ew, eh) / d->max_texture * (1 + 1e-9);
+        wf = ceil(ew / T), hf = ceil(eh / T);
+        L->capped = 1;
+    }
+    L->w = (uint32_t)fmax(1, fmin(wf, d->max_texture));
+    L->h = (uint32_t)fmax(1, fmin(hf, d->max_texture));
+    L->texel = T;
+    double ms = 0.5 * (L->pl.smin + L->pl.smax), mt = 0.5 * (L->pl.tmin + L->pl.tmax);
+    L->s0 = ms - 0.5 * L->w * T;
+    L->t0 = mt - 0.5 * L->h * T;
+}
+
+/* Pass 2 for one domain: samples in texel units, then the texture into the atlas. */
+static void texture_one(const build_src *src, const asp_amg_csr *dom, const asp_prim_desc *d, const layout *L,
+                        const asp_prim *P, asp_image *atlas, asp_image *natlas, void *scratch)
+{
+    size_t a = dom->row_ptr[L->row], n = dom->row_ptr[L->row + 1] - a;
+    int C = d->normal_map ? 7 : 4;
+    float *x = scratch, *y = x + n, *r = y + n, *attr = r + n;
+    size_t head = ((size_t)(3 + C) * n * sizeof(float) + 63) & ~(size_t)63;
+    const asp_cloud *c = src->cloud;
+    for (size_t k = 0; k < n; k++) {
+        size_t p = dom->col[a + k];
+        const float *q = &c->positions[3 * p];
+        double dv[3] = {q[0] - L->pl.c[0], q[1] - L->pl.c[1], q[2] - L->pl.c[2]};
+        double s = dv[0] * L->pl.u[0] + dv[1] * L->pl.u[1] + dv[2] * L->pl.u[2];
+        double t = dv[0] * L->pl.v[0] + dv[1] * L->pl.v[1] + dv[2] * L->pl.v[2];
+        x[k] = (float)((s - L->s0) / L->texel);
+        y[k] = (float)((t - L->t0) / L->texel);
+        r[k] = (float)(L->foot * point_radius(src, &L->pl, d, p) / L->texel);
+        float *o = &attr[(size_t)C * k];
+        for (int j = 0; j < 3; j++)
+            o[j] = src->colors ? src->colors[4 * p + (size_t)j] : 200.0f;
+        o[3] = (float)dom->val[a + k];
+        if (C == 7)
+            for (int j = 0; j < 3; j++)
+                o[4 + j] = c->normals ? c->normals[3 * p + (size_t)j] : (float)L->pl.n[j];
+    }
+    asp__tex_input in = {.n = n, .x = x, .y = y, .r = r, .attr = attr, .channels = C, .w = L->w, .h = L->h,
+                         .method = d->method, .shape = d->shape, .normalise = d->normalise,
+                         .extend_color = !d->no_extend_color};
+    size_t off = 4 * ((size_t)P->tex_y * atlas->width + P->tex_x);
+    asp__prim_texture(&in, (uint8_t *)scratch + head, atlas->pixels + off, natlas ? natlas->pixels + off : NULL,
+                      atlas->width);
+}
+
+static size_t scratch_bytes(size_t n, size_t texels, int C)
+{
+    return (((size_t)(3 + C) * n * sizeof(float) + 63) & ~(size_t)63) + asp__prim_texture_scratch(n, texels, C);
+}
+
+static void release_level(const asp_context *ctx, asp_dps_level *lv)
+{
+    asp_free(ctx, lv->prims);
+    asp_free(ctx, lv->neighbours);
+    asp_image_release(&lv->atlas);
+    asp_image_release(&lv->normal_atlas);
+    memset(lv, 0, sizeof *lv);
+}
+
+static void level_name(const asp_amg *amg, size_t level, char *buf, size_t cap)
+{
+    size_t top = asp_amg_level_count(amg) - 1;
+    if (level == top)
+        snprintf(buf, cap, "L");
+    else
+        snprintf(buf, cap, "L-%zu", top - level);
+}
+
+/* Fills the primitive records, atlas and neighbours of one level from its (possibly merged) domains. */
+static int construct(const build_src *src, const asp_amg_csr *dom, const uint32_t *basis_first,
+                     const uint32_t *basis_count, const asp_prim_desc *d, const char *name, const asp_context *ctx,
+                     asp_dps_level *lv, asp_error *err)
+{
+    size_t rows = dom->rows, np = 0;
+    for (size_t r = 0; r < rows; r++)
+        np += dom->row_ptr[r + 1] > dom->row_ptr[r];
+    lv->skipped = (uint32_t)(rows - np);
+    if (np == 0)
+        return asp_error_set(err, ASP_EDEGENERATE, "level %s: no domain has a point with Psi > %g", name, d->tau);
+    int threads = asp_context_threads(ctx), C = d->normal_map ? 7 : 4, rc = 0;
+    layout *L = asp_calloc(ctx, np, sizeof *L);
+    uint32_t *ws = asp_alloc(ctx, 4 * np * sizeof *ws);
+    size_t *first = asp_calloc(ctx, rows + 1, sizeof *first);
+    uint32_t *nbr = NULL, *row_to_prim = NULL;
+    uint8_t *scratch = NULL;
+    lv->prims = asp_calloc(ctx, np, sizeof *lv->prims);
+    if (!L || !ws || !first || !lv->prims) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu primitives of level %s", np, name);
+        goto done;
+    }
+    lv->prim_count = np;
+    for (size_t r = 0, k = 0; r < rows; r++)
+        if (dom->row_ptr[r + 1] > dom->row_ptr[r])
+            L[k++].row = r;
+    long lnp = (long)np;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long k = 0; k < lnp; k++)
+        plan_one(src, dom, d, &L[k]);
+
+    uint32_t *w = ws, *h = ws + np, *x = ws + 2 * np, *y = ws + 3 * np;
+    size_t max_n = 0, max_t = 0;
+    for (size_t k = 0; k < np; k++) {
+        w[k] = L[k].w, h[k] = L[k].h;
+        size_t n = dom->row_ptr[L[k].row + 1] - dom->row_ptr[L[k].row];
+        size_t need = scratch_bytes(n, (size_t)L[k].w * L[k].h, C);
+        max_t = need > max_t ? need : max_t;
+        max_n = n > max_n ? n : max_n;
+    }
+    uint32_t aw = 0, ah = 0;
+    int pk = asp__atlas_pack(w, h, np, d->padding, ATLAS_MAX, x, y, &aw, &ah, ctx);
+    if (pk == -2) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the atlas layout of level %s", name);
+        goto done;
+    }
+    if (pk) {
+        rc = asp_error_set(err, ASP_EUNSUPPORTED,
+                           "level %s: the textures of %zu primitives do not fit a %dx%d atlas; raise --texel-size",
+                           name, np, ATLAS_MAX, ATLAS_MAX);
+        goto done;
+    }
+    if ((rc = asp_image_init(&lv->atlas, aw, ah, err)) ||
+        (d->normal_map && (rc = asp_image_init(&lv->normal_atlas, aw, ah, err))))
+        goto done;
+    scratch = asp_alloc(ctx, (size_t)threads * max_t);
+    if (!scratch) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %d texture scratch buffers of %zu bytes", threads,
+                           max_t);
+        goto done;
+    }
+    const asp_cloud *c = src->cloud;
+    for (size_t k = 0; k < np; k++) {
+        asp_prim *P = &lv->prims[k];
+        const layout *l = &L[k];
+        double ms = l->s0 + 0.5 * l->w * l->texel, mt = l->t0 + 0.5 * l->h * l->texel;
+        for (int j = 0; j < 3; j++) {
+            P->centre[j] = c->origin[j] + l->pl.c[j] + ms * l->pl.u[j] + mt * l->pl.v[j];
+            P->axis_u[j] = (float)l->pl.u[j];
+            P->axis_v[j] = (float)l->pl.v[j];
+            P->normal[j] = (float)l->pl.n[j];
+        }
+        P->half_u = (float)(0.5 * l->w * l->texel);
+        P->half_v = (float)(0.5 * l->h * l->texel);
+        P->texel = (float)l->texel;
+        P->error = (float)l->pl.error;
+        P->error_norm = (float)(l->pl.error / src->mean_radius);
+        P->curvature = (float)l->pl.curvature;
+        P->points = (uint32_t)(dom->row_ptr[l->row + 1] - dom->row_ptr[l->row]);
+        P->basis = basis_first ? basis_first[l->row] : (uint32_t)l->row;
+        P->merged = basis_count ? basis_count[l->row] : 1;
+        P->flags = (l->pl.degenerate ? ASP_PRIM_FLAG_DEGENERATE : 0u) | (l->capped ? ASP_PRIM_FLAG_CAPPED : 0u);
+        P->tex_x = x[k], P->tex_y = y[k], P->tex_w = l->w, P->tex_h = l->h;
+    }
+    asp_image *natlas = d->normal_map ? &lv->normal_atlas : NULL;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long k = 0; k < lnp; k++) {
+        int tid = 0;
+#ifdef _OPENMP
+        tid = omp_get_thread_num();
+#endif
+        texture_one(src, dom, d, &L[k], &lv->prims[k], &lv->atlas, natlas, scratch + (size_t)tid * max_t);
+    }
+    asp__atlas_pad(&lv->atlas, lv->prims, np, d->padding);
+    if (natlas)
+        asp__atlas_pad(natlas, lv->prims, np, d->padding);
+
+    /* neighbours per domain row, renumbered to primitive indices (empty rows have none) */
+    size_t total = 0;
+    if ((rc = asp_prim_neighbours(dom, d->neighbour_fraction, ctx, first, &nbr, &total, err)))
+        goto done;
+    row_to_prim = asp_alloc(ctx, rows * sizeof *row_to_prim);
+    if (!row_to_prim) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu domain indices", rows);
+        goto done;
+    }
+    for (size_t k = 0; k < np; k++)
+        row_to_prim[L[k].row] = (uint32_t)k;
+    lv->neighbours = asp_alloc(ctx, (total ? total : 1) * sizeof *lv->neighbours);
+    if (!lv->neighbours) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu neighbour entries", total);
+        goto done;
+    }
+    lv->neighbour_total = total;
+    double esum = 0, pts = 0;
+    for (size_t k = 0; k < np; k++) {
+        asp_prim *P = &lv->prims[k];
+        size_t r = L[k].row;
+        P->neighbour_first = (uint32_t)first[r];
+        P->neighbour_count = (uint32_t)(first[r + 1] - first[r]);
+        for (size_t q = first[r]; q < first[r + 1]; q++)
+            lv->neighbours[q] = row_to_prim[nbr[q]]; /* rows increase with k, so lists stay sorted */
+        lv->texels += (uint64_t)P->tex_w * P->tex_h;
+        esum += (double)P->error * P->points;
+        pts += P->points;
+        lv->degenerate += (P->flags & ASP_PRIM_FLAG_DEGENERATE) != 0;
+        lv->capped += (P->flags & ASP_PRIM_FLAG_CAPPED) != 0;
+    }
+    lv->error = esum / pts;
+    lv->error_norm = lv->error / src->mean_radius;
+done:
+    asp_free(ctx, L);
+    asp_free(ctx, ws);
+    asp_free(ctx, first);
+    asp_free(ctx, nbr);
+    asp_free(ctx, row_to_prim);
+    asp_free(ctx, scratch);
+    return rc;
+}
+
+static int build_level(const asp_amg *amg, const build_src *src, size_t level, const asp_prim_desc *d,
+                       const asp_context *ctx, asp_dps_level *lv, asp_error *err)
+{
+    char name[32];
+    level_name(amg, level, name, sizeof name);
+    double t0 = asp_time_now();
+    asp_amg_csr *psi = NULL, *dom = NULL, *merged = NULL;
+    uint32_t *bfirst = NULL, *bcount = NULL;
+    int rc = asp_amg_basis(amg, level, ctx, &psi, err);
+    if (!rc)
+        rc = asp_amg_domains(psi, d->tau, ctx, &dom, err);
+    asp_amg_csr_destroy(psi);
+    if (rc)
+        return rc;
+    lv->level = (uint32_t)level;
+    lv->basis_count = (uint32_t)dom->rows;
+    lv->t_basis = asp_time_now() - t0;
+    double t1 = asp_time_now();
+    if (d->merge) {
+        rc = asp__prim_merge(dom, src->cloud->positions, src->cloud->normals, d->merge_flatness, d->merge_angle, ctx,
+                             &merged, &bfirst, &bcount, &lv->merges, err);
+        if (rc) {
+            asp_amg_csr_destroy(dom);
+            return rc;
+        }
+    }
+    rc = construct(src, merged ? merged : dom, bfirst, bcount, d, name, ctx, lv, err);
+    lv->t_construct = asp_time_now() - t1;
+    asp_amg_csr_destroy(dom);
+    asp_amg_csr_destroy(merged);
+    asp_free(ctx, bfirst);
+    asp_free(ctx, bcount);
+    if (rc)
+        release_level(ctx, lv);
+    return rc;
+}
+
+int asp_prim_level_for_budget(const asp_amg *amg, size_t max_prims, size_t *level, asp_error *err)
+{
+    if (!amg || !level || max_prims == 0)
+        return asp_error_set(err, ASP_EINVAL, "primitive budget must be at least 1");
+    size_t nl = asp_amg_level_count(amg);
+    for (size_t l = 0; l < nl; l++)
+        if (asp_amg_level_size(amg, l) <= max_prims) {
+            *level = l;
+            return 0;
+        }
+    *level = nl - 1;
+    return 0;
+}
+
+static int cmp_size(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+int asp_prim_build(const asp_amg *amg, const asp_cloud *attrs, const size_t *levels, size_t nlevels,
+                   const asp_prim_desc *desc, const char *source, const asp_context *ctx, asp_dps **out,
+                   asp_error *err)
+{
+    if (!amg || !levels || !out || nlevels == 0)
+        return asp_error_set(err, ASP_EINVAL, "asp_prim_build needs a decomposition and at least one level");
+    asp_prim_desc d;
+    resolve_desc(desc, &d);
+    int rc = check_desc(&d, err);
+    if (rc)
+        return rc;
+    const asp_cloud *cloud = asp_amg_cloud(amg);
+    size_t n = cloud->count, nl = asp_amg_level_count(amg);
+    if (attrs && attrs->count != n)
+        return asp_error_set(err, ASP_EINVAL, "attribute cloud has %zu points, the decomposition %zu", attrs->count, n);
+    for (size_t i = 0; i < nlevels; i++)
+        if (levels[i] >= nl)
+            return asp_error_set(err, ASP_EINVAL, "level %zu out of range: the decomposition has levels 0..%zu",
+                                 levels[i], nl - 1);
+    size_t *lv_sorted = asp_alloc(ctx, nlevels * sizeof *lv_sorted);
+    float *own_radii = NULL;
+    asp_dps *dps = asp_calloc(ctx, 1, sizeof *dps);
+    if (!lv_sorted || !dps) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory");
+        goto fail;
+    }
+    dps->ctx = ctx ? *ctx : (asp_context){0};
+    memcpy(lv_sorted, levels, nlevels * sizeof *lv_sorted);
+    qsort(lv_sorted, nlevels, sizeof *lv_sorted, cmp_size);
+    size_t nu = 0;
+    for (size_t i = 0; i < nlevels; i++)
+        if (nu == 0 || lv_sorted[i] != lv_sorted[nu - 1])
+            lv_sorted[nu++] = lv_sorted[i];
+
+    build_src src = {.cloud = cloud};
+    src.colors = attrs && attrs->colors ? attrs->colors : cloud->colors;
+    src.radii = attrs && attrs->radii ? attrs->radii : cloud->radii;
+    if (!src.radii) {
+        own_radii = asp_alloc(ctx, n * sizeof *own_radii);
+        if (!own_radii) {
+            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu radii", n);
+            goto fail;
+        }
+        if ((rc = asp_estimate_radii(cloud->positions, n, 12, NULL, own_radii, ctx, err)))
+            goto fail;
+        src.radii = own_radii;
+    }
+    double rs = 0; /* double: a float sum of 10^6 radii would lose digits */
+    for (size_t i = 0; i < n; i++)
+        rs += src.radii[i];
+    src.mean_radius = rs / (double)n;
+    if (!(src.mean_radius > 0) || !isfinite(src.mean_radius)) {
+        rc = asp_error_set(err, ASP_EDEGENERATE, "mean point radius is %g; expected a positive radius",
+                           src.mean_radius);
+        goto fail;
+    }
+    dps->levels = asp_calloc(ctx, nu, sizeof *dps->levels);
+    if (!dps->levels) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t i = 0; i < nu; i++) {
+        if ((rc = asp_progress(ctx, "primitives", (double)i / (double)nu))) {
+            asp_error_set(err, rc, "primitive construction canceled");
+            goto fail;
+        }
+        if ((rc = build_level(amg, &src, lv_sorted[i], &d, ctx, &dps->levels[i], err)))
+            goto fail;
+        dps->level_count = i + 1;
+    }
+    asp_progress(ctx, "primitives", 1.0);
+    dps->amg_levels = (uint32_t)nl;
+    dps->source_points = n;
+    dps->mean_radius = src.mean_radius;
+    dps->desc = d;
+    snprintf(dps->source, sizeof dps->source, "%s", source ? source : "");
+    *out = dps;
+    asp_free(ctx, lv_sorted);
+    asp_free(ctx, own_radii);
+    return 0;
+fail:
+    asp_dps_destroy(dps);
+    asp_free(ctx, lv_sorted);
+    asp_free(ctx, own_radii);
+    return rc;
+}
+
+void asp_dps_destroy(asp_dps *dps)
+{
+    if (!dps)
+        return;
+    asp_context ctx = dps->ctx;
+    for (size_t i = 0; i < dps->level_count; i++)
+        release_level(&ctx, &dps->levels[i]);
+    asp_free(&ctx, dps->levels);
+    asp_free(&ctx, dps);
+}

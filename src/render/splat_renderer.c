@@ -1,0 +1,545 @@
+/*
+ * Blended elliptical splats on the point-octree (Pajarola, Sainz, Guidotti
+ * 2003, seed 001): the kernel psi_E of section 4.2 on each selected surfel's
+ * ellipse, visibility splatting with an epsilon-z-buffer (5.3, Fig. 15),
+ * additive blending of (psi * colour, psi) (eq. 10), per-pixel normalisation
+ * (5.4, eq. 9) and Gouraud lighting with normal-cone offsets (5.2, Fig. 14).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "render/splat_internal.h"
+#include "util/banned.h"
+
+/*
+ * One triangle per splat (section 5.2, Fig. 13): the equilateral triangle
+ * around the kernel's support circle in ellipse coordinates, grown by 5% so
+ * the support never touches an edge. Otherwise a fragment on the rim could be
+ * rasterised by the offset triangle of pass 1 and not by the plain one of
+ * pass 2 (or the reverse), leaving a pixel with depth but no weight.
+ * u_lighting: 0 Gouraud with cone offsets, 1 per pixel, 2 flat, 3 unlit.
+ */
+static const char *vertex_src =
+    "#version 450 core\n" ASP__LOD_GLSL
+    "uniform mat4 u_view;\n"
+    "uniform mat4 u_proj;\n"
+    "uniform vec3 u_eye;\n"
+    "uniform vec3 u_light;\n"
+    "uniform float u_epsilon;\n"
+    "uniform float u_support;\n"
+    "uniform float u_radius_scale;\n"
+    "uniform uint u_node_count;\n"
+    "uniform int u_has_colors;\n"
+    "uniform vec4 u_default_color;\n"
+    "uniform int u_lighting;\n"
+    "uniform int u_unoriented;\n"
+    "out vec2 v_local;\n"
+    "out vec3 v_color;\n"
+    "out vec3 v_normal;\n"
+    "const vec2 corners[3] = vec2[3](vec2(-1.7320508, -1.0), vec2(1.7320508, -1.0), vec2(0.0, 2.0));\n"
+    "void main() {\n"
+    "    uint id = ids[gl_InstanceID];\n"
+    "    splat s = read_splat(id);\n"
+    "    float a = s.a * u_radius_scale, b = s.b * u_radius_scale;\n"
+    "    vec2 q = corners[gl_VertexID] * (1.05 * u_support);\n"
+    "    vec3 off = q.x * a * s.u + q.y * b * s.v;\n"
+    "    vec3 p = s.c + off;\n"
+    // Fig. 15: pass 1 moves the corners away from the eye along their projectors
+    "    vec3 ray = p - u_eye;\n"
+    "    if (u_epsilon > 0.0 && dot(ray, ray) > 0.0)\n"
+    "        p += (u_epsilon * a) * normalize(ray);\n"
+    "    v_local = q;\n"
+    "    gl_Position = u_proj * (u_view * vec4(p, 1.0));\n"
+    // PCA normals have no sign: face them to the eye. Oriented normals stay, so that blended
+    // normals of the front and back sides at a silhouette do not cancel into a frontal one
+    "    vec3 n = u_unoriented != 0 && dot(s.n, u_eye - s.c) < 0.0 ? -s.n : s.n;\n"
+    "    float theta = id < u_node_count && u_lighting < 2 ? cones[id] : 0.0;\n"
+    "    vec3 d = dot(off, off) > 0.0 ? normalize(off) : vec3(0.0);\n"
+    "    vec3 nc = normalize(cos(theta) * n + sin(theta) * d);\n"
+    "    v_normal = mat3(u_view) * nc;\n"
+    "    vec4 col = u_has_colors != 0 ? unpackUnorm4x8(s.color) : u_default_color;\n"
+    "    vec3 lin = srgb_to_linear(col.rgb);\n"
+    "    float shade = 0.25 + 0.75 * abs(dot(normalize(v_normal), u_light));\n"
+    "    v_color = u_lighting == 1 || u_lighting == 3 ? lin : lin * shade;\n"
+    "}\n";
+
+/*
+ * The support test per sample when multisampling (as the disc renderer: the
+ * shader runs at the pixel centre, which may lie outside a small splat), so
+ * both passes cover exactly the same samples.
+ */
+#define COVERAGE_GLSL                                                   \
+    "int coverage() {\n"                                                \
+    "    float s2 = u_support * u_support;\n"                           \
+    "    int mask = 0;\n"                                               \
+    "    if (gl_NumSamples > 1) {\n"                                    \
+    "        for (int i = 0; i < gl_NumSamples; i++) {\n"               \
+    "            vec2 q = interpolateAtSample(v_local, i);\n"           \
+    "            if (dot(q, q) <= s2)\n"                                \
+    "                mask |= 1 << i;\n"                                 \
+    "        }\n"                                                       \
+    "    } else if (dot(v_local, v_local) <= s2) {\n"                   \
+    "        mask = -1;\n"                                              \
+    "    }\n"                                                           \
+    "    return mask;\n"                                                \
+    "}\n"
+
+/* Pass 1 (section 5.3): depth only, the alpha test shaping the ellipse. */
+static const char *depth_fragment_src =
+    "#version 450 core\n"
+    "in vec2 v_local;\n"
+    "uniform float u_support;\n" COVERAGE_GLSL
+    "void main() {\n"
+    "    int mask = coverage();\n"
+    "    if (mask == 0)\n"
+    "        discard;\n"
+    "    gl_SampleMask[0] = mask;\n"
+    "}\n";
+
+/*
+ * Pass 2: psi_E (eq. 12) at the fragment's ellipse radius r, in units of the
+ * semi-axes (asp_splat_renderer_desc explains b). A sample inside the support
+ * whose pixel centre is outside gets the rim weight. Opaque mode writes the
+ * shaded colour straight into the caller's framebuffer instead.
+ */
+static const char *blend_fragment_src =
+    "#version 450 core\n"
+    "in vec2 v_local;\n"
+    "in vec3 v_color;\n"
+    "in vec3 v_normal;\n"
+    "uniform float u_support;\n"
+    "uniform float u_ka, u_kb, u_kn;\n"
+    "uniform int u_opaque;\n"
+    "layout(location = 0) out vec4 o_accum;\n"
+    "layout(location = 1) out vec4 o_normal;\n" COVERAGE_GLSL
+    "void main() {\n"
+    "    int mask = coverage();\n"
+    "    if (mask == 0)\n"
+    "        discard;\n"
+    "    gl_SampleMask[0] = mask;\n"
+    "    if (u_opaque != 0) {\n"
+    "        o_accum = vec4(v_color, 1.0);\n"
+    "        o_normal = vec4(0.0);\n"
+    "        return;\n"
+    "    }\n"
+    "    float r = min(length(v_local), u_support);\n"
+    "    float w = exp(-u_ka * pow(r / u_kb, u_kn));\n"
+    "    o_accum = vec4(w * v_color, w);\n"
+    "    o_normal = vec4(w * v_normal, w);\n"
+    "}\n";
+
+static const char *resolve_vertex_src =
+    "#version 450 core\n"
+    "void main() {\n"
+    "    vec2 p = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID & 2) * 2 - 1));\n"
+    "    gl_Position = vec4(p, 0.0, 1.0);\n"
+    "}\n";
+
+/*
+ * Pass 3 (section 5.4): colour = sum(psi c) / sum(psi); with per-pixel
+ * lighting the blended normal is lit here. Pixels without weight keep the
+ * caller's background. The pass-1 depth goes along so the image has a depth
+ * buffer like the other renderers'. Multisampled targets are resolved per
+ * sample (gl_SampleID), so silhouettes keep their antialiasing.
+ */
+#define RESOLVE_GLSL                                                                         \
+    "uniform vec3 u_light;\n"                                                                \
+    "uniform int u_pixel_light;\n"                                                           \
+    "layout(location = 0) out vec4 o_color;\n"                                               \
+    "void main() {\n"                                                                        \
+    "    ivec2 p = ivec2(gl_FragCoord.xy);\n"                                                \
+    "    vec4 acc = FETCH(u_accum);\n"                                                       \
+    "    if (!(acc.a > 0.0))\n"                                                              \
+    "        discard;\n"                                                                     \
+    "    vec3 c = acc.rgb / acc.a;\n"                                                        \
+    "    if (u_pixel_light != 0) {\n"                                                        \
+    "        vec3 n = FETCH(u_normal).xyz;\n"                                                \
+    "        float lambert = dot(n, n) > 0.0 ? abs(dot(normalize(n), u_light)) : 1.0;\n"     \
+    "        c *= 0.25 + 0.75 * lambert;\n"                                                  \
+    "    }\n"                                                                                \
+    "    gl_FragDepth = FETCH(u_depth).r;\n"                                                 \
+    "    o_color = vec4(c, 1.0);\n"                                                          \
+    "}\n"
+
+static const char *resolve_fragment_src[2] = {
+    "#version 450 core\n"
+    "#define FETCH(t) texelFetch(t, p, 0)\n"
+    "layout(binding = 0) uniform sampler2D u_accum;\n"
+    "layout(binding = 1) uniform sampler2D u_normal;\n"
+    "layout(binding = 2) uniform sampler2D u_depth;\n" RESOLVE_GLSL,
+    "#version 450 core\n"
+    "#define FETCH(t) texelFetch(t, p, gl_SampleID)\n"
+    "layout(binding = 0) uniform sampler2DMS u_accum;\n"
+    "layout(binding = 1) uniform sampler2DMS u_normal;\n"
+    "layout(binding = 2) uniform sampler2DMS u_depth;\n" RESOLVE_GLSL};
+
+enum { U_VIEW, U_PROJ, U_EYE, U_LIGHT, U_EPSILON, U_SUPPORT, U_RADIUS_SCALE, U_NODE_COUNT, U_HAS_COLORS,
+       U_DEFAULT_COLOR, U_LIGHTING, U_KA, U_KB, U_KN, U_OPAQUE, U_UNORIENTED, U_COUNT };
+static const char *uniform_names[U_COUNT] = {"u_view", "u_proj", "u_eye", "u_light", "u_epsilon", "u_support",
+                                             "u_radius_scale", "u_node_count", "u_has_colors", "u_default_color",
+                                             "u_lighting", "u_ka", "u_kb", "u_kn", "u_opaque",
+                                             "u_unoriented"};
+enum { PROG_DEPTH, PROG_BLEND, PROG_COUNT };
+
+/* The float accumulation target of passes 1 and 2, kept while size and samples stay. */
+typedef struct accum_target {
+    uint32_t width, height, samples;
+    int with_normals;
+    asp__gl_framebuffer fbo;
+    GLuint color, normal, depth; /* textures */
+} accum_target;
+
+typedef struct splat_renderer {
+    asp_renderer base; // first two members as asp__lod_renderer
+    asp__lod lod;
+    asp__gl_program programs[PROG_COUNT];
+    GLint uniforms[PROG_COUNT][U_COUNT];
+    asp__gl_program resolve[2]; // single-sample, multisample; built when first needed
+    GLint resolve_light[2], resolve_pixel_light[2];
+    asp__gl_vertex_array vao; // no attributes: everything comes from storage buffers
+    accum_target acc;
+    float ka, kb, kn, epsilon, support, radius_scale;
+    asp_splat_lighting lighting;
+    asp_splat_mode mode;
+} splat_renderer;
+
+static void accum_release(accum_target *t)
+{
+    if (t->fbo.id)
+        glDeleteFramebuffers(1, &t->fbo.id);
+    GLuint tex[3] = {t->color, t->normal, t->depth};
+    for (int i = 0; i < 3; i++)
+        if (tex[i])
+            glDeleteTextures(1, &tex[i]);
+    memset(t, 0, sizeof *t);
+}
+
+static GLuint make_texture(uint32_t w, uint32_t h, uint32_t samples, GLenum format)
+{
+    GLuint tex = 0;
+    if (samples > 1) {
+        glCreateTextures(GL_TEXTURE_2D_MULTISAMPLE, 1, &tex);
+        glTextureStorage2DMultisample(tex, (GLsizei)samples, format, (GLsizei)w, (GLsizei)h, GL_TRUE);
+    } else {
+        glCreateTextures(GL_TEXTURE_2D, 1, &tex);
+        glTextureStorage2D(tex, 1, format, (GLsizei)w, (GLsizei)h);
+    }
+    return tex;
+}
+
+/*
+ * RGBA32F: the weights of a pixel can be as small as the rim weight times a
+ * dark linear colour (1e-4 and less), and a 1M-point cut piles hundreds of
+ * splats on a pixel of a distant view; half floats would lose the 8-bit result.
+ */
+static int accum_ensure(asp_gl_context *gl, accum_target *t, uint32_t w, uint32_t h, uint32_t samples,
+                        int with_normals, asp_error *err)
+{
+    if (t->fbo.id && t->width == w && t->height == h && t->samples == samples && t->with_normals == with_normals)
+        return 0;
+    accum_release(t);
+    asp__gl_clear_errors(gl);
+    t->color = make_texture(w, h, samples, GL_RGBA32F);
+    if (with_normals)
+        t->normal = make_texture(w, h, samples, GL_RGBA16F);
+    t->depth = make_texture(w, h, samples, GL_DEPTH_COMPONENT32F);
+    glCreateFramebuffers(1, &t->fbo.id);
+    glNamedFramebufferTexture(t->fbo.id, GL_COLOR_ATTACHMENT0, t->color, 0);
+    if (with_normals)
+        glNamedFramebufferTexture(t->fbo.id, GL_COLOR_ATTACHMENT1, t->normal, 0);
+    glNamedFramebufferTexture(t->fbo.id, GL_DEPTH_ATTACHMENT, t->depth, 0);
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(t->fbo.id, with_normals ? 2 : 1, bufs);
+    int rc = asp__gl_check(gl, "create the splat accumulation target", err);
+    if (!rc) {
+        GLenum status = glCheckNamedFramebufferStatus(t->fbo.id, GL_DRAW_FRAMEBUFFER);
+        if (status != GL_FRAMEBUFFER_COMPLETE)
+            rc = asp_error_set(err, ASP_EGL, "cannot create the splat accumulation framebuffer: status 0x%04x",
+                               (unsigned)status);
+    }
+    if (rc) {
+        accum_release(t);
+        return rc;
+    }
+    t->width = w;
+    t->height = h;
+    t->samples = samples;
+    t->with_normals = with_normals;
+    return 0;
+}
+
+static void splat_destroy(asp_renderer *base)
+{
+    splat_renderer *s = (splat_renderer *)base;
+    accum_release(&s->acc);
+    for (int i = 0; i < PROG_COUNT; i++)
+        asp__gl_program_destroy(&s->programs[i]);
+    for (int i = 0; i < 2; i++)
+        asp__gl_program_destroy(&s->resolve[i]);
+    if (s->vao.id)
+        glDeleteVertexArrays(1, &s->vao.id);
+    asp_context actx = base->gl->actx;
+    asp__lod_release(&actx, &s->lod);
+    asp_free(&actx, s);
+}
+
+static int lighting_code(const splat_renderer *s, const asp__frame *f)
+{
+    if (f->flags & ASP_RENDER_UNLIT)
+        return 3;
+    // per-pixel lighting needs the resolve pass; opaque splats have none, so they get Gouraud
+    if (s->lighting == ASP_SPLAT_LIGHT_PIXEL && s->mode == ASP_SPLAT_OPAQUE)
+        return 0;
+    return (int)s->lighting;
+}
+
+static void set_frame_uniforms(splat_renderer *s, int prog, const asp__frame *f, float epsilon, int opaque)
+{
+    GLuint p = s->programs[prog].id;
+    const GLint *u = s->uniforms[prog];
+    glProgramUniformMatrix4fv(p, u[U_VIEW], 1, GL_FALSE, f->view);
+    glProgramUniformMatrix4fv(p, u[U_PROJ], 1, GL_FALSE, f->proj);
+    glProgramUniform3fv(p, u[U_EYE], 1, f->eye);
+    glProgramUniform3fv(p, u[U_LIGHT], 1, f->light_eye);
+    glProgramUniform1f(p, u[U_EPSILON], epsilon);
+    glProgramUniform1i(p, u[U_LIGHTING], lighting_code(s, f));
+    glProgramUniform1i(p, u[U_OPAQUE], opaque);
+}
+
+static void draw_splats(splat_renderer *s, int prog)
+{
+    glUseProgram(s->programs[prog].id);
+    glBindVertexArray(s->vao.id);
+    glDrawArraysInstanced(GL_TRIANGLES, 0, 3, (GLsizei)s->lod.count);
+}
+
+static int ensure_resolve(splat_renderer *s, int ms, asp_error *err)
+{
+    if (s->resolve[ms].id)
+        return 0;
+    int rc = asp__gl_program_create(s->base.gl, ms ? "splat resolve (multisample)" : "splat resolve",
+                                    resolve_vertex_src, resolve_fragment_src[ms], &s->resolve[ms], err);
+    if (rc)
+        return rc;
+    s->resolve_light[ms] = glGetUniformLocation(s->resolve[ms].id, "u_light");
+    s->resolve_pixel_light[ms] = glGetUniformLocation(s->resolve[ms].id, "u_pixel_light");
+    return 0;
+}
+
+/* Samples of the caller's draw framebuffer, which the accumulation target matches when it can. */
+static uint32_t target_samples(const asp_gl_context *gl)
+{
+    GLint samples = 0, max_color = 1, max_depth = 1;
+    glGetIntegerv(GL_SAMPLES, &samples);
+    glGetIntegerv(GL_MAX_COLOR_TEXTURE_SAMPLES, &max_color);
+    glGetIntegerv(GL_MAX_DEPTH_TEXTURE_SAMPLES, &max_depth);
+    (void)gl;
+    // a per-sample resolve needs equal counts; otherwise accumulate per pixel
+    if (samples > 1 && samples <= max_color && samples <= max_depth)
+        return (uint32_t)samples;
+    return 1;
+}
+
+static void restore_state(GLint fbo)
+{
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)fbo);
+    glDisable(GL_BLEND);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glBindVertexArray(0);
+    glUseProgram(0);
+}
+
+static int draw_blended(splat_renderer *s, const asp__frame *f, GLint caller_fbo, asp_error *err)
+{
+    asp_gl_context *gl = s->base.gl;
+    int pixel_light = lighting_code(s, f) == 1;
+    uint32_t samples = target_samples(gl);
+    int ms = samples > 1;
+    int rc = accum_ensure(gl, &s->acc, f->width, f->height, samples, pixel_light, err);
+    if (!rc)
+        rc = ensure_resolve(s, ms, err);
+    if (rc)
+        return rc;
+    static const GLfloat zero[4] = {0, 0, 0, 0};
+    const GLfloat far_depth = 1.0f;
+    // clears obey the write masks
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    glClearNamedFramebufferfv(s->acc.fbo.id, GL_COLOR, 0, zero);
+    if (pixel_light)
+        glClearNamedFramebufferfv(s->acc.fbo.id, GL_COLOR, 1, zero);
+    glClearNamedFramebufferfv(s->acc.fbo.id, GL_DEPTH, 0, &far_depth);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, s->acc.fbo.id);
+
+    // pass 1: the epsilon-offset depth of the visible surface
+    set_frame_uniforms(s, PROG_DEPTH, f, s->epsilon, 0);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    draw_splats(s, PROG_DEPTH);
+
+    // pass 2: every splat within epsilon of it adds (psi c, psi); depth read-only
+    set_frame_uniforms(s, PROG_BLEND, f, 0.0f, 0);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_LEQUAL);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    draw_splats(s, PROG_BLEND);
+
+    // pass 3: normalise into the caller's framebuffer
+    glDisable(GL_BLEND);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)caller_fbo);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    GLuint rp = s->resolve[ms].id;
+    glProgramUniform3fv(rp, s->resolve_light[ms], 1, f->light_eye);
+    glProgramUniform1i(rp, s->resolve_pixel_light[ms], pixel_light);
+    glBindTextureUnit(0, s->acc.color);
+    glBindTextureUnit(1, pixel_light ? s->acc.normal : s->acc.color);
+    glBindTextureUnit(2, s->acc.depth);
+    glUseProgram(rp);
+    glBindVertexArray(s->vao.id);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    for (GLuint unit = 0; unit < 3; unit++)
+        glBindTextureUnit(unit, 0);
+    return 0;
+}
+
+static int splat_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
+{
+    splat_renderer *s = (splat_renderer *)base;
+    GLint caller_fbo = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &caller_fbo);
+    int rc = asp__lod_select((asp__lod_renderer *)s, f, err);
+    if (rc)
+        return rc;
+    if (s->lod.count == 0)
+        return 0; // everything culled: the background stays
+    if (s->mode == ASP_SPLAT_OPAQUE) {
+        set_frame_uniforms(s, PROG_BLEND, f, 0.0f, 1);
+        draw_splats(s, PROG_BLEND);
+    } else {
+        rc = draw_blended(s, f, caller_fbo, err);
+    }
+    restore_state(caller_fbo);
+    if (rc)
+        return rc;
+    return asp__gl_check(base->gl, "draw splats", err);
+}
+
+const asp__renderer_vtable asp__splat_vtable = {"splat", splat_draw, splat_destroy};
+
+static void set_static_uniforms(splat_renderer *s)
+{
+    for (int i = 0; i < PROG_COUNT; i++) {
+        GLuint p = s->programs[i].id;
+        const GLint *u = s->uniforms[i];
+        glProgramUniform1f(p, u[U_SUPPORT], s->support);
+        glProgramUniform1f(p, u[U_RADIUS_SCALE], s->radius_scale);
+        glProgramUniform1ui(p, u[U_NODE_COUNT], (GLuint)s->lod.nodes);
+        glProgramUniform1i(p, u[U_HAS_COLORS], s->lod.has_colors);
+        glProgramUniform4fv(p, u[U_DEFAULT_COLOR], 1, s->lod.default_color);
+        glProgramUniform1f(p, u[U_KA], s->ka);
+        glProgramUniform1f(p, u[U_KB], s->kb);
+        glProgramUniform1f(p, u[U_KN], s->kn);
+        glProgramUniform1i(p, u[U_UNORIENTED], (asp_hier_flags(s->lod.hier) & ASP_HIER_UNORIENTED) != 0);
+    }
+}
+
+static int check_desc(const asp_splat_renderer_desc *d, asp_error *err)
+{
+    const struct {
+        const char *name;
+        float v;
+    } opts[] = {{"kernel_a", d->kernel_a}, {"kernel_b", d->kernel_b}, {"kernel_n", d->kernel_n},
+                {"tolerance", d->tolerance}, {"radius_scale", d->radius_scale}};
+    for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
+        int rc = asp__lod_check_option("splat", opts[i].name, opts[i].v, err);
+        if (rc)
+            return rc;
+    }
+    if (!isfinite(d->epsilon))
+        return asp_error_set(err, ASP_EINVAL, "splat renderer option epsilon = %g is not finite", (double)d->epsilon);
+    if ((unsigned)d->lighting > ASP_SPLAT_LIGHT_FLAT)
+        return asp_error_set(err, ASP_EINVAL, "unknown splat lighting mode %d (expected 0..2)", (int)d->lighting);
+    if ((unsigned)d->mode > ASP_SPLAT_OPAQUE)
+        return asp_error_set(err, ASP_EINVAL, "unknown splat mode %d (expected 0..1)", (int)d->mode);
+    return 0;
+}
+
+static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hier, const asp_splat_renderer_desc *desc,
+                  asp_renderer **out, asp_error *err)
+{
+    static const asp_splat_renderer_desc zero_desc;
+    if (!desc)
+        desc = &zero_desc;
+    int rc = check_desc(desc, err);
+    if (rc)
+        return rc;
+    rc = asp__gl_ensure_current(gl, err);
+    if (rc)
+        return rc;
+    splat_renderer *s = asp_calloc(&gl->actx, 1, sizeof *s);
+    if (!s)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for a splat renderer");
+    rc = asp__lod_prepare(&s->lod, cloud, hier, &desc->hier, desc->ctx, desc->tolerance, desc->flags,
+                          desc->default_color, err);
+    if (rc) {
+        asp_free(&gl->actx, s);
+        return rc;
+    }
+    s->base.vt = &asp__splat_vtable;
+    s->base.gl = gl;
+    s->base.count = s->lod.count;
+    s->ka = desc->kernel_a > 0 ? desc->kernel_a : 6.0f;
+    s->kb = desc->kernel_b > 0 ? desc->kernel_b : 1.5f;
+    s->kn = desc->kernel_n > 0 ? desc->kernel_n : 3.0f;
+    // the ellipse is the surfel's support (4.1); b < 1 narrows it to the kernel's own
+    s->support = fminf(s->kb, 1.0f);
+    s->epsilon = desc->epsilon > 0 ? desc->epsilon : desc->epsilon < 0 ? 0.0f : 1.0f;
+    s->radius_scale = desc->radius_scale > 0 ? desc->radius_scale : 1.0f;
+    s->lighting = desc->lighting;
+    s->mode = desc->mode;
+
+    rc = asp__gl_program_create(gl, "splat depth", vertex_src, depth_fragment_src, &s->programs[PROG_DEPTH], err);
+    if (!rc)
+        rc = asp__gl_program_create(gl, "splat blend", vertex_src, blend_fragment_src, &s->programs[PROG_BLEND],
+                                    err);
+    if (!rc)
+        rc = asp__lod_upload(gl, &s->lod, "splat", err);
+    if (rc) {
+        splat_destroy(&s->base);
+        return rc;
+    }
+    for (int i = 0; i < PROG_COUNT; i++)
+        for (int j = 0; j < U_COUNT; j++)
+            s->uniforms[i][j] = glGetUniformLocation(s->programs[i].id, uniform_names[j]);
+    glCreateVertexArrays(1, &s->vao.id);
+    set_static_uniforms(s);
+    rc = asp__gl_check(gl, "create the splat renderer", err);
+    if (rc) {
+        splat_destroy(&s->base);
+        return rc;
+    }
+    *out = &s->base;
+    return 0;
+}
+
+int asp_splat_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_splat_renderer_desc *desc,
+                              asp_renderer **out, asp_error *err)
+{
+    return create(gl, cloud, NULL, desc, out, err);
+}
+
+int asp_splat_renderer_create_hier(asp_gl_context *gl, const asp_hier *hier, const asp_splat_renderer_desc *desc,
+                                   asp_renderer **out, asp_error *err)
+{
+    return create(gl, NULL, hier, desc, out, err);
+}

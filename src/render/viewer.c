@@ -1,0 +1,728 @@
+/*
+ * The interactive viewer behind `amgsplat view`: a GLFW window, an orbit
+ * camera driven by the mouse, keys that switch renderers (opaque discs,
+ * Pajarola et al. 2003 section 5; splats and squares, seed 004 3.2.6), the
+ * screen tolerance and the .amg colouring, and a scripted mode for tests.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "render/internal.h"
+#include "render/viewer_internal.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include "util/banned.h"
+
+/* ---- renderer kinds: one row each; the 1..9 keys pick them in this order ---- */
+
+typedef struct viewer viewer;
+
+typedef struct renderer_kind {
+    const char *name;
+    unsigned inputs; /* asp__viewer_input_bits it draws */
+    int has_lod;     /* draws a cut of the point hierarchy: tau matters (asp_renderer_set_lod) */
+    int (*create)(viewer *v, asp_renderer **out, asp_error *err);
+} renderer_kind;
+
+static int make_disc(viewer *v, asp_renderer **out, asp_error *err);
+static int make_splat(viewer *v, asp_renderer **out, asp_error *err);
+static int make_square(viewer *v, asp_renderer **out, asp_error *err);
+
+enum { INPUT_CLOUDS = ASP__VIEWER_INPUT_POINTS | ASP__VIEWER_INPUT_AMG };
+
+static const renderer_kind renderer_kinds[] = {
+    {"disc", INPUT_CLOUDS, 0, make_disc},
+    {"splat", INPUT_CLOUDS, 1, make_splat},
+    {"square", INPUT_CLOUDS, 1, make_square},
+};
+enum { N_RENDERER_KINDS = sizeof renderer_kinds / sizeof renderer_kinds[0] };
+
+const char *asp_viewer_renderer_name(size_t i)
+{
+    return i < N_RENDERER_KINDS ? renderer_kinds[i].name : NULL;
+}
+
+static size_t find_renderer(const char *name)
+{
+    for (size_t i = 0; i < N_RENDERER_KINDS; i++)
+        if (strcmp(renderer_kinds[i].name, name) == 0)
+            return i;
+    return N_RENDERER_KINDS;
+}
+
+/* ---- options ---- */
+
+enum { MAX_SIDE = 16384, QUEUE_CAP = 64, LOG_CAP = 512 };
+
+static int ends_with_png(const char *path)
+{
+    size_t n = strlen(path);
+    if (n < 4)
+        return 0;
+    const char *e = path + n - 4;
+    return e[0] == '.' && (e[1] | 32) == 'p' && (e[2] | 32) == 'n' && (e[3] | 32) == 'g';
+}
+
+int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err)
+{
+    if (desc->width > MAX_SIDE || desc->height > MAX_SIDE)
+        return asp_error_set(err, ASP_EINVAL, "window size %ux%u is outside 1..%d", desc->width, desc->height,
+                             MAX_SIDE);
+    if (desc->renderer && find_renderer(desc->renderer) == N_RENDERER_KINDS) {
+        char names[128] = "";
+        size_t len = 0;
+        for (size_t i = 0; i < N_RENDERER_KINDS && len < sizeof names; i++)
+            len += (size_t)snprintf(names + len, sizeof names - len, "%s%s", i ? ", " : "", renderer_kinds[i].name);
+        return asp_error_set(err, ASP_EINVAL, "unknown renderer '%s' (expected %s)", desc->renderer, names);
+    }
+    if (!(desc->tolerance >= 0) || !isfinite(desc->tolerance))
+        return asp_error_set(err, ASP_EINVAL, "tolerance %g is not a number of pixels >= 0", desc->tolerance);
+    if (desc->set_view && (!isfinite(desc->azimuth) || !(desc->elevation >= -90 && desc->elevation <= 90) ||
+                           !(desc->distance >= 0) || !isfinite(desc->distance)))
+        return asp_error_set(err, ASP_EINVAL,
+                             "view %g,%g,%g is invalid (expected EL in -90..90 and DIST >= 0 radii)", desc->azimuth,
+                             desc->elevation, desc->distance);
+    int rc = asp__viewer_scene_check_desc(desc, err);
+    if (rc)
+        return rc;
+    if (desc->keys) {
+        for (const char *k = desc->keys; *k; k++)
+            if (!asp__viewer_key_find((unsigned char)*k))
+                return asp_error_set(err, ASP_EINVAL, "key '%c' (character %zu of '%s') is not a viewer key", *k,
+                                     (size_t)(k - desc->keys) + 1, desc->keys);
+        if (desc->frames > 0 && strlen(desc->keys) > desc->frames)
+            return asp_error_set(err, ASP_EINVAL, "%zu keys need at least as many frames, got %zu",
+                                 strlen(desc->keys), desc->frames);
+    }
+    if (desc->screenshot && desc->frames == 0)
+        return asp_error_set(err, ASP_EINVAL, "a screenshot file needs a number of frames (scripted mode)");
+    if (desc->screenshot && !ends_with_png(desc->screenshot))
+        return asp_error_set(err, ASP_EINVAL, "screenshot '%s' must end in .png", desc->screenshot);
+    return 0;
+}
+
+/* ---- viewer state ---- */
+
+typedef struct action {
+    enum asp__viewer_action what;
+    int arg;
+} action;
+
+struct viewer {
+    const asp_viewer_desc *desc;
+    const char *path;
+    asp__viewer_scene scene;
+    asp_gl_context *gl;
+    GLFWwindow *window;
+    asp_renderer *r;
+    size_t kind;           /* index into renderer_kinds of r */
+    asp_hier *hier;        /* point hierarchy of scene.cloud, built when a renderer first needs it */
+    float tolerance;
+    int unlit;
+    asp_camera cam;
+    int quit;
+    int dirty;             /* something changed: draw a frame */
+    int screenshot_wanted; /* the s key: save after the next draw */
+    unsigned screenshot_seq;
+    /* mouse */
+    int buttons;           /* bit per GLFW mouse button held */
+    int shift;
+    double mx, my;
+    /* keys pressed in callbacks, applied by the loop (which can report errors) */
+    action queue[QUEUE_CAP];
+    size_t queued;
+    /* statistics */
+    size_t frames;
+    double total_ms, last_ms;
+    double window_start;   /* verbose: start of the current one-second window */
+    size_t window_frames;
+    double window_ms;
+    double title_time;
+    asp_viewer_stats stats;
+};
+
+static void vlog(const viewer *v, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static void vlog(const viewer *v, const char *fmt, ...)
+{
+    if (!v->desc->log)
+        return;
+    char line[LOG_CAP];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    v->desc->log(v->desc->log_user, line);
+}
+
+static void push(viewer *v, enum asp__viewer_action what, int arg)
+{
+    if (v->queued < QUEUE_CAP)
+        v->queue[v->queued++] = (action){what, arg};
+}
+
+/* ---- camera ---- */
+
+static void reset_view(viewer *v)
+{
+    const asp_viewer_desc *d = v->desc;
+    float aspect = v->cam.aspect > 0 ? v->cam.aspect : 1.0f;
+    asp_camera_init(&v->cam);
+    v->cam.azimuth = d->set_view ? d->azimuth : 30.0f;
+    v->cam.elevation = d->set_view ? d->elevation : 20.0f;
+    // the same framing as amgsplat render, so a scripted view matches its --view
+    asp_camera_fit(&v->cam, v->scene.center, v->scene.radius, aspect);
+    if (d->set_view && d->distance > 0)
+        v->cam.distance = d->distance * v->scene.radius;
+    asp_camera_clip_to_sphere(&v->cam, v->scene.center, v->scene.radius);
+    v->dirty = 1;
+}
+
+/* ---- GLFW callbacks: they only record input; the loop acts on it ---- */
+
+static viewer *from_window(GLFWwindow *w)
+{
+    return glfwGetWindowUserPointer(w);
+}
+
+static void on_char(GLFWwindow *w, unsigned codepoint)
+{
+    viewer *v = from_window(w);
+    const asp__viewer_key *k = asp__viewer_key_find(codepoint);
+    if (k)
+        push(v, k->action, k->arg);
+}
+
+static void on_key(GLFWwindow *w, int key, int scancode, int act, int mods)
+{
+    (void)scancode;
+    viewer *v = from_window(w);
+    v->shift = (mods & GLFW_MOD_SHIFT) != 0;
+    if (act == GLFW_RELEASE)
+        return;
+    // keys without a character; printable keys arrive through on_char (layout-aware)
+    static const struct {
+        int key;
+        enum asp__viewer_action what;
+    } special[] = {
+        {GLFW_KEY_ESCAPE, ASP__VIEWER_QUIT},        {GLFW_KEY_TAB, ASP__VIEWER_NEXT_RENDERER},
+        {GLFW_KEY_HOME, ASP__VIEWER_RESET},         {GLFW_KEY_F1, ASP__VIEWER_HELP},
+        {GLFW_KEY_LEFT, ASP__VIEWER_ORBIT_LEFT},    {GLFW_KEY_RIGHT, ASP__VIEWER_ORBIT_RIGHT},
+        {GLFW_KEY_UP, ASP__VIEWER_ORBIT_UP},        {GLFW_KEY_DOWN, ASP__VIEWER_ORBIT_DOWN},
+        {GLFW_KEY_PAGE_UP, ASP__VIEWER_ZOOM_IN},    {GLFW_KEY_PAGE_DOWN, ASP__VIEWER_ZOOM_OUT},
+    };
+    for (size_t i = 0; i < sizeof special / sizeof special[0]; i++)
+        if (special[i].key == key && (act == GLFW_PRESS || key != GLFW_KEY_ESCAPE))
+            push(v, special[i].what, 0);
+}
+
+static void on_button(GLFWwindow *w, int button, int act, int mods)
+{
+    viewer *v = from_window(w);
+    if (button < 0 || button > 7)
+        return;
+    v->shift = (mods & GLFW_MOD_SHIFT) != 0;
+    if (act == GLFW_PRESS)
+        v->buttons |= 1 << button;
+    else
+        v->buttons &= ~(1 << button);
+    glfwGetCursorPos(w, &v->mx, &v->my);
+}
+
+static void on_cursor(GLFWwindow *w, double x, double y)
+{
+    viewer *v = from_window(w);
+    double dx = x - v->mx, dy = y - v->my;
+    v->mx = x;
+    v->my = y;
+    int left = v->buttons & (1 << GLFW_MOUSE_BUTTON_LEFT), right = v->buttons & (1 << GLFW_MOUSE_BUTTON_RIGHT);
+    int middle = v->buttons & (1 << GLFW_MOUSE_BUTTON_MIDDLE);
+    if (middle || (left && v->shift)) {
+        int ww = 0, wh = 0;
+        glfwGetWindowSize(w, &ww, &wh); // cursor positions are in screen units, not framebuffer pixels
+        asp__viewer_pan(&v->cam, dx, dy, wh > 0 ? (uint32_t)wh : 1);
+    } else if (left) {
+        asp__viewer_orbit(&v->cam, dx, dy);
+    } else if (right) {
+        asp__viewer_dolly(&v->cam, exp(0.01 * dy), v->scene.radius); // drag up to come closer
+    } else {
+        return;
+    }
+    v->dirty = 1;
+}
+
+static void on_scroll(GLFWwindow *w, double xoff, double yoff)
+{
+    (void)xoff;
+    viewer *v = from_window(w);
+    asp__viewer_dolly(&v->cam, pow(0.85, yoff), v->scene.radius);
+    v->dirty = 1;
+}
+
+static void on_redraw(GLFWwindow *w)
+{
+    from_window(w)->dirty = 1;
+}
+
+static void on_resize(GLFWwindow *w, int width, int height)
+{
+    (void)width;
+    (void)height;
+    from_window(w)->dirty = 1;
+}
+
+/* ---- renderers ---- */
+
+static int make_disc(viewer *v, asp_renderer **out, asp_error *err)
+{
+    return asp_disc_renderer_create(v->gl, v->scene.cloud, &(asp_disc_renderer_desc){.radius_scale = 1}, out, err);
+}
+
+/* The splat and square renderers share one hierarchy, so switching between them is instant. */
+static int ensure_hier(viewer *v, asp_error *err)
+{
+    if (v->hier)
+        return 0;
+    double t0 = asp_time_now();
+    int rc = asp_hier_build(v->scene.cloud, NULL, &v->scene.ctx, &v->hier, err);
+    if (rc)
+        return rc;
+    vlog(v, "built the point hierarchy: %zu nodes over %zu points in %.2f s", asp_hier_node_count(v->hier),
+         asp_hier_point_count(v->hier), asp_time_now() - t0);
+    return 0;
+}
+
+static int make_splat(viewer *v, asp_renderer **out, asp_error *err)
+{
+    int rc = ensure_hier(v, err);
+    if (rc)
+        return rc;
+    return asp_splat_renderer_create_hier(v->gl, v->hier, &(asp_splat_renderer_desc){.tolerance = v->tolerance},
+                                          out, err);
+}
+
+static int make_square(viewer *v, asp_renderer **out, asp_error *err)
+{
+    int rc = ensure_hier(v, err);
+    if (rc)
+        return rc;
+    return asp_square_renderer_create_hier(v->gl, v->hier, &(asp_square_renderer_desc){.tolerance = v->tolerance},
+                                           out, err);
+}
+
+static int kind_accepts(const viewer *v, size_t k)
+{
+    return (renderer_kinds[k].inputs & v->scene.kind->bit) != 0;
+}
+
+/* Makes renderer kind k for the scene; replaces the current one only on success. */
+static int switch_renderer(viewer *v, size_t k, asp_error *err)
+{
+    if (!kind_accepts(v, k))
+        return asp_error_set(err, ASP_EUNSUPPORTED, "renderer '%s' cannot draw %s input", renderer_kinds[k].name,
+                             v->scene.kind->name);
+    asp_renderer *r = NULL;
+    int rc = renderer_kinds[k].create(v, &r, err);
+    if (rc)
+        return rc;
+    asp_renderer_destroy(v->r);
+    v->r = r;
+    v->kind = k;
+    v->dirty = 1;
+    return 0;
+}
+
+/*
+ * After the scene's points changed (new colours): the current renderer is
+ * made again from them, with a new hierarchy if it needs one. The old renderer
+ * and hierarchy stay in use until the new ones exist.
+ */
+static int rebuild_renderer(viewer *v, asp_error *err)
+{
+    asp_hier *old_hier = v->hier;
+    v->hier = NULL;
+    int rc = switch_renderer(v, v->kind, err);
+    if (rc) {
+        asp_hier_destroy(v->hier);
+        v->hier = old_hier;
+        return rc;
+    }
+    asp_hier_destroy(old_hier); // the old renderer that referenced it is gone
+    return 0;
+}
+
+/* Interactive switch: a renderer that cannot be made is reported and skipped, never fatal. */
+static void try_renderer(viewer *v, size_t k)
+{
+    asp_error e = {0, ""};
+    if (switch_renderer(v, k, &e))
+        vlog(v, "renderer '%s' unavailable: %s", renderer_kinds[k].name, e.msg);
+}
+
+static void next_renderer(viewer *v)
+{
+    for (size_t step = 1; step < N_RENDERER_KINDS; step++) {
+        size_t k = (v->kind + step) % N_RENDERER_KINDS;
+        if (!kind_accepts(v, k))
+            continue;
+        asp_error e = {0, ""};
+        if (switch_renderer(v, k, &e) == 0)
+            return;
+        vlog(v, "renderer '%s' unavailable: %s", renderer_kinds[k].name, e.msg);
+    }
+    vlog(v, "no other renderer for this input; still '%s'", renderer_kinds[v->kind].name);
+}
+
+/* ---- actions ---- */
+
+static void print_help(const viewer *v)
+{
+    vlog(v, "mouse: left drag orbit, wheel or right drag zoom, middle drag or shift + left drag pan");
+    for (const asp__viewer_key *k = asp__viewer_keys; k->key; k++) {
+        if (!k->help)
+            continue;
+        if (k->action == ASP__VIEWER_PICK_RENDERER) {
+            const char *name = asp_viewer_renderer_name((size_t)k->arg);
+            if (name)
+                vlog(v, "  %c  renderer %s", k->key, name);
+            continue;
+        }
+        vlog(v, "  %c  %s", k->key, k->help);
+    }
+}
+
+static void print_view(const viewer *v)
+{
+    const asp_camera *c = &v->cam;
+    vlog(v, "view: --view %.1f,%.1f,%.3f (target %.4g,%.4g,%.4g, scene centre %.4g,%.4g,%.4g)", c->azimuth,
+         c->elevation, c->distance / v->scene.radius, c->target[0], c->target[1], c->target[2],
+         v->scene.center[0], v->scene.center[1], v->scene.center[2]);
+}
+
+static void change_tolerance(viewer *v, int dir)
+{
+    float old = v->tolerance;
+    v->tolerance = asp__viewer_tolerance_step(old, dir);
+    if (!renderer_kinds[v->kind].has_lod) {
+        vlog(v, "tau %g px (renderer '%s' draws every point; tau applies to the hierarchy renderers)", v->tolerance,
+             renderer_kinds[v->kind].name);
+        return;
+    }
+    asp_error e = {0, ""};
+    if (asp_renderer_set_lod(v->r, v->tolerance, 0, &e)) {
+        vlog(v, "cannot change tau to %g px: %s", v->tolerance, e.msg);
+        v->tolerance = old;
+    }
+}
+
+static void scene_action(viewer *v, enum asp__viewer_action a)
+{
+    if (!v->scene.kind->action) {
+        vlog(v, "colour modes and levels apply to .amg input only");
+        return;
+    }
+    char note[160] = "";
+    asp_error e = {0, ""};
+    int rc = v->scene.kind->action(&v->scene, a, note, sizeof note, &e);
+    if (rc < 0) {
+        vlog(v, "%s", e.msg);
+        return;
+    }
+    if (rc == 0) {
+        if (note[0])
+            vlog(v, "%s", note);
+        return;
+    }
+    // the points' colours changed: upload them again
+    if (rebuild_renderer(v, &e))
+        vlog(v, "cannot redraw with the new colours: %s", e.msg);
+    vlog(v, "%s", v->scene.status);
+}
+
+static void apply(viewer *v, const action *a)
+{
+    const double step_px = 10.0 / ASP__VIEWER_ORBIT_DEG_PER_PX; // 10 degrees per key press
+    switch (a->what) {
+    case ASP__VIEWER_NONE: break;
+    case ASP__VIEWER_QUIT: v->quit = 1; break;
+    case ASP__VIEWER_RESET: reset_view(v); break;
+    case ASP__VIEWER_LIGHT: v->unlit = !v->unlit; break;
+    case ASP__VIEWER_NEXT_RENDERER: next_renderer(v); break;
+    case ASP__VIEWER_PICK_RENDERER:
+        if ((size_t)a->arg < N_RENDERER_KINDS)
+            try_renderer(v, (size_t)a->arg);
+        else
+            vlog(v, "no renderer %d (this build has %d)", a->arg + 1, (int)N_RENDERER_KINDS);
+        break;
+    case ASP__VIEWER_TAU_UP: change_tolerance(v, +1); break;
+    case ASP__VIEWER_TAU_DOWN: change_tolerance(v, -1); break;
+    case ASP__VIEWER_COLOR_MODE:
+    case ASP__VIEWER_LEVEL_FINER:
+    case ASP__VIEWER_LEVEL_COARSER: scene_action(v, a->what); break;
+    case ASP__VIEWER_SCREENSHOT: v->screenshot_wanted = 1; break;
+    case ASP__VIEWER_HELP: print_help(v); break;
+    case ASP__VIEWER_PRINT_VIEW: print_view(v); break;
+    case ASP__VIEWER_ORBIT_LEFT: asp__viewer_orbit(&v->cam, -step_px, 0); break;
+    case ASP__VIEWER_ORBIT_RIGHT: asp__viewer_orbit(&v->cam, step_px, 0); break;
+    case ASP__VIEWER_ORBIT_UP: asp__viewer_orbit(&v->cam, 0, -step_px); break;
+    case ASP__VIEWER_ORBIT_DOWN: asp__viewer_orbit(&v->cam, 0, step_px); break;
+    case ASP__VIEWER_ZOOM_IN: asp__viewer_dolly(&v->cam, 0.85, v->scene.radius); break;
+    case ASP__VIEWER_ZOOM_OUT: asp__viewer_dolly(&v->cam, 1 / 0.85, v->scene.radius); break;
+    }
+    v->dirty = 1;
+}
+
+/* ---- screenshots ---- */
+
+/* Reads the window's back buffer (what the frame just drew, before the swap) into a PNG. */
+static int save_back_buffer(viewer *v, const char *path, uint32_t w, uint32_t h, asp_error *err)
+{
+    asp_image img;
+    int rc = asp_image_init(&img, w, h, err);
+    if (rc)
+        return rc;
+    size_t stride = 4 * (size_t)w;
+    uint8_t *row = asp_alloc(&v->scene.ctx, stride);
+    if (!row) {
+        asp_image_release(&img);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for a %ux%u screenshot", w, h);
+    }
+    asp__gl_clear_errors(v->gl);
+    // the bytes as stored: already sRGB-encoded when the window is sRGB-capable
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    glReadBuffer(GL_BACK);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadnPixels(0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_UNSIGNED_BYTE, (GLsizei)(stride * h), img.pixels);
+    rc = asp__gl_check(v->gl, "read the window back", err);
+    if (!rc) {
+        for (uint32_t y = 0; y < h / 2; y++) { // GL rows run bottom-up, asp_image top-down
+            uint8_t *a = img.pixels + y * stride, *b = img.pixels + (h - 1 - y) * stride;
+            memcpy(row, a, stride);
+            memcpy(a, b, stride);
+            memcpy(b, row, stride);
+        }
+        // a window is opaque whatever alpha its visual stores (or lacks)
+        for (size_t i = 0; i < (size_t)w * h; i++)
+            img.pixels[4 * i + 3] = 255;
+        rc = asp_image_save_png(&img, path, err);
+    }
+    asp_free(&v->scene.ctx, row);
+    asp_image_release(&img);
+    if (!rc) {
+        v->stats.screenshots++;
+        vlog(v, "wrote '%s' (%ux%u)", path, w, h);
+    }
+    return rc;
+}
+
+/* "<dir>/<stem>-NNN.png" for the s key: the input's name without extension, first free number. */
+static int next_screenshot_name(viewer *v, char *out, size_t cap)
+{
+    const char *base = strrchr(v->path, '/');
+    base = base ? base + 1 : v->path;
+    const char *dot = strrchr(base, '.');
+    int stem = (int)(dot && dot != base ? (size_t)(dot - base) : strlen(base));
+    if (stem > 200)
+        stem = 200;
+    while (v->screenshot_seq < 9999) {
+        v->screenshot_seq++;
+        snprintf(out, cap, "%.*s-%03u.png", stem, base, v->screenshot_seq);
+        if (access(out, F_OK) != 0)
+            return 0;
+    }
+    return -1;
+}
+
+/* ---- the loop ---- */
+
+static void update_title(viewer *v, double now, int force)
+{
+    if (!force && now - v->title_time < 0.25) // setting a title is a round trip to the window system
+        return;
+    v->title_time = now;
+    const char *base = strrchr(v->path, '/');
+    base = base ? base + 1 : v->path;
+    char tau[32] = "";
+    if (renderer_kinds[v->kind].has_lod)
+        snprintf(tau, sizeof tau, " | tau %g px", v->tolerance);
+    char title[320];
+    snprintf(title, sizeof title, "amgsplat view: %s | %s | %zu %s | %.1f ms (%.0f fps)%s | %s%s%s", base,
+             renderer_kinds[v->kind].name, v->r ? asp_renderer_count(v->r) : 0,
+             renderer_kinds[v->kind].has_lod ? "splats" : "points", v->last_ms,
+             v->last_ms > 0 ? 1000.0 / v->last_ms : 0.0, tau, v->unlit ? "unlit" : "lit",
+             v->scene.status[0] ? " | " : "", v->scene.status);
+    glfwSetWindowTitle(v->window, title);
+}
+
+static void account_frame(viewer *v, double ms, double now)
+{
+    v->frames++;
+    v->total_ms += ms;
+    v->last_ms = ms;
+    v->window_frames++;
+    v->window_ms += ms;
+    if ((v->desc->flags & ASP_VIEWER_VERBOSE) && now - v->window_start >= 1.0) {
+        asp_renderer_stats rs;
+        asp_renderer_stats_get(v->r, &rs);
+        char lod[96] = "";
+        if (renderer_kinds[v->kind].has_lod)
+            snprintf(lod, sizeof lod, ", tau %g px, cut %.2f ms", v->tolerance, 1000.0 * rs.select_seconds);
+        vlog(v, "%zu frames in %.1f s: %.2f ms per frame drawn, %zu %s (%s%s)", v->window_frames,
+             now - v->window_start, v->window_ms / (double)v->window_frames, rs.count,
+             renderer_kinds[v->kind].has_lod ? "splats" : "points", renderer_kinds[v->kind].name, lod);
+        v->window_start = now;
+        v->window_frames = 0;
+        v->window_ms = 0;
+    }
+}
+
+static int draw(viewer *v, int last, asp_error *err)
+{
+    uint32_t w = 0, h = 0;
+    asp_gl_context_framebuffer_size(v->gl, &w, &h);
+    if (w == 0 || h == 0) // minimised
+        return 0;
+    v->cam.aspect = (float)w / (float)h;
+    asp_camera_clip_to_sphere(&v->cam, v->scene.center, v->scene.radius);
+    const uint8_t *bg = v->desc->background;
+    asp_render_desc rd = {.flags = ASP_RENDER_WAIT | (v->unlit ? ASP_RENDER_UNLIT : 0u)};
+    if (bg[3])
+        memcpy(rd.background, bg, 4);
+    else
+        memset(rd.background, 255, 4);
+    double t0 = asp_time_now();
+    int rc = asp_render_frame(v->gl, v->r, &v->cam, &rd, err);
+    if (rc)
+        return rc;
+    double now = asp_time_now();
+    account_frame(v, 1000.0 * (now - t0), now);
+    if (v->screenshot_wanted) {
+        v->screenshot_wanted = 0;
+        char name[256];
+        asp_error e = {0, ""};
+        if (next_screenshot_name(v, name, sizeof name))
+            vlog(v, "no free screenshot name in the current directory");
+        else if (save_back_buffer(v, name, w, h, &e))
+            vlog(v, "%s", e.msg);
+    }
+    if (last && v->desc->screenshot) {
+        rc = save_back_buffer(v, v->desc->screenshot, w, h, err);
+        if (rc)
+            return rc;
+    }
+    v->stats.width = w;
+    v->stats.height = h;
+    asp_gl_context_swap_buffers(v->gl);
+    update_title(v, now, v->frames == 1);
+    return 0;
+}
+
+static int loop(viewer *v, asp_error *err)
+{
+    const asp_viewer_desc *d = v->desc;
+    const char *keys = d->keys ? d->keys : "";
+    size_t nkeys = strlen(keys);
+    for (size_t i = 0;; i++) {
+        int scripted = d->frames > 0;
+        if (scripted && i >= d->frames)
+            return 0;
+        if (scripted || v->dirty || v->queued || i < nkeys)
+            glfwPollEvents();
+        else
+            glfwWaitEventsTimeout(0.5); // idle: sleep until input instead of redrawing
+        if (i < nkeys) {
+            const asp__viewer_key *k = asp__viewer_key_find((unsigned char)keys[i]);
+            push(v, k->action, k->arg);
+        }
+        for (size_t q = 0; q < v->queued && !v->quit; q++)
+            apply(v, &v->queue[q]);
+        v->queued = 0;
+        if (v->quit || glfwWindowShouldClose(v->window))
+            return 0;
+        if (!scripted && !v->dirty && !v->screenshot_wanted)
+            continue;
+        v->dirty = 0;
+        int rc = draw(v, scripted && i + 1 == d->frames, err);
+        if (rc)
+            return rc;
+    }
+}
+
+static int open_window(viewer *v, asp_error *err)
+{
+    const asp_viewer_desc *d = v->desc;
+    const char *base = strrchr(v->path, '/');
+    char title[256];
+    snprintf(title, sizeof title, "amgsplat view: %s", base ? base + 1 : v->path);
+    int rc = asp_gl_context_create_window(
+        &(asp_gl_context_desc){.width = d->width, .height = d->height, .title = title, .ctx = d->ctx}, &v->gl, err);
+    if (rc)
+        return rc;
+    v->window = v->gl->window;
+    glfwSetWindowUserPointer(v->window, v);
+    glfwSetCharCallback(v->window, on_char);
+    glfwSetKeyCallback(v->window, on_key);
+    glfwSetMouseButtonCallback(v->window, on_button);
+    glfwSetCursorPosCallback(v->window, on_cursor);
+    glfwSetScrollCallback(v->window, on_scroll);
+    glfwSetWindowRefreshCallback(v->window, on_redraw);
+    glfwSetFramebufferSizeCallback(v->window, on_resize);
+    // scripted runs go as fast as they can; interactive ones wait for the display's refresh
+    glfwSwapInterval(d->frames > 0 ? 0 : 1);
+    snprintf(v->stats.gl_renderer, sizeof v->stats.gl_renderer, "%s", asp_gl_context_renderer(v->gl));
+    return 0;
+}
+
+int asp_viewer_run(const char *path, const asp_viewer_desc *desc, asp_viewer_stats *stats, asp_error *err)
+{
+    static const asp_viewer_desc zero_desc;
+    if (!desc)
+        desc = &zero_desc;
+    int rc = asp_viewer_desc_check(desc, err);
+    if (rc)
+        return rc;
+    viewer v;
+    memset(&v, 0, sizeof v);
+    v.desc = desc;
+    v.path = path;
+    v.tolerance = desc->tolerance;
+    v.unlit = (desc->flags & ASP_VIEWER_UNLIT) != 0;
+    v.kind = desc->renderer ? find_renderer(desc->renderer) : 0;
+    rc = asp__viewer_scene_load(&v.scene, path, desc, err);
+    if (rc)
+        return rc;
+    rc = open_window(&v, err);
+    if (!rc) {
+        uint32_t w = 0, h = 0;
+        asp_gl_context_framebuffer_size(v.gl, &w, &h);
+        v.cam.aspect = w && h ? (float)w / (float)h : 1.0f;
+        reset_view(&v);
+        v.window_start = v.title_time = asp_time_now();
+        rc = switch_renderer(&v, v.kind, err);
+    }
+    if (!rc)
+        rc = loop(&v, err);
+    if (!rc && stats) {
+        v.stats.frames = v.frames;
+        v.stats.mean_frame_ms = v.frames ? v.total_ms / (double)v.frames : 0;
+        v.stats.last_frame_ms = v.last_ms;
+        v.stats.count = asp_renderer_count(v.r);
+        snprintf(v.stats.renderer, sizeof v.stats.renderer, "%s", renderer_kinds[v.kind].name);
+        *stats = v.stats;
+    }
+    asp_renderer_destroy(v.r);
+    asp_hier_destroy(v.hier);
+    asp_gl_context_destroy(v.gl);
+    asp__viewer_scene_release(&v.scene);
+    return rc;
+}

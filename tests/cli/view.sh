@@ -1,0 +1,174 @@
+# amgsplat view: scripted frames in a real window (Xvfb + Mesa llvmpipe through GLX), screenshots
+# checked against headless 'amgsplat render' of the same view, keys, .amg colouring, errors.
+source "$(dirname "$0")/common.sh"
+
+# The viewer needs a display. xvfb-run is a declared dependency (scripts/bootstrap.sh): without it
+# and without a DISPLAY this test fails rather than skips, so CI cannot silently lose it.
+if command -v xvfb-run >/dev/null; then
+  X=(xvfb-run -a -s "-screen 0 1024x768x24")
+elif [[ -n "${DISPLAY:-}" ]]; then
+  X=()
+else
+  fail "no xvfb-run and no DISPLAY: install xvfb (scripts/bootstrap.sh) to run the viewer tests"
+fi
+view() { "${X[@]}" "$AMGSPLAT" view "$@"; }
+
+# png.py FILE EXPR: decodes an 8-bit RGBA PNG and evaluates EXPR with w, h, px(x, y) -> (r, g, b, a)
+# and fg = the fraction of pixels that are not the white background.
+cat >"$T/png.py" <<'PY'
+import struct, sys, zlib
+data = open(sys.argv[1], 'rb').read()
+assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
+pos, idat = 8, b''
+while pos < len(data):
+    n, t = struct.unpack('>I4s', data[pos:pos + 8])
+    if t == b'IHDR':
+        w, h, depth, ctype = struct.unpack('>IIBB', data[pos + 8:pos + 18])
+        assert depth == 8 and ctype == 6, 'expected 8-bit RGBA'
+    elif t == b'IDAT':
+        idat += data[pos + 8:pos + 8 + n]
+    pos += 12 + n
+raw, s, rows, prev = zlib.decompress(idat), 4 * w, [], bytearray(4 * w)
+for y in range(h):
+    f, line = raw[y * (s + 1)], bytearray(raw[y * (s + 1) + 1:(y + 1) * (s + 1)])
+    for i in range(s):
+        a, b, c = (line[i - 4] if i >= 4 else 0), prev[i], (prev[i - 4] if i >= 4 else 0)
+        p = a + b - c
+        pred = [0, a, b, (a + b) // 2, a if abs(p - a) <= abs(p - b) and abs(p - a) <= abs(p - c) else b if abs(p - b) <= abs(p - c) else c][f]
+        line[i] = (line[i] + pred) & 255
+    rows.append(line); prev = line
+px = lambda x, y: tuple(rows[y][4 * x:4 * x + 4])
+fg = sum(px(x, y)[:3] != (255, 255, 255) for x in range(w) for y in range(h)) / (w * h)
+if not eval(sys.argv[2]):
+    sys.exit('assertion failed: %s (w=%d h=%d fg=%.4f centre %s)' % (sys.argv[2], w, h, fg, px(w // 2, h // 2)))
+PY
+check() { python3 "$T/png.py" "$1" "$2" || fail "$1: $2"; }
+# metric A B NAME: prints psnr, ssim or iou (of the non-white silhouettes) from imgdiff
+metric() { "$AMGSPLAT" imgdiff "$1" "$2" --background 255,255,255 | awk -v m="$3" '$1 == m { print $2 }'; }
+# field FILE.json NAME: one value of a --json result
+field() { python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])' "$1" "$2"; }
+at_least() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a == "inf" || a + 0 >= b) }' || fail "$3: $1 < $2"; }
+
+"$AMGSPLAT" synth sphere -n 3000 -o "$T/sphere.ply" -q
+
+# Scripted mode: 3 frames at a fixed view, screenshot of the last one at the requested size. The
+# bounding sphere fills the 120 px height: the unit sphere covers a bit over half the image.
+view "$T/sphere.ply" --frames 3 --screenshot "$T/shot.png" --size 160x120 --view 0,0 --json \
+  >"$T/shot.json" 2>"$T/shot.err" || fail "view exited $?: $(cat "$T/shot.err")"
+[[ -s "$T/shot.png" ]] || fail "no screenshot"
+check "$T/shot.png" "w == 160 and h == 120 and 0.40 < fg < 0.62"
+check "$T/shot.png" "px(0, 0) == (255, 255, 255, 255) and px(80, 60)[:3] != (255, 255, 255)"
+grep -qF "wrote '$T/shot.png' (160x120)" "$T/shot.err" || fail "screenshot name not printed: $(cat "$T/shot.err")"
+python3 - "$T/shot.json" <<'PY' || fail "bad --json: $(cat "$T/shot.json")"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j['frames'] == 3 and j['width'] == 160 and j['height'] == 120, j
+assert j['renderer'] == 'disc' and j['count'] == 3000 and j['screenshots'] == 1, j
+assert j['mean_frame_ms'] > 0 and j['gl_renderer'], j
+PY
+
+# The window's back buffer matches the headless renderer of the same view: the camera conventions
+# agree (identical without multisampling, SSIM >= 0.9 against the default 4x multisampled render).
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/ref0.png" --size 160x120 --view 0,0 --samples 0 -q
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/ref4.png" --size 160x120 --view 0,0 -q
+at_least "$(metric "$T/shot.png" "$T/ref0.png" ssim)" 0.99 "viewer vs render --samples 0"
+at_least "$(metric "$T/shot.png" "$T/ref4.png" ssim)" 0.9 "viewer vs render"
+at_least "$(metric "$T/shot.png" "$T/ref0.png" psnr)" 40 "viewer vs render --samples 0 (PSNR)"
+
+# Keys move the camera as documented: d orbits right by 10 degrees (azimuth -10), z comes 0.85 times
+# closer (the fitted distance is 1 / sin(20 deg) radii), r resets to the first view.
+view "$T/sphere.ply" --frames 2 --keys d --screenshot "$T/orbit.png" --size 160x120 --view 0,0 -q
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/orbit_ref.png" --size 160x120 --view -10,0 --samples 0 -q
+at_least "$(metric "$T/orbit.png" "$T/orbit_ref.png" ssim)" 0.99 "d key vs render --view -10,0"
+view "$T/sphere.ply" --frames 1 --keys z --screenshot "$T/zoom.png" --size 160x120 --view 0,0 -q
+"$AMGSPLAT" render "$T/sphere.ply" -o "$T/zoom_ref.png" --size 160x120 --view 0,0,2.485234 --samples 0 -q
+at_least "$(metric "$T/zoom.png" "$T/zoom_ref.png" ssim)" 0.99 "z key vs render --view 0,0,2.485234"
+check "$T/zoom.png" "fg > 0.62"
+view "$T/sphere.ply" --frames 4 --keys dzwr --screenshot "$T/reset.png" --size 160x120 --view 0,0 -q
+at_least "$(metric "$T/reset.png" "$T/ref0.png" psnr)" 40 "r key resets the view"
+
+# Renderers: 2 = splat, 3 = square (the hierarchy renderers), n cycles back to disc. The splats cover
+# the same silhouette as the discs; tau = 0 draws every point, a larger tau fewer splats, and the
+# +/- keys reach the same cut as --tau.
+view "$T/sphere.ply" --frames 3 --keys 2 --screenshot "$T/splat.png" --size 160x120 --view 0,0 --json -q >"$T/splat.json"
+[[ "$(field "$T/splat.json" renderer)" == splat && "$(field "$T/splat.json" count)" == 3000 ]] || fail "2 key: $(cat "$T/splat.json")"
+at_least "$(metric "$T/splat.png" "$T/ref0.png" iou)" 0.98 "splat vs disc silhouette"
+at_least "$(metric "$T/splat.png" "$T/ref0.png" ssim)" 0.9 "splat vs disc"
+view "$T/sphere.ply" --frames 2 --renderer splat --tau 16 --size 160x120 --view 0,0 --json -q >"$T/t16.json"
+c16=$(field "$T/t16.json" count)
+(( c16 > 0 && c16 < 3000 )) || fail "tau 16 draws $c16 splats of 3000"
+view "$T/sphere.ply" --frames 11 --renderer splat --keys +++++++++++ --size 160x120 --view 0,0 --json -q >"$T/tk.json"
+[[ "$(field "$T/tk.json" count)" == "$c16" ]] || fail "11 x + (tau 16) draws $(field "$T/tk.json" count), --tau 16 $c16"
+view "$T/sphere.ply" --frames 11 --renderer splat --tau 16 --keys ----------- --size 160x120 --view 0,0 --json -q >"$T/tk0.json"
+[[ "$(field "$T/tk0.json" count)" == 3000 ]] || fail "11 x - from tau 16 draws $(field "$T/tk0.json" count)"
+view "$T/sphere.ply" --frames 2 --keys 3 --screenshot "$T/square.png" --size 160x120 --view 0,0 --json -q >"$T/sq.json"
+[[ "$(field "$T/sq.json" renderer)" == square && "$(field "$T/sq.json" count)" == 3000 ]] || fail "3 key: $(cat "$T/sq.json")"
+at_least "$(metric "$T/square.png" "$T/ref0.png" iou)" 0.85 "square vs disc silhouette"
+view "$T/sphere.ply" --frames 4 --keys nnn --screenshot "$T/cycle.png" --size 160x120 --view 0,0 --json -q >"$T/cycle.json"
+[[ "$(field "$T/cycle.json" renderer)" == disc ]] || fail "n x 3 ends at $(field "$T/cycle.json" renderer)"
+[[ "$(metric "$T/cycle.png" "$T/ref0.png" psnr)" == inf ]] || fail "disc after a cycle differs from render"
+view "$T/sphere.ply" --frames 2 --keys 4+ --size 64x48 2>"$T/r4.err"
+grep -qF "no renderer 4" "$T/r4.err" && grep -qF "applies to the hierarchy renderers" "$T/r4.err" || fail "4, + on disc: $(cat "$T/r4.err")"
+
+# l turns lighting off: same silhouette, flat colours (the rim is no darker than the centre's colour)
+view "$T/sphere.ply" --frames 1 --keys l --screenshot "$T/unlit.png" --size 160x120 --view 0,0 -q
+[[ "$(metric "$T/unlit.png" "$T/shot.png" iou)" == "1.000000" ]] || fail "unlit changes the silhouette"
+ssim=$(metric "$T/unlit.png" "$T/shot.png" ssim)
+awk -v s="$ssim" 'BEGIN { exit !(s < 0.99) }' || fail "l key changed nothing (SSIM $ssim)"
+view "$T/sphere.ply" --frames 1 --unlit --screenshot "$T/unlit2.png" --size 160x120 --view 0,0 -q
+[[ "$(metric "$T/unlit.png" "$T/unlit2.png" psnr)" == "inf" ]] || fail "--unlit differs from the l key"
+
+# s writes <input>-NNN.png into the current directory, numbering past existing files
+mkdir -p "$T/shots" && touch "$T/shots/sphere-001.png"
+(cd "$T/shots" && view ../sphere.ply --frames 2 --keys ss --size 64x48 2>"$T/s.err") || fail "s key: $(cat "$T/s.err")"
+grep -qF "wrote 'sphere-002.png' (64x48)" "$T/s.err" || fail "s key: $(cat "$T/s.err")"
+grep -qF "wrote 'sphere-003.png' (64x48)" "$T/s.err" || fail "s key: $(cat "$T/s.err")"
+check "$T/shots/sphere-003.png" "w == 64 and h == 48 and 0.3 < fg < 0.7"
+
+# h prints every key; v prints the view in the form --view takes
+view "$T/sphere.ply" --frames 2 --keys hv --size 64x48 --view 12,-34,5 2>"$T/h.err" >/dev/null
+for k in q r l n + - c '[' ']' s v h a d w x z o 1; do
+  grep -q "^  [$k]  " "$T/h.err" || fail "help lacks key $k: $(cat "$T/h.err")"
+done
+grep -qF "view: --view 12.0,-34.0,5.000" "$T/h.err" || fail "v key: $(cat "$T/h.err")"
+
+# .amg input: classifier colours, then the domains of the coarsest level; ] at the coarsest level says so
+"$AMGSPLAT" synth octahedron -n 2000 -o "$T/oct.ply" -q
+"$AMGSPLAT" decompose "$T/oct.ply" -o "$T/oct.amg" -q
+view "$T/oct.amg" --frames 1 --screenshot "$T/classifier.png" --size 96x96 -q
+view "$T/oct.amg" --frames 2 --keys ']' --screenshot "$T/domains.png" --size 96x96 2>"$T/amg.err"
+grep -qE "^domains, level [0-9]+ \(L-0\), [0-9]+ domains" "$T/amg.err" || fail "] key: $(cat "$T/amg.err")"
+[[ "$(metric "$T/classifier.png" "$T/domains.png" iou)" == "1.000000" ]] || fail "colour modes change the shape"
+ssim=$(metric "$T/classifier.png" "$T/domains.png" ssim)
+awk -v s="$ssim" 'BEGIN { exit !(s < 0.98) }' || fail "] did not recolour (SSIM $ssim)"
+view "$T/oct.amg" --frames 3 --color domains --keys ']c' --size 64x64 2>"$T/amg2.err"
+grep -qF "already at the coarsest level" "$T/amg2.err" || fail "] at L: $(cat "$T/amg2.err")"
+grep -qE "^strict domains, level" "$T/amg2.err" || fail "c key: $(cat "$T/amg2.err")"
+# the same colours as the option says: --color domains --level L-1 equals [ from L
+view "$T/oct.amg" --frames 1 --color domains --level L-1 --screenshot "$T/lm1.png" --size 96x96 -q
+view "$T/oct.amg" --frames 2 --color domains --keys '[' --screenshot "$T/lm1k.png" --size 96x96 -q
+[[ "$(metric "$T/lm1.png" "$T/lm1k.png" psnr)" == "inf" ]] || fail "[ differs from --level L-1"
+# colour keys on a plain point file are explained, not fatal
+view "$T/sphere.ply" --frames 1 --keys c --size 64x48 2>"$T/c.err"
+grep -qF ".amg input only" "$T/c.err" || fail "c on points: $(cat "$T/c.err")"
+
+# Errors: a missing or bad file exits 1 naming it (before any window opens); bad options exit 2.
+expect_fail 1 "cannot open '$T/missing.ply'" view "$T/missing.ply" --frames 1
+printf 'ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n' >"$T/empty.ply"
+expect_fail 1 "empty.ply" view "$T/empty.ply" --frames 1
+expect_fail 1 "L-99" view "$T/oct.amg" --frames 1 --level L-99
+expect_fail 2 "unknown option '--bogus'" "$AMGSPLAT" view "$T/sphere.ply" --bogus
+expect_fail 2 "unknown renderer 'blob'" "$AMGSPLAT" view "$T/sphere.ply" --renderer blob
+expect_fail 2 "key 'Q'" "$AMGSPLAT" view "$T/sphere.ply" --frames 2 --keys lQ
+expect_fail 2 "needs a number of frames" "$AMGSPLAT" view "$T/sphere.ply" --screenshot "$T/x.png"
+expect_fail 2 "must end in .png" "$AMGSPLAT" view "$T/sphere.ply" --frames 1 --screenshot "$T/x.jpg"
+expect_fail 2 "--size expects WxH" "$AMGSPLAT" view "$T/sphere.ply" --size 0x10
+expect_fail 2 "--view expects" "$AMGSPLAT" view "$T/sphere.ply" --view 0,95
+expect_fail 2 "--color expects" "$AMGSPLAT" view "$T/oct.amg" --color rainbow
+expect_fail 2 "--tau expects" "$AMGSPLAT" view "$T/sphere.ply" --tau -1
+expect_fail 2 "expected one input file" "$AMGSPLAT" view
+# no display at all: a clear GL error, exit 1
+expect_fail 1 "no OpenGL 4.5 window" env -u DISPLAY -u WAYLAND_DISPLAY "$AMGSPLAT" view "$T/sphere.ply" --frames 1
+[[ ! -e "$T/x.png" && ! -e "$T/x.jpg" ]] || fail "a failed run left a file"
+"$AMGSPLAT" view -h | grep -q "usage: amgsplat view" || fail "-h"
+echo "view: ok"

@@ -1,0 +1,294 @@
+/*
+ * The viewer without a window: mouse interaction on the orbit camera (orbit
+ * follows the drag, pan keeps the grabbed point under the cursor, dolly is
+ * clamped), the tau ladder, the key table, option checking, and the .amg
+ * input kind stepping colour modes and levels (render/viewer_*.c).
+ */
+#include <math.h>
+#include <unistd.h>
+
+#include "amgsplat/amg.h"
+#include "amgsplat/render.h"
+#include "amgsplat/sample.h"
+#include "harness.h"
+#include "render/viewer_internal.h"
+
+static void camera_at(asp_camera *cam, float az, float el)
+{
+    asp_camera_init(cam);
+    cam->azimuth = az;
+    cam->elevation = el;
+    cam->target[0] = 0.5f;
+    cam->target[1] = -0.25f;
+    cam->target[2] = 2.0f;
+    cam->distance = 4.0f;
+    cam->aspect = 4.0f / 3.0f;
+    cam->z_near = 0.1f;
+    cam->z_far = 50.0f;
+}
+
+/* Dragging right turns the object's front to the right, dragging down turns it down; distance is kept. */
+static void test_orbit_follows_drag(void)
+{
+    static const float views[][2] = {{0, 0}, {30, 20}, {-120, -40}, {170, 60}};
+    for (size_t i = 0; i < sizeof views / sizeof views[0]; i++) {
+        asp_camera cam;
+        camera_at(&cam, views[i][0], views[i][1]);
+        float eye[3], front[3], before[3], after[3];
+        asp_camera_eye(&cam, eye);
+        // the point of a unit sphere around the target nearest to the eye
+        for (int k = 0; k < 3; k++)
+            front[k] = cam.target[k] + (eye[k] - cam.target[k]) / cam.distance;
+        CHECK(asp_camera_project(&cam, front, 400, 300, before));
+        asp__viewer_orbit(&cam, 8, 0);
+        CHECK_NEAR(cam.azimuth, views[i][0] - 8 * ASP__VIEWER_ORBIT_DEG_PER_PX, 1e-4);
+        CHECK(asp_camera_project(&cam, front, 400, 300, after));
+        CHECK_MSG(after[0] > before[0] + 1, "view %zu: front x %g -> %g", i, before[0], after[0]);
+        asp__viewer_orbit(&cam, -8, 8);
+        CHECK(asp_camera_project(&cam, front, 400, 300, after));
+        CHECK_MSG(after[1] > before[1] + 1, "view %zu: front y %g -> %g", i, before[1], after[1]);
+        float eye2[3];
+        asp_camera_eye(&cam, eye2);
+        double d = sqrt(pow(eye2[0] - cam.target[0], 2) + pow(eye2[1] - cam.target[1], 2) +
+                        pow(eye2[2] - cam.target[2], 2));
+        CHECK_NEAR(d, 4.0, 1e-5);
+    }
+    asp_camera cam;
+    camera_at(&cam, 170, 10);
+    asp__viewer_orbit(&cam, 0, 1e6); // elevation clamps at the pole
+    CHECK_NEAR(cam.elevation, 90, 0);
+    asp__viewer_orbit(&cam, 0, -1e6);
+    CHECK_NEAR(cam.elevation, -90, 0);
+    asp__viewer_orbit(&cam, -100, 0); // 170 + 25 = 195 wraps to -165
+    CHECK_NEAR(cam.azimuth, -165, 1e-4);
+    for (int i = 0; i < 100; i++)
+        asp__viewer_orbit(&cam, 977, 0);
+    CHECK(cam.azimuth >= -180 && cam.azimuth < 180);
+}
+
+/* A point at the target's depth moves by exactly the cursor's motion in pixels. */
+static void test_pan_keeps_point_under_cursor(void)
+{
+    static const float views[][2] = {{0, 0}, {30, 20}, {-120, -40}, {10, 90}, {75, -90}};
+    static const double moves[][2] = {{10, 0}, {0, -7}, {-23.5, 41}};
+    for (size_t i = 0; i < sizeof views / sizeof views[0]; i++) {
+        for (size_t m = 0; m < sizeof moves / sizeof moves[0]; m++) {
+            asp_camera cam;
+            camera_at(&cam, views[i][0], views[i][1]);
+            float grabbed[3] = {cam.target[0], cam.target[1], cam.target[2]}, before[3], after[3];
+            CHECK(asp_camera_project(&cam, grabbed, 400, 300, before));
+            CHECK_NEAR(before[0], 200, 1e-3);
+            CHECK_NEAR(before[1], 150, 1e-3);
+            asp__viewer_pan(&cam, moves[m][0], moves[m][1], 300);
+            CHECK(asp_camera_project(&cam, grabbed, 400, 300, after));
+            CHECK_NEAR(after[0] - before[0], moves[m][0], 1e-3);
+            CHECK_NEAR(after[1] - before[1], moves[m][1], 1e-3);
+            CHECK_NEAR(after[2], before[2], 1e-6); // same depth: the pan is parallel to the image
+        }
+    }
+}
+
+static void test_dolly_clamps(void)
+{
+    asp_camera cam;
+    camera_at(&cam, 0, 0);
+    asp__viewer_dolly(&cam, 0.5, 1.0f);
+    CHECK_NEAR(cam.distance, 2.0, 1e-6);
+    asp__viewer_dolly(&cam, 1e-9, 1.0f);
+    CHECK_NEAR(cam.distance, 1e-3, 1e-9);
+    asp__viewer_dolly(&cam, 1e12, 1.0f);
+    CHECK_NEAR(cam.distance, 1e3, 1e-3);
+    asp__viewer_dolly(&cam, NAN, 1.0f);
+    asp__viewer_dolly(&cam, 0, 1.0f);
+    asp__viewer_dolly(&cam, -2, 1.0f);
+    CHECK_NEAR(cam.distance, 1e3, 1e-3);
+}
+
+static void test_tolerance_ladder(void)
+{
+    float tau = 0;
+    int steps = 0;
+    for (;;) {
+        float up = asp__viewer_tolerance_step(tau, +1);
+        if (up == tau)
+            break;
+        CHECK(up > tau);
+        tau = up;
+        steps++;
+    }
+    CHECK(steps == 15);
+    CHECK_NEAR(tau, 64, 0);
+    while (tau > 0) {
+        float down = asp__viewer_tolerance_step(tau, -1);
+        CHECK(down < tau);
+        tau = down;
+        steps--;
+    }
+    CHECK(steps == 0);
+    CHECK_NEAR(asp__viewer_tolerance_step(0, -1), 0, 0);
+    CHECK_NEAR(asp__viewer_tolerance_step(5, +1), 6, 0);
+    CHECK_NEAR(asp__viewer_tolerance_step(5, -1), 4, 0);
+    CHECK_NEAR(asp__viewer_tolerance_step(100, +1), 100, 0);
+    CHECK_NEAR(asp__viewer_tolerance_step(100, -1), 64, 0);
+}
+
+static void test_key_table(void)
+{
+    int seen[256] = {0};
+    for (const asp__viewer_key *k = asp__viewer_keys; k->key; k++) {
+        CHECK_MSG(!seen[(unsigned char)k->key], "key '%c' twice", k->key);
+        seen[(unsigned char)k->key] = 1;
+        CHECK(asp__viewer_key_find((unsigned char)k->key) == k);
+    }
+    CHECK(asp__viewer_key_find('q')->action == ASP__VIEWER_QUIT);
+    CHECK(asp__viewer_key_find('s')->action == ASP__VIEWER_SCREENSHOT);
+    CHECK(asp__viewer_key_find(']')->action == ASP__VIEWER_LEVEL_COARSER);
+    CHECK(asp__viewer_key_find('2')->action == ASP__VIEWER_PICK_RENDERER && asp__viewer_key_find('2')->arg == 1);
+    CHECK(asp__viewer_key_find('Q') == NULL && asp__viewer_key_find(0x263A) == NULL);
+    CHECK(strcmp(asp_viewer_renderer_name(0), "disc") == 0);
+    size_t n = 0;
+    while (asp_viewer_renderer_name(n))
+        n++;
+    CHECK(n >= 1 && n <= 9);
+}
+
+static void expect_invalid(const asp_viewer_desc *d, const char *text)
+{
+    asp_error err = {0, ""};
+    CHECK(asp_viewer_desc_check(d, &err) == ASP_EINVAL);
+    CHECK_MSG(strstr(err.msg, text) != NULL, "'%s' lacks '%s'", err.msg, text);
+}
+
+static void test_desc_check(void)
+{
+    asp_error err = {0, ""};
+    CHECK_OK(asp_viewer_desc_check(&(asp_viewer_desc){0}, &err), &err);
+    CHECK_OK(asp_viewer_desc_check(&(asp_viewer_desc){.frames = 3, .keys = "l]s", .screenshot = "a/b.PNG"}, &err),
+             &err);
+    expect_invalid(&(asp_viewer_desc){.renderer = "blob"}, "unknown renderer 'blob' (expected disc");
+    expect_invalid(&(asp_viewer_desc){.keys = "lQ"}, "key 'Q' (character 2 of 'lQ')");
+    expect_invalid(&(asp_viewer_desc){.frames = 2, .keys = "lll"}, "3 keys need at least as many frames, got 2");
+    expect_invalid(&(asp_viewer_desc){.screenshot = "x.png"}, "needs a number of frames");
+    expect_invalid(&(asp_viewer_desc){.frames = 1, .screenshot = "x.jpg"}, "'x.jpg' must end in .png");
+    expect_invalid(&(asp_viewer_desc){.tolerance = -1}, "tolerance -1");
+    expect_invalid(&(asp_viewer_desc){.tolerance = NAN}, "tolerance");
+    expect_invalid(&(asp_viewer_desc){.set_view = 1, .elevation = 91}, "expected EL in -90..90");
+    expect_invalid(&(asp_viewer_desc){.width = 20000, .height = 10}, "20000x10");
+    expect_invalid(&(asp_viewer_desc){.amg_color = 4}, "colour mode 4");
+}
+
+static size_t distinct_colours(const asp_cloud *c)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < c->count; i++) {
+        size_t j = 0;
+        while (j < i && memcmp(c->colors + 4 * j, c->colors + 4 * i, 3) != 0)
+            j++;
+        n += j == i;
+    }
+    return n;
+}
+
+/* Writes the decomposition of cloud c to path; returns its level count (0 on failure). */
+static size_t write_amg(const asp_cloud *c, const char *path)
+{
+    asp_error err = {0, ""};
+    asp_amg *amg = NULL;
+    CHECK_OK(asp_amg_decompose(c, NULL, NULL, &amg, &err), &err);
+    if (amg)
+        CHECK_OK(asp_amg_save(amg, path, &err), &err);
+    size_t levels = amg ? asp_amg_level_count(amg) : 0;
+    asp_amg_destroy(amg);
+    return levels;
+}
+
+/* The .amg kind: colours by classifier, then domains; [ and ] step levels and stop at the ends. */
+static void test_amg_scene_actions(void)
+{
+    asp_error err = {0, ""};
+    asp_cloud *c = NULL, *bare = NULL;
+    char path[128], bare_path[128];
+    snprintf(path, sizeof path, "/tmp/asp_test_viewer_%ld.amg", (long)getpid());
+    snprintf(bare_path, sizeof bare_path, "/tmp/asp_test_viewer_bare_%ld.amg", (long)getpid());
+    CHECK_OK(asp_synth(ASP_SYNTH_OCTAHEDRON, &(asp_synth_desc){.points = 1500}, NULL, &c, &err), &err);
+    if (!c)
+        return;
+    CHECK(c->colors != NULL); // the synthetic octahedron is coloured by face
+    // the same points without colours
+    CHECK_OK(asp_cloud_create(c->count, ASP_ATTR_NORMALS, NULL, &bare, &err), &err);
+    if (bare) {
+        memcpy(bare->positions, c->positions, 12 * c->count);
+        memcpy(bare->normals, c->normals, 12 * c->count);
+    }
+    size_t levels = write_amg(c, path), bare_levels = bare ? write_amg(bare, bare_path) : 0;
+    if (levels < 3 || bare_levels < 1) {
+        CHECK_MSG(0, "decompositions have %zu and %zu levels", levels, bare_levels);
+        asp_cloud_destroy(c);
+        asp_cloud_destroy(bare);
+        return;
+    }
+    CHECK(asp__viewer_input_for(path)->bit == ASP__VIEWER_INPUT_AMG);
+    CHECK(asp__viewer_input_for("x.PLY")->bit == ASP__VIEWER_INPUT_POINTS);
+
+    asp__viewer_scene s;
+    memset(&s, 0, sizeof s);
+    asp_error bad = {0, ""};
+    CHECK(asp__viewer_scene_load(&s, path, &(asp_viewer_desc){.amg_level = "L-99"}, &bad) == ASP_EINVAL);
+    CHECK_MSG(strstr(bad.msg, path) && strstr(bad.msg, "L-99"), "%s", bad.msg);
+    CHECK(s.cloud == NULL && s.kind == NULL);
+
+    CHECK_OK(asp__viewer_scene_load(&s, path, &(asp_viewer_desc){0}, &err), &err);
+    if (!s.cloud) {
+        asp_cloud_destroy(c);
+        asp_cloud_destroy(bare);
+        return;
+    }
+    CHECK(s.radius > 1.0f && s.radius < 1.2f); // the octahedron |x|+|y|+|z| = 1 plus disc radii
+    CHECK(strcmp(s.status, "classifier") == 0);
+    CHECK(s.cloud->colors != NULL && memcmp(s.cloud->colors, c->colors, 4 * c->count) != 0);
+    char note[160] = "";
+    // ] from classifier colours shows the domains of the first level (L, the coarsest)
+    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 1);
+    char want[64];
+    snprintf(want, sizeof want, "domains, level %zu (L-0)", levels - 1);
+    CHECK_MSG(strncmp(s.status, want, strlen(want)) == 0, "%s", s.status);
+    size_t coarse_colours = distinct_colours(s.cloud);
+    // already coarsest: nothing changes and the note says why
+    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 0);
+    CHECK(strstr(note, "coarsest") != NULL);
+    for (size_t l = levels - 1; l > 0; l--)
+        CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_FINER, note, sizeof note, &err) == 1);
+    CHECK(strncmp(s.status, "domains, level 0 (L-", 20) == 0);
+    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_FINER, note, sizeof note, &err) == 0);
+    CHECK(strstr(note, "finest") != NULL);
+    // finer levels have more domains, so more distinct mixed colours
+    CHECK_MSG(distinct_colours(s.cloud) > coarse_colours, "%zu vs %zu", distinct_colours(s.cloud), coarse_colours);
+    CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
+    CHECK(strncmp(s.status, "strict domains", 14) == 0);
+    CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
+    CHECK(strcmp(s.status, "input colours") == 0);
+    CHECK(memcmp(s.cloud->colors, c->colors, 4 * c->count) == 0);
+    CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
+    CHECK(strcmp(s.status, "classifier") == 0);
+    asp__viewer_scene_release(&s);
+
+    // without colours the cycle skips "input colours", and asking for them is an error
+    CHECK_OK(asp__viewer_scene_load(&s, bare_path, &(asp_viewer_desc){.amg_color = 2}, &err), &err);
+    if (s.cloud) {
+        CHECK(strncmp(s.status, "strict domains", 14) == 0);
+        CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
+        CHECK(strcmp(s.status, "classifier") == 0);
+    }
+    asp__viewer_scene_release(&s);
+    CHECK(asp__viewer_scene_load(&s, bare_path, &(asp_viewer_desc){.amg_color = 3}, &bad) == ASP_EINVAL);
+    CHECK_MSG(strstr(bad.msg, "no colours") != NULL, "%s", bad.msg);
+    unlink(path);
+    unlink(bare_path);
+    asp_cloud_destroy(c);
+    asp_cloud_destroy(bare);
+    asp_amg_shutdown();
+}
+
+TEST_MAIN(TEST_CASE(test_orbit_follows_drag), TEST_CASE(test_pan_keeps_point_under_cursor),
+          TEST_CASE(test_dolly_clamps), TEST_CASE(test_tolerance_ladder), TEST_CASE(test_key_table),
+          TEST_CASE(test_desc_check), TEST_CASE(test_amg_scene_actions))
