@@ -127,7 +127,7 @@ static double median(double *t, int n)
 enum { MAX_RUNS = 9 };
 
 typedef struct bench_opts {
-    size_t k;
+    size_t k, group;
     int threads, runs, flann, baseline;
 } bench_opts;
 
@@ -177,7 +177,7 @@ static void bench_set(const char *name, const float *p, size_t n, const bench_op
     asp_index *idx = malloc(n * k * sizeof(asp_index));
     float *d2 = malloc(n * k * sizeof(float));
     double ob, oq;
-    time_ours(p, n, o, NULL, idx, d2, &ob, &oq);
+    time_ours(p, n, o, o->group ? &(asp__knn_tuning){.group_max = o->group} : NULL, idx, d2, &ob, &oq);
     print_row(name, "ours (grouped)", ob, oq, 0, "");
     if (o->baseline) {
         /* the per-query tree search alone: the previous algorithm, kept as the fallback path */
@@ -238,7 +238,7 @@ static void bench_set(const char *name, const float *p, size_t n, const bench_op
 
 int main(int argc, char **argv)
 {
-    bench_opts o = {64, 0, 3, 1, 1};
+    bench_opts o = {64, 0, 0, 3, 1, 1};
     size_t n = 1000000;
     const char *sets = "cube,sphere,bunny";
     int pos = 0;
@@ -247,6 +247,8 @@ int main(int argc, char **argv)
             o.flann = 0;
         else if (strcmp(argv[i], "--no-baseline") == 0)
             o.baseline = 0;
+        else if (strncmp(argv[i], "--group=", 8) == 0)
+            o.group = strtoull(argv[i] + 8, NULL, 10);
         else if (strncmp(argv[i], "--sets=", 7) == 0)
             sets = argv[i] + 7;
         else if (pos == 0 && ++pos)
@@ -263,7 +265,7 @@ int main(int argc, char **argv)
     if (o.runs < 1 || o.runs > MAX_RUNS || n < 2 || o.k < 1 || o.k >= n) {
         fprintf(stderr,
                 "usage: bench_knn [points>=2] [1<=k<points] [threads] [runs 1..%d] [--no-flann] [--no-baseline] "
-                "[--sets=cube,sphere,bunny]\n",
+                "[--sets=cube,sphere,bunny] [--group=N]\n",
                 MAX_RUNS);
         return 2;
     }

@@ -16,6 +16,7 @@
 #include "eval.h"
 #include "hier.h"
 #include "amg.h"
+#include "prim.h"
 #include "render.h"
 
 #endif

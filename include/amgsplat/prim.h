@@ -118,6 +118,7 @@ typedef struct asp_dps {
     size_t level_count;
     asp_dps_level *levels;    /* finest first */
     uint32_t amg_levels;      /* level count of the decomposition (to name levels "L-k") */
+    uint32_t skipped_levels;  /* requested levels left out because no domain had a point above tau */
     uint64_t source_points;
     double mean_radius;       /* mean point radius, world units */
     asp_prim_desc desc;       /* parameters used, defaults resolved */
@@ -130,14 +131,15 @@ typedef struct asp_dps {
 /**
  * Builds the primitives of levels[0 .. nlevels-1] of amg (indices as given by
  * asp_amg_level_parse; nlevels >= 1, each < asp_amg_level_count) into a new
- * asp_dps (*out, levels stored finest first, duplicates removed). Colours and
+ * asp_dps (*out, levels stored finest first, duplicates removed; a level
+ * whose domains are all empty is left out and counted in skipped_levels). Colours and
  * radii come from attrs when it is not NULL (it must have the amg's point
  * count), else from asp_amg_cloud(amg); missing colours are light grey,
  * missing radii are estimated (16th neighbour). source names the input in the
  * file (NULL = ""). desc may be NULL (defaults). Runs with
  * asp_context_threads(ctx) threads; the result is identical for any count.
  * Errors: ASP_EINVAL (bad option, level out of range, attrs of another size),
- * ASP_EDEGENERATE (every domain of a level is empty), ASP_ENOMEM,
+ * ASP_EDEGENERATE (every requested level is empty), ASP_ENOMEM,
  * ASP_EUNSUPPORTED (an atlas would exceed 16384 texels a side: raise
  * texel_size), ASP_ECANCELED. On failure *out is unchanged. Reports progress
  * as stage "primitives". Thread-safe on a shared amg.
@@ -145,6 +147,23 @@ typedef struct asp_dps {
 int asp_prim_build(const asp_amg *amg, const asp_cloud *attrs, const size_t *levels, size_t nlevels,
                    const asp_prim_desc *desc, const char *source, const asp_context *ctx, asp_dps **out,
                    asp_error *err);
+
+/**
+ * Builds one level from explicit domains: dom has one row per domain listing
+ * its points (indices into cloud, increasing) and their Psi values, as
+ * asp_amg_domains writes it; dom->cols == cloud->count. cloud needs positions;
+ * normals, colours and radii are used when present (radii are estimated
+ * otherwise). Empty rows are skipped and counted; domains of 1 or 2 points or
+ * colinear points become small primitives flagged DEGENERATE, their plane
+ * normal taken from the point normals. Fills *out (level = 0, t_basis = 0;
+ * release with asp_dps_level_release). Errors: ASP_EINVAL, ASP_EDEGENERATE
+ * (every row empty, or no positive radius), ASP_ENOMEM, ASP_EUNSUPPORTED
+ * (atlas too large). On failure *out is zeroed. Thread-safe.
+ */
+int asp_prim_build_level(const asp_cloud *cloud, const asp_amg_csr *dom, const asp_prim_desc *desc,
+                         const asp_context *ctx, asp_dps_level *out, asp_error *err);
+/** Frees what asp_prim_build_level put in lv (ctx as given to it) and zeroes it. */
+void asp_dps_level_release(asp_dps_level *lv, const asp_context *ctx);
 
 /**
  * Picks the finest level with at most max_prims basis functions (the budget

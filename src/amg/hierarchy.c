@@ -8,8 +8,6 @@
  */
 #include <math.h>
 #include <string.h>
-#include <stdio.h>
-#include <stdlib.h>
 
 #include "amg/internal.h"
 #include "util/banned.h"
@@ -119,10 +117,6 @@ static void crease_cuts(const asp_amg_csr *ac, const asp_amg_csr *fc, const doub
                 continue;
             double f = lookup(fc, r, c);
             /* no geometric coupling to compare with (f >= 0): keep, the test cannot tell */
-            if (getenv("ASP_DEBUG_CREASE") && f < 0) { /* DEBUG-REMOVE */
-                double q = ac->val[k] / f / fmin(cmean[r], cmean[c]);
-                fprintf(stderr, "DBG %zu %.4f %.1f %.1f\n", ac->rows, q, cmean[r], cmean[c]);
-            }
             if (f < 0 && ac->val[k] / f < ratio * fmin(cmean[r], cmean[c])) {
                 cut[k] = 1;
                 (*ncut)++;

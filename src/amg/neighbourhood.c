@@ -33,12 +33,14 @@ int asp__amg_resolve_desc(const asp_amg_desc *in, size_t count, asp_amg_desc *ou
     if (d.beta == 0)
         d.beta = 100;
     /*
-     * 0.9 by experiment (docs/cli/decompose.md): with the default 0.25 BoomerAMG
-     * treats the weakened couplings across creases as strong and domains
-     * spill over creases; 0.9 also slows coarsening to about 2-2.5x per level.
+     * 0.5 by experiment (docs/cli/decompose.md): the crease test (crease_cut)
+     * keeps coarse unknowns from merging across creases, so the threshold only
+     * shapes the coarsening; 0.5 coarsens by about 2 per level and gives the
+     * best face purity (octahedron, cube: 8,000..64,000 points, k_min 16..32);
+     * hypre's 0.25 can merge faces through crease slivers.
      */
     if (d.strong_threshold == 0)
-        d.strong_threshold = 0.9;
+        d.strong_threshold = 0.5;
     if (d.max_levels == 0)
         d.max_levels = 25;
     if (d.max_coarse == 0)

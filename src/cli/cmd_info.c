@@ -15,7 +15,8 @@ static const char usage[] =
     "Prints the number of points and faces, the attributes present (normals, colours,\n"
     "radii, texture coordinates, labels and any extra properties with their types), the\n"
     "bounding box in world coordinates and the radius statistics of a point file\n"
-    "(.ply, .xyz, .pts, .txt).";
+    "(.ply, .xyz, .pts, .txt). For a primitive file (.dps, from 'amgsplat build') it prints\n"
+    "per level: primitives, texels, error, normalised error, cb and dpc times, atlas size.";
 
 struct radius_stats {
     double mean, min, max;
@@ -93,6 +94,49 @@ static void print_json(const char *path, const asp_cloud *c, const double lo[3],
     printf("]}\n");
 }
 
+/* A .dps file (amgsplat build): the thesis Table 5.2 columns per stored level. */
+static int info_dps(const char *path, struct cli_env *env)
+{
+    asp_dps *dps = NULL;
+    asp_error err = {0};
+    if (asp_dps_load(path, &env->ctx, &dps, &err))
+        return cli_fail(env, &err);
+    asp_dps_summary rows[64];
+    size_t nl = dps->level_count < 64 ? dps->level_count : 64;
+    asp_dps_summarize(&(asp_dps){.level_count = nl, .levels = dps->levels, .amg_levels = dps->amg_levels}, rows);
+    cli_progress_end(env);
+    if (env->json) {
+        printf("{\"file\": ");
+        cli_json_string(stdout, path);
+        printf(", \"source\": ");
+        cli_json_string(stdout, dps->source);
+        printf(", \"points\": %llu, \"mean_radius\": %.9g, \"method\": \"%s\", \"texel_size\": %g, \"levels\": [",
+               (unsigned long long)dps->source_points, dps->mean_radius, asp_prim_method_name(dps->desc.method),
+               dps->desc.texel_size);
+        for (size_t i = 0; i < nl; i++)
+            printf("%s{\"level\": %u, \"name\": \"%s\", \"primitives\": %zu, \"texels\": %llu, \"error\": %.9g, "
+                   "\"normalised_error\": %.6g, \"cb_seconds\": %.4f, \"dpc_seconds\": %.4f, \"skipped\": %u, "
+                   "\"degenerate\": %u, \"capped\": %u, \"merges\": %u, \"atlas\": [%u, %u], "
+                   "\"neighbour_pairs\": %zu, \"normal_map\": %s}",
+                   i ? ", " : "", rows[i].level, rows[i].name, rows[i].primitives, (unsigned long long)rows[i].texels,
+                   rows[i].error, rows[i].error_norm, rows[i].t_basis, rows[i].t_construct, rows[i].skipped,
+                   rows[i].degenerate, rows[i].capped, rows[i].merges, rows[i].atlas_width, rows[i].atlas_height,
+                   rows[i].neighbour_pairs, rows[i].normal_map ? "true" : "false");
+        printf("]}\n");
+    } else {
+        printf("file        %s\nsource      %s (%llu points, mean radius %.6g)\n", path, dps->source,
+               (unsigned long long)dps->source_points, dps->mean_radius);
+        printf("textures    %s, texel size %g\n", asp_prim_method_name(dps->desc.method), dps->desc.texel_size);
+        printf("level  name   primitives    texels        error  normalised   cb (s)  dpc (s)  atlas\n");
+        for (size_t i = 0; i < nl; i++)
+            printf("%5u  %-5s %11zu %9llu  %11.6g  %10.3f  %7.3f  %7.3f  %ux%u\n", rows[i].level, rows[i].name,
+                   rows[i].primitives, (unsigned long long)rows[i].texels, rows[i].error, rows[i].error_norm,
+                   rows[i].t_basis, rows[i].t_construct, rows[i].atlas_width, rows[i].atlas_height);
+    }
+    asp_dps_destroy(dps);
+    return 0;
+}
+
 int cmd_info(int argc, char **argv, struct cli_env *env)
 {
     const struct cli_option opts[] = {{0}};
@@ -101,6 +145,9 @@ int cmd_info(int argc, char **argv, struct cli_env *env)
         return rc > 0 ? 0 : 2;
     if (npos != 1)
         return cli_usage_error(env, "expected one file, got %d; see 'amgsplat info -h'", npos);
+    size_t len = strlen(argv[0]);
+    if (len >= 4 && strcmp(argv[0] + len - 4, ".dps") == 0)
+        return info_dps(argv[0], env);
     asp_cloud *c = NULL;
     asp_error err = {0};
     if (asp_cloud_load(argv[0], &env->ctx, &c, &err))

@@ -1,7 +1,9 @@
 /*
- * amgsplat render: draw a point file headlessly (EGL) to PNG, one view or a
- * contact sheet of views around the object. Glue only: loading, framing and
- * drawing are library calls (io.h, render.h); see docs/cli/render.md.
+ * amgsplat render: draw a point file or the points of an .amg decomposition
+ * (coloured by classifier or domains, journal Fig. 1b, 5) headlessly (EGL) to
+ * PNG with discs, blended splats (Pajarola et al. 2003) or squares, one view
+ * or a contact sheet. Glue only: loading, colouring, framing and drawing are
+ * library calls (io.h, amg.h, render.h); see docs/cli/render.md.
  */
 #include <ctype.h>
 #include <math.h>
@@ -14,14 +16,19 @@
 
 static const char usage[] =
     "usage: amgsplat render IN.ply -o OUT.png [--size WxH] [--view AZ,EL[,DIST]] [--views N]\n"
-    "                      [--renderer disc] [--background R,G,B[,A] | --transparent] [--light AZ,EL]\n"
+    "                      [--renderer disc|splat|square] [--tolerance PX] [--kernel A,B,N] [--epsilon X]\n"
+    "                      [--lighting gouraud|pixel|flat] [--opaque] [--point-size PX]\n"
+    "                      [--background R,G,B[,A] | --transparent] [--light AZ,EL]\n"
+    "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict] [--level L-3] ...\n"
     "\n"
-    "Renders a point set (PLY, XYZ) headlessly through EGL (a GPU, or Mesa llvmpipe without one)\n"
-    "to a PNG. Points are opaque discs in their tangent planes, Lambert-shaded by a light fixed to\n"
-    "the camera. AZ turns around +y (0 looks from +z), EL is the angle above the horizon, both in\n"
-    "degrees; DIST is the eye distance in bounding-sphere radii (default: the sphere fills the view).\n"
-    "--views N renders N views at azimuths AZ + 360 i / N, elevation alternating +EL and -EL,\n"
-    "into one contact sheet.";
+    "Renders a point set (PLY, XYZ) or the points of an AMG decomposition (.amg) headlessly through\n"
+    "EGL (a GPU, or Mesa llvmpipe without one) to a PNG. Renderers: disc (opaque discs in the tangent\n"
+    "planes), splat (blended elliptical splats of the point hierarchy for a screen tolerance of PX\n"
+    "pixels, Pajarola et al. 2003), square (screen-aligned squares of the hierarchy, the cheapest).\n"
+    "Lambert shading by a light fixed to the camera. AZ turns around +y (0 looks from +z), EL is the\n"
+    "angle above the horizon, both in degrees; DIST is the eye distance in bounding-sphere radii\n"
+    "(default: the sphere fills the view). --views N renders N views at azimuths AZ + 360 i / N,\n"
+    "elevation alternating +EL and -EL, into one contact sheet.";
 
 enum { MAX_VIEWS = 256, MAX_SIDE = 16384 };
 
@@ -32,29 +39,74 @@ struct render_opts {
     const char *renderer;
     const char *background;
     const char *light;
+    const char *kernel;
+    const char *lighting;
+    const char *color_by;
+    const char *level;
     size_t views;
     size_t samples;
     int transparent;
     double fov;
     double radius_scale;
+    double tolerance;
+    double epsilon;
+    double point_size;
+    int opaque;
     /* parsed */
     unsigned width, height;
     double az, el, dist; /* dist 0 = fit */
     double light_az, light_el;
     uint8_t bg[4];
+    float kernel_abn[3];
+    asp_splat_lighting light_mode;
+    int amg_input;
+    asp_amg_color_mode color_mode;
+    const asp_context *ctx;
 };
 
-/* What was loaded from IN. Later inputs (.amg, .dps domain primitives) add their members here. */
+/* What was loaded from IN. Later inputs (.dps domain primitives) add their members here. */
 struct scene {
-    asp_cloud *cloud;
+    asp_cloud *cloud; /* owned: the file's points, or a copy of the .amg points with their colours */
+    asp_amg *amg;
     float center[3];
     float radius;
     size_t count;
 };
 
-static int load_scene(const char *path, const struct cli_env *env, struct scene *s, asp_error *err)
+static int ends_with_ci(const char *path, const char *ext)
 {
-    int rc = asp_cloud_load(path, &env->ctx, &s->cloud, err);
+    size_t n = strlen(path), m = strlen(ext);
+    if (n < m)
+        return 0;
+    for (size_t i = 0; i < m; i++)
+        if (tolower((unsigned char)path[n - m + i]) != ext[i])
+            return 0;
+    return 1;
+}
+
+/* The .amg points coloured by classifier or domains (or as the input had them, without --color-by). */
+static int load_amg(const char *path, const struct render_opts *o, const struct cli_env *env, struct scene *s,
+                    asp_error *err)
+{
+    int rc = asp_amg_load(path, &env->ctx, &s->amg, err);
+    if (!rc)
+        rc = asp_cloud_clone(asp_amg_cloud(s->amg), &s->cloud, err);
+    if (rc || !o->color_by)
+        return rc;
+    size_t level = 0;
+    if (o->color_mode != ASP_AMG_COLOR_CLASSIFIER)
+        rc = asp_amg_level_parse(s->amg, o->level ? o->level : "L-3", &level, err);
+    if (!rc)
+        rc = asp_cloud_add_attrs(s->cloud, ASP_ATTR_COLORS, err);
+    if (!rc)
+        rc = asp_amg_colorize(s->amg, o->color_mode, level, &env->ctx, s->cloud->colors, err);
+    return rc;
+}
+
+static int load_scene(const char *path, const struct render_opts *o, const struct cli_env *env, struct scene *s,
+                      asp_error *err)
+{
+    int rc = o->amg_input ? load_amg(path, o, env, s, err) : asp_cloud_load(path, &env->ctx, &s->cloud, err);
     if (rc)
         return rc;
     s->count = s->cloud->count;
@@ -64,6 +116,7 @@ static int load_scene(const char *path, const struct cli_env *env, struct scene 
 static void scene_release(struct scene *s)
 {
     asp_cloud_destroy(s->cloud);
+    asp_amg_destroy(s->amg);
     memset(s, 0, sizeof *s);
 }
 
@@ -74,25 +127,38 @@ static int make_disc(asp_gl_context *gl, const struct scene *s, const struct ren
     return asp_disc_renderer_create(gl, s->cloud, &desc, r, err);
 }
 
-/* --renderer values; splat and square renderers get a row each. */
+static int make_splat(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
+                      asp_error *err)
+{
+    asp_splat_renderer_desc desc = {.kernel_a = o->kernel_abn[0], .kernel_b = o->kernel_abn[1],
+                                    .kernel_n = o->kernel_abn[2],
+                                    .epsilon = o->epsilon > 0 ? (float)o->epsilon : -1.0f, // 0 = no offset
+                                    .tolerance = (float)o->tolerance, .radius_scale = (float)o->radius_scale,
+                                    .lighting = o->light_mode, .mode = o->opaque ? ASP_SPLAT_OPAQUE : ASP_SPLAT_BLEND,
+                                    .ctx = o->ctx};
+    return asp_splat_renderer_create(gl, s->cloud, &desc, r, err);
+}
+
+static int make_square(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
+                       asp_error *err)
+{
+    asp_square_renderer_desc desc = {.point_size = (float)o->point_size, .tolerance = (float)o->tolerance,
+                                     .radius_scale = (float)o->radius_scale, .ctx = o->ctx};
+    return asp_square_renderer_create(gl, s->cloud, &desc, r, err);
+}
+
+/* --renderer values */
 static const struct {
     const char *name;
     int (*make)(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
                 asp_error *err);
 } renderers[] = {
     {"disc", make_disc},
+    {"splat", make_splat},
+    {"square", make_square},
 };
 enum { N_RENDERERS = sizeof renderers / sizeof renderers[0] };
 
-static int ends_with_png(const char *path)
-{
-    size_t n = strlen(path);
-    if (n < 4)
-        return 0;
-    const char *e = path + n - 4;
-    return e[0] == '.' && tolower((unsigned char)e[1]) == 'p' && tolower((unsigned char)e[2]) == 'n' &&
-           tolower((unsigned char)e[3]) == 'g';
-}
 
 static int parse_colour(struct cli_env *env, const char *s, uint8_t out[4])
 {
@@ -108,11 +174,57 @@ static int parse_colour(struct cli_env *env, const char *s, uint8_t out[4])
     return 0;
 }
 
+/* Options of the hierarchy renderers and of .amg inputs. */
+static int parse_splat_options(struct cli_env *env, struct render_opts *o)
+{
+    if (!(o->tolerance >= 0) || !isfinite(o->tolerance))
+        return cli_usage_error(env, "--tolerance expects pixels >= 0, got %g", o->tolerance);
+    if (!(o->epsilon >= 0) || !isfinite(o->epsilon))
+        return cli_usage_error(env, "--epsilon expects a number >= 0 (splat radii), got %g", o->epsilon);
+    if (!(o->point_size >= 0) || !(o->point_size <= 256))
+        return cli_usage_error(env, "--point-size expects pixels in 0..256 (0 = projected size), got %g",
+                               o->point_size);
+    if (o->kernel) {
+        double v[3] = {0, 0, 0};
+        if (cli_parse_doubles(o->kernel, v, 3) != 3 || !(v[0] > 0 && v[1] > 0 && v[2] > 0) || !isfinite(v[0]) ||
+            !isfinite(v[1]) || !isfinite(v[2]))
+            return cli_usage_error(env, "--kernel expects A,B,N, three positive numbers (e.g. 6,1.5,3), got '%s'",
+                                   o->kernel);
+        for (int i = 0; i < 3; i++)
+            o->kernel_abn[i] = (float)v[i];
+    }
+    static const char *const modes[] = {"gouraud", "pixel", "flat"};
+    if (o->lighting) {
+        int found = -1;
+        for (int i = 0; i < 3; i++)
+            if (strcmp(o->lighting, modes[i]) == 0)
+                found = i;
+        if (found < 0)
+            return cli_usage_error(env, "--lighting expects gouraud, pixel or flat, got '%s'", o->lighting);
+        o->light_mode = (asp_splat_lighting)found;
+    }
+    static const char *const colorings[] = {"classifier", "domains", "strict"};
+    if (o->color_by) {
+        int found = -1;
+        for (int i = 0; i < 3; i++)
+            if (strcmp(o->color_by, colorings[i]) == 0)
+                found = i;
+        if (found < 0)
+            return cli_usage_error(env, "--color-by expects classifier, domains or strict, got '%s'", o->color_by);
+        o->color_mode = (asp_amg_color_mode)found;
+    }
+    if (o->color_by && !o->amg_input)
+        return cli_usage_error(env, "--color-by needs an .amg input (amgsplat decompose makes one)");
+    if (o->level && !(o->color_by && o->color_mode != ASP_AMG_COLOR_CLASSIFIER))
+        return cli_usage_error(env, "--level needs --color-by domains or strict");
+    return 0;
+}
+
 static int parse_options(struct cli_env *env, struct render_opts *o)
 {
     if (!o->output)
         return cli_usage_error(env, "missing -o OUT.png");
-    if (!ends_with_png(o->output))
+    if (!ends_with_ci(o->output, ".png"))
         return cli_usage_error(env, "output '%s' must end in .png", o->output);
     if (o->size && (cli_parse_size2(o->size, &o->width, &o->height) != 0 || o->width == 0 || o->height == 0 ||
                     o->width > MAX_SIDE || o->height > MAX_SIDE))
@@ -149,13 +261,20 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
         return cli_usage_error(env, "--fov expects degrees in (0, 180), got %g", o->fov);
     if (!(o->radius_scale > 0) || !isfinite(o->radius_scale))
         return cli_usage_error(env, "--radius-scale expects a positive number, got %g", o->radius_scale);
-    return 0;
+    return parse_splat_options(env, o);
 }
+
+/* What the views drew: primitives per view (the cut depends on the view) and the time per view. */
+struct view_stats {
+    size_t min_count, max_count, last_count;
+    double seconds; /* all asp_render_to_image calls, read-back included */
+};
 
 /* Renders the views into tiles[0 .. views-1]. */
 static int render_views(asp_gl_context *gl, asp_renderer *r, const struct scene *s, const struct render_opts *o,
-                        const struct cli_env *env, asp_image *tiles, asp_error *err)
+                        const struct cli_env *env, asp_image *tiles, struct view_stats *vs, asp_error *err)
 {
+    vs->min_count = SIZE_MAX;
     asp_render_desc desc = {.width = o->width, .height = o->height, .samples = (uint32_t)o->samples,
                             .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el};
     memcpy(desc.background, o->bg, 4);
@@ -170,9 +289,14 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const struct scene 
             cam.distance = (float)(o->dist * s->radius);
             asp_camera_clip_to_sphere(&cam, s->center, s->radius);
         }
+        double t0 = asp_time_now();
         int rc = asp_render_to_image(gl, r, &cam, &desc, &tiles[i], err);
         if (rc)
             return rc;
+        vs->seconds += asp_time_now() - t0;
+        vs->last_count = asp_renderer_count(r);
+        vs->min_count = vs->last_count < vs->min_count ? vs->last_count : vs->min_count;
+        vs->max_count = vs->last_count > vs->max_count ? vs->last_count : vs->max_count;
         rc = asp_progress(&env->ctx, "render", (double)(i + 1) / (double)o->views);
         if (rc)
             return asp_error_set(err, rc, "rendering canceled");
@@ -181,7 +305,7 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const struct scene 
 }
 
 static void print_json(const struct render_opts *o, const struct scene *s, asp_gl_context *gl, const char *renderer,
-                       const asp_image *img, double seconds)
+                       const asp_image *img, const struct view_stats *vs, double seconds)
 {
     printf("{\"output\": ");
     cli_json_string(stdout, o->output);
@@ -193,26 +317,38 @@ static void print_json(const struct render_opts *o, const struct scene *s, asp_g
     cli_json_string(stdout, asp_gl_context_renderer(gl));
     printf(", \"gl_backend\": ");
     cli_json_string(stdout, asp_gl_context_backend(gl));
+    printf(", \"primitives\": %zu, \"primitives_min\": %zu, \"primitives_max\": %zu, \"tolerance\": %g, "
+           "\"view_ms\": %.3f",
+           vs->last_count, vs->min_count, vs->max_count, strcmp(renderer, "disc") ? o->tolerance : 0.0,
+           1e3 * vs->seconds / (double)o->views);
     printf(", \"seconds\": %.3f}\n", seconds);
 }
 
 int cmd_render(int argc, char **argv, struct cli_env *env)
 {
     struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .renderer = "disc",
-                            .width = 512, .height = 512, .az = 30.0, .el = 20.0,
-                            .bg = {255, 255, 255, 255}};
+                            .width = 512, .height = 512, .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0,
+                            .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
         {"size", 0, CLI_STRING, &o.size, "WxH", "image size of one view (default 512x512)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "camera azimuth, elevation (degrees), distance in radii (default 30,20)"},
         {"views", 0, CLI_SIZE, &o.views, "N", "N views around the object in a contact sheet (default 1)"},
-        {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "how points are drawn: disc (default)"},
+        {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "how points are drawn: disc (default), splat, square"},
+        {"tolerance", 0, CLI_DOUBLE, &o.tolerance, "PX", "splat, square: screen tolerance tau in pixels (default 1; 0 = every point)"},
+        {"kernel", 0, CLI_STRING, &o.kernel, "A,B,N", "splat: kernel exp(-A (r/B)^N) (default 6,1.5,3)"},
+        {"epsilon", 0, CLI_DOUBLE, &o.epsilon, "X", "splat: depth offset in splat radii for blending (default 1; 0 = none)"},
+        {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
+        {"opaque", 0, CLI_FLAG, &o.opaque, NULL, "splat: opaque ellipses, no blending"},
+        {"point-size", 0, CLI_DOUBLE, &o.point_size, "PX", "square: fixed side in pixels (default 0: projected size)"},
+        {"color-by", 0, CLI_STRING, &o.color_by, "MODE", ".amg input: classifier, domains or strict"},
+        {"level", 0, CLI_STRING, &o.level, "L", ".amg input: level of the domain colours, L, L-3 or an index (default L-3)"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
         {"transparent", 0, CLI_FLAG, &o.transparent, NULL, "transparent background"},
         {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
         {"samples", 0, CLI_SIZE, &o.samples, "N", "multisamples per pixel, 0..64 (default 4)"},
         {"fov", 0, CLI_DOUBLE, &o.fov, "DEG", "vertical field of view (default 40)"},
-        {"radius-scale", 0, CLI_DOUBLE, &o.radius_scale, "X", "multiply every disc radius by X (default 1)"},
+        {"radius-scale", 0, CLI_DOUBLE, &o.radius_scale, "X", "multiply every disc, ellipse or square size by X (default 1)"},
         {0},
     };
     int npos = 0;
@@ -221,6 +357,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         return prc > 0 ? 0 : 2;
     if (npos != 1)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat render -h'", npos);
+    o.amg_input = ends_with_ci(argv[0], ".amg");
     if (parse_options(env, &o))
         return 2;
     size_t kind = N_RENDERERS;
@@ -228,7 +365,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         if (strcmp(renderers[i].name, o.renderer) == 0)
             kind = i;
     if (kind == N_RENDERERS)
-        return cli_usage_error(env, "unknown renderer '%s' (expected disc)", o.renderer);
+        return cli_usage_error(env, "unknown renderer '%s' (expected disc, splat or square)", o.renderer);
 
     double t0 = asp_time_now();
     asp_error err = {0, ""};
@@ -239,13 +376,14 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     asp_image tiles[MAX_VIEWS];
     asp_image sheet = {0, 0, NULL};
     memset(tiles, 0, sizeof tiles);
-    int rc = load_scene(argv[0], env, &s, &err);
+    struct view_stats vs = {0, 0, 0, 0};
+    int rc = load_scene(argv[0], &o, env, &s, &err);
     if (!rc)
         rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.ctx = &env->ctx}, &gl, &err);
     if (!rc)
         rc = renderers[kind].make(gl, &s, &o, &r, &err);
     if (!rc)
-        rc = render_views(gl, r, &s, &o, env, tiles, &err);
+        rc = render_views(gl, r, &s, &o, env, tiles, &vs, &err);
     if (!rc && o.views > 1)
         rc = asp_image_contact_sheet(tiles, o.views, 0, &sheet, &err);
     const asp_image *result = o.views > 1 ? &sheet : &tiles[0];
@@ -258,11 +396,14 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     } else {
         cli_progress_end(env);
         if (env->json)
-            print_json(&o, &s, gl, renderers[kind].name, result, seconds);
+            print_json(&o, &s, gl, renderers[kind].name, result, &vs, seconds);
         else
-            cli_info(env, "rendered %zu view%s of %zu points (%s, %s) to '%s' (%ux%u) in %.2f s\n", o.views,
-                     o.views > 1 ? "s" : "", s.count, renderers[kind].name, asp_gl_context_renderer(gl), o.output,
-                     result->width, result->height, seconds);
+            cli_info(env,
+                     "rendered %zu view%s of %zu points (%s, %zu primitives in the last view, %.1f ms per view, %s) "
+                     "to '%s' (%ux%u) in %.2f s\n",
+                     o.views, o.views > 1 ? "s" : "", s.count, renderers[kind].name, vs.last_count,
+                     1e3 * vs.seconds / (double)o.views, asp_gl_context_renderer(gl), o.output, result->width,
+                     result->height, seconds);
     }
     asp_image_release(&sheet);
     for (size_t i = 0; i < o.views; i++)

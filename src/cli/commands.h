@@ -15,6 +15,7 @@ int cmd_estimate(int argc, char **argv, struct cli_env *env);
 int cmd_render(int argc, char **argv, struct cli_env *env);
 int cmd_imgdiff(int argc, char **argv, struct cli_env *env);
 int cmd_decompose(int argc, char **argv, struct cli_env *env);
+int cmd_build(int argc, char **argv, struct cli_env *env);
 int cmd_view(int argc, char **argv, struct cli_env *env);
 
 #endif

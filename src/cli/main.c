@@ -24,6 +24,7 @@ static const struct cli_command commands[] = {
     {"render", cmd_render, "render points to PNG headlessly (EGL)"},
     {"imgdiff", cmd_imgdiff, "compare two images: PSNR, SSIM, silhouette IoU"},
     {"decompose", cmd_decompose, "multiscale AMG decomposition of a point set into domains"},
+    {"build", cmd_build, "domain primitives (textured polygons) of AMG levels into a .dps file"},
     {"view", cmd_view, "open a window on points or an .amg decomposition (interactive viewer)"},
 };
 enum { N_COMMANDS = sizeof commands / sizeof commands[0] };

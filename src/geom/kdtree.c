@@ -82,13 +82,32 @@ static int cmp_item_index(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* A subtree left for a parallel pass: items[begin, end), nodes from id on. */
+typedef struct kd_task {
+    uint32_t begin, end, id;
+} kd_task;
+
+/* Nodes a subtree of m >= 6 points can need: its leaves hold >= ASP__KD_LEAF_MAX / 2 points. */
+static size_t subtree_cap(size_t m)
+{
+    return 2 * (m / (ASP__KD_LEAF_MAX / 2)) + 2;
+}
+
 /*
  * Builds the subtree over items[begin, end) and returns its node index.
  * Depth is at most log2(count) + 1 because every split halves the count, even
- * when many points share the split coordinate.
+ * when many points share the split coordinate. With tasks, the subtrees
+ * defer levels down are only reserved (subtree_cap nodes each) and listed,
+ * for build_tasks to fill in parallel; the layout does not depend on threads.
  */
-static uint32_t build_node(kd_build *b, uint32_t begin, uint32_t end)
+static uint32_t build_node(kd_build *b, uint32_t begin, uint32_t end, int defer, kd_task *tasks, size_t *ntasks)
 {
+    if (tasks && defer == 0) {
+        uint32_t at = (uint32_t)b->node_count;
+        tasks[(*ntasks)++] = (kd_task){begin, end, at};
+        b->node_count += subtree_cap(end - begin);
+        return at;
+    }
     uint32_t id = (uint32_t)b->node_count++;
     asp__kd_node *nd = &b->nodes[id];
     const kd_item *it = b->items;
@@ -133,10 +152,37 @@ static uint32_t build_node(kd_build *b, uint32_t begin, uint32_t end)
     select_nth(b->items + begin, end - begin, mid - begin, axis);
     nd->axis = (uint32_t)axis;
     nd->split = b->items[mid].p[axis];
-    build_node(b, begin, mid);
-    uint32_t right = build_node(b, mid, end);
+    build_node(b, begin, mid, defer - 1, tasks, ntasks);
+    uint32_t right = build_node(b, mid, end, defer - 1, tasks, ntasks);
     b->nodes[id].right = right;
     return id;
+}
+
+/* Levels split serially before the subtrees below are built in parallel; fixed, so the tree is too. */
+enum { KD_DEFER_LEVELS = 4, KD_PARALLEL_MIN = 1 << 16 };
+
+/*
+ * Builds the tree over all items: for large inputs the top KD_DEFER_LEVELS
+ * levels serially, then their 2^KD_DEFER_LEVELS subtrees in parallel, each
+ * into its own reserved node range (unused slots between ranges are never
+ * reached). Returns the number of node slots used.
+ */
+static size_t build_tree(kd_build *b, uint32_t count, int threads)
+{
+    if (count < KD_PARALLEL_MIN || threads <= 1) {
+        build_node(b, 0, count, -1, NULL, NULL);
+        return b->node_count;
+    }
+    kd_task tasks[1 << KD_DEFER_LEVELS];
+    size_t ntasks = 0;
+    build_node(b, 0, count, KD_DEFER_LEVELS, tasks, &ntasks);
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long t = 0; t < (long long)ntasks; t++) {
+        kd_build sub = *b;
+        sub.node_count = tasks[t].id;
+        build_node(&sub, tasks[t].begin, tasks[t].end, -1, NULL, NULL);
+    }
+    return b->node_count;
 }
 
 int asp_kdtree_create(const float *positions, size_t count, size_t stride_bytes, const asp_context *ctx,
@@ -165,7 +211,7 @@ int asp_kdtree_create(const float *positions, size_t count, size_t stride_bytes,
 
     asp_context c = ctx ? *ctx : (asp_context){0};
     /* Every leaf below the root holds >= ASP__KD_LEAF_MAX / 2 points (only nodes above the cap split). */
-    size_t cap = 2 * (count / (ASP__KD_LEAF_MAX / 2)) + 2;
+    size_t cap = subtree_cap(count) + 2 * (1u << KD_DEFER_LEVELS) * 2;
     asp_kdtree *t = asp_calloc(&c, 1, sizeof *t);
     kd_item *items = asp_calloc(&c, count, sizeof(kd_item));
     asp__kd_node *nodes = asp_calloc(&c, cap, sizeof(asp__kd_node));
@@ -186,7 +232,7 @@ int asp_kdtree_create(const float *positions, size_t count, size_t stride_bytes,
         items[i] = (kd_item){{p[0], p[1], p[2]}, (uint32_t)i};
     }
     kd_build b = {items, nodes, box, 0, cap};
-    build_node(&b, 0, (uint32_t)count);
+    build_tree(&b, (uint32_t)count, asp_context_threads(&c));
     for (size_t i = 0; i < count; i++) {
         memcpy(xyz + 3 * i, items[i].p, 3 * sizeof(float));
         perm[i] = items[i].idx;
@@ -379,16 +425,8 @@ void asp__kd_select_keys(uint64_t *v, size_t n, size_t nth)
     }
 }
 
-void asp__kd_sort_keys(uint64_t *v, size_t n)
+static void insertion_sort_keys(uint64_t *v, size_t n)
 {
-    while (n > 16) {
-        size_t m = n / 2;
-        asp__kd_select_keys(v, n, m);
-        /* recurse into the smaller half, loop on the larger */
-        asp__kd_sort_keys(v, m);
-        v += m + 1;
-        n -= m + 1;
-    }
     for (size_t i = 1; i < n; i++) {
         uint64_t x = v[i];
         size_t j = i;
@@ -396,6 +434,62 @@ void asp__kd_sort_keys(uint64_t *v, size_t n)
             v[j] = v[j - 1];
         v[j] = x;
     }
+}
+
+enum { KD_BUCKET_MAX = 512 };
+
+/*
+ * Distribution pass for 17..KD_BUCKET_MAX keys: the distance bits (the high
+ * word, which orders like the distance) are spread linearly over 2n buckets,
+ * leaving an almost sorted array that one insertion pass finishes. Results
+ * do not depend on how well the buckets spread, only the time does.
+ */
+static void bucket_sort_keys(uint64_t *v, size_t n)
+{
+    uint64_t tmp[KD_BUCKET_MAX];
+    uint16_t bucket[KD_BUCKET_MAX];
+    uint16_t start[2 * KD_BUCKET_MAX + 1];
+    uint32_t lo = UINT32_MAX, hi = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t b = (uint32_t)(v[i] >> 32);
+        lo = b < lo ? b : lo;
+        hi = b > hi ? b : hi;
+    }
+    /* 2n buckets: bucket = (bits - lo) * (nb - 1) / (hi - lo), by a 32.32 fixed-point multiplier */
+    const size_t nb = 2 * n;
+    uint64_t mul = hi > lo ? ((uint64_t)(nb - 1) << 32) / (hi - lo) : 0;
+    memset(start, 0, (nb + 1) * sizeof start[0]);
+    for (size_t i = 0; i < n; i++) {
+        uint64_t b = ((uint64_t)((uint32_t)(v[i] >> 32) - lo) * mul) >> 32;
+        bucket[i] = (uint16_t)(b < nb ? b : nb - 1);
+        start[bucket[i] + 1]++;
+    }
+    for (size_t b = 0; b < nb; b++)
+        start[b + 1] = (uint16_t)(start[b + 1] + start[b]);
+    for (size_t i = 0; i < n; i++)
+        tmp[start[bucket[i]]++] = v[i];
+    memcpy(v, tmp, n * sizeof v[0]);
+    insertion_sort_keys(v, n);
+}
+
+void asp__kd_sort_keys(uint64_t *v, size_t n)
+{
+    if (n > 16 && n <= KD_BUCKET_MAX) {
+        bucket_sort_keys(v, n);
+        return;
+    }
+    while (n > KD_BUCKET_MAX) {
+        size_t m = n / 2;
+        asp__kd_select_keys(v, n, m);
+        /* recurse into the smaller half, loop on the larger */
+        asp__kd_sort_keys(v, m);
+        v += m + 1;
+        n -= m + 1;
+    }
+    if (n > 16)
+        bucket_sort_keys(v, n);
+    else
+        insertion_sort_keys(v, n);
 }
 
 /* Restores the buffer invariants after appends: a bound once k keys exist, at most 2k keys kept. */

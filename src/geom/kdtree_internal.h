@@ -79,15 +79,20 @@ int asp__knn_graph(const float *positions, size_t count, size_t stride_bytes, si
                    float **dist2, const asp_context *ctx, asp_error *err);
 
 /*
- * Tuning of asp_knn_all, exposed so tests can force every code path; the zero
- * value means the defaults. group_max: queries answered together share one
- * candidate list (subtrees of at most this many points). cand_max: candidate
- * points a group may gather before it falls back to one tree search per query
- * (1 forces the fallback). tree_only: skip the grouped path entirely.
+ * Tuning of asp_knn_all, exposed so tests and the benchmark can force every
+ * code path; the zero value means the defaults. Results never depend on it.
+ * group_max: queries answered together share one candidate list (subtrees of
+ * at most this many points). cand_max: candidate points a group may gather
+ * before it falls back to one tree search per query (1 forces that). reach:
+ * the gather radius in units of the last group's largest k-th distance (tiny
+ * values make most queries fall back). guess: the first scan radius, in units
+ * of the last k-th squared distance. tree_only: one tree search per query.
  */
 typedef struct asp__knn_tuning {
     size_t group_max;
     size_t cand_max;
+    double reach;
+    float guess;
     int tree_only;
 } asp__knn_tuning;
 

@@ -11,16 +11,24 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include "geom/kdtree_internal.h"
 #include "util/banned.h"
 
-#include <stdio.h>
-size_t st_q, st_cand, st_leaf, st_m, st_mf, st_second, st_groups, st_fb1, st_fb2, st_gcalls;
 /* Queries between progress reports; the block boundaries do not affect results. */
 enum { KNN_BLOCK = 1 << 16 };
-/* Default group size: one leaf (6..12 points) answered together. */
-enum { KNN_GROUP_MAX = 12 };
+/*
+ * Defaults (asp__knn_tuning): groups of 32..64 points; gather within 1.25
+ * times the expected k-th distance (Poisson noise makes fewer than k points
+ * inside rare); first scan within 1.2 times the last k-th squared distance
+ * (usually a little more than k points).
+ */
+enum { KNN_GROUP_MAX = 64 };
+#define KNN_REACH 1.25
+#define KNN_GUESS 1.2f
 
 static float key_distance(uint64_t key)
 {
@@ -78,7 +86,8 @@ typedef struct knn_scratch {
     float *ld;        /* per query: lower bound of the squared distance to each leaf */
     uint64_t *keys;   /* selection buffer, also the tree search scratch */
     uint64_t *far;    /* candidates beyond the guessed k-th distance */
-    float guess_factor;
+    float guess_factor; /* first scan within guess_factor times the last k-th squared distance */
+    double reach_factor; /* gather within reach_factor times the group's largest k-th distance */
     size_t n_cand, n_leaf;
     size_t cap;    /* candidates allowed */
     size_t stride; /* length of each array, >= cap */
@@ -144,7 +153,7 @@ static int gather(const asp_kdtree *tree, uint32_t node, float r2, size_t k, knn
 {
     const float *b = tree->box + 6 * (size_t)node;
     knn_gather g = {tree, s, {b[0], b[1], b[2]}, {b[3], b[4], b[5]}, r2, k + 1, 0};
-    s->n_cand = 0; st_gcalls++;
+    s->n_cand = 0;
     s->n_leaf = 0;
     s->lbeg[0] = 0;
     gather_rec(&g, 0);
@@ -192,7 +201,7 @@ static void scan_leaves(const knn_scratch *s, const float q[3], asp_index self, 
  */
 static size_t scan_candidates(knn_scratch *s, const float q[3], asp_index self, float r2, float guess2, size_t k,
                               size_t *n_far)
-{ st_q++; st_cand += s->n_cand; st_leaf += s->n_leaf;
+{
     const size_t nl = s->n_leaf, stride = s->stride;
     const float *restrict lox = s->lbox, *restrict loy = s->lbox + stride, *restrict loz = s->lbox + 2 * stride;
     const float *restrict hix = s->lbox + 3 * stride, *restrict hiy = s->lbox + 4 * stride;
@@ -205,9 +214,8 @@ static size_t scan_candidates(knn_scratch *s, const float q[3], asp_index self, 
                         axis_gap(loz[j], hiz[j], qz, qz));
     size_t m = 0, mf = 0;
     scan_leaves(s, q, self, -1.0f, guess2, guess2, r2, &m, &mf);
-    if (m < k && guess2 < r2) { st_second++;
-        scan_leaves(s, q, self, guess2, r2, guess2, r2, &m, &mf);}
-    st_m += m; st_mf += mf;
+    if (m < k && guess2 < r2)
+        scan_leaves(s, q, self, guess2, r2, guess2, r2, &m, &mf);
     *n_far = mf;
     return m;
 }
@@ -235,8 +243,26 @@ static void finish_keys(uint64_t *keys, size_t m, uint64_t *far, size_t nf, size
     memcpy(keys + m, far, need * sizeof(uint64_t));
 }
 
-static void emit_row(const uint64_t *keys, size_t k, asp_index *idx, float *d)
+/*
+ * Writes one output row. Rows land in original-index order while queries run
+ * in leaf order, so every row is a cache miss; with SSE2 (baseline on x86-64)
+ * aligned rows are written with streaming stores, which skip reading the
+ * lines first (about half the memory traffic). knn_fence() orders them.
+ */
+static void emit_row(const uint64_t *keys, size_t k, asp_index *restrict idx, float *restrict d)
 {
+#ifdef __SSE2__
+    if (k % 4 == 0 && ((uintptr_t)idx & 15) == 0 && ((uintptr_t)d & 15) == 0) {
+        for (size_t j = 0; j < k; j += 4) {
+            __m128 a = _mm_castsi128_ps(_mm_loadu_si128((const __m128i *)(const void *)(keys + j)));
+            __m128 b = _mm_castsi128_ps(_mm_loadu_si128((const __m128i *)(const void *)(keys + j + 2)));
+            _mm_stream_si128((__m128i *)(void *)(idx + j), _mm_castps_si128(_mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0))));
+            if (d)
+                _mm_stream_ps(d + j, _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
+        }
+        return;
+    }
+#endif
     for (size_t j = 0; j < k; j++)
         idx[j] = (asp_index)(keys[j] & 0xffffffffu);
     if (d)
@@ -244,11 +270,20 @@ static void emit_row(const uint64_t *keys, size_t k, asp_index *idx, float *d)
             d[j] = key_distance(keys[j]);
 }
 
+/* Makes the streaming stores of this thread visible before the next barrier. */
+static void knn_fence(void)
+{
+#ifdef __SSE2__
+    _mm_sfence();
+#endif
+}
+
 /* Per-thread memory of the last answered query, the source of the coherent bounds. */
 typedef struct knn_last {
     size_t group; /* group index + 1 of the last query, 0 when none */
     uint32_t slot;
     float d2;     /* its k-th squared distance */
+    float group_d2; /* largest k-th squared distance in the last group */
 } knn_last;
 
 /* One query by tree search, bounded by the last query when there is one. */
@@ -265,9 +300,12 @@ static void tree_query(const asp_kdtree *tree, size_t k, uint32_t s, knn_last *l
 
 /*
  * Answers the queries of one group (a subtree of at most group_max points):
- * a bound that holds for every query of the group gathers one candidate list,
- * then each query scans it with its own, tighter bound (thesis 3.3.1 needs
- * the k-NN of every point; this shares the tree walk among close queries).
+ * one candidate list is gathered for the whole group, then each query scans
+ * it (thesis 3.3.1 needs the k-NN of every point; this shares the tree walk
+ * among close queries). The gather radius is a guess from the last query's
+ * k-th distance: the list holds every point within it of the group's box, so
+ * a query that finds k points within it has its exact answer; the others,
+ * rare, fall back to a tree search.
  */
 static void answer_group(const asp_kdtree *tree, size_t k, size_t gi, uint32_t node, knn_scratch *s,
                          knn_last *last, asp_index *idx, float *dist2)
@@ -275,53 +313,57 @@ static void answer_group(const asp_kdtree *tree, size_t k, size_t gi, uint32_t n
     const asp__kd_node *nd = &tree->nodes[node];
     uint32_t b = nd->begin;
     const uint32_t e = nd->end;
-    if (last->group == 0 || last->group != gi) { /* no recent query (chunk start): anchor on the first one */
+    if (last->group == 0 || last->group != gi) { /* no recent query (chunk start): start with a search */
         last->group = 0;
         tree_query(tree, k, b++, last, s->keys, idx, dist2);
+        last->group_d2 = last->d2;
     }
     last->group = gi + 1;
-    const float *anchor = tree->xyz + 3 * (size_t)last->slot;
-    float anchor_d2 = last->d2, r2 = 0.0f;
-    for (uint32_t q = b; q < e; q++) {
-        float r = coherent_bound(tree->xyz + 3 * (size_t)q, anchor, anchor_d2);
-        r2 = r > r2 ? r : r2;
-    }
-    if (b < e && !(r2 < INFINITY && gather(tree, node, r2, k, s))) {
-        st_fb1++;
-        tree_query(tree, k, b++, last, s->keys, idx, dist2);
-        anchor = tree->xyz + 3 * (size_t)last->slot;
-        anchor_d2 = last->d2;
-        r2 = 0.0f;
-        for (uint32_t q = b; q < e; q++) {
-            float r = coherent_bound(tree->xyz + 3 * (size_t)q, anchor, anchor_d2);
-            r2 = r > r2 ? r : r2;
-        }
-        if (b < e && !(r2 < INFINITY && gather(tree, node, r2, k, s))) {
-            st_fb2++;
-            for (uint32_t q = b; q < e; q++)
-                tree_query(tree, k, q, last, s->keys, idx, dist2);
-            return;
-        }
-    }
+    if (b == e)
+        return;
+    const float *box = tree->box + 6 * (size_t)node;
+    double reach = 0.0;
     for (uint32_t q = b; q < e; q++) {
         const float *p = tree->xyz + 3 * (size_t)q;
-        /* both bounds hold; the anchor's never exceeds the gathered r2 */
-        float rq = coherent_bound(p, anchor, anchor_d2);
-        float rl = coherent_bound(p, tree->xyz + 3 * (size_t)last->slot, last->d2);
-        rq = rl < rq ? rl : rq;
-        size_t nf = 0;
-        float guess = last->d2 * s->guess_factor;
-        size_t m = scan_candidates(s, p, tree->perm[q], rq, guess < rq ? guess : rq, k, &nf);
-        if (m + nf < k) { /* cannot happen when the bounds hold; stay exact regardless */
-            tree_query(tree, k, q, last, s->keys, idx, dist2);
-            continue;
+        double r = 0.0;
+        for (int a = 0; a < 3; a++) {
+            double c = 0.5 * ((double)box[a] + box[a + 3]) - p[a];
+            r += c * c;
         }
-        finish_keys(s->keys, m, s->far, nf, k);
-        const size_t row = (size_t)tree->perm[q] * k;
-        emit_row(s->keys, k, idx + row, dist2 ? dist2 + row : NULL);
-        last->slot = q;
-        last->d2 = key_distance(s->keys[k - 1]);
+        reach = r > reach ? r : reach;
     }
+    /* farthest query from the box centre plus the expected k-th distance with a margin */
+    double rg = sqrt(reach) + s->reach_factor * sqrt((double)last->group_d2);
+    rg = rg * rg;
+    const float r2g = rg < FLT_MAX ? (float)rg : FLT_MAX;
+    if (!gather(tree, node, r2g, k, s)) {
+        for (uint32_t q = b; q < e; q++)
+            tree_query(tree, k, q, last, s->keys, idx, dist2);
+        last->group_d2 = last->d2;
+        return;
+    }
+    float group_d2 = 0.0f;
+    for (uint32_t q = b; q < e; q++) {
+        const float *p = tree->xyz + 3 * (size_t)q;
+        /* a proven bound from the last query, clipped to what the list covers */
+        float rq = coherent_bound(p, tree->xyz + 3 * (size_t)last->slot, last->d2);
+        rq = rq < r2g ? rq : r2g;
+        float guess = last->d2 * s->guess_factor;
+        size_t nf = 0;
+        size_t m = scan_candidates(s, p, tree->perm[q], rq, guess < rq ? guess : rq, k, &nf);
+        if (m + nf < k) {
+            tree_query(tree, k, q, last, s->keys, idx, dist2);
+        } else {
+            finish_keys(s->keys, m, s->far, nf, k);
+            const size_t row = (size_t)tree->perm[q] * k;
+            emit_row(s->keys, k, idx + row, dist2 ? dist2 + row : NULL);
+            last->slot = q;
+            last->d2 = key_distance(s->keys[k - 1]);
+        }
+        group_d2 = last->d2 > group_d2 ? last->d2 : group_d2;
+    }
+    knn_fence();
+    last->group_d2 = group_d2;
 }
 
 /* Preorder list of the query groups: subtrees of at most group_max points, or leaves. */
@@ -362,8 +404,8 @@ int asp__knn_all_tuned(const asp_kdtree *tree, size_t k, asp_index *idx, float *
     const size_t group_max = tune.tree_only ? 0 : tune.group_max ? tune.group_max : KNN_GROUP_MAX;
     /* candidates never exceed n; about 32 k covers a surface or volume neighbourhood of a leaf */
     size_t cap = n;
-    if (k < (SIZE_MAX - 1024) / 32 && 32 * k + 1024 < n)
-        cap = 32 * k + 1024;
+    if (k < (SIZE_MAX - 4096) / 128 && 128 * k + 4096 < n)
+        cap = 128 * k + 4096;
     if (tune.cand_max)
         cap = tune.cand_max < cap ? tune.cand_max : cap;
     const size_t nkeys = round16(cap > ASP__KD_SCRATCH(k) ? cap : ASP__KD_SCRATCH(k));
@@ -400,7 +442,8 @@ int asp__knn_all_tuned(const asp_kdtree *tree, size_t k, asp_index *idx, float *
             knn_scratch s;
             s.keys = (uint64_t *)(void *)base;
             s.far = s.keys + nkeys;
-            s.guess_factor = 1.2f;
+            s.guess_factor = tune.guess > 0.0f ? tune.guess : KNN_GUESS;
+            s.reach_factor = tune.reach > 0.0 ? tune.reach : KNN_REACH;
             s.cx = (float *)(void *)(base + (nkeys + cap16) * 8);
             s.cy = s.cx + cap16;
             s.cz = s.cy + cap16;
@@ -428,8 +471,6 @@ int asp__knn_all_tuned(const asp_kdtree *tree, size_t k, asp_index *idx, float *
         rc = asp_progress(ctx, "knn", (double)done / (double)n);
         g0 = g1;
     }
-    if (st_q) fprintf(stderr, "groups %zu gathers %zu q %zu cand %.1f leaves %.1f m %.1f mf %.1f second %zu fb1 %zu fb2 %zu\n", ngroups, st_gcalls, st_q, (double)st_cand/st_q, (double)st_leaf/st_q, (double)st_m/st_q, (double)st_mf/st_q, st_second, st_fb1, st_fb2);
-    st_q=st_cand=st_leaf=st_m=st_mf=st_second=st_fb1=st_fb2=st_gcalls=0;
     asp_free(ctx, mem);
     asp_free(ctx, lasts);
     asp_free(ctx, groups);

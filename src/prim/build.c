@@ -373,6 +373,71 @@ int asp_prim_level_for_budget(const asp_amg *amg, size_t max_prims, size_t *leve
     return 0;
 }
 
+/* Estimates radii when there are none (16th neighbour) and takes their mean. */
+static int prepare_src(build_src *src, const asp_context *ctx, float **own, asp_error *err)
+{
+    size_t n = src->cloud->count;
+    if (!src->radii) {
+        *own = asp_alloc(ctx, n * sizeof **own);
+        if (!*own)
+            return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu radii", n);
+        int rc = asp_estimate_radii(src->cloud->positions, n, 12, NULL, *own, ctx, err);
+        if (rc)
+            return rc;
+        src->radii = *own;
+    }
+    double rs = 0; /* double: a float sum of 10^6 radii would lose digits */
+    for (size_t i = 0; i < n; i++)
+        rs += src->radii[i];
+    src->mean_radius = rs / (double)n;
+    if (!(src->mean_radius > 0) || !isfinite(src->mean_radius))
+        return asp_error_set(err, ASP_EDEGENERATE, "mean point radius is %g; expected a positive radius",
+                             src->mean_radius);
+    return 0;
+}
+
+int asp_prim_build_level(const asp_cloud *cloud, const asp_amg_csr *dom, const asp_prim_desc *desc,
+                         const asp_context *ctx, asp_dps_level *out, asp_error *err)
+{
+    if (!cloud || !dom || !out || cloud->count == 0 || dom->cols != cloud->count)
+        return asp_error_set(err, ASP_EINVAL, "domains over %zu points do not match the cloud's %zu",
+                             dom ? dom->cols : 0, cloud ? cloud->count : 0);
+    asp_prim_desc d;
+    resolve_desc(desc, &d);
+    int rc = check_desc(&d, err);
+    if (rc)
+        return rc;
+    for (size_t k = 0; k < dom->row_ptr[dom->rows]; k++)
+        if (dom->col[k] >= cloud->count || !(dom->val[k] >= 0 && dom->val[k] <= 1.000001))
+            return asp_error_set(err, ASP_EINVAL, "domain entry %zu: point %u, Psi %g; expected a point below %zu and "
+                                 "Psi in [0, 1]", k, dom->col[k], dom->val[k], cloud->count);
+    build_src src = {.cloud = cloud, .colors = cloud->colors, .radii = cloud->radii};
+    float *own = NULL;
+    asp_dps_level lv;
+    memset(&lv, 0, sizeof lv);
+    double t0 = asp_time_now();
+    rc = prepare_src(&src, ctx, &own, err);
+    if (!rc) {
+        lv.basis_count = (uint32_t)dom->rows;
+        rc = construct(&src, dom, NULL, NULL, &d, "of explicit domains", ctx, &lv, err);
+        lv.t_construct = asp_time_now() - t0;
+    }
+    asp_free(ctx, own);
+    memset(out, 0, sizeof *out);
+    if (rc) {
+        release_level(ctx, &lv);
+        return rc;
+    }
+    *out = lv;
+    return 0;
+}
+
+void asp_dps_level_release(asp_dps_level *lv, const asp_context *ctx)
+{
+    if (lv)
+        release_level(ctx, lv);
+}
+
 static int cmp_size(const void *a, const void *b)
 {
     size_t x = *(const size_t *)a, y = *(const size_t *)b;
@@ -416,25 +481,8 @@ int asp_prim_build(const asp_amg *amg, const asp_cloud *attrs, const size_t *lev
     build_src src = {.cloud = cloud};
     src.colors = attrs && attrs->colors ? attrs->colors : cloud->colors;
     src.radii = attrs && attrs->radii ? attrs->radii : cloud->radii;
-    if (!src.radii) {
-        own_radii = asp_alloc(ctx, n * sizeof *own_radii);
-        if (!own_radii) {
-            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu radii", n);
-            goto fail;
-        }
-        if ((rc = asp_estimate_radii(cloud->positions, n, 12, NULL, own_radii, ctx, err)))
-            goto fail;
-        src.radii = own_radii;
-    }
-    double rs = 0; /* double: a float sum of 10^6 radii would lose digits */
-    for (size_t i = 0; i < n; i++)
-        rs += src.radii[i];
-    src.mean_radius = rs / (double)n;
-    if (!(src.mean_radius > 0) || !isfinite(src.mean_radius)) {
-        rc = asp_error_set(err, ASP_EDEGENERATE, "mean point radius is %g; expected a positive radius",
-                           src.mean_radius);
+    if ((rc = prepare_src(&src, ctx, &own_radii, err)))
         goto fail;
-    }
     dps->levels = asp_calloc(ctx, nu, sizeof *dps->levels);
     if (!dps->levels) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory");
@@ -445,9 +493,18 @@ int asp_prim_build(const asp_amg *amg, const asp_cloud *attrs, const size_t *lev
             asp_error_set(err, rc, "primitive construction canceled");
             goto fail;
         }
-        if ((rc = build_level(amg, &src, lv_sorted[i], &d, ctx, &dps->levels[i], err)))
+        rc = build_level(amg, &src, lv_sorted[i], &d, ctx, &dps->levels[dps->level_count], err);
+        if (rc == ASP_EDEGENERATE) {
+            dps->skipped_levels++;
+            continue;
+        }
+        if (rc)
             goto fail;
-        dps->level_count = i + 1;
+        dps->level_count++;
+    }
+    if (dps->level_count == 0) {
+        rc = asp_error_set(err, ASP_EDEGENERATE, "no requested level has a domain with a point above tau = %g", d.tau);
+        goto fail;
     }
     asp_progress(ctx, "primitives", 1.0);
     dps->amg_levels = (uint32_t)nl;

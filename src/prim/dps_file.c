@@ -144,7 +144,8 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
     put_f64(&w, dps->mean_radius);
     put_u32(&w, dps->amg_levels);
     put_u32(&w, normals ? 1u : 0u);
-    put_u64(&w, 0);
+    put_u32(&w, dps->skipped_levels);
+    put_u32(&w, 0);
     /* parameters: 128 bytes */
     const asp_prim_desc *d = &dps->desc;
     put_f64(&w, d->tau);
@@ -181,7 +182,6 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
         put_f64(&w, lv->error_norm);
         put_f64(&w, lv->t_basis);
         put_f64(&w, lv->t_construct);
-        put_u64(&w, 0);
         for (size_t k = 0; k < lv->prim_count; k++)
             put_prim(&w, &lv->prims[k]);
         for (size_t k = 0; k < lv->neighbour_total; k++)
@@ -291,7 +291,6 @@ static int read_level(reader *r, const asp_dps *dps, size_t li, asp_dps_level *l
     (void)get_u32(r);
     lv->texels = get_u64(r);
     lv->error = get_f64(r), lv->error_norm = get_f64(r), lv->t_basis = get_f64(r), lv->t_construct = get_f64(r);
-    (void)get_u64(r);
     if (lv->level >= dps->amg_levels) {
         snprintf(msg, sizeof msg, "level %zu: AMG level %u, expected below %u", li, lv->level, dps->amg_levels);
         return bad(r, err, msg);
@@ -308,7 +307,7 @@ static int read_level(reader *r, const asp_dps *dps, size_t li, asp_dps_level *l
                  "than the %zu bytes left", li, (unsigned long long)np, (unsigned long long)nn, r->left);
         return bad(r, err, msg);
     }
-    lv->prims = asp_alloc(ctx, (size_t)np * sizeof *lv->prims);
+    lv->prims = asp_calloc(ctx, (size_t)np, sizeof *lv->prims); /* zeroed padding: records compare with memcmp */
     lv->neighbours = asp_alloc(ctx, (size_t)(nn ? nn : 1) * sizeof *lv->neighbours);
     if (!lv->prims || !lv->neighbours)
         return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", r->path);
@@ -382,7 +381,8 @@ static int parse(reader *r, const asp_context *ctx, asp_dps *dps, asp_error *err
     dps->mean_radius = get_f64(r);
     dps->amg_levels = get_u32(r);
     (void)get_u32(r);
-    (void)get_u64(r);
+    dps->skipped_levels = get_u32(r);
+    (void)get_u32(r);
     if (payload != total - DPS_HEADER - 4) {
         snprintf(msg, sizeof msg, "%s: header says %llu payload bytes, the file has %zu",
                  payload > total - DPS_HEADER - 4 ? "truncated" : "trailing bytes", (unsigned long long)payload,

@@ -64,9 +64,10 @@ size_t asp__prim_texture_scratch(size_t n, size_t texels, int channels);
 void asp__prim_texture(const asp__tex_input *in, void *scratch, uint8_t *rgba, uint8_t *nrm, size_t stride);
 
 /* Radial pass: adds phi-weighted attributes to acc (texels x channels) and phi to f, skipping texels with
- * skip[t] != 0 when skip is not NULL (thesis 3.3.2; 3.3.3 outside the triangulation). */
-void asp__prim_splat_radial(const asp__tex_input *in, asp_prim_shape shape, const uint8_t *skip, float *acc,
-                            float *f);
+ * skip[t] != 0 when skip is not NULL (thesis 3.3.2; 3.3.3 outside the triangulation). nearest: evaluate
+ * phi at the texel's point nearest the sample, so the texel holding a point gets its full weight. */
+void asp__prim_splat_radial(const asp__tex_input *in, asp_prim_shape shape, const uint8_t *skip, int nearest,
+                            float *acc, float *f);
 /* Affine pass: barycentric interpolation inside the kept Delaunay triangles; sets covered[t] = 1.
  * Returns 0, or -1 when there were too few distinct points for a triangle. */
 void asp__prim_affine(const asp__tex_input *in, void *scratch, float *acc, uint8_t *covered);

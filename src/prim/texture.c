@@ -53,13 +53,13 @@ void asp__prim_texture(const asp__tex_input *in, void *scratch, uint8_t *rgba, u
     if (in->method == ASP_PRIM_AFFINE) {
         asp__prim_affine(in, s, acc, covered);
         /* outside the triangulation: radial linear within a point's radius; alpha fades (eq. 3.3) */
-        asp__prim_splat_radial(in, ASP_PRIM_LINEAR, covered, acc, f);
+        asp__prim_splat_radial(in, ASP_PRIM_LINEAR, covered, 1, acc, f);
         for (size_t t = 0; t < T; t++)
             if (covered[t])
                 f[t] = 1.0f; /* acc already holds the interpolated values */
         crit = ASP_PRIM_NORM_GE1;
     } else {
-        asp__prim_splat_radial(in, in->shape, NULL, acc, f);
+        asp__prim_splat_radial(in, in->shape, NULL, 0, acc, f);
     }
     for (size_t t = 0; t < T; t++) {
         if (!(f[t] > 0) || covered[t])

@@ -10,8 +10,8 @@
 #include "prim/internal.h"
 #include "util/banned.h"
 
-void asp__prim_splat_radial(const asp__tex_input *in, asp_prim_shape shape, const uint8_t *skip, float *acc,
-                            float *f)
+void asp__prim_splat_radial(const asp__tex_input *in, asp_prim_shape shape, const uint8_t *skip, int nearest,
+                            float *acc, float *f)
 {
     const int C = in->channels;
     for (size_t p = 0; p < in->n; p++) {
@@ -32,9 +32,12 @@ void asp__prim_splat_radial(const asp__tex_input *in, asp_prim_shape shape, cons
                 size_t t = (size_t)j * in->w + (size_t)i;
                 if (skip && skip[t])
                     continue;
+                double d = sqrt(d2);
+                if (nearest) /* distance to the nearest point of the texel square, not its centre */
+                    d = d > 0.5 ? d - 0.5 : 0.0, d2 = d * d;
                 double phi = shape == ASP_PRIM_CONSTANT ? 1.0
                              : shape == ASP_PRIM_GAUSSIAN ? exp(-d2 * inv2s2)
-                                                          : 1.0 - sqrt(d2) / R;
+                                                          : 1.0 - d / R;
                 if (!(phi > 0))
                     continue;
                 f[t] += (float)phi;

@@ -125,6 +125,12 @@ grep -qF "wrote 'sphere-002.png' (64x48)" "$T/s.err" || fail "s key: $(cat "$T/s
 grep -qF "wrote 'sphere-003.png' (64x48)" "$T/s.err" || fail "s key: $(cat "$T/s.err")"
 check "$T/shots/sphere-003.png" "w == 64 and h == 48 and 0.3 < fg < 0.7"
 
+# Interactive mode (no --frames) runs until q: keys are pressed one per loop turn, s saves the frame
+(cd "$T/shots" && timeout 60 "${X[@]}" "$AMGSPLAT" view ../sphere.ply --keys dsq --size 64x48 --json \
+  >"$T/i.json" 2>"$T/i.err") || fail "interactive q: exit $?: $(cat "$T/i.err")"
+[[ "$(field "$T/i.json" frames)" == 2 && "$(field "$T/i.json" screenshots)" == 1 ]] || fail "interactive: $(cat "$T/i.json")"
+grep -qF "wrote 'sphere-004.png' (64x48)" "$T/i.err" || fail "interactive s: $(cat "$T/i.err")"
+
 # h prints every key; v prints the view in the form --view takes
 view "$T/sphere.ply" --frames 2 --keys hv --size 64x48 --view 12,-34,5 2>"$T/h.err" >/dev/null
 for k in q r l n + - c '[' ']' s v h a d w x z o 1; do

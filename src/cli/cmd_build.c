@@ -1,0 +1,241 @@
+/*
+ * amgsplat build: domain primitives (textured support rectangles) for one or
+ * more AMG levels, written as a .dps file (journal section 3, thesis ch. 3).
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "amgsplat/prim.h"
+#include "cli/cli.h"
+#include "cli/commands.h"
+#include "util/banned.h"
+
+static const char usage[] =
+    "usage: amgsplat build IN.amg|IN.ply -o OUT.dps [--level L-5 | --level L-6..L | --primitives 400]\n"
+    "                      [--texel-size X] [--method affine|radial] [--shape linear|constant|gaussian]\n"
+    "                      [--width W] [--normalise positive|ge1] [--merge] [--normals] [--atlas X.png]\n"
+    "\n"
+    "Turns every domain of the chosen AMG level(s) into one planar rectangle (weighted PCA of\n"
+    "its points) with a texture: colour = the points' colours, alpha = the domain's basis\n"
+    "function. A .ply input is decomposed first (as 'amgsplat decompose'). Levels: L is the\n"
+    "coarsest, L-3 three levels finer, an index, a list 'L-5,L-3' or a range 'L-6..L'.\n"
+    "--primitives N picks the finest level with at most N domains. Prints per level the\n"
+    "thesis Table 5.2 columns: primitives, texels, error, normalised error, basis time (cb)\n"
+    "and construction time (dpc).";
+
+static int add_level(size_t *levels, size_t *n, size_t cap, size_t l)
+{
+    for (size_t i = 0; i < *n; i++)
+        if (levels[i] == l)
+            return 0;
+    if (*n >= cap)
+        return -1;
+    levels[(*n)++] = l;
+    return 0;
+}
+
+/* "L-5", "L-6..L", "2,L-1": every named level, at most cap. */
+static int parse_levels(const asp_amg *amg, const char *text, size_t *levels, size_t *n, size_t cap, asp_error *err)
+{
+    char buf[256];
+    if (strlen(text) >= sizeof buf)
+        return asp_error_set(err, ASP_EINVAL, "level list '%.32s...' is too long", text);
+    snprintf(buf, sizeof buf, "%s", text);
+    char *item = buf;
+    while (item && *item) {
+        char *comma = strchr(item, ',');
+        if (comma)
+            *comma = 0;
+        char *dots = strstr(item, "..");
+        size_t a = 0, b = 0;
+        if (dots) {
+            *dots = 0;
+            int rc = asp_amg_level_parse(amg, item, &a, err);
+            if (!rc)
+                rc = asp_amg_level_parse(amg, dots + 2, &b, err);
+            if (rc)
+                return rc;
+            if (a > b) {
+                size_t t = a;
+                a = b;
+                b = t;
+            }
+        } else {
+            int rc = asp_amg_level_parse(amg, item, &a, err);
+            if (rc)
+                return rc;
+            b = a;
+        }
+        for (size_t l = a; l <= b; l++)
+            if (add_level(levels, n, cap, l))
+                return asp_error_set(err, ASP_EINVAL, "at most %zu levels per file", cap);
+        item = comma ? comma + 1 : NULL;
+    }
+    if (*n == 0)
+        return asp_error_set(err, ASP_EINVAL, "empty level list '%s'", text);
+    return 0;
+}
+
+static void print_table(const asp_dps *dps, const asp_dps_summary *rows)
+{
+    printf("level  name   primitives    texels        error  normalised   cb (s)  dpc (s)  skipped  degenerate\n");
+    for (size_t i = 0; i < dps->level_count; i++) {
+        const asp_dps_summary *s = &rows[i];
+        printf("%5u  %-5s %11zu %9llu  %11.6g  %10.3f  %7.3f  %7.3f  %7u  %10u\n", s->level, s->name, s->primitives,
+               (unsigned long long)s->texels, s->error, s->error_norm, s->t_basis, s->t_construct, s->skipped,
+               s->degenerate);
+    }
+}
+
+static void print_json(const char *input, const char *output, const asp_dps *dps, const asp_dps_summary *rows,
+                       double t_decompose, double t_total)
+{
+    printf("{\"input\": ");
+    cli_json_string(stdout, input);
+    printf(", \"output\": ");
+    cli_json_string(stdout, output);
+    printf(", \"points\": %llu, \"mean_radius\": %.9g, \"method\": \"%s\", \"texel_size\": %g, "
+           "\"decompose_seconds\": %.4f, \"total_seconds\": %.4f, \"levels\": [",
+           (unsigned long long)dps->source_points, dps->mean_radius, asp_prim_method_name(dps->desc.method),
+           dps->desc.texel_size, t_decompose, t_total);
+    for (size_t i = 0; i < dps->level_count; i++) {
+        const asp_dps_summary *s = &rows[i];
+        printf("%s{\"level\": %u, \"name\": \"%s\", \"primitives\": %zu, \"texels\": %llu, \"error\": %.9g, "
+               "\"normalised_error\": %.6g, \"cb_seconds\": %.4f, \"dpc_seconds\": %.4f, \"skipped\": %u, "
+               "\"degenerate\": %u, \"capped\": %u, \"merges\": %u, \"atlas\": [%u, %u], \"neighbour_pairs\": %zu}",
+               i ? ", " : "", s->level, s->name, s->primitives, (unsigned long long)s->texels, s->error,
+               s->error_norm, s->t_basis, s->t_construct, s->skipped, s->degenerate, s->capped, s->merges,
+               s->atlas_width, s->atlas_height, s->neighbour_pairs);
+    }
+    printf("]}\n");
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), m = strlen(suffix);
+    return n >= m && strcmp(s + n - m, suffix) == 0;
+}
+
+/* Atlas PNGs: X.png for one level, X-L-3.png for each of several. */
+static int save_atlases(const char *path, const asp_dps *dps, const asp_dps_summary *rows, asp_error *err)
+{
+    for (size_t i = 0; i < dps->level_count; i++) {
+        char name[4096];
+        size_t n = strlen(path);
+        if (dps->level_count == 1)
+            snprintf(name, sizeof name, "%s", path);
+        else if (ends_with(path, ".png"))
+            snprintf(name, sizeof name, "%.*s-%s.png", (int)(n - 4), path, rows[i].name);
+        else
+            snprintf(name, sizeof name, "%s-%s.png", path, rows[i].name);
+        int rc = asp_image_save_png(&dps->levels[i].atlas, name, err);
+        if (rc)
+            return rc;
+    }
+    return 0;
+}
+
+int cmd_build(int argc, char **argv, struct cli_env *env)
+{
+    const char *output = NULL, *level_text = NULL, *method = "affine", *shape = "linear", *norm = "positive";
+    const char *atlas = NULL;
+    size_t budget = 0, max_texture = 0, padding = 0;
+    double texel = 0, width = 0, tau = 0, fraction = 0, flat = 0, angle = 0;
+    int unweighted = 0, project = 0, no_extend = 0, normals = 0, merge = 0;
+    const struct cli_option opts[] = {
+        {"output", 'o', CLI_STRING, &output, "FILE", "output primitives (.dps)"},
+        {"level", 'l', CLI_STRING, &level_text, "L", "level(s): L, L-5, 3, 'L-5,L-3' or 'L-6..L' (default L-3)"},
+        {"primitives", 'p', CLI_SIZE, &budget, "N", "the finest level with at most N domains"},
+        {"texel-size", 0, CLI_DOUBLE, &texel, "X", "texel edge in mean point radii (default 1)"},
+        {"max-texture", 0, CLI_SIZE, &max_texture, "N", "cap on a texture's side in texels (default 512)"},
+        {"method", 'm', CLI_STRING, &method, "M", "affine (default: Delaunay + barycentric) or radial"},
+        {"shape", 0, CLI_STRING, &shape, "S", "radial shape: linear (default), constant, gaussian"},
+        {"width", 'w', CLI_DOUBLE, &width, "W", "radial width factor (default 1)"},
+        {"normalise", 0, CLI_STRING, &norm, "N", "radial: positive (f > 0, default) or ge1 (f >= 1)"},
+        {"tau", 0, CLI_DOUBLE, &tau, "X", "domain threshold Psi > X (default 0.05)"},
+        {"unweighted", 0, CLI_FLAG, &unweighted, NULL, "plain PCA instead of weighting by Psi"},
+        {"project-radii", 0, CLI_FLAG, &project, NULL, "radius r |n_p . n| (thesis 3.1)"},
+        {"no-extend-color", 0, CLI_FLAG, &no_extend, NULL, "leave uncovered texels black"},
+        {"normals", 'n', CLI_FLAG, &normals, NULL, "also store a normal map per level"},
+        {"neighbours", 0, CLI_DOUBLE, &fraction, "X", "neighbour threshold on shared points (default 0.05)"},
+        {"merge", 0, CLI_FLAG, &merge, NULL, "merge flat, aligned, overlapping domains (thesis 3.4)"},
+        {"merge-flatness", 0, CLI_DOUBLE, &flat, "X", "merge while l_min/sum l < X (default 0.01)"},
+        {"merge-angle", 0, CLI_DOUBLE, &angle, "DEG", "and normals within DEG degrees (default 15)"},
+        {"padding", 0, CLI_SIZE, &padding, "N", "atlas padding in texels (default 2)"},
+        {"atlas", 0, CLI_STRING, &atlas, "X.png", "also write each level's atlas as PNG"},
+        {0},
+    };
+    int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
+    if (rc)
+        return rc > 0 ? 0 : 2;
+    if (npos != 1)
+        return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat build -h'", npos);
+    if (!output)
+        return cli_usage_error(env, "missing -o OUT.dps");
+    if (level_text && budget)
+        return cli_usage_error(env, "--level and --primitives exclude each other");
+    if (max_texture > 8192 || padding > 64)
+        return cli_usage_error(env, "--max-texture must be at most 8192 and --padding at most 64");
+    asp_error err = {0};
+    asp_prim_desc desc = {.tau = tau, .texel_size = texel, .max_texture = (uint32_t)max_texture, .width = width,
+                          .unweighted = unweighted, .project_radii = project, .no_extend_color = no_extend,
+                          .normal_map = normals, .neighbour_fraction = fraction, .merge = merge,
+                          .merge_flatness = flat, .merge_angle = angle, .padding = (uint32_t)padding};
+    if (asp_prim_method_parse(method, &desc.method, &err) || asp_prim_shape_parse(shape, &desc.shape, &err) ||
+        asp_prim_normalise_parse(norm, &desc.normalise, &err))
+        return cli_usage_error(env, "%s", err.msg);
+    if (texel < 0 || width < 0 || tau < 0 || fraction < 0 || flat < 0 || angle < 0)
+        return cli_usage_error(env, "option values must not be negative");
+
+    double t0 = asp_time_now(), t_dec = 0;
+    asp_amg *amg = NULL;
+    asp_cloud *cloud = NULL;
+    if (ends_with(argv[0], ".amg")) {
+        rc = asp_amg_load(argv[0], &env->ctx, &amg, &err);
+    } else {
+        rc = asp_cloud_load(argv[0], &env->ctx, &cloud, &err);
+        if (!rc)
+            rc = asp_amg_decompose(cloud, NULL, &env->ctx, &amg, &err);
+        t_dec = asp_time_now() - t0;
+    }
+    size_t levels[64], nlevels = 0;
+    if (!rc && budget)
+        rc = asp_prim_level_for_budget(amg, budget, &levels[nlevels++], &err);
+    else if (!rc)
+        rc = parse_levels(amg, level_text ? level_text : "L-3", levels, &nlevels, 64, &err);
+    asp_dps *dps = NULL;
+    if (!rc)
+        rc = asp_prim_build(amg, cloud, levels, nlevels, &desc, argv[0], &env->ctx, &dps, &err);
+    if (!rc)
+        rc = asp_dps_save(dps, output, &err);
+    asp_dps_summary rows[64];
+    if (!rc)
+        asp_dps_summarize(dps, rows);
+    if (!rc && atlas)
+        rc = save_atlases(atlas, dps, rows, &err);
+    double t_total = asp_time_now() - t0;
+    asp_amg_destroy(amg);
+    asp_cloud_destroy(cloud);
+    asp_amg_shutdown();
+    cli_progress_end(env);
+    if (rc) {
+        asp_dps_destroy(dps);
+        return cli_fail(env, &err);
+    }
+    for (size_t i = 0; i < dps->level_count; i++)
+        if (rows[i].capped)
+            cli_info(env, "warning: level %s: %u of %zu textures reached --max-texture %u; their texels are larger",
+                     rows[i].name, rows[i].capped, rows[i].primitives, dps->desc.max_texture);
+    if (env->json) {
+        print_json(argv[0], output, dps, rows, t_dec, t_total);
+    } else {
+        if (!env->quiet)
+            printf("%s: %llu points, %zu level(s), mean radius %.4g, %s textures, texel size %g%s, %.2f s\n", output,
+                   (unsigned long long)dps->source_points, dps->level_count, dps->mean_radius,
+                   asp_prim_method_name(dps->desc.method), dps->desc.texel_size,
+                   t_dec > 0 ? " (decomposition included)" : "", t_total);
+        print_table(dps, rows);
+    }
+    asp_dps_destroy(dps);
+    return 0;
+}

@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# amgsplat build: octahedron primitives (8 faces at the coarsest level), the
+# Table 5.2 output in text and JSON, info on the .dps, several levels, budget,
+# texture methods, merge and normal maps, and the error cases (exit 1 / 2).
+set -euo pipefail
+T="$ASP_TEST_TMP/build"
+rm -rf "$T" && mkdir -p "$T"
+A="$AMGSPLAT"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+expect_exit() { # code, command...
+    local want=$1; shift
+    set +e; "$@" >"$T/out" 2>"$T/err"; local got=$?; set -e
+    [ "$got" = "$want" ] || { cat "$T/err" >&2; fail "'$*' exited $got, expected $want"; }
+}
+
+"$A" build -h | grep -q "usage: amgsplat build" || fail "help"
+"$A" help | grep -q "^  build " || fail "build missing from the command list"
+"$A" synth octahedron -o "$T/oct.ply" -q
+"$A" decompose "$T/oct.ply" -o "$T/oct.amg" -q
+
+# the level with 8 basis functions: 8 primitives, small error, an atlas PNG
+"$A" build "$T/oct.amg" -o "$T/oct.dps" --primitives 8 --atlas "$T/oct.png" --json > "$T/oct.json"
+[ -s "$T/oct.dps" ] && [ -s "$T/oct.png" ] || fail "no .dps or atlas written"
+python3 - "$T/oct.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["points"] == 16000 and d["method"] == "affine", d
+(lv,) = d["levels"]
+assert lv["primitives"] == 8, lv
+assert lv["normalised_error"] < 0.1 and lv["skipped"] == 0 and lv["degenerate"] == 0, lv
+assert lv["texels"] > 8 * 0.866 / d["mean_radius"] ** 2, lv
+assert lv["atlas"][0] >= 64 and lv["atlas"][1] >= 1
+PY
+head -c 8 "$T/oct.png" | od -c | grep -q "P   N   G" || fail "atlas is not a PNG"
+
+# info reads the same table back from the file
+"$A" info "$T/oct.dps" > "$T/info.txt"
+grep -q "^level  name   primitives" "$T/info.txt" || fail "info header: $(cat "$T/info.txt")"
+grep -Eq "^ +[0-9]+  L +8 " "$T/info.txt" || fail "info row: $(cat "$T/info.txt")"
+"$A" info "$T/oct.dps" --json | python3 -c "
+import json, sys
+d = json.load(sys.stdin)
+b = json.load(open('$T/oct.json'))
+assert d['levels'][0]['primitives'] == 8 and d['levels'][0]['texels'] == b['levels'][0]['texels']
+assert d['source'].endswith('oct.amg'), d['source']"
+
+# several levels in one file (range syntax), text table with the Table 5.2 columns
+"$A" build "$T/oct.amg" -o "$T/multi.dps" --level L-3..L > "$T/multi.txt"
+grep -q "primitives    texels        error  normalised   cb (s)  dpc (s)" "$T/multi.txt" || fail "table header"
+[ "$(grep -Ec '^ +[0-9]+  L' "$T/multi.txt")" = 4 ] || fail "expected 4 level rows: $(cat "$T/multi.txt")"
+"$A" info "$T/multi.dps" --json | python3 -c "
+import json, sys
+d = json.load(sys.stdin)
+names = [l['name'] for l in d['levels']]
+assert names == ['L-3', 'L-2', 'L-1', 'L'], names
+p = [l['primitives'] for l in d['levels']]
+assert p == sorted(p, reverse=True), p"
+
+# a .ply input is decomposed first; every texture method and option runs
+"$A" build "$T/oct.ply" -o "$T/ply.dps" --level L -q
+for m in "--method radial --shape constant" "--method radial --shape gaussian --width 2" \
+         "--method radial --normalise ge1 --width 2" "--normals --merge" "--unweighted --project-radii --no-extend-color" \
+         "--texel-size 3 --padding 1"; do
+    # shellcheck disable=SC2086
+    "$A" build "$T/oct.amg" -o "$T/m.dps" --level L $m --json > "$T/m.json" || fail "build $m"
+    python3 -c "import json; d = json.load(open('$T/m.json')); assert 8 <= d['levels'][0]['primitives'] <= 9, d" \
+        || fail "$m: $(cat "$T/m.json")"
+done
+"$A" info "$T/m.dps" > /dev/null
+# the texture cap bites: a warning, still a valid file
+"$A" build "$T/oct.amg" -o "$T/cap.dps" --level L --texel-size 0.1 --max-texture 32 2> "$T/cap.err" > /dev/null
+grep -q "warning: level L: .* reached --max-texture 32" "$T/cap.err" || fail "cap warning: $(cat "$T/cap.err")"
+
+# damaged files: exit 1 with the reason
+head -c 3000 "$T/oct.dps" > "$T/cut.dps"
+expect_exit 1 "$A" info "$T/cut.dps"
+grep -q "truncated" "$T/err" || fail "truncated: $(cat "$T/err")"
+cp "$T/oct.dps" "$T/flip.dps"
+printf '\x7f' | dd of="$T/flip.dps" bs=1 seek=2000 conv=notrunc status=none
+expect_exit 1 "$A" info "$T/flip.dps"
+grep -q "checksum" "$T/err" || fail "corrupted: $(cat "$T/err")"
+cp "$T/oct.ply" "$T/notdps.dps"
+expect_exit 1 "$A" info "$T/notdps.dps"
+grep -q "not a .dps file" "$T/err" || fail "foreign: $(cat "$T/err")"
+
+# bad input: exit 1, no output file
+expect_exit 1 "$A" build "$T/missing.amg" -o "$T/x.dps"
+expect_exit 1 "$A" build "$T/oct.amg" -o "$T/x.dps" --level L-99
+grep -q "L-99" "$T/err" || fail "bad level: $(cat "$T/err")"
+expect_exit 1 "$A" build "$T/oct.amg" -o "$T/x.dps" --level L --texel-size 1e-3 --max-texture 8192
+grep -q "do not fit" "$T/err" || fail "atlas too large: $(cat "$T/err")"
+[ ! -e "$T/x.dps" ] || fail "output written on failure"
+
+# usage errors: exit 2
+expect_exit 2 "$A" build
+expect_exit 2 "$A" build "$T/oct.amg"
+expect_exit 2 "$A" build "$T/oct.amg" -o "$T/x.dps" --method nope
+grep -q "unknown texture method 'nope'" "$T/err" || fail "method: $(cat "$T/err")"
+expect_exit 2 "$A" build "$T/oct.amg" -o "$T/x.dps" --level L --primitives 4
+expect_exit 2 "$A" build "$T/oct.amg" -o "$T/x.dps" --texel-size -1
+echo "build: ok"

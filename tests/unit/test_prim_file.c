@@ -1,0 +1,158 @@
+/*
+ * The .dps file (issue 4 item 8): a save/load round trip keeps every field and
+ * texel; damaged files (truncated, flipped byte, foreign, trailing bytes, a
+ * texture rectangle outside its atlas) give a clear error and no result.
+ */
+#include <stdio.h>
+#include <unistd.h>
+
+#include "amgsplat/amg.h"
+#include "amgsplat/prim.h"
+#include "harness.h"
+
+#ifndef ASP_TEST_TMP_DIR
+#define ASP_TEST_TMP_DIR "/tmp"
+#endif
+
+/* A wavy 30x30 patch cut into 4 overlapping domains. */
+static int make_level(asp_cloud **cloud, asp_dps_level *lv)
+{
+    enum { G = 30 };
+    asp_error err;
+    asp_cloud *c = NULL;
+    CHECK_OK(asp_cloud_create(G * G, ASP_ATTR_NORMALS | ASP_ATTR_COLORS | ASP_ATTR_RADII, NULL, &c, &err), &err);
+    if (!c)
+        return -1;
+    c->origin[0] = 1000.5; /* centres are stored in world coordinates */
+    for (size_t i = 0; i < G * G; i++) {
+        float x = (float)(i % G) * 0.02f, y = (float)(i / G) * 0.02f;
+        c->positions[3 * i] = x, c->positions[3 * i + 1] = y, c->positions[3 * i + 2] = 0.01f * sinf(10 * x);
+        c->normals[3 * i + 2] = 1;
+        c->radii[i] = 0.02f;
+        c->colors[4 * i] = (uint8_t)(i * 7), c->colors[4 * i + 1] = 90, c->colors[4 * i + 2] = (uint8_t)(i / 4);
+        c->colors[4 * i + 3] = 255;
+    }
+    asp_amg_csr *dom = NULL;
+    CHECK_OK(asp_amg_csr_create(4, G * G, 4 * G * G, NULL, &dom, &err), &err);
+    size_t k = 0;
+    for (size_t r = 0; dom && r < 4; r++) {
+        for (size_t i = 0; i < G * G; i++) {
+            size_t x = i % G, y = i / G;
+            if (((r & 1) ? x >= G / 2 - 3 : x < G / 2 + 3) && ((r & 2) ? y >= G / 2 - 3 : y < G / 2 + 3)) {
+                dom->col[k] = (asp_index)i;
+                dom->val[k++] = 0.3 + 0.1 * (double)r;
+            }
+        }
+        dom->row_ptr[r + 1] = k;
+    }
+    int rc = dom ? asp_prim_build_level(c, dom, &(asp_prim_desc){.normal_map = 1}, NULL, lv, &err) : -1;
+    CHECK_OK(rc, &err);
+    asp_amg_csr_destroy(dom);
+    *cloud = c;
+    return rc;
+}
+
+static long file_size(const char *path)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return -1;
+    fseek(fp, 0, SEEK_END);
+    long n = ftell(fp);
+    fclose(fp);
+    return n;
+}
+
+static void copy_damaged(const char *src, const char *dst, long keep, long flip_at, const char *append)
+{
+    FILE *in = fopen(src, "rb"), *out = fopen(dst, "wb");
+    long n = file_size(src);
+    for (long i = 0; in && out && i < n && i < keep; i++) {
+        int ch = fgetc(in);
+        fputc(i == flip_at ? ch ^ 0x10 : ch, out);
+    }
+    if (append && out)
+        fputs(append, out);
+    if (in)
+        fclose(in);
+    if (out)
+        fclose(out);
+}
+
+static void expect_bad(const char *path, const char *text)
+{
+    asp_dps *d = NULL;
+    asp_error err = {0};
+    int rc = asp_dps_load(path, NULL, &d, &err);
+    CHECK_MSG(rc == ASP_EFORMAT, "%s: rc %d (%s)", path, rc, err.msg);
+    CHECK_MSG(strstr(err.msg, text) != NULL && strstr(err.msg, path) != NULL, "%s: message '%s' lacks '%s'", path,
+              err.msg, text);
+    CHECK(d == NULL);
+}
+
+static void test_round_trip_and_damage(void)
+{
+    asp_cloud *c = NULL;
+    asp_dps_level lv;
+    if (make_level(&c, &lv))
+        return;
+    CHECK(lv.prim_count == 4 && lv.neighbour_total == 12); /* the quadrants overlap pairwise */
+    asp_dps dps = {.level_count = 1, .levels = &lv, .amg_levels = 7, .skipped_levels = 1, .source_points = c->count,
+                   .mean_radius = 0.02, .desc = {.tau = 0.05, .texel_size = 1, .normal_map = 1}};
+    snprintf(dps.source, sizeof dps.source, "patch.ply");
+    lv.level = 4;
+    char path[256], bad[300];
+    snprintf(path, sizeof path, "%s/asp_test_prim_file_%d.dps", ASP_TEST_TMP_DIR, (int)getpid());
+    asp_error err;
+    CHECK_OK(asp_dps_save(&dps, path, &err), &err);
+    asp_dps *back = NULL;
+    CHECK_OK(asp_dps_load(path, NULL, &back, &err), &err);
+    if (back) {
+        CHECK(back->level_count == 1 && back->amg_levels == 7 && back->skipped_levels == 1);
+        CHECK(strcmp(back->source, "patch.ply") == 0 && back->source_points == c->count);
+        CHECK(back->desc.normal_map == 1 && back->desc.texel_size == 1);
+        const asp_dps_level *b = &back->levels[0];
+        CHECK(b->level == 4 && b->prim_count == lv.prim_count && b->texels == lv.texels);
+        CHECK(memcmp(b->prims, lv.prims, lv.prim_count * sizeof *lv.prims) == 0);
+        CHECK(memcmp(b->neighbours, lv.neighbours, lv.neighbour_total * sizeof *lv.neighbours) == 0);
+        CHECK(b->atlas.width == lv.atlas.width && b->atlas.height == lv.atlas.height);
+        CHECK(memcmp(b->atlas.pixels, lv.atlas.pixels, 4 * (size_t)lv.atlas.width * lv.atlas.height) == 0);
+        CHECK(memcmp(b->normal_atlas.pixels, lv.normal_atlas.pixels, 4 * (size_t)lv.atlas.width * lv.atlas.height) ==
+              0);
+        CHECK(fabs(b->prims[0].centre[0] - 1000.5) < 1); /* world coordinates */
+        asp_dps_summary row;
+        asp_dps_summarize(back, &row);
+        CHECK(strcmp(row.name, "L-2") == 0 && row.primitives == 4 && row.neighbour_pairs == 6 && row.normal_map);
+        asp_dps_destroy(back);
+    }
+    long n = file_size(path);
+    snprintf(bad, sizeof bad, "%s.bad.dps", path);
+    copy_damaged(path, bad, n - 100, -1, NULL);
+    expect_bad(bad, "truncated");
+    copy_damaged(path, bad, 40, -1, NULL);
+    expect_bad(bad, "truncated");
+    copy_damaged(path, bad, n, n / 2, NULL);
+    expect_bad(bad, "checksum");
+    copy_damaged(path, bad, n, -1, "xx");
+    expect_bad(bad, "trailing");
+    copy_damaged(path, bad, n, 0, NULL);
+    expect_bad(bad, "not a .dps file");
+    copy_damaged(path, bad, n, 8, NULL);
+    expect_bad(bad, "version");
+    /* consistent checksum, inconsistent content: the reader checks rectangles and neighbour indices */
+    lv.prims[2].tex_x = lv.atlas.width - 1;
+    CHECK_OK(asp_dps_save(&dps, bad, &err), &err);
+    expect_bad(bad, "primitive 2: texture");
+    lv.prims[2].tex_x = 0;
+    lv.neighbours[0] = 99;
+    CHECK_OK(asp_dps_save(&dps, bad, &err), &err);
+    expect_bad(bad, "neighbour entry 0");
+    asp_dps *d = NULL;
+    CHECK(asp_dps_load("/nonexistent/x.dps", NULL, &d, &err) == ASP_EIO);
+    remove(path);
+    remove(bad);
+    asp_dps_level_release(&lv, NULL);
+    asp_cloud_destroy(c);
+}
+
+TEST_MAIN(TEST_CASE(test_round_trip_and_damage))
