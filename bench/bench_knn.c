@@ -1,10 +1,12 @@
 /*
  * k-NN benchmark: our kd-tree (build + asp_knn_all) against FLANN's exact
  * single kd-tree (KDTreeSingleIndex through the C API) on the same points:
- * a uniform cube, a sphere surface and the Stanford bunny surface. Also times
- * the per-query tree search alone (the fallback path) as an in-run baseline.
+ * a uniform cube, a sphere surface and the Stanford bunny surface, printed as
+ * one table (build, query, total seconds, each total relative to ours).
+ * --per-query also times our per-query tree search (the fallback path of
+ * asp_knn_all) and checks it gives the same bits; --group=N sets the group size.
  * usage: bench_knn [points=1000000] [k=64] [threads=0] [runs=3] [--no-flann]
- *        [--no-baseline] [--sets=cube,sphere,bunny]
+ *        [--per-query] [--sets=cube,sphere,bunny] [--group=N]
  */
 #include <math.h>
 #include <stdint.h>
@@ -161,14 +163,11 @@ static void time_ours(const float *p, size_t n, const bench_opts *o, const asp__
     *query_s = median(tq, o->runs);
 }
 
-static void print_row(const char *set, const char *impl, double b, double q, double ref_total, const char *note)
+/* One table row; the last column is this row's total time over ours (2.00x: twice as slow as ours). */
+static void print_row(const char *set, const char *impl, double b, double q, double ours_total, const char *note)
 {
-    printf("%-7s %-22s %8.3f %8.3f %8.3f", set, impl, b, q, b + q);
-    if (ref_total > 0)
-        printf(" %7.2fx", ref_total / (b + q));
-    else
-        printf(" %8s", "1.00x");
-    printf("  %s\n", note);
+    printf("%-7s %-22s %8.3f %8.3f %8.3f %7.2fx  %s\n", set, impl, b, q, b + q,
+           ours_total > 0 ? (b + q) / ours_total : 1.0, note);
 }
 
 static void bench_set(const char *name, const float *p, size_t n, const bench_opts *o)
@@ -178,7 +177,7 @@ static void bench_set(const char *name, const float *p, size_t n, const bench_op
     float *d2 = malloc(n * k * sizeof(float));
     double ob, oq;
     time_ours(p, n, o, o->group ? &(asp__knn_tuning){.group_max = o->group} : NULL, idx, d2, &ob, &oq);
-    print_row(name, "ours (grouped)", ob, oq, 0, "");
+    print_row(name, "ours", ob, oq, 0, "");
     if (o->baseline) {
         /* the per-query tree search alone: the previous algorithm, kept as the fallback path */
         asp_index *bi = malloc(n * k * sizeof(asp_index));
@@ -186,7 +185,7 @@ static void bench_set(const char *name, const float *p, size_t n, const bench_op
         double bb, bq;
         time_ours(p, n, o, &(asp__knn_tuning){.tree_only = 1}, bi, bd, &bb, &bq);
         int same = memcmp(bi, idx, n * k * sizeof(asp_index)) == 0 && memcmp(bd, d2, n * k * sizeof(float)) == 0;
-        print_row(name, "ours (per-query tree)", bb, bq, ob + oq, same ? "identical output" : "OUTPUT DIFFERS");
+        print_row(name, "ours, per-query search", bb, bq, ob + oq, same ? "identical output" : "OUTPUT DIFFERS");
         free(bi);
         free(bd);
     }
@@ -224,7 +223,7 @@ static void bench_set(const char *name, const float *p, size_t n, const bench_op
                 if (fabsf(fd[i * kf + j + 1] - d2[i * k + j]) > 1e-6f * (1.0f + d2[i * k + j]))
                     bad++;
         char note[64];
-        snprintf(note, sizeof note, "distances differ in %zu sampled entries", bad);
+        snprintf(note, sizeof note, "%zu sampled distances differ from ours", bad);
         print_row(name, "FLANN kdtree_single", fb, fq, ob + oq, note);
         free(fi);
         free(fd);
@@ -238,15 +237,15 @@ static void bench_set(const char *name, const float *p, size_t n, const bench_op
 
 int main(int argc, char **argv)
 {
-    bench_opts o = {64, 0, 0, 3, 1, 1};
+    bench_opts o = {64, 0, 0, 3, 1, 0};
     size_t n = 1000000;
     const char *sets = "cube,sphere,bunny";
     int pos = 0;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--no-flann") == 0)
             o.flann = 0;
-        else if (strcmp(argv[i], "--no-baseline") == 0)
-            o.baseline = 0;
+        else if (strcmp(argv[i], "--per-query") == 0)
+            o.baseline = 1;
         else if (strncmp(argv[i], "--group=", 8) == 0)
             o.group = strtoull(argv[i] + 8, NULL, 10);
         else if (strncmp(argv[i], "--sets=", 7) == 0)
@@ -264,18 +263,18 @@ int main(int argc, char **argv)
     }
     if (o.runs < 1 || o.runs > MAX_RUNS || n < 2 || o.k < 1 || o.k >= n) {
         fprintf(stderr,
-                "usage: bench_knn [points>=2] [1<=k<points] [threads] [runs 1..%d] [--no-flann] [--no-baseline] "
+                "usage: bench_knn [points>=2] [1<=k<points] [threads] [runs 1..%d] [--no-flann] [--per-query] "
                 "[--sets=cube,sphere,bunny] [--group=N]\n",
                 MAX_RUNS);
         return 2;
     }
-    printf("bench_knn: %zu points, k = %zu, %d threads, median of %d runs (seconds; speed-up = ours total / row "
-           "total)\n",
+    printf("bench_knn: %zu points, k = %zu, %d threads, median of %d runs; seconds; 'x ours' = row total / our "
+           "total\n",
            n, o.k, asp_context_threads(&(asp_context){.threads = o.threads}), o.runs);
 #ifndef ASP_HAVE_FLANN
     printf("FLANN: not found at build time, comparison skipped\n");
 #endif
-    printf("%-7s %-22s %8s %8s %8s %8s\n", "set", "implementation", "build", "query", "total", "speed-up");
+    printf("%-7s %-22s %8s %8s %8s %8s\n", "set", "implementation", "build", "query", "total", "x ours");
     float *p = malloc(3 * n * sizeof(float));
     if (strstr(sets, "cube")) {
         make_cube(p, n);

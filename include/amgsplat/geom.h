@@ -21,11 +21,14 @@ typedef struct asp_kdtree asp_kdtree;
 /**
  * Builds a kd-tree over count points read from positions with stride_bytes
  * between consecutive points (12 for packed xyz; a multiple of 4). The
- * positions are copied into leaf order (about 40 bytes per point in all), so
+ * positions are copied into leaf order (about 45 bytes per point in all), so
  * the array may be freed afterwards. Median splits on the widest axis, leaves
  * of at most 12 points; all-equal subsets become one leaf, so duplicates cost
- * no extra depth (depth <= log2(count) + 1). O(n log n), serial. On success
- * *out owns the tree (free with asp_kdtree_destroy). Returns 0; ASP_ENOMEM;
+ * no extra depth (depth <= log2(count) + 1). O(n log n); from 65536 points on,
+ * the subtrees below the top four levels are built in parallel with
+ * asp_context_threads(ctx) threads, and the tree does not depend on the
+ * thread count. On success *out owns the tree (free with asp_kdtree_destroy).
+ * Returns 0; ASP_ENOMEM;
  * ASP_EINVAL for count == 0, count >= 2^32 - 1, a bad stride, NULL arrays or
  * a non-finite coordinate ("point 17: coordinate y is not finite").
  */
@@ -67,8 +70,8 @@ size_t asp_kdtree_radius(const asp_kdtree *tree, const float q[3], float radius,
  * NULL) likewise. 1 <= k < count. Queries run in the tree's leaf order for
  * locality; each writes only its own row, so results are bit-identical for
  * any thread count. Reports progress as stage "knn". Returns 0; ASP_EINVAL;
- * ASP_ENOMEM (per-thread scratch of about 16 k + 96 bytes); ASP_ECANCELED,
- * with the rows partially written.
+ * ASP_ENOMEM (per-thread scratch of about 64 min(count, 128 k + 4096) bytes);
+ * ASP_ECANCELED, with the rows partially written.
  */
 int asp_knn_all(const asp_kdtree *tree, size_t k, asp_index *idx, float *dist2,
                 const asp_context *ctx, asp_error *err);

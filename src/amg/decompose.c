@@ -219,24 +219,11 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
     t = t1;
     if ((rc = stage(ctx, "assembly", 0, err)) != 0)
         goto fail;
-    rc = asp__amg_assemble(pos, a->classifier, &fans, ctx, &a->matrix, &a->info.positive_offdiag, err);
+    /* with the crease test, also the same fans with C = 1: its reference (hierarchy.c) */
+    rc = asp__amg_assemble(pos, a->classifier, &fans, ctx, &a->matrix, d.crease_cut > 0 ? &flat : NULL,
+                           &a->info.positive_offdiag, err);
     if (rc)
         goto fail;
-    if (d.crease_cut > 0) {
-        /* the same fans with C = 1: the reference the crease test compares coarse couplings with (hierarchy.c) */
-        float *ones = asp_alloc(ctx, n * sizeof *ones);
-        size_t unused = 0;
-        if (!ones) {
-            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the stiffness matrix of %zu points", n);
-            goto fail;
-        }
-        for (size_t i = 0; i < n; i++)
-            ones[i] = 1.0f;
-        rc = asp__amg_assemble(pos, ones, &fans, ctx, &flat, &unused, err);
-        asp_free(ctx, ones);
-        if (rc)
-            goto fail;
-    }
     asp__amg_fans_release(ctx, &fans);
     a->info.matrix_nnz = a->matrix->row_ptr[n];
     for (size_t i = 0; i < n; i++)

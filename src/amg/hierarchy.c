@@ -8,6 +8,8 @@
  */
 #include <math.h>
 #include <string.h>
+#include <stdio.h>
+#include <stdlib.h>
 
 #include "amg/internal.h"
 #include "util/banned.h"
@@ -273,7 +275,9 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
     while (levels < maxl && cur->rows > desc->max_coarse) {
         asp_amg_csr *praw = NULL, *araw = NULL, *next = NULL, *fnext = NULL;
         size_t fresh = 0, offdiag = 0, ncut = 0;
+        double T0 = asp_time_now(); /* PROF-REMOVE */
         rc = asp__amg_hypre_coarsen(cur, desc, ctx, &praw, &araw, err);
+        double T1 = asp_time_now(); /* PROF-REMOVE */
         if (rc)
             goto done;
         if (!praw) {
@@ -288,7 +292,9 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
             memcpy(cm, tmp, praw->cols * sizeof *cm);
         }
         if (!rc && crease) {
+            double T2 = asp_time_now(); /* PROF-REMOVE */
             rc = asp__amg_galerkin(praw, fcur, ctx, &fnext, err);
+            if (getenv("PROF")) fprintf(stderr, "PROF rows %zu hypre %.3f galerkin %.3f\n", cur->rows, T1 - T0, asp_time_now() - T2); /* PROF-REMOVE */
             asp_free(ctx, cutflag);
             cutflag = rc ? NULL : asp_alloc(ctx, (araw->row_ptr[araw->rows] + 1) * sizeof *cutflag);
             if (!rc && !cutflag)

@@ -30,9 +30,12 @@ static double half_cot(const double *a, const double *b, const double *c)
     return 0.5 * dot / cr;
 }
 
-/* Row i of A~ into (col, val), merged and sorted by column; returns the entry count (<= 2 * ntri). */
+/*
+ * Row i of A~ into (col, val), merged and sorted by column; returns the entry
+ * count (<= 2 * ntri). fval (may be NULL) receives the same row with C = 1.
+ */
 static size_t tilde_row(const float *pos, const float *cls, const asp__amg_fans *f, size_t i, asp_index *col,
-                        double *val)
+                        double *val, double *fval)
 {
     size_t nt = f->ntri[i], cnt = 0;
     const asp_index *tri = f->tri + 2 * i * f->stride;
@@ -43,19 +46,24 @@ static size_t tilde_row(const float *pos, const float *cls, const asp__amg_fans 
         double pb[3] = {pos[3 * (size_t)b], pos[3 * (size_t)b + 1], pos[3 * (size_t)b + 2]};
         /* C(T): mean of the nodal classifier values (journal eq. 5) */
         double ct = ((double)cls[i] + cls[a] + cls[b]) / 3.0;
-        double wa = -ct * half_cot(x, pa, pb); /* edge i-a, opposite corner b */
-        double wb = -ct * half_cot(x, pb, pa); /* edge i-b, opposite corner a */
+        double ga = -half_cot(x, pa, pb); /* edge i-a, opposite corner b */
+        double gb = -half_cot(x, pb, pa); /* edge i-b, opposite corner a */
         asp_index js[2] = {a, b};
-        double ws[2] = {wa, wb};
+        double gs[2] = {ga, gb};
         for (int e = 0; e < 2; e++) {
             size_t q = 0;
             while (q < cnt && col[q] != js[e])
                 q++;
             if (q == cnt) {
                 col[cnt] = js[e];
-                val[cnt++] = 0;
+                val[cnt] = 0;
+                if (fval)
+                    fval[cnt] = 0;
+                cnt++;
             }
-            val[q] += ws[e];
+            val[q] += ct * gs[e];
+            if (fval)
+                fval[q] += gs[e];
         }
     }
     /* insertion sort by column: rows hold a handful of entries */
@@ -70,60 +78,73 @@ static size_t tilde_row(const float *pos, const float *cls, const asp__amg_fans 
         }
         col[r] = c;
         val[r] = v;
+        if (fval) {
+            double fv = fval[q];
+            size_t u = q;
+            while (u > r) {
+                fval[u] = fval[u - 1];
+                u--;
+            }
+            fval[r] = fv;
+        }
     }
     return cnt;
 }
 
 int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f, const asp_context *ctx,
-                      asp_amg_csr **out, size_t *positive, asp_error *err)
+                      asp_amg_csr **out, asp_amg_csr **flat_out, size_t *positive, asp_error *err)
 {
     const size_t n = f->n;
     const int threads = asp_context_threads(ctx);
-    const size_t rowcap = 2 * f->stride;
-    asp_amg_csr *at = NULL, *tt = NULL, *a = NULL;
+    const int want_flat = flat_out != NULL;
+    asp_amg_csr *at = NULL, *tt = NULL, *a = NULL, *fl = NULL;
+    double *atf = NULL, *ttf = NULL;
     size_t *cnt = asp_calloc(ctx, n + 1, sizeof *cnt);
+    size_t *slot = asp_alloc(ctx, (n + 1) * sizeof *slot);
     size_t *pos_count = asp_calloc(ctx, (size_t)threads, sizeof *pos_count);
     int rc = 0;
-    if (!cnt || !pos_count) {
+    if (!cnt || !slot || !pos_count) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the stiffness matrix");
         goto done;
     }
-    /* A~ (journal eq. 5): rows are independent, so fill them in parallel into fixed-capacity slots */
-    size_t nnz_t = 0;
-    {
-        asp_index *scol = asp_alloc(ctx, n * rowcap * sizeof *scol);
-        double *sval = asp_alloc(ctx, n * rowcap * sizeof *sval);
-        if (!scol || !sval) {
-            asp_free(ctx, scol);
-            asp_free(ctx, sval);
-            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the stiffness matrix");
-            goto done;
-        }
-#pragma omp parallel for schedule(static) num_threads(threads)
-        for (long long ii = 0; ii < (long long)n; ii++)
-            cnt[ii] = tilde_row(pos, cls, f, (size_t)ii, scol + (size_t)ii * rowcap, sval + (size_t)ii * rowcap);
-        for (size_t i = 0; i < n; i++)
-            nnz_t += cnt[i];
-        rc = asp_amg_csr_create(n, n, nnz_t, ctx, &at, err);
-        if (!rc) {
-            for (size_t i = 0; i < n; i++)
-                at->row_ptr[i + 1] = at->row_ptr[i] + cnt[i];
-#pragma omp parallel for schedule(static) num_threads(threads)
-            for (long long ii = 0; ii < (long long)n; ii++) {
-                size_t i = (size_t)ii, b = at->row_ptr[i];
-                memcpy(at->col + b, scol + i * rowcap, cnt[i] * sizeof *scol);
-                memcpy(at->val + b, sval + i * rowcap, cnt[i] * sizeof *sval);
-            }
-        }
-        asp_free(ctx, scol);
-        asp_free(ctx, sval);
-        if (rc)
-            goto done;
+    /*
+     * A~ (journal eq. 5): rows are independent, so fill them in parallel, each
+     * into a slot of 2 * (its triangle count) entries (the row's upper bound),
+     * then close the gaps in order.
+     */
+    slot[0] = 0;
+    for (size_t i = 0; i < n; i++)
+        slot[i + 1] = slot[i] + 2 * (size_t)f->ntri[i];
+    if ((rc = asp_amg_csr_create(n, n, slot[n], ctx, &at, err)) != 0)
+        goto done;
+    if (want_flat && !(atf = asp_alloc(ctx, (slot[n] + 1) * sizeof *atf))) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the stiffness matrix");
+        goto done;
     }
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long ii = 0; ii < (long long)n; ii++) {
+        size_t i = (size_t)ii;
+        cnt[i] = tilde_row(pos, cls, f, i, at->col + slot[i], at->val + slot[i], atf ? atf + slot[i] : NULL);
+    }
+    for (size_t i = 0; i < n; i++) {
+        size_t b = at->row_ptr[i];
+        if (b != slot[i]) {
+            memmove(at->col + b, at->col + slot[i], cnt[i] * sizeof *at->col);
+            memmove(at->val + b, at->val + slot[i], cnt[i] * sizeof *at->val);
+            if (atf)
+                memmove(atf + b, atf + slot[i], cnt[i] * sizeof *atf);
+        }
+        at->row_ptr[i + 1] = b + cnt[i];
+    }
+    const size_t nnz_t = at->row_ptr[n];
     /* transpose by counting sort: sequential, so the column order is fixed */
     rc = asp_amg_csr_create(n, n, nnz_t, ctx, &tt, err);
     if (rc)
         goto done;
+    if (want_flat && !(ttf = asp_alloc(ctx, (nnz_t + 1) * sizeof *ttf))) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the stiffness matrix");
+        goto done;
+    }
     for (size_t k = 0; k < nnz_t; k++)
         tt->row_ptr[at->col[k] + 1]++;
     for (size_t i = 0; i < n; i++)
@@ -134,12 +155,16 @@ int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f
             size_t d = cnt[at->col[k]]++;
             tt->col[d] = (asp_index)i;
             tt->val[d] = at->val[k];
+            if (ttf)
+                ttf[d] = atf[k];
         }
     /*
      * A_ij = (A~_ij + A~_ji) / 2 (eq. 6). A positive result comes from obtuse
      * 3D angles (a non-Delaunay lifted fan); classical AMG interpolation needs
      * an M-matrix (non-positive off-diagonals) to give weights in [0,1], so
      * such entries are clamped to 0 and counted. Pass 1 counts, pass 2 fills.
+     * The flat matrix (C = 1, the crease test's reference) takes A's pattern,
+     * its positive entries clamped too, with zero row sums.
      */
     for (int pass = 0; pass < 2 && !rc; pass++) {
         if (pass == 1) {
@@ -151,9 +176,13 @@ int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f
             }
             cnt[n] = total;
             rc = asp_amg_csr_create(n, n, total, ctx, &a, err);
+            if (!rc && want_flat)
+                rc = asp_amg_csr_create(n, n, total, ctx, &fl, err);
             if (rc)
                 break;
             memcpy(a->row_ptr, cnt, (n + 1) * sizeof *cnt);
+            if (fl)
+                memcpy(fl->row_ptr, cnt, (n + 1) * sizeof *cnt);
         }
 #pragma omp parallel for schedule(static) num_threads(threads)
         for (long long ii = 0; ii < (long long)n; ii++) {
@@ -163,24 +192,28 @@ int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f
             t = omp_get_thread_num();
 #endif
             size_t p = at->row_ptr[i], pe = at->row_ptr[i + 1], q = tt->row_ptr[i], qe = tt->row_ptr[i + 1];
-            size_t w = pass ? a->row_ptr[i] : 0, w0 = w, diag_slot = 0;
-            double diag = 0;
+            size_t w = pass ? a->row_ptr[i] : 0, diag_slot = 0;
+            double diag = 0, fdiag = 0;
             int diag_done = 0;
             size_t c = 0;
             while (p < pe || q < qe) {
                 asp_index j;
-                double v = 0;
+                double v = 0, fv = 0;
                 if (q >= qe || (p < pe && at->col[p] < tt->col[q])) {
                     j = at->col[p];
+                    fv = atf ? atf[p] : 0;
                     v = at->val[p++];
                 } else if (p >= pe || tt->col[q] < at->col[p]) {
                     j = tt->col[q];
+                    fv = ttf ? ttf[q] : 0;
                     v = tt->val[q++];
                 } else {
                     j = at->col[p];
+                    fv = atf ? atf[p] + ttf[q] : 0;
                     v = at->val[p++] + tt->val[q++];
                 }
                 v *= 0.5;
+                fv *= 0.5;
                 if (j == i)
                     continue;
                 if (v > 0) {
@@ -199,6 +232,11 @@ int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f
                 if (pass) {
                     a->col[w] = j;
                     a->val[w] = v;
+                    if (fl) {
+                        fl->col[w] = j;
+                        fl->val[w] = fv < 0 ? fv : 0.0;
+                        fdiag -= fl->val[w];
+                    }
                 }
                 w++;
                 c++;
@@ -211,10 +249,13 @@ int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f
             if (pass) {
                 a->col[diag_slot] = (asp_index)i;
                 a->val[diag_slot] = diag; /* eq. 7: zero row sum */
+                if (fl) {
+                    fl->col[diag_slot] = (asp_index)i;
+                    fl->val[diag_slot] = fdiag;
+                }
             } else {
                 cnt[i] = c;
             }
-            (void)w0;
         }
     }
     if (!rc) {
@@ -224,12 +265,20 @@ int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f
         *positive = total;
         *out = a;
         a = NULL;
+        if (flat_out) {
+            *flat_out = fl;
+            fl = NULL;
+        }
     }
 done:
     asp_amg_csr_destroy(at);
     asp_amg_csr_destroy(tt);
     asp_amg_csr_destroy(a);
+    asp_amg_csr_destroy(fl);
+    asp_free(ctx, atf);
+    asp_free(ctx, ttf);
     asp_free(ctx, cnt);
+    asp_free(ctx, slot);
     asp_free(ctx, pos_count);
     return rc;
 }

@@ -13,7 +13,8 @@ static const char usage[] =
     "usage: amgsplat decompose IN.ply -o OUT.amg [--k N] [--k-max N] [--epsilon X] [--fan-k N]\n"
     "                          [--classifier variation|moment] [--alpha X] [--beta X]\n"
     "                          [--coarsen rs|falgout|cljp|pmis|hmis] [--interp classical|direct|standard|ext+i]\n"
-    "                          [--strong X] [--trunc X] [--max-levels N] [--max-coarse N] [--weak-cut X]\n"
+    "                          [--strong X] [--trunc X] [--max-levels N] [--max-coarse N] [--crease-cut X]\n"
+    "                          [--weak-cut X]\n"
     "                          [--drop X] [--stats] [--tau X] [--json]\n"
     "                          [--export-colors classifier|domains|strict --level L-3 --colors-out X.ply]\n"
     "       amgsplat decompose IN.amg --stats | --export-colors ...\n"
@@ -21,7 +22,8 @@ static const char usage[] =
     "Classifies every point's neighbourhood (surface variation or the journal's moment\n"
     "classifier), builds a stiffness matrix on local Delaunay fans and coarsens it with\n"
     "hypre BoomerAMG into levels of basis functions (a partition of unity) whose domains\n"
-    "stop at creases. Level names: L is the coarsest, L-5 five levels finer, or an index.\n"
+    "stop at creases (a coarse coupling across a crease is cut, so flat faces never merge).\n"
+    "Level names: L is the coarsest, L-5 five levels finer, or an index.\n"
     "--stats prints per level: unknowns, domains (Psi > tau), mean and max domain size,\n"
     "mean domains per point and time. An existing .amg file can be inspected or coloured.";
 
@@ -132,7 +134,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     const char *output = NULL, *classifier = "variation", *coarsen = "rs", *interp = "classical";
     const char *export_mode = NULL, *level_name = "L-3", *colors_out = NULL;
     size_t k = 0, k_max = 0, fan_k = 0, max_levels = 0, max_coarse = 0;
-    double epsilon = 0, alpha = 0, beta = 0, strong = 0, trunc = 0, weak = 0, drop = 0, tau = 0.05;
+    double epsilon = 0, alpha = 0, beta = 0, strong = 0, trunc = 0, weak = 0, drop = 0, tau = 0.05, crease = 0;
     int stats = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output decomposition (.amg)"},
@@ -145,10 +147,12 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         {"beta", 0, CLI_DOUBLE, &beta, "X", "beta (default 100)"},
         {"coarsen", 0, CLI_STRING, &coarsen, "M", "BoomerAMG coarsening: rs (default), falgout, cljp, pmis, hmis"},
         {"interp", 0, CLI_STRING, &interp, "M", "interpolation: classical (default), direct, standard, ext+i"},
-        {"strong", 0, CLI_DOUBLE, &strong, "X", "strength threshold (default 0.9)"},
+        {"strong", 0, CLI_DOUBLE, &strong, "X", "strength threshold (default 0.5)"},
         {"trunc", 0, CLI_DOUBLE, &trunc, "X", "interpolation truncation factor (default 0: none)"},
         {"max-levels", 0, CLI_SIZE, &max_levels, "N", "at most N levels (default 25)"},
         {"max-coarse", 0, CLI_SIZE, &max_coarse, "N", "stop at N unknowns (default 4)"},
+        {"crease-cut", 0, CLI_DOUBLE, &crease, "X",
+         "cut coarse couplings whose interface classifier is below X times the flatter side's (default 0.25, <0: off)"},
         {"weak-cut", 0, CLI_DOUBLE, &weak, "X", "cut coarse couplings below X times the median (default 0: off)"},
         {"drop", 0, CLI_DOUBLE, &drop, "X", "drop basis values below X, renormalised (default 1e-4)"},
         {"stats", 0, CLI_FLAG, &stats, NULL, "print per-level statistics"},
@@ -168,7 +172,8 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     int color_mode = 0;
     asp_amg_desc desc = {.k_min = k, .k_max = k_max, .epsilon = epsilon, .fan_k = fan_k, .alpha = alpha,
                          .beta = beta, .strong_threshold = strong, .trunc_factor = trunc, .max_levels = max_levels,
-                         .max_coarse = max_coarse, .weak_coupling = weak, .drop_tol = drop};
+                         .max_coarse = max_coarse, .weak_coupling = weak, .drop_tol = drop,
+                         .crease_cut = crease};
     int code;
     if (lookup(classifiers, classifier, &code))
         return cli_usage_error(env, "--classifier must be variation or moment, got '%s'", classifier);

@@ -402,7 +402,11 @@ int asp__knn_all_tuned(const asp_kdtree *tree, size_t k, asp_index *idx, float *
                              n - 1);
     const asp__knn_tuning tune = tuning ? *tuning : (asp__knn_tuning){0};
     const size_t group_max = tune.tree_only ? 0 : tune.group_max ? tune.group_max : KNN_GROUP_MAX;
-    /* candidates never exceed n; about 32 k covers a surface or volume neighbourhood of a leaf */
+    /*
+     * Candidates never exceed n; a group's neighbourhood holds far fewer than
+     * 128 k + 4096 points unless the data is very uneven, and an overflow
+     * only sends that group to the per-query search.
+     */
     size_t cap = n;
     if (k < (SIZE_MAX - 4096) / 128 && 128 * k + 4096 < n)
         cap = 128 * k + 4096;

@@ -140,7 +140,8 @@ grep -qF "view: --view 12.0,-34.0,5.000" "$T/h.err" || fail "v key: $(cat "$T/h.
 
 # .amg input: classifier colours, then the domains of the coarsest level; ] at the coarsest level says so
 "$AMGSPLAT" synth octahedron -n 2000 -o "$T/oct.ply" -q
-"$AMGSPLAT" decompose "$T/oct.ply" -o "$T/oct.amg" -q
+# decompose starts MPI, whose by-design leaks LSan matches only with full stacks (CMakeLists.txt)
+ASAN_OPTIONS="${ASAN_OPTIONS:-}:fast_unwind_on_malloc=0" "$AMGSPLAT" decompose "$T/oct.ply" -o "$T/oct.amg" -q
 view "$T/oct.amg" --frames 1 --screenshot "$T/classifier.png" --size 96x96 -q
 view "$T/oct.amg" --frames 2 --keys ']' --screenshot "$T/domains.png" --size 96x96 2>"$T/amg.err"
 grep -qE "^domains, level [0-9]+ \(L-0\), [0-9]+ domains" "$T/amg.err" || fail "] key: $(cat "$T/amg.err")"

@@ -1,11 +1,13 @@
 /*
  * kd-tree k-NN and radius queries against brute force: uniform, clustered,
  * duplicated and all-equal point sets, ties, tiny sets, strided input, thread
- * count independence and malformed input.
+ * count independence, every asp_knn_all path (grouped scan, its fallbacks,
+ * per-query search), the parallel build and malformed input.
  */
 #include <stdint.h>
 
 #include "amgsplat/geom.h"
+#include "geom/kdtree_internal.h"
 #include "harness.h"
 
 static uint64_t rng_state = 88172645463325252ull;
@@ -155,7 +157,7 @@ static void check_set(enum set_kind kind, size_t n, const char *name)
     size_t k = n > 9 ? 9 : n - 1;
     if (k > 0) {
         asp_index *all1 = malloc(n * k * sizeof(asp_index)), *all2 = malloc(n * k * sizeof(asp_index));
-        float *d1 = malloc(n * k * sizeof(float));
+        float *d1 = malloc(n * k * sizeof(float)), *d2 = malloc(n * k * sizeof(float));
         CHECK_OK(asp_knn_all(t, k, all1, d1, &(asp_context){.threads = 1}, err), err);
         CHECK_OK(asp_knn_all(t, k, all2, NULL, &(asp_context){.threads = 2}, err), err);
         CHECK(memcmp(all1, all2, n * k * sizeof(asp_index)) == 0);
@@ -166,9 +168,41 @@ static void check_set(enum set_kind kind, size_t n, const char *name)
                 bad_all++;
         }
         CHECK_MSG(bad_all == 0, "%s: %d knn_all rows differ from brute force", name, bad_all);
+        /* every internal path must give the same bits as the default */
+        const asp__knn_tuning paths[] = {
+            {.tree_only = 1},            /* one tree search per query */
+            {.group_max = 1},            /* groups are single leaves */
+            {.group_max = 4000},         /* one group for the whole set */
+            {.cand_max = 1},             /* every gather overflows */
+            {.reach = 1e-3},             /* gathers too small: queries fall back */
+            {.guess = 1e-3f},            /* first scans too small: second scans */
+            {.guess = 100.0f, .reach = 4.0}, /* first scans take everything */
+        };
+        for (size_t pi = 0; pi < sizeof paths / sizeof paths[0]; pi++) {
+            CHECK_OK(asp__knn_all_tuned(t, k, all2, d2, &paths[pi], &(asp_context){.threads = 2}, err), err);
+            CHECK_MSG(memcmp(all1, all2, n * k * sizeof(asp_index)) == 0 && memcmp(d1, d2, n * k * sizeof(float)) == 0,
+                      "%s: knn_all path %zu differs", name, pi);
+        }
         free(all1);
         free(all2);
         free(d1);
+        free(d2);
+    }
+    /* k = 64 (or n - 1): the selection and sorting sizes of real use */
+    size_t k64 = n > 65 ? 64 : n - 1;
+    if (k64 > 0) {
+        asp_index *all = malloc(n * k64 * sizeof(asp_index));
+        float *dd = malloc(n * k64 * sizeof(float));
+        CHECK_OK(asp_knn_all(t, k64, all, dd, &(asp_context){.threads = 2}, err), err);
+        int bad64 = 0;
+        for (size_t i = 0; i < n; i += (n > 400 ? 13 : 1)) {
+            size_t m = brute(p, n, p + 3 * i, i, ref);
+            if (m < k64 || !same_knn(ref, k64, all + i * k64, dd + i * k64))
+                bad64++;
+        }
+        CHECK_MSG(bad64 == 0, "%s: %d knn_all rows (k = %zu) differ from brute force", name, bad64, k64);
+        free(all);
+        free(dd);
     }
     asp_kdtree_destroy(t);
     free(ref);
@@ -241,6 +275,91 @@ static void test_half_equal(void)
     free(ref);
     free(idx);
     asp_kdtree_destroy(t);
+    free(p);
+}
+
+/* Large k: single queries sort more keys than the distribution sort handles at once. */
+static void test_large_k(void)
+{
+    size_t n = 3000, k = 1500;
+    float *p = make_set(SET_CLUSTERED, n);
+    asp_kdtree *t = NULL;
+    asp_error err_storage = {0}, *err = &err_storage;
+    CHECK_OK(asp_kdtree_create(p, n, 12, NULL, &t, err), err);
+    pair *ref = malloc(n * sizeof(pair));
+    asp_index *idx = malloc(k * sizeof(asp_index));
+    float *d = malloc(k * sizeof(float));
+    int bad = 0;
+    for (int qi = 0; qi < 5; qi++) {
+        const float *q = p + 3 * (size_t)(qi * 577);
+        brute(p, n, q, SIZE_MAX, ref);
+        bad += asp_kdtree_knn(t, q, k, idx, d) != k || !same_knn(ref, k, idx, d);
+    }
+    CHECK(bad == 0);
+    /* all points with k = 300: grouped path with long rows */
+    size_t ka = 300;
+    asp_index *all = malloc(n * ka * sizeof(asp_index));
+    CHECK_OK(asp_knn_all(t, ka, all, NULL, &(asp_context){.threads = 2}, err), err);
+    bad = 0;
+    for (size_t i = 0; i < n; i += 61) {
+        brute(p, n, p + 3 * i, i, ref);
+        bad += !same_knn(ref, ka, all + i * ka, NULL);
+    }
+    CHECK(bad == 0);
+    free(all);
+    free(idx);
+    free(d);
+    free(ref);
+    asp_kdtree_destroy(t);
+    free(p);
+}
+
+/*
+ * Above 65536 points the tree's top levels are split serially and the
+ * subtrees built in parallel: the tree, hence every answer, must not depend
+ * on the thread count, and must match brute force. Surface-like data (a
+ * sphere) with a block of duplicates, as users have.
+ */
+static void test_parallel_build(void)
+{
+    size_t n = 70000, k = 16;
+    float *p = make_set(SET_UNIFORM, n);
+    for (size_t i = 0; i < n; i++) {
+        float *x = p + 3 * i;
+        float r = sqrtf(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        for (int a = 0; a < 3 && r > 0.0f; a++)
+            x[a] /= r;
+        if (i % 10 == 3) /* duplicates of a few positions */
+            memcpy(x, p + 3 * (i % 50), 3 * sizeof(float));
+    }
+    asp_kdtree *t1 = NULL, *t2 = NULL;
+    asp_error err_storage = {0}, *err = &err_storage;
+    CHECK_OK(asp_kdtree_create(p, n, 12, &(asp_context){.threads = 1}, &t1, err), err);
+    CHECK_OK(asp_kdtree_create(p, n, 12, &(asp_context){.threads = 2}, &t2, err), err);
+    asp_index *a1 = malloc(n * k * sizeof(asp_index)), *a2 = malloc(n * k * sizeof(asp_index));
+    float *d1 = malloc(n * k * sizeof(float)), *d2 = malloc(n * k * sizeof(float));
+    CHECK_OK(asp_knn_all(t1, k, a1, d1, &(asp_context){.threads = 1}, err), err);
+    CHECK_OK(asp_knn_all(t2, k, a2, d2, &(asp_context){.threads = 2}, err), err);
+    CHECK(memcmp(a1, a2, n * k * sizeof(asp_index)) == 0);
+    CHECK(memcmp(d1, d2, n * k * sizeof(float)) == 0);
+    pair *ref = malloc(n * sizeof(pair));
+    int bad = 0;
+    for (size_t i = 0; i < n; i += 1999) {
+        brute(p, n, p + 3 * i, i, ref);
+        bad += !same_knn(ref, k, a2 + i * k, d2 + i * k);
+    }
+    CHECK(bad == 0);
+    float q[3] = {0.3f, -0.2f, 0.9f};
+    asp_index i1[64], i2[64];
+    CHECK(asp_kdtree_knn(t1, q, 64, i1, NULL) == 64 && asp_kdtree_knn(t2, q, 64, i2, NULL) == 64);
+    CHECK(memcmp(i1, i2, sizeof i1) == 0);
+    free(ref);
+    free(a1);
+    free(a2);
+    free(d1);
+    free(d2);
+    asp_kdtree_destroy(t1);
+    asp_kdtree_destroy(t2);
     free(p);
 }
 
@@ -324,4 +443,4 @@ static void test_cancel(void)
 
 TEST_MAIN(TEST_CASE(test_uniform), TEST_CASE(test_clustered), TEST_CASE(test_duplicates),
           TEST_CASE(test_grid_ties), TEST_CASE(test_all_equal), TEST_CASE(test_tiny), TEST_CASE(test_large_equal),
-          TEST_CASE(test_half_equal), TEST_CASE(test_stride), TEST_CASE(test_errors), TEST_CASE(test_cancel))
+          TEST_CASE(test_half_equal), TEST_CASE(test_large_k), TEST_CASE(test_parallel_build), TEST_CASE(test_stride), TEST_CASE(test_errors), TEST_CASE(test_cancel))

@@ -1,15 +1,12 @@
 /*
  * The viewer without a window: mouse interaction on the orbit camera (orbit
  * follows the drag, pan keeps the grabbed point under the cursor, dolly is
- * clamped), the tau ladder, the key table, option checking, and the .amg
- * input kind stepping colour modes and levels (render/viewer_*.c).
+ * clamped), the tau ladder, the key table and option checking
+ * (render/viewer_control.c, viewer.c). The .amg input: test_render_viewer_amg.c.
  */
 #include <math.h>
-#include <unistd.h>
 
-#include "amgsplat/amg.h"
 #include "amgsplat/render.h"
-#include "amgsplat/sample.h"
 #include "harness.h"
 #include "render/viewer_internal.h"
 
@@ -177,118 +174,6 @@ static void test_desc_check(void)
     expect_invalid(&(asp_viewer_desc){.amg_color = 4}, "colour mode 4");
 }
 
-static size_t distinct_colours(const asp_cloud *c)
-{
-    size_t n = 0;
-    for (size_t i = 0; i < c->count; i++) {
-        size_t j = 0;
-        while (j < i && memcmp(c->colors + 4 * j, c->colors + 4 * i, 3) != 0)
-            j++;
-        n += j == i;
-    }
-    return n;
-}
-
-/* Writes the decomposition of cloud c to path; returns its level count (0 on failure). */
-static size_t write_amg(const asp_cloud *c, const char *path)
-{
-    asp_error err = {0, ""};
-    asp_amg *amg = NULL;
-    CHECK_OK(asp_amg_decompose(c, NULL, NULL, &amg, &err), &err);
-    if (amg)
-        CHECK_OK(asp_amg_save(amg, path, &err), &err);
-    size_t levels = amg ? asp_amg_level_count(amg) : 0;
-    asp_amg_destroy(amg);
-    return levels;
-}
-
-/* The .amg kind: colours by classifier, then domains; [ and ] step levels and stop at the ends. */
-static void test_amg_scene_actions(void)
-{
-    asp_error err = {0, ""};
-    asp_cloud *c = NULL, *bare = NULL;
-    char path[128], bare_path[128];
-    snprintf(path, sizeof path, "/tmp/asp_test_viewer_%ld.amg", (long)getpid());
-    snprintf(bare_path, sizeof bare_path, "/tmp/asp_test_viewer_bare_%ld.amg", (long)getpid());
-    CHECK_OK(asp_synth(ASP_SYNTH_OCTAHEDRON, &(asp_synth_desc){.points = 1500}, NULL, &c, &err), &err);
-    if (!c)
-        return;
-    CHECK(c->colors != NULL); // the synthetic octahedron is coloured by face
-    // the same points without colours
-    CHECK_OK(asp_cloud_create(c->count, ASP_ATTR_NORMALS, NULL, &bare, &err), &err);
-    if (bare) {
-        memcpy(bare->positions, c->positions, 12 * c->count);
-        memcpy(bare->normals, c->normals, 12 * c->count);
-    }
-    size_t levels = write_amg(c, path), bare_levels = bare ? write_amg(bare, bare_path) : 0;
-    if (levels < 3 || bare_levels < 1) {
-        CHECK_MSG(0, "decompositions have %zu and %zu levels", levels, bare_levels);
-        asp_cloud_destroy(c);
-        asp_cloud_destroy(bare);
-        return;
-    }
-    CHECK(asp__viewer_input_for(path)->bit == ASP__VIEWER_INPUT_AMG);
-    CHECK(asp__viewer_input_for("x.PLY")->bit == ASP__VIEWER_INPUT_POINTS);
-
-    asp__viewer_scene s;
-    memset(&s, 0, sizeof s);
-    asp_error bad = {0, ""};
-    CHECK(asp__viewer_scene_load(&s, path, &(asp_viewer_desc){.amg_level = "L-99"}, &bad) == ASP_EINVAL);
-    CHECK_MSG(strstr(bad.msg, path) && strstr(bad.msg, "L-99"), "%s", bad.msg);
-    CHECK(s.cloud == NULL && s.kind == NULL);
-
-    CHECK_OK(asp__viewer_scene_load(&s, path, &(asp_viewer_desc){0}, &err), &err);
-    if (!s.cloud) {
-        asp_cloud_destroy(c);
-        asp_cloud_destroy(bare);
-        return;
-    }
-    CHECK(s.radius > 1.0f && s.radius < 1.2f); // the octahedron |x|+|y|+|z| = 1 plus disc radii
-    CHECK(strcmp(s.status, "classifier") == 0);
-    CHECK(s.cloud->colors != NULL && memcmp(s.cloud->colors, c->colors, 4 * c->count) != 0);
-    char note[160] = "";
-    // ] from classifier colours shows the domains of the first level (L, the coarsest)
-    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 1);
-    char want[64];
-    snprintf(want, sizeof want, "domains, level %zu (L-0)", levels - 1);
-    CHECK_MSG(strncmp(s.status, want, strlen(want)) == 0, "%s", s.status);
-    size_t coarse_colours = distinct_colours(s.cloud);
-    // already coarsest: nothing changes and the note says why
-    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 0);
-    CHECK(strstr(note, "coarsest") != NULL);
-    for (size_t l = levels - 1; l > 0; l--)
-        CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_FINER, note, sizeof note, &err) == 1);
-    CHECK(strncmp(s.status, "domains, level 0 (L-", 20) == 0);
-    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_FINER, note, sizeof note, &err) == 0);
-    CHECK(strstr(note, "finest") != NULL);
-    // finer levels have more domains, so more distinct mixed colours
-    CHECK_MSG(distinct_colours(s.cloud) > coarse_colours, "%zu vs %zu", distinct_colours(s.cloud), coarse_colours);
-    CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
-    CHECK(strncmp(s.status, "strict domains", 14) == 0);
-    CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
-    CHECK(strcmp(s.status, "input colours") == 0);
-    CHECK(memcmp(s.cloud->colors, c->colors, 4 * c->count) == 0);
-    CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
-    CHECK(strcmp(s.status, "classifier") == 0);
-    asp__viewer_scene_release(&s);
-
-    // without colours the cycle skips "input colours", and asking for them is an error
-    CHECK_OK(asp__viewer_scene_load(&s, bare_path, &(asp_viewer_desc){.amg_color = 2}, &err), &err);
-    if (s.cloud) {
-        CHECK(strncmp(s.status, "strict domains", 14) == 0);
-        CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
-        CHECK(strcmp(s.status, "classifier") == 0);
-    }
-    asp__viewer_scene_release(&s);
-    CHECK(asp__viewer_scene_load(&s, bare_path, &(asp_viewer_desc){.amg_color = 3}, &bad) == ASP_EINVAL);
-    CHECK_MSG(strstr(bad.msg, "no colours") != NULL, "%s", bad.msg);
-    unlink(path);
-    unlink(bare_path);
-    asp_cloud_destroy(c);
-    asp_cloud_destroy(bare);
-    asp_amg_shutdown();
-}
-
 TEST_MAIN(TEST_CASE(test_orbit_follows_drag), TEST_CASE(test_pan_keeps_point_under_cursor),
           TEST_CASE(test_dolly_clamps), TEST_CASE(test_tolerance_ladder), TEST_CASE(test_key_table),
-          TEST_CASE(test_desc_check), TEST_CASE(test_amg_scene_actions))
+          TEST_CASE(test_desc_check))
