@@ -2,7 +2,8 @@
  * Benchmark of the AMG decomposition (journal 2, Table 1 "sd time"): samples
  * the bunny with N points (area method) and prints the median time of each
  * stage (neighbours, classifier, fans, assembly, AMG, basis of all levels) and
- * the peak memory. Usage: bench_decompose [N=1000000] [RUNS=3] [THREADS=0].
+ * the peak memory. Usage: bench_decompose [N=1000000] [RUNS=3] [THREADS=0]
+ * [STRONG=0 (default 0.9)] [CREASE_CUT=0 (default 0.25, -1 off)].
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,6 +30,7 @@ int main(int argc, char **argv)
     size_t n = argc > 1 ? (size_t)atof(argv[1]) : 1000000;
     int runs = argc > 2 ? atoi(argv[2]) : 3;
     asp_context ctx = {.threads = argc > 3 ? atoi(argv[3]) : 0};
+    asp_amg_desc desc = {.strong_threshold = argc > 4 ? atof(argv[4]) : 0, .crease_cut = argc > 5 ? atof(argv[5]) : 0};
     if (runs < 1 || runs > 50)
         runs = 3;
     asp_error err;
@@ -47,7 +49,7 @@ int main(int argc, char **argv)
     for (int r = 0; r < runs; r++) {
         asp_amg *amg = NULL;
         double t0 = asp_time_now();
-        if (asp_amg_decompose(cloud, NULL, &ctx, &amg, &err)) {
+        if (asp_amg_decompose(cloud, &desc, &ctx, &amg, &err)) {
             fprintf(stderr, "bench_decompose: %s\n", err.msg);
             return 1;
         }
@@ -73,8 +75,17 @@ int main(int argc, char **argv)
     }
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
-    printf("bench_decompose: bunny, %zu points, %d runs, %d threads, %zu levels (coarsest %zu unknowns)\n",
-           cloud->count, runs, asp_context_threads(&ctx), levels, coarsest);
+    double load[3] = {0, 0, 0};
+    FILE *fp = fopen("/proc/loadavg", "r");
+    if (fp) {
+        if (fscanf(fp, "%lf %lf %lf", &load[0], &load[1], &load[2]) != 3)
+            load[0] = 0;
+        fclose(fp);
+    }
+    printf("bench_decompose: bunny, %zu points, %d runs, %d threads, strength %g, crease cut %g, %zu levels (coarsest "
+           "%zu unknowns), load average %.2f\n",
+           cloud->count, runs, asp_context_threads(&ctx), desc.strong_threshold ? desc.strong_threshold : 0.9,
+           desc.crease_cut ? desc.crease_cut : 0.25, levels, coarsest, load[0]);
     for (int s = 0; s < STAGES; s++)
         printf("  %-11s %8.3f s (median)\n", names[s], median(t[s], runs));
     printf("  peak memory %.0f MB (max RSS, includes sampling)\n", (double)ru.ru_maxrss / 1024.0);

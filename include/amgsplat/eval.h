@@ -6,7 +6,10 @@
 #ifndef AMGSPLAT_EVAL_H
 #define AMGSPLAT_EVAL_H
 
+#include "amg.h"
 #include "image.h"
+#include "prim.h"
+#include "render.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -36,6 +39,234 @@ int asp_image_silhouette_iou(const asp_image *a, const asp_image *b, const uint8
 
 /** Number of foreground pixels (same rule as asp_image_silhouette_iou). */
 size_t asp_image_foreground_count(const asp_image *img, const uint8_t background[3]);
+
+/* ------------------------------------------------------------------------ */
+/* Line charts (src/eval/chart.c; no GL, thread safe)                       */
+/* ------------------------------------------------------------------------ */
+
+/** One line of a chart: count points (x[i], y[i]); non-finite points are skipped (the line breaks). */
+typedef struct asp_chart_series {
+    const char *name;  /* legend text; NULL or "" = not in the legend */
+    const double *x, *y;
+    size_t count;
+} asp_chart_series;
+
+/** Flags for asp_chart_desc.flags. */
+enum asp_chart_flags {
+    ASP_CHART_LOG_X = 1 << 0, /* logarithmic x axis (values <= 0 are skipped) */
+    ASP_CHART_LOG_Y = 1 << 1  /* logarithmic y axis (values <= 0 are skipped) */
+};
+
+/** Chart layout; the zero value means defaults. */
+typedef struct asp_chart_desc {
+    uint32_t width, height;  /* pixels; 0 = 560 x 340; each in 160..4096 */
+    const char *title;       /* top line; may be NULL */
+    const char *x_label, *y_label;
+    double y_min, y_max;     /* fixed y range when y_min < y_max; else from the data */
+    unsigned flags;          /* asp_chart_flags */
+} asp_chart_desc;
+
+/**
+ * Draws a line chart into dst (initialised here, opaque white background,
+ * release with asp_image_release): axes with "nice" 1-2-5 ticks (decades on
+ * log axes), a light grid, one coloured polyline with square markers per
+ * series (series i gets palette colour i mod 8), a legend right of the plot
+ * area, the title and axis labels in stb_easy_font's bitmap font. Axis
+ * ranges cover every finite point (padded by 5%); a single value gets a unit
+ * range around it. nseries may be 0 (axes only, range 0..1). Deterministic.
+ * Returns 0, ASP_EINVAL (size out of range, a series with count > 0 and NULL
+ * x or y) or ASP_ENOMEM; dst is unchanged on failure. Thread safe.
+ */
+int asp_chart_draw(const asp_chart_series *series, size_t nseries, const asp_chart_desc *desc, asp_image *dst,
+                   asp_error *err);
+
+/* ------------------------------------------------------------------------ */
+/* Models (src/eval/model.c)                                                */
+/* ------------------------------------------------------------------------ */
+
+/**
+ * Loads what the eval and bench-paper commands call a MODEL: a point file
+ * (.ply, .xyz, .pts, .txt through asp_cloud_load), a synthetic shape name
+ * ("octahedron", "cube", "sphere", "torus", "checker-plane" through asp_synth
+ * with points samples, 0 = the shape's default), or a mesh (any other
+ * extension assimp reads, sampled by area with points samples, 0 = 100000,
+ * seed 1, colours from textures or vertex colours when present; texture, when
+ * not NULL, is the image of every material without one, as asp_mesh_load's
+ * texture_override; it is refused for the other inputs). *out is the new cloud (free with asp_cloud_destroy). Errors are those of the loaders,
+ * e.g. ASP_EIO "cannot open 'x.obj': ..."; *out is unchanged on failure.
+ * Reentrant.
+ */
+int asp_eval_load_model(const char *model, size_t points, const char *texture, const asp_context *ctx,
+                        asp_cloud **out, asp_error *err);
+
+/* ------------------------------------------------------------------------ */
+/* Evaluation: representations against the reference (src/eval/eval_run.c) */
+/* ------------------------------------------------------------------------ */
+
+/** Options of asp_eval_run; the zero value means defaults. */
+typedef struct asp_eval_desc {
+    size_t views;              /* cameras around the model; 0 = 16; at most 256 */
+    const uint32_t *sizes;     /* square image sides in pixels, each 16..2048; NULL = 128, 256, 512 */
+    size_t size_count;         /* entries of sizes; at most 8 */
+    size_t max_primitives;     /* levels with more primitives are not evaluated; 0 = 2000 */
+    size_t frames;             /* timed frames per figure (median); 0 = 5 */
+    float elevation;           /* degrees; views alternate +elevation and -elevation; 0 = 20 */
+    uint32_t sheet_size;       /* tile side of the contact sheet; 0 = the smallest size */
+    const asp_prim_render_method *methods; /* domain-primitive rendering methods to evaluate; NULL = normalized,
+                                              prefix, overlap, two-pass */
+    size_t method_count;       /* entries of methods (0 with methods != NULL: points only); at most 16 */
+    const asp_amg_desc *amg;   /* decomposition options; NULL = defaults */
+    const asp_prim_desc *prim; /* primitive options; NULL = defaults */
+    const asp_context *ctx;    /* threads, allocator, progress (stages "decompose", "primitives", "render") */
+} asp_eval_desc;
+
+/** Figures of one representation at one level and image size, over all views. */
+typedef struct asp_eval_row {
+    char representation[32];   /* "reference", "points" (the hierarchy cut) or "dp-<method>", e.g.
+                                  "dp-normalized" (asp_prim_render_method_name) */
+    uint32_t level;            /* AMG level index (0 for the reference) */
+    char level_name[16];       /* "L-3"; "points" for the reference */
+    uint32_t size;             /* image side, pixels */
+    size_t primitives;         /* primitives of the level (the cut's target; the point count for the reference) */
+    double drawn;              /* mean primitives actually drawn over the views */
+    uint64_t texels;           /* texels of the level's textures; 0 for splats */
+    double psnr_mean, psnr_min; /* dB over RGB; a view identical to the reference counts as 99 dB */
+    double ssim_mean, ssim_min;
+    double iou_mean, iou_min;  /* silhouette IoU (alpha) */
+    double frame_ms;           /* median time of a finished frame at view 0 */
+} asp_eval_row;
+
+/** Result of asp_eval_run; free with asp_eval_result_destroy. */
+typedef struct asp_eval_result {
+    size_t row_count;
+    asp_eval_row *rows;        /* by size, then representation, then level (fewest primitives last) */
+    size_t views;
+    double *ssim;              /* row_count * views: SSIM of row r at view v is ssim[r * views + v] */
+    double *psnr;              /* likewise, dB (99 for identical images) */
+    size_t points;             /* input points */
+    size_t level_count;        /* AMG levels evaluated */
+    double t_decompose, t_build, t_render; /* seconds */
+    char gl_renderer[128];     /* GL_RENDERER of the context used */
+    asp_image sheet;           /* contact sheet of view 0 at sheet_size: one row per representation,
+                                  the reference first, then the levels; width 0 when not made */
+    uint32_t sheet_cols, sheet_rows;
+    asp_context ctx;
+} asp_eval_result;
+
+/**
+ * Evaluates the representations of cloud against the reference: decomposes it
+ * once (asp_amg_decompose), builds the domain primitives of every level with
+ * at most max_primitives primitives (asp_prim_build), and renders from views
+ * cameras (azimuth 360 i / views, elevation alternating, the bounding sphere
+ * filling the view) at each size: the reference (the full point set as
+ * blended, normalised splats at tolerance 0, seed 001 section 5), then every
+ * representation at every level: the point hierarchy cut to the level's
+ * primitive count (thesis Fig. 1.1: the tolerance is bisected per view until
+ * the cut is closest to the count), and the domain primitives with each
+ * rendering method this build has. Each image is compared to the reference
+ * of the same camera (PSNR, SSIM, silhouette IoU), and frame times are timed
+ * at view 0. Creates its own headless GL context on the calling thread.
+ * *out receives the result (free with asp_eval_result_destroy).
+ * Returns 0; ASP_EINVAL (bad option); the errors of asp_amg_decompose,
+ * asp_prim_build, asp_gl_context_create_headless and the renderers;
+ * ASP_EUNSUPPORTED (built without GL); ASP_ECANCELED; ASP_ENOMEM. *out is
+ * unchanged on failure. Not thread safe against other hypre users.
+ */
+int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_result **out, asp_error *err);
+
+/** Frees a result; NULL is accepted. */
+void asp_eval_result_destroy(asp_eval_result *res);
+
+/**
+ * Number of views in which row a has a higher SSIM than row b (both indices
+ * below res->row_count; rows of the same size compare the same cameras).
+ */
+size_t asp_eval_ssim_wins(const asp_eval_result *res, size_t a, size_t b);
+
+/**
+ * Writes the rows as CSV (header line, one line per row; columns:
+ * representation,level,level_name,size,primitives,drawn,texels,psnr_mean,
+ * psnr_min,ssim_mean,ssim_min,iou_mean,iou_min,frame_ms) atomically.
+ * Returns 0 or ASP_EIO.
+ */
+int asp_eval_save_csv(const asp_eval_result *res, const char *path, asp_error *err);
+
+/**
+ * Writes the result as JSON atomically: {"points", "views", "gl_renderer",
+ * timings, "rows": [{the CSV columns..., "ssim_views": [...], "psnr_views":
+ * [...]}]}; model names the input (may be NULL). Returns 0 or ASP_EIO.
+ */
+int asp_eval_save_json(const asp_eval_result *res, const char *model, const char *path, asp_error *err);
+
+/**
+ * Draws the charts of res at image side size: which = 0 gives SSIM against
+ * primitive count, which = 1 frame time (ms) against primitive count, one line
+ * per representation (log x axis; the reference is a single marker). dst as
+ * asp_chart_draw. Returns 0, ASP_EINVAL (no rows of that size, which not 0
+ * or 1), ASP_ENOMEM.
+ */
+int asp_eval_chart(const asp_eval_result *res, uint32_t size, int which, asp_image *dst, asp_error *err);
+
+/* ------------------------------------------------------------------------ */
+/* The seeds' tables (src/eval/paper.c; amgsplat bench-paper)               */
+/* ------------------------------------------------------------------------ */
+
+/** Options of asp_eval_paper; the zero value means defaults. */
+typedef struct asp_eval_paper_desc {
+    const uint32_t *sizes;     /* screen sizes of the frame rates; NULL = 128, 256, 512 */
+    size_t size_count;         /* at most 8 */
+    size_t frames;             /* timed frames per figure (median); 0 = 10 */
+    size_t max_primitives;     /* Table 5.2 lists the levels with at most this many primitives; 0 = 2000 */
+    size_t budget;             /* Table 1 / 5.3 / 5.4 level: the finest with at most budget primitives; 0 = 500 */
+    int skip_texture_methods;  /* 1: leave Table 5.4 out (it builds 12 variants of the level) */
+    const asp_amg_desc *amg;
+    const asp_prim_desc *prim;
+    const asp_context *ctx;
+} asp_eval_paper_desc;
+
+/** One level of journal Table 2 / thesis Table 5.2. */
+typedef struct asp_eval_paper_level {
+    uint32_t level;
+    char name[16];
+    size_t primitives;
+    uint64_t texels;
+    double error, error_norm;
+    double t_basis, t_construct; /* seconds ("cb", "dpc") */
+    double fps[8];               /* frames per second at sizes[i]; NAN when not measured */
+} asp_eval_paper_level;
+
+/** The tables; free with asp_eval_paper_destroy. */
+typedef struct asp_eval_paper {
+    size_t points;
+    double t_decompose;          /* journal Table 1 "sd" */
+    size_t size_count;
+    uint32_t sizes[8];
+    size_t level_count;
+    asp_eval_paper_level *levels; /* coarsest first, as in the thesis */
+    size_t budget_level;         /* index into levels of the Table 1 level */
+    double fps_points[8];        /* the full point set (splats, tolerance 0) per size: Table 5.3 */
+    char fps_method[32];         /* domain-primitive rendering method of the fps figures ("" = none) */
+    double t54_texel_size[3];    /* Table 5.4: 2, 1, 0.5 */
+    uint64_t t54_texels[3];
+    double t54_seconds[3][4];    /* radial constant, radial linear, radial Gaussian, linear affine; NAN = skipped */
+    char gl_renderer[128];
+    asp_context ctx;
+} asp_eval_paper;
+
+/**
+ * Measures the seeds' tables on cloud: decomposition time, per level the
+ * Table 5.2 columns (asp_prim_build figures) and the frame rate of the domain
+ * primitives at each size when this build renders them, the frame rate of the
+ * full point set, and the construction time of the budget level per texture
+ * method and texel size. Frame rates: median of frames finished frames,
+ * model filling a square view at azimuth 30, elevation 20. Errors as
+ * asp_eval_run. *out is unchanged on failure.
+ */
+int asp_eval_paper_run(const asp_cloud *cloud, const asp_eval_paper_desc *desc, asp_eval_paper **out,
+                       asp_error *err);
+
+/** Frees a result of asp_eval_paper_run; NULL is accepted. */
+void asp_eval_paper_destroy(asp_eval_paper *p);
 
 #ifdef __cplusplus
 }

@@ -17,6 +17,7 @@
 #include "cloud.h"
 #include "hier.h"
 #include "image.h"
+#include "prim.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -334,6 +335,7 @@ typedef struct asp_viewer_stats {
     uint32_t width, height;   /* framebuffer size of the last frame, pixels */
     size_t screenshots;       /* PNG files written (the s key and desc->screenshot) */
     char gl_renderer[128];    /* GL_RENDERER of the window's context */
+    char title[320];          /* the window title at the end: file, renderer, count, frame time, tau, mode */
 } asp_viewer_stats;
 
 /**
@@ -521,6 +523,143 @@ typedef struct asp_renderer_stats {
 
 /** Fills *out for any renderer (disc: count = points, the rest 0). Thread rules of the renderer. */
 void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out);
+
+/* ------------------------------------------------------------------------ */
+/* Domain primitives (prim.h levels): journal section 4, thesis chapter 4   */
+/* ------------------------------------------------------------------------ */
+
+/**
+ * How the textured domain primitives of a .dps level are blended back into a
+ * surface (asp_prim_render_options.method). The seeds' methods come first,
+ * faithful to their fixed-pipeline algorithms; the last two use programmable
+ * hardware. docs/render-methods.md compares them.
+ */
+typedef enum asp_prim_render_method {
+    /* Sum (colour x alpha, alpha) of the fragments near the front-most
+     * alpha-tested layer (within depth_window of it along the eye ray; the
+     * visibility splatting of Pajarola et al. 5.3) in a float target, then
+     * divide per pixel (their 5.4): the partition of unity is restored after
+     * projection, so no over-bright or too-dark spots (thesis 5.3.1). Back
+     * faces are culled (the normalisation makes up for their weight). Default. */
+    ASP_PRIM_RENDER_NORMALIZED = 0,
+    /* Order-independent form of the thesis's "conceptually correct" algorithm
+     * (4.4, Fig. 4.4-4.5): pass 1 keeps the front-most alpha-tested
+     * primitive's id and depth per pixel; pass 2 adds only fragments of that
+     * primitive or its neighbours within depth_window behind it; then
+     * normalise, back faces culled. No sorting, so no sorting artefacts
+     * (thesis 5.3.3). */
+    ASP_PRIM_RENDER_PREFIX = 1,
+    /* Journal Fig. 10 / thesis 4.4.4: front to back by eye-to-centre
+     * distance; each front-facing primitive and its not yet drawn neighbours
+     * are added (colour x alpha), then the primitive is written to depth only
+     * where alpha > alpha_ref (0.1, thesis Fig. 4.13), locking its pixels.
+     * Back faces are culled. */
+    ASP_PRIM_RENDER_OVERLAP = 2,
+    /* Thesis 4.4.2: depth pass pushed back by depth_window along the eye
+     * rays, then every front face within it is added. */
+    ASP_PRIM_RENDER_TWO_PASS = 3,
+    /* Thesis 4.4.3, hard: back to front, front faces added, back faces reset
+     * the pixels where their alpha > 0 to black. */
+    ASP_PRIM_RENDER_DARK_BACKFACE = 4,
+    /* Thesis 4.4.3, soft: back faces subtract their alpha from every channel
+     * (clamped at 0) instead, darkening by alpha. */
+    ASP_PRIM_RENDER_DARK_BACKFACE_SOFT = 5,
+    /* Thesis appendix C "Blend All" (Fig. 4.3): everything added, no
+     * visibility at all. A reference for what visibility fixes. */
+    ASP_PRIM_RENDER_BLEND_ALL = 6,
+    /* Thesis appendix C "No Blend": opaque, depth-tested texels where
+     * alpha > alpha_ref, for strict (non-overlapping) domains. */
+    ASP_PRIM_RENDER_NO_BLEND = 7,
+    /* Journal Fig. 12b: the support rectangles drawn opaque (texture colour,
+     * alpha ignored), a flat-shaded polygon soup. */
+    ASP_PRIM_RENDER_POLYGONS = 8
+} asp_prim_render_method;
+
+/** Flags for asp_prim_render_options.flags; 0 is the default. */
+enum asp_prim_render_flags {
+    ASP_PRIM_RENDER_OUTLINE = 1 << 0,       /* draw each support rectangle's edges (journal Fig. 12b) */
+    ASP_PRIM_RENDER_COLOR_BY_DOMAIN = 1 << 1, /* one colour per primitive, neighbours distinct (journal Fig. 5d) */
+    ASP_PRIM_RENDER_NO_NORMAL_MAP = 1 << 2  /* light with the primitive normal even when the level has a normal map */
+};
+
+/**
+ * Rendering options of a domain-primitive renderer; the zero value means
+ * defaults. Shading is that of asp_render_to_image (colour * (0.25 + 0.75
+ * |n . l|), ASP_RENDER_UNLIT turns it off) with n the primitive's normal, or
+ * per texel from the level's normal map when it has one (journal section 6:
+ * relighting), so the light direction of asp_render_desc applies.
+ */
+typedef struct asp_prim_render_options {
+    asp_prim_render_method method;
+    float alpha_ref;     /* alpha test of every depth write (locks, front layer); 0 = 0.1 (thesis
+                            Fig. 4.13); < 0 = 0 (every texel with alpha > 0); at most 1 */
+    float transparency;  /* global opacity factor scaling alpha (journal section 6); 0 = 1 (opaque); else in (0, 1] */
+    float depth_window;  /* world units along the eye ray: two-pass offset and the normalized / prefix
+                            window; 0 = the renderer's default (asp_prim_renderer_options reports it);
+                            < 0 = none */
+    unsigned flags;      /* asp_prim_render_flags */
+    uint8_t outline_color[4]; /* sRGB; all 0 = green 0,255,0 (journal Fig. 12b) */
+} asp_prim_render_options;
+
+/** Options of asp_prim_renderer_create; the zero value means defaults. */
+typedef struct asp_prim_renderer_desc {
+    asp_prim_render_options options;
+    double origin[3]; /* world point the renderer's frame is centred on: primitive centres are drawn at
+                         centre - origin (pass a cloud's origin to share its camera); zero = world origin */
+} asp_prim_renderer_desc;
+
+/**
+ * Uploads level (one level of an asp_dps: primitives, neighbour lists, RGBA
+ * atlas and the normal atlas when present) to GL: one storage buffer of
+ * primitives, one of neighbour indices and the atlas as one sRGB texture with
+ * linear filtering (straight colour, alpha = basis function). Returns a
+ * renderer drawing every primitive as its textured support rectangle with
+ * desc->options (changeable later with asp_prim_renderer_set_options).
+ * level is only read during the call. Makes gl current.
+ * Returns 0; ASP_EDEGENERATE (no primitives); ASP_EFORMAT (a non-finite
+ * value, a texture rectangle outside the atlas, a neighbour index out of
+ * range, a missing atlas; names the primitive); ASP_EINVAL (bad options, as
+ * asp_prim_renderer_set_options); ASP_EUNSUPPORTED (an atlas larger than
+ * GL_MAX_TEXTURE_SIZE, more than 2^31 - 1 primitives); ASP_EGL; ASP_ENOMEM.
+ * *out is unchanged on failure; free it with asp_renderer_destroy.
+ */
+int asp_prim_renderer_create(asp_gl_context *gl, const asp_dps_level *level, const asp_prim_renderer_desc *desc,
+                             asp_renderer **out, asp_error *err);
+
+/**
+ * Sets the options of a domain-primitive renderer for the following frames
+ * (no GL calls, no re-upload: cheap enough per key press). Returns 0;
+ * ASP_EINVAL for an unknown method or flag, a NaN option, alpha_ref > 1 or
+ * transparency outside [0, 1] (the renderer keeps its options); ASP_EUNSUPPORTED
+ * if r is not a domain-primitive renderer (names its kind).
+ */
+int asp_prim_renderer_set_options(asp_renderer *r, const asp_prim_render_options *options, asp_error *err);
+
+/**
+ * Fills *out with r's options as resolved (defaults filled in: alpha_ref,
+ * transparency, depth_window in world units, outline colour). Returns 0 or
+ * ASP_EUNSUPPORTED if r is not a domain-primitive renderer.
+ */
+int asp_prim_renderer_options(const asp_renderer *r, asp_prim_render_options *out, asp_error *err);
+
+/**
+ * Bounding sphere of the support rectangles of level in the frame centred on
+ * origin (NULL = world origin): centre of their corners' bounding box and the
+ * largest corner distance from it. Returns 0, ASP_EDEGENERATE (no primitives,
+ * or all corners at one point) or ASP_EFORMAT (non-finite values); outputs
+ * are unchanged on failure. Thread safe; no GL.
+ */
+int asp_prim_level_bounding_sphere(const asp_dps_level *level, const double origin[3], float center[3],
+                                   float *radius, asp_error *err);
+
+/**
+ * Method names: "normalized", "prefix", "overlap", "two-pass",
+ * "dark-backface", "dark-backface-soft", "blend-all", "no-blend", "polygons"
+ * (the enum order). asp_prim_render_method_name returns NULL past the last,
+ * so callers can list them. Parse returns 0 or ASP_EINVAL naming the choices.
+ */
+const char *asp_prim_render_method_name(asp_prim_render_method m);
+int asp_prim_render_method_parse(const char *name, asp_prim_render_method *out, asp_error *err);
 
 #ifdef __cplusplus
 }

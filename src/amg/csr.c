@@ -126,7 +126,8 @@ static int transpose(const asp_amg_csr *p, const asp_context *ctx, asp_amg_csr *
 }
 
 /*
- * Row I of P^T F P into (col, val) sorted by column; returns its length. acc
+ * Row I of P^T F P into (col, val), columns in the order first reached (not
+ * sorted); returns its length. acc
  * and mark are the thread's dense accumulator over the coarse columns (zero on
  * entry and exit), list (capacity listcap) the touched columns.
  */
@@ -154,15 +155,7 @@ static size_t rap_row(const asp_amg_csr *pt, const asp_amg_csr *f, const asp_amg
     }
     if (cnt > listcap)
         cnt = listcap; /* cannot happen: listcap is the number of coarse columns */
-    for (size_t q = 1; q < cnt; q++) {
-        asp_index c = list[q];
-        size_t s = q;
-        while (s > 0 && list[s - 1] > c) {
-            list[s] = list[s - 1];
-            s--;
-        }
-        list[s] = c;
-    }
+    /* columns stay in the order first touched: fixed by the input, so any thread count gives the same row */
     for (size_t q = 0; q < cnt; q++) {
         if (col) {
             col[q] = list[q];
@@ -178,45 +171,71 @@ int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_cont
                       asp_error *err)
 {
     const int threads = asp_context_threads(ctx);
-    const size_t nc = p->cols;
+    const size_t n = p->rows, nc = p->cols;
     asp_amg_csr *pt = NULL, *c = NULL;
-    double *acc = asp_calloc(ctx, (size_t)threads * nc, sizeof *acc);
+    double *acc = asp_calloc(ctx, (size_t)threads * nc, sizeof *acc), *sval = NULL;
     uint8_t *mark = asp_calloc(ctx, (size_t)threads * nc, 1);
-    asp_index *list = asp_alloc(ctx, (size_t)threads * nc * sizeof *list);
+    asp_index *list = asp_alloc(ctx, (size_t)threads * nc * sizeof *list), *scol = NULL;
     size_t *cnt = asp_calloc(ctx, nc + 1, sizeof *cnt);
+    size_t *ub = asp_calloc(ctx, (n > nc ? n : nc) + 1, sizeof *ub);
     int rc = 0;
-    if (!acc || !mark || !list || !cnt) {
+    if (!acc || !mark || !list || !cnt || !ub) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for a coarse matrix of %zu rows", nc);
         goto done;
     }
     if ((rc = transpose(p, ctx, &pt, err)) != 0)
         goto done;
-    /* two passes, count then fill: each row is summed in the same fixed order, so any thread count gives the same bits */
-    for (int pass = 0; pass < 2; pass++) {
-        if (pass == 1) {
-            size_t total = 0;
-            for (size_t r = 0; r < nc; r++)
-                total += cnt[r];
-            if ((rc = asp_amg_csr_create(nc, nc, total, ctx, &c, err)) != 0)
-                goto done;
-            for (size_t r = 0; r < nc; r++)
-                c->row_ptr[r + 1] = c->row_ptr[r] + cnt[r];
-        }
+    /*
+     * One pass into slots of a per-row upper bound (the number of products the
+     * row sums), then a copy: half the work of a count pass plus a fill pass.
+     * ub first holds, per fine row i, the products one P^T entry of it brings.
+     */
 #pragma omp parallel for schedule(static) num_threads(threads)
-        for (long long rr = 0; rr < (long long)nc; rr++) {
-            size_t r = (size_t)rr;
-            int t = 0;
+    for (long long ii = 0; ii < (long long)n; ii++) {
+        size_t i = (size_t)ii, w = 0;
+        for (size_t b = f->row_ptr[i]; b < f->row_ptr[i + 1]; b++)
+            w += p->row_ptr[f->col[b] + 1] - p->row_ptr[f->col[b]];
+        ub[i] = w;
+    }
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long rr = 0; rr < (long long)nc; rr++) {
+        size_t r = (size_t)rr, w = 0;
+        for (size_t a = pt->row_ptr[r]; a < pt->row_ptr[r + 1]; a++)
+            w += ub[pt->col[a]];
+        cnt[r] = w < nc ? w : nc;
+    }
+    ub[0] = 0;
+    for (size_t r = 0; r < nc; r++)
+        ub[r + 1] = ub[r] + cnt[r];
+    scol = asp_alloc(ctx, (ub[nc] + 1) * sizeof *scol);
+    sval = asp_alloc(ctx, (ub[nc] + 1) * sizeof *sval);
+    if (!scol || !sval) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for a coarse matrix of %zu rows", nc);
+        goto done;
+    }
+    /* each row is summed in the same fixed order, so any thread count gives the same bits */
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long rr = 0; rr < (long long)nc; rr++) {
+        size_t r = (size_t)rr;
+        int t = 0;
 #ifdef _OPENMP
-            t = omp_get_thread_num();
+        t = omp_get_thread_num();
 #endif
-            double *ac = acc + (size_t)t * nc;
-            uint8_t *mk = mark + (size_t)t * nc;
-            asp_index *ls = list + (size_t)t * nc;
-            if (pass == 0)
-                cnt[r] = rap_row(pt, f, p, r, ac, mk, ls, nc, NULL, NULL);
-            else
-                rap_row(pt, f, p, r, ac, mk, ls, nc, c->col + c->row_ptr[r], c->val + c->row_ptr[r]);
-        }
+        cnt[r] = rap_row(pt, f, p, r, acc + (size_t)t * nc, mark + (size_t)t * nc, list + (size_t)t * nc, nc,
+                         scol + ub[r], sval + ub[r]);
+    }
+    size_t total = 0;
+    for (size_t r = 0; r < nc; r++)
+        total += cnt[r];
+    if ((rc = asp_amg_csr_create(nc, nc, total, ctx, &c, err)) != 0)
+        goto done;
+    for (size_t r = 0; r < nc; r++)
+        c->row_ptr[r + 1] = c->row_ptr[r] + cnt[r];
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long rr = 0; rr < (long long)nc; rr++) {
+        size_t r = (size_t)rr;
+        memcpy(c->col + c->row_ptr[r], scol + ub[r], cnt[r] * sizeof *scol);
+        memcpy(c->val + c->row_ptr[r], sval + ub[r], cnt[r] * sizeof *sval);
     }
     *out = c;
     c = NULL;
@@ -227,5 +246,8 @@ done:
     asp_free(ctx, mark);
     asp_free(ctx, list);
     asp_free(ctx, cnt);
+    asp_free(ctx, ub);
+    asp_free(ctx, scol);
+    asp_free(ctx, sval);
     return rc;
 }

@@ -8,8 +8,6 @@
  */
 #include <math.h>
 #include <string.h>
-#include <stdio.h>
-#include <stdlib.h>
 
 #include "amg/internal.h"
 #include "util/banned.h"
@@ -83,20 +81,6 @@ static asp_index strongest(const asp_amg_csr *a, size_t r)
     return best;
 }
 
-/* Value of m(r, c) by binary search in the sorted row, 0 when absent. */
-static double lookup(const asp_amg_csr *m, size_t r, asp_index c)
-{
-    size_t lo = m->row_ptr[r], hi = m->row_ptr[r + 1];
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (m->col[mid] < c)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < m->row_ptr[r + 1] && m->col[lo] == c ? m->val[lo] : 0.0;
-}
-
 /*
  * Crease test on a coarse level (journal 2.3: "domains stop at creases").
  * a_IJ / f_IJ, the Galerkin coupling of the classifier-weighted matrix over
@@ -109,21 +93,27 @@ static double lookup(const asp_amg_csr *m, size_t r, asp_index c)
  * row of the smaller index) so the matrix stays symmetric.
  */
 static void crease_cuts(const asp_amg_csr *ac, const asp_amg_csr *fc, const double *cmean, double ratio,
-                        uint8_t *cut, size_t *ncut)
+                        double *dense, uint8_t *cut, size_t *ncut)
 {
-    for (size_t r = 0; r < ac->rows; r++)
+    /* dense (fc->cols zeros on entry and exit) holds row r of fc, whose columns are unsorted */
+    for (size_t r = 0; r < ac->rows; r++) {
+        for (size_t k = fc->row_ptr[r]; k < fc->row_ptr[r + 1]; k++)
+            dense[fc->col[k]] = fc->val[k];
         for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++) {
             asp_index c = ac->col[k];
             cut[k] = 0;
             if (c <= r || ac->val[k] >= 0)
                 continue;
-            double f = lookup(fc, r, c);
+            double f = dense[c];
             /* no geometric coupling to compare with (f >= 0): keep, the test cannot tell */
             if (f < 0 && ac->val[k] / f < ratio * fmin(cmean[r], cmean[c])) {
                 cut[k] = 1;
                 (*ncut)++;
             }
         }
+        for (size_t k = fc->row_ptr[r]; k < fc->row_ptr[r + 1]; k++)
+            dense[fc->col[k]] = 0;
+    }
     for (size_t r = 0; r < ac->rows; r++)
         for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++) {
             asp_index c = ac->col[k];
@@ -251,7 +241,7 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
     const asp_amg_csr *cur = a0, *fcur = f0;
     asp_amg_csr *owned = NULL, *fowned = NULL;
     size_t levels = 1;
-    double *mass = NULL, *cm = NULL, *tmp = NULL;
+    double *mass = NULL, *cm = NULL, *tmp = NULL, *dense = NULL;
     uint8_t *cutflag = NULL;
     int rc = 0;
     if (!p || !sizes) {
@@ -262,7 +252,8 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
     mass = asp_alloc(ctx, n * sizeof *mass);
     cm = asp_alloc(ctx, n * sizeof *cm);
     tmp = asp_alloc(ctx, n * sizeof *tmp);
-    if (!mass || !cm || !tmp) {
+    dense = crease ? asp_calloc(ctx, n, sizeof *dense) : NULL;
+    if (!mass || !cm || !tmp || (crease && !dense)) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
         goto done;
     }
@@ -275,9 +266,7 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
     while (levels < maxl && cur->rows > desc->max_coarse) {
         asp_amg_csr *praw = NULL, *araw = NULL, *next = NULL, *fnext = NULL;
         size_t fresh = 0, offdiag = 0, ncut = 0;
-        double T0 = asp_time_now(); /* PROF-REMOVE */
         rc = asp__amg_hypre_coarsen(cur, desc, ctx, &praw, &araw, err);
-        double T1 = asp_time_now(); /* PROF-REMOVE */
         if (rc)
             goto done;
         if (!praw) {
@@ -292,9 +281,7 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
             memcpy(cm, tmp, praw->cols * sizeof *cm);
         }
         if (!rc && crease) {
-            double T2 = asp_time_now(); /* PROF-REMOVE */
             rc = asp__amg_galerkin(praw, fcur, ctx, &fnext, err);
-            if (getenv("PROF")) fprintf(stderr, "PROF rows %zu hypre %.3f galerkin %.3f\n", cur->rows, T1 - T0, asp_time_now() - T2); /* PROF-REMOVE */
             asp_free(ctx, cutflag);
             cutflag = rc ? NULL : asp_alloc(ctx, (araw->row_ptr[araw->rows] + 1) * sizeof *cutflag);
             if (!rc && !cutflag)
@@ -303,7 +290,7 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
                 /* cmean = cm / mass, kept in tmp for the crease test */
                 for (size_t j = 0; j < araw->rows; j++)
                     tmp[j] = mass[j] > 0 ? cm[j] / mass[j] : 0;
-                crease_cuts(araw, fnext, tmp, desc->crease_cut, cutflag, &ncut);
+                crease_cuts(araw, fnext, tmp, desc->crease_cut, dense, cutflag, &ncut);
             }
         }
         if (!rc)
@@ -347,6 +334,7 @@ done:
     asp_free(ctx, mass);
     asp_free(ctx, cm);
     asp_free(ctx, tmp);
+    asp_free(ctx, dense);
     asp_free(ctx, cutflag);
     if (rc) {
         if (p)

@@ -65,7 +65,7 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
                              const asp_amg_desc *desc, const asp_context *ctx, size_t *nlevels, asp_amg_csr ***p,
                              size_t **sizes, size_t *repaired, asp_error *err);
 
-/* Galerkin product P^T F P (p: n x nc, f: n x n), rows sorted by column. */
+/* Galerkin product P^T F P (p: n x nc, f: n x n); columns within a row are not sorted. */
 int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_context *ctx, asp_amg_csr **out,
                       asp_error *err);
 

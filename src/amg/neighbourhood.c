@@ -33,14 +33,13 @@ int asp__amg_resolve_desc(const asp_amg_desc *in, size_t count, asp_amg_desc *ou
     if (d.beta == 0)
         d.beta = 100;
     /*
-     * 0.5 by experiment (docs/cli/decompose.md): the crease test (crease_cut)
-     * keeps coarse unknowns from merging across creases, so the threshold only
-     * shapes the coarsening; 0.5 coarsens by about 2 per level and gives the
-     * best face purity (octahedron, cube: 8,000..64,000 points, k_min 16..32);
-     * hypre's 0.25 can merge faces through crease slivers.
+     * 0.9 by experiment (docs/cli/decompose.md): with hypre's 0.25 domains
+     * spill over creases at fine levels and faces merge through crease
+     * slivers; 0.9 coarsens by about 2-2.5 per level. 0.5 gives slightly purer
+     * faces (+0.3..1 point) for about 50% more AMG time.
      */
     if (d.strong_threshold == 0)
-        d.strong_threshold = 0.5;
+        d.strong_threshold = 0.9;
     if (d.max_levels == 0)
         d.max_levels = 25;
     if (d.max_coarse == 0)

@@ -147,7 +147,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         {"beta", 0, CLI_DOUBLE, &beta, "X", "beta (default 100)"},
         {"coarsen", 0, CLI_STRING, &coarsen, "M", "BoomerAMG coarsening: rs (default), falgout, cljp, pmis, hmis"},
         {"interp", 0, CLI_STRING, &interp, "M", "interpolation: classical (default), direct, standard, ext+i"},
-        {"strong", 0, CLI_DOUBLE, &strong, "X", "strength threshold (default 0.5)"},
+        {"strong", 0, CLI_DOUBLE, &strong, "X", "strength threshold (default 0.9)"},
         {"trunc", 0, CLI_DOUBLE, &trunc, "X", "interpolation truncation factor (default 0: none)"},
         {"max-levels", 0, CLI_SIZE, &max_levels, "N", "at most N levels (default 25)"},
         {"max-coarse", 0, CLI_SIZE, &max_coarse, "N", "stop at N unknowns (default 4)"},

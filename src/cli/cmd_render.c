@@ -1,8 +1,9 @@
 /*
  * amgsplat render: draw a point file or the points of an .amg decomposition
  * (coloured by classifier or domains, journal Fig. 1b, 5) headlessly (EGL) to
- * PNG with discs, blended splats (Pajarola et al. 2003) or squares, one view
- * or a contact sheet. Glue only: loading, colouring, framing and drawing are
+ * PNG with discs, blended splats (Pajarola et al. 2003) or squares, or the
+ * domain primitives of a .dps level (journal section 4, thesis chapter 4),
+ * one view or a contact sheet. Glue only: loading, colouring, framing and drawing are
  * library calls (io.h, amg.h, render.h); see docs/cli/render.md.
  */
 #include <ctype.h>
@@ -20,6 +21,9 @@ static const char usage[] =
     "                      [--lighting gouraud|pixel|flat] [--opaque] [--point-size PX]\n"
     "                      [--background R,G,B[,A] | --transparent] [--light AZ,EL]\n"
     "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict] [--level L-3] ...\n"
+    "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
+    "                      dark-backface-soft|blend-all|no-blend|polygons] [--level L] [--alpha-ref X]\n"
+    "                      [--transparency X] [--depth-window X] [--outline] [--color-by domain] ...\n"
     "\n"
     "Renders a point set (PLY, XYZ) or the points of an AMG decomposition (.amg) headlessly through\n"
     "EGL (a GPU, or Mesa llvmpipe without one) to a PNG. Renderers: disc (opaque discs in the tangent\n"
@@ -28,7 +32,8 @@ static const char usage[] =
     "Lambert shading by a light fixed to the camera. AZ turns around +y (0 looks from +z), EL is the\n"
     "angle above the horizon, both in degrees; DIST is the eye distance in bounding-sphere radii\n"
     "(default: the sphere fills the view). --views N renders N views at azimuths AZ + 360 i / N,\n"
-    "elevation alternating +EL and -EL, into one contact sheet.";
+    "elevation alternating +EL and -EL, into one contact sheet. A .dps input (amgsplat build) draws\n"
+    "the textured domain primitives of one level, blended by --method (docs/render-methods.md).";
 
 enum { MAX_VIEWS = 256, MAX_SIDE = 16384 };
 
@@ -52,6 +57,12 @@ struct render_opts {
     double epsilon;
     double point_size;
     int opaque;
+    const char *method;
+    double alpha_ref;
+    double transparency;
+    double depth_window;
+    int outline;
+    int no_normal_map;
     /* parsed */
     unsigned width, height;
     double az, el, dist; /* dist 0 = fit */
@@ -60,7 +71,9 @@ struct render_opts {
     float kernel_abn[3];
     asp_splat_lighting light_mode;
     int amg_input;
+    int dps_input;
     asp_amg_color_mode color_mode;
+    asp_prim_render_options prim;
     const asp_context *ctx;
 };
 
@@ -68,6 +81,8 @@ struct render_opts {
 struct scene {
     asp_cloud *cloud; /* owned: the file's points, or a copy of the .amg points with their colours */
     asp_amg *amg;
+    asp_dps *dps;
+    const asp_dps_level *dps_level; /* the level drawn, inside dps */
     float center[3];
     float radius;
     size_t count;
@@ -103,9 +118,43 @@ static int load_amg(const char *path, const struct render_opts *o, const struct 
     return rc;
 }
 
+/* A .dps file and the level --level names (default: the finest level in the file). */
+static int load_dps(const char *path, const struct render_opts *o, const struct cli_env *env, struct scene *s,
+                    asp_error *err)
+{
+    int rc = asp_dps_load(path, &env->ctx, &s->dps, err);
+    if (rc)
+        return rc;
+    asp_dps_summary rows[64];
+    size_t n = s->dps->level_count < 64 ? s->dps->level_count : 64;
+    asp_dps_summarize(s->dps, rows); // level_count rows; files hold at most the AMG's levels (< 64)
+    size_t pick = 0;
+    if (o->level) {
+        pick = SIZE_MAX;
+        for (size_t i = 0; i < n; i++) {
+            char index[16];
+            snprintf(index, sizeof index, "%u", rows[i].level);
+            if (strcmp(o->level, rows[i].name) == 0 || strcmp(o->level, index) == 0)
+                pick = i;
+        }
+        if (pick == SIZE_MAX) {
+            char list[160] = "";
+            size_t len = 0;
+            for (size_t i = 0; i < n && len < sizeof list; i++)
+                len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", rows[i].name);
+            return asp_error_set(err, ASP_EINVAL, "'%s' has no level '%s' (it holds %s)", path, o->level, list);
+        }
+    }
+    s->dps_level = &s->dps->levels[pick];
+    s->count = s->dps_level->prim_count;
+    return asp_prim_level_bounding_sphere(s->dps_level, NULL, s->center, &s->radius, err);
+}
+
 static int load_scene(const char *path, const struct render_opts *o, const struct cli_env *env, struct scene *s,
                       asp_error *err)
 {
+    if (o->dps_input)
+        return load_dps(path, o, env, s, err);
     int rc = o->amg_input ? load_amg(path, o, env, s, err) : asp_cloud_load(path, &env->ctx, &s->cloud, err);
     if (rc)
         return rc;
@@ -117,6 +166,7 @@ static void scene_release(struct scene *s)
 {
     asp_cloud_destroy(s->cloud);
     asp_amg_destroy(s->amg);
+    asp_dps_destroy(s->dps);
     memset(s, 0, sizeof *s);
 }
 
@@ -147,7 +197,14 @@ static int make_square(asp_gl_context *gl, const struct scene *s, const struct r
     return asp_square_renderer_create(gl, s->cloud, &desc, r, err);
 }
 
-/* --renderer values */
+static int make_prim(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
+                     asp_error *err)
+{
+    asp_prim_renderer_desc desc = {.options = o->prim};
+    return asp_prim_renderer_create(gl, s->dps_level, &desc, r, err);
+}
+
+/* --renderer values; "prim" is what a .dps input gets */
 static const struct {
     const char *name;
     int (*make)(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
@@ -156,8 +213,9 @@ static const struct {
     {"disc", make_disc},
     {"splat", make_splat},
     {"square", make_square},
+    {"prim", make_prim},
 };
-enum { N_RENDERERS = sizeof renderers / sizeof renderers[0] };
+enum { N_RENDERERS = sizeof renderers / sizeof renderers[0], PRIM_RENDERER = N_RENDERERS - 1 };
 
 
 static int parse_colour(struct cli_env *env, const char *s, uint8_t out[4])
@@ -204,6 +262,11 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
         o->light_mode = (asp_splat_lighting)found;
     }
     static const char *const colorings[] = {"classifier", "domains", "strict"};
+    if (o->dps_input) {
+        if (o->color_by && strcmp(o->color_by, "domain") != 0 && strcmp(o->color_by, "domains") != 0)
+            return cli_usage_error(env, "--color-by on a .dps input expects domain, got '%s'", o->color_by);
+        return 0;
+    }
     if (o->color_by) {
         int found = -1;
         for (int i = 0; i < 3; i++)
@@ -217,6 +280,47 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
         return cli_usage_error(env, "--color-by needs an .amg input (amgsplat decompose makes one)");
     if (o->level && !(o->color_by && o->color_mode != ASP_AMG_COLOR_CLASSIFIER))
         return cli_usage_error(env, "--level needs --color-by domains or strict");
+    return 0;
+}
+
+/* Options of .dps inputs (asp_prim_render_options). */
+static int parse_prim_options(struct cli_env *env, struct render_opts *o)
+{
+    int given = o->method || o->alpha_ref >= 0 || o->transparency >= 0 || o->depth_window >= 0 || o->outline ||
+                o->no_normal_map;
+    if (!o->dps_input) {
+        if (given)
+            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline and "
+                                        "--no-normal-map need a .dps input (amgsplat build makes one)");
+        return 0;
+    }
+    asp_prim_render_options *p = &o->prim;
+    asp_error err = {0, ""};
+    if (o->method && asp_prim_render_method_parse(o->method, &p->method, &err))
+        return cli_usage_error(env, "--method: %s", err.msg);
+    if (o->alpha_ref >= 0) {
+        if (!(o->alpha_ref <= 1))
+            return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
+        p->alpha_ref = o->alpha_ref > 0 ? (float)o->alpha_ref : -1.0f; // the library's "exactly 0"
+    } else if (o->alpha_ref != -1) {
+        return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
+    }
+    if (o->transparency >= 0) {
+        if (!(o->transparency > 0 && o->transparency <= 1))
+            return cli_usage_error(env, "--transparency expects an opacity in (0, 1], got %g", o->transparency);
+        p->transparency = (float)o->transparency;
+    } else if (o->transparency != -1) {
+        return cli_usage_error(env, "--transparency expects an opacity in (0, 1], got %g", o->transparency);
+    }
+    if (o->depth_window >= 0) {
+        if (!isfinite(o->depth_window))
+            return cli_usage_error(env, "--depth-window expects world units >= 0, got %g", o->depth_window);
+        p->depth_window = o->depth_window > 0 ? (float)o->depth_window : -1.0f; // 0 = no window
+    } else if (o->depth_window != -1) {
+        return cli_usage_error(env, "--depth-window expects world units >= 0, got %g", o->depth_window);
+    }
+    p->flags = (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
+               (o->no_normal_map ? ASP_PRIM_RENDER_NO_NORMAL_MAP : 0u);
     return 0;
 }
 
@@ -261,7 +365,9 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
         return cli_usage_error(env, "--fov expects degrees in (0, 180), got %g", o->fov);
     if (!(o->radius_scale > 0) || !isfinite(o->radius_scale))
         return cli_usage_error(env, "--radius-scale expects a positive number, got %g", o->radius_scale);
-    return parse_splat_options(env, o);
+    if (parse_splat_options(env, o))
+        return 2;
+    return parse_prim_options(env, o);
 }
 
 /* What the views drew: primitives per view (the cut depends on the view) and the time per view. */
@@ -313,22 +419,29 @@ static void print_json(const struct render_opts *o, const struct scene *s, asp_g
            "\"points\": %zu, \"renderer\": ",
            img->width, img->height, o->width, o->height, o->views, s->count);
     cli_json_string(stdout, renderer);
+    if (o->dps_input) {
+        printf(", \"method\": ");
+        cli_json_string(stdout, asp_prim_render_method_name(o->prim.method));
+        printf(", \"level\": %u", s->dps_level->level);
+    }
     printf(", \"gl_renderer\": ");
     cli_json_string(stdout, asp_gl_context_renderer(gl));
     printf(", \"gl_backend\": ");
     cli_json_string(stdout, asp_gl_context_backend(gl));
     printf(", \"primitives\": %zu, \"primitives_min\": %zu, \"primitives_max\": %zu, \"tolerance\": %g, "
            "\"view_ms\": %.3f",
-           vs->last_count, vs->min_count, vs->max_count, strcmp(renderer, "disc") ? o->tolerance : 0.0,
+           vs->last_count, vs->min_count, vs->max_count,
+           strcmp(renderer, "disc") && strcmp(renderer, "prim") ? o->tolerance : 0.0,
            1e3 * vs->seconds / (double)o->views);
     printf(", \"seconds\": %.3f}\n", seconds);
 }
 
 int cmd_render(int argc, char **argv, struct cli_env *env)
 {
-    struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .renderer = "disc",
-                            .width = 512, .height = 512, .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0,
-                            .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
+    // -1 marks the .dps numbers as not given
+    struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .width = 512, .height = 512,
+                            .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0, .alpha_ref = -1,
+                            .transparency = -1, .depth_window = -1, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
         {"size", 0, CLI_STRING, &o.size, "WxH", "image size of one view (default 512x512)"},
@@ -341,8 +454,14 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
         {"opaque", 0, CLI_FLAG, &o.opaque, NULL, "splat: opaque ellipses, no blending"},
         {"point-size", 0, CLI_DOUBLE, &o.point_size, "PX", "square: fixed side in pixels (default 0: projected size)"},
-        {"color-by", 0, CLI_STRING, &o.color_by, "MODE", ".amg input: classifier, domains or strict"},
-        {"level", 0, CLI_STRING, &o.level, "L", ".amg input: level of the domain colours, L, L-3 or an index (default L-3)"},
+        {"color-by", 0, CLI_STRING, &o.color_by, "MODE", ".amg input: classifier, domains or strict; .dps input: domain"},
+        {"level", 0, CLI_STRING, &o.level, "L", ".amg: level of the domain colours (default L-3); .dps: level drawn (default the finest in the file)"},
+        {"method", 0, CLI_STRING, &o.method, "NAME", ".dps: how primitives blend (default normalized; see docs/render-methods.md)"},
+        {"alpha-ref", 0, CLI_DOUBLE, &o.alpha_ref, "X", ".dps: alpha test of the locks and the front layer, 0..1 (default 0.1)"},
+        {"transparency", 0, CLI_DOUBLE, &o.transparency, "X", ".dps: global opacity scaling alpha, (0, 1] (default 1)"},
+        {"depth-window", 0, CLI_DOUBLE, &o.depth_window, "X", ".dps: depth offset / window in world units (default: half the mean primitive radius)"},
+        {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
+        {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
         {"transparent", 0, CLI_FLAG, &o.transparent, NULL, "transparent background"},
         {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
@@ -358,11 +477,14 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     if (npos != 1)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat render -h'", npos);
     o.amg_input = ends_with_ci(argv[0], ".amg");
+    o.dps_input = ends_with_ci(argv[0], ".dps");
     if (parse_options(env, &o))
         return 2;
-    size_t kind = N_RENDERERS;
-    for (size_t i = 0; i < N_RENDERERS; i++)
-        if (strcmp(renderers[i].name, o.renderer) == 0)
+    if (o.dps_input && o.renderer)
+        return cli_usage_error(env, "--renderer is for point inputs; a .dps input is drawn with --method");
+    size_t kind = o.dps_input ? PRIM_RENDERER : N_RENDERERS;
+    for (size_t i = 0; !o.dps_input && i < PRIM_RENDERER; i++)
+        if (strcmp(renderers[i].name, o.renderer ? o.renderer : "disc") == 0)
             kind = i;
     if (kind == N_RENDERERS)
         return cli_usage_error(env, "unknown renderer '%s' (expected disc, splat or square)", o.renderer);
@@ -399,9 +521,10 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
             print_json(&o, &s, gl, renderers[kind].name, result, &vs, seconds);
         else
             cli_info(env,
-                     "rendered %zu view%s of %zu points (%s, %zu primitives in the last view, %.1f ms per view, %s) "
+                     "rendered %zu view%s of %zu %s (%s, %zu primitives in the last view, %.1f ms per view, %s) "
                      "to '%s' (%ux%u) in %.2f s\n",
-                     o.views, o.views > 1 ? "s" : "", s.count, renderers[kind].name, vs.last_count,
+                     o.views, o.views > 1 ? "s" : "", s.count, o.dps_input ? "domain primitives" : "points",
+                     o.dps_input ? asp_prim_render_method_name(o.prim.method) : renderers[kind].name, vs.last_count,
                      1e3 * vs.seconds / (double)o.views, asp_gl_context_renderer(gl), o.output, result->width,
                      result->height, seconds);
     }

@@ -113,6 +113,8 @@ static void print_json(const char *path, const asp_viewer_desc *d, const asp_vie
         printf("null");
     printf(", \"gl_renderer\": ");
     cli_json_string(stdout, s->gl_renderer);
+    printf(", \"title\": ");
+    cli_json_string(stdout, s->title);
     printf("}\n");
 }
 

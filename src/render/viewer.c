@@ -131,7 +131,7 @@ struct viewer {
     unsigned screenshot_seq;
     /* mouse */
     int buttons;           /* bit per GLFW mouse button held */
-    int shift;
+    int shift;             /* shift was held when the drag started */
     double mx, my;
     /* keys pressed in callbacks, applied by the loop (which can report errors) */
     action queue[QUEUE_CAP];
@@ -143,6 +143,7 @@ struct viewer {
     size_t window_frames;
     double window_ms;
     double title_time;
+    int title_stale;       /* the last frame's figures are not in the title yet */
     asp_viewer_stats stats;
 };
 
@@ -205,8 +206,8 @@ static void on_char(GLFWwindow *w, unsigned codepoint)
 static void on_key(GLFWwindow *w, int key, int scancode, int act, int mods)
 {
     (void)scancode;
+    (void)mods;
     viewer *v = from_window(w);
-    v->shift = (mods & GLFW_MOD_SHIFT) != 0;
     if (act == GLFW_RELEASE)
         return;
     // keys without a character; printable keys arrive through on_char (layout-aware)
@@ -230,11 +231,12 @@ static void on_button(GLFWwindow *w, int button, int act, int mods)
     viewer *v = from_window(w);
     if (button < 0 || button > 7)
         return;
-    v->shift = (mods & GLFW_MOD_SHIFT) != 0;
-    if (act == GLFW_PRESS)
+    if (act == GLFW_PRESS) {
         v->buttons |= 1 << button;
-    else
+        v->shift = (mods & GLFW_MOD_SHIFT) != 0; // shift chooses pan for the whole drag
+    } else {
         v->buttons &= ~(1 << button);
+    }
     glfwGetCursorPos(w, &v->mx, &v->my);
 }
 
@@ -547,16 +549,19 @@ static int next_screenshot_name(viewer *v, char *out, size_t cap)
 
 static void update_title(viewer *v, double now, int force)
 {
-    if (!force && now - v->title_time < 0.25) // setting a title is a round trip to the window system
+    if (!force && now - v->title_time < 0.25) { // setting a title is a round trip to the window system
+        v->title_stale = 1;
         return;
+    }
     v->title_time = now;
+    v->title_stale = 0;
     const char *base = strrchr(v->path, '/');
     base = base ? base + 1 : v->path;
     char tau[32] = "";
     if (renderer_kinds[v->kind].has_lod)
         snprintf(tau, sizeof tau, " | tau %g px", v->tolerance);
-    char title[320];
-    snprintf(title, sizeof title, "amgsplat view: %s | %s | %zu %s | %.1f ms (%.0f fps)%s | %s%s%s", base,
+    char *title = v->stats.title;
+    snprintf(title, sizeof v->stats.title, "amgsplat view: %s | %s | %zu %s | %.1f ms (%.0f fps)%s | %s%s%s", base,
              renderer_kinds[v->kind].name, v->r ? asp_renderer_count(v->r) : 0,
              renderer_kinds[v->kind].has_lod ? "splats" : "points", v->last_ms,
              v->last_ms > 0 ? 1000.0 / v->last_ms : 0.0, tau, v->unlit ? "unlit" : "lit",
@@ -636,10 +641,13 @@ static int loop(viewer *v, asp_error *err)
         int scripted = d->frames > 0;
         if (scripted && i >= d->frames)
             return 0;
-        if (scripted || v->dirty || v->queued || i < nkeys)
+        if (scripted || v->dirty || v->queued || i < nkeys) {
             glfwPollEvents();
-        else
+        } else {
+            if (v->title_stale)
+                update_title(v, asp_time_now(), 1);
             glfwWaitEventsTimeout(0.5); // idle: sleep until input instead of redrawing
+        }
         if (i < nkeys) {
             const asp__viewer_key *k = asp__viewer_key_find((unsigned char)keys[i]);
             push(v, k->action, k->arg);
@@ -669,6 +677,7 @@ static int open_window(viewer *v, asp_error *err)
     if (rc)
         return rc;
     v->window = v->gl->window;
+    asp__viewer_pin_gl_driver();
     glfwSetWindowUserPointer(v->window, v);
     glfwSetCharCallback(v->window, on_char);
     glfwSetKeyCallback(v->window, on_key);
@@ -712,6 +721,8 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, asp_viewer_sta
     }
     if (!rc)
         rc = loop(&v, err);
+    if (!rc && v.title_stale)
+        update_title(&v, asp_time_now(), 1);
     if (!rc && stats) {
         v.stats.frames = v.frames;
         v.stats.mean_frame_ms = v.frames ? v.total_ms / (double)v.frames : 0;

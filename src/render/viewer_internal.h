@@ -123,4 +123,10 @@ int asp__viewer_scene_check_desc(const asp_viewer_desc *desc, asp_error *err);
 int asp__viewer_scene_load(asp__viewer_scene *s, const char *path, const asp_viewer_desc *desc, asp_error *err);
 void asp__viewer_scene_release(asp__viewer_scene *s);
 
+/*
+ * Sanitizer builds: keeps the current context's GL driver loaded until exit
+ * (viewer_sanitizer.c explains why). A no-op otherwise.
+ */
+void asp__viewer_pin_gl_driver(void);
+
 #endif

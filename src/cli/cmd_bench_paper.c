@@ -1,0 +1,286 @@
+/*
+ * amgsplat bench-paper: the seeds' tables measured on this build, printed in
+ * their layouts: journal Table 1 (pre-processing) and Table 2 / thesis Table
+ * 5.2 (per level), thesis Table 5.3 (points against domain primitives) and
+ * Table 5.4 (texture construction methods).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cli/cli.h"
+#include "cli/commands.h"
+#include "util/banned.h"
+
+static const char usage[] =
+    "usage: amgsplat bench-paper MODEL [--sizes 128,256,512] [--frames 10] [--max-primitives 2000]\n"
+    "                            [--budget 500] [--no-texture-methods] [--points N] [--texture IMG]\n"
+    "                            [--markdown]\n"
+    "\n"
+    "Measures and prints, in the layouts of the seeds: journal Table 1 (points, level, polygons,\n"
+    "texels, decomposition and construction time), journal Table 2 / thesis Table 5.2 (per level:\n"
+    "polygons, texels, error, normalised error, basis and construction times, frame rate at each\n"
+    "screen size), thesis Table 5.3 (frame rate of the point set against domain primitives, speed-up)\n"
+    "and thesis Table 5.4 (construction time per texture method at texel sizes 2, 1 and 0.5). The\n"
+    "Table 1 / 5.3 / 5.4 level is the finest with at most --budget primitives. MODEL as for\n"
+    "'amgsplat eval'. --markdown prints the tables as Markdown (docs/results.md uses it).";
+
+enum { MAX_SIZES = 8 };
+
+static void fmt_fps(char *buf, size_t cap, double v)
+{
+    if (isfinite(v))
+        snprintf(buf, cap, "%.0f", v);
+    else
+        snprintf(buf, cap, "-");
+}
+
+static void fmt_time(char *buf, size_t cap, double v)
+{
+    if (!isfinite(v))
+        snprintf(buf, cap, "-");
+    else if (v < 0.01)
+        snprintf(buf, cap, "< 0.01");
+    else
+        snprintf(buf, cap, "%.2f", v);
+}
+
+/* One table row: cells separated by '|' in Markdown, padded columns otherwise. */
+struct table {
+    int md;
+    int widths[16];
+    int ncols;
+    int header_done;
+};
+
+static void row(struct table *t, const char *const *cells)
+{
+    for (int i = 0; i < t->ncols; i++) {
+        if (t->md)
+            printf("| %s ", cells[i]);
+        else
+            printf(i ? "  %*s" : "%-*s", t->widths[i], cells[i]);
+    }
+    printf(t->md ? "|\n" : "\n");
+    if (t->md && !t->header_done) {
+        // the separator after the header row
+        for (int i = 0; i < t->ncols; i++)
+            printf("|---");
+        printf("|\n");
+    }
+    t->header_done = 1;
+}
+
+static void title(int md, const char *text)
+{
+    printf(md ? "\n**%s**\n\n" : "\n%s\n", text);
+}
+
+static void table1(const asp_eval_paper *p, const char *model, int md)
+{
+    const asp_eval_paper_level *l = &p->levels[p->budget_level];
+    title(md, "Journal Table 1: pre-processing times");
+    struct table t = {.md = md, .widths = {24, 10, 9, 12, 14, 11, 12}, .ncols = 7};
+    const char *head[] = {"model", "points", "AMG level", "no. of polys", "no. of texels", "sd time (s)",
+                          "dpc time (s)"};
+    row(&t, head);
+    char pts[32], polys[32], tex[32], sd[32], dpc[32];
+    snprintf(pts, sizeof pts, "%zu", p->points);
+    snprintf(polys, sizeof polys, "%zu", l->primitives);
+    snprintf(tex, sizeof tex, "%llu", (unsigned long long)l->texels);
+    fmt_time(sd, sizeof sd, p->t_decompose);
+    fmt_time(dpc, sizeof dpc, l->t_construct);
+    const char *base = strrchr(model, '/');
+    const char *cells[] = {base ? base + 1 : model, pts, l->name, polys, tex, sd, dpc};
+    row(&t, cells);
+}
+
+static void table52(const asp_eval_paper *p, int md)
+{
+    title(md, "Journal Table 2 / thesis Table 5.2: statistics per AMG level (fps: domain primitives)");
+    struct table t = {.md = md, .widths = {5, 6, 9, 12, 10, 10, 7, 7}, .ncols = 8 + (int)p->size_count};
+    char hdr[MAX_SIZES][24];
+    const char *head[16] = {"level", "name", "#poly", "#tex", "error", "normalized", "cb (s)", "dpc (s)"};
+    for (size_t i = 0; i < p->size_count; i++) {
+        snprintf(hdr[i], sizeof hdr[i], "fps %u", p->sizes[i]);
+        head[8 + i] = hdr[i];
+        t.widths[8 + i] = 8;
+    }
+    row(&t, head);
+    for (size_t l = 0; l < p->level_count; l++) {
+        const asp_eval_paper_level *lv = &p->levels[l];
+        char c[16][32];
+        const char *cells[16];
+        snprintf(c[0], 32, "%u", lv->level);
+        snprintf(c[1], 32, "%s", lv->name);
+        snprintf(c[2], 32, "%zu", lv->primitives);
+        snprintf(c[3], 32, "%llu", (unsigned long long)lv->texels);
+        snprintf(c[4], 32, "%.6f", lv->error);
+        snprintf(c[5], 32, "%.3g", lv->error_norm);
+        fmt_time(c[6], 32, lv->t_basis);
+        fmt_time(c[7], 32, lv->t_construct);
+        for (size_t i = 0; i < p->size_count; i++)
+            fmt_fps(c[8 + i], 32, lv->fps[i]);
+        for (int i = 0; i < t.ncols; i++)
+            cells[i] = c[i];
+        row(&t, cells);
+    }
+}
+
+static void table53(const asp_eval_paper *p, const char *model, int md)
+{
+    const asp_eval_paper_level *l = &p->levels[p->budget_level];
+    char text[160];
+    snprintf(text, sizeof text, "Thesis Table 5.3: frame rate of points against domain primitives (%s, level %s)",
+             p->fps_method[0] ? p->fps_method : "no renderer", l->name);
+    title(md, text);
+    struct table t = {.md = md, .widths = {24, 6, 11, 8, 8}, .ncols = 5};
+    const char *head[] = {"model", "size", "fps points", "fps dp", "speedup"};
+    row(&t, head);
+    const char *base = strrchr(model, '/');
+    for (size_t i = 0; i < p->size_count; i++) {
+        char sz[16], a[32], b[32], s[32];
+        snprintf(sz, sizeof sz, "%u", p->sizes[i]);
+        fmt_fps(a, sizeof a, p->fps_points[i]);
+        fmt_fps(b, sizeof b, l->fps[i]);
+        double up = l->fps[i] / p->fps_points[i];
+        if (isfinite(up))
+            snprintf(s, sizeof s, "%.1f", up);
+        else
+            snprintf(s, sizeof s, "-");
+        const char *cells[] = {base ? base + 1 : model, sz, a, b, s};
+        row(&t, cells);
+    }
+}
+
+static void table54(const asp_eval_paper *p, int md)
+{
+    char text[160];
+    snprintf(text, sizeof text, "Thesis Table 5.4: construction time (s) per texture method, level %s",
+             p->levels[p->budget_level].name);
+    title(md, text);
+    struct table t = {.md = md, .widths = {10, 9, 9, 9, 9, 13}, .ncols = 6};
+    const char *head[] = {"texel size", "#texels", "constant", "linear", "Gaussian", "linear affine"};
+    row(&t, head);
+    for (int k = 0; k < 3; k++) {
+        char c[6][32];
+        snprintf(c[0], 32, "%g", p->t54_texel_size[k]);
+        snprintf(c[1], 32, "%.0f k", (double)p->t54_texels[k] / 1000.0);
+        for (int m = 0; m < 4; m++)
+            fmt_time(c[2 + m], 32, p->t54_seconds[k][m]);
+        const char *cells[] = {c[0], c[1], c[2], c[3], c[4], c[5]};
+        row(&t, cells);
+    }
+}
+
+static void print_json(const asp_eval_paper *p, const char *model, int texture_methods)
+{
+    printf("{\"model\": ");
+    cli_json_string(stdout, model);
+    printf(", \"points\": %zu, \"decompose_seconds\": %.4f, \"gl_renderer\": ", p->points, p->t_decompose);
+    cli_json_string(stdout, p->gl_renderer);
+    printf(", \"fps_method\": ");
+    cli_json_string(stdout, p->fps_method);
+    printf(", \"sizes\": [");
+    for (size_t i = 0; i < p->size_count; i++)
+        printf("%s%u", i ? ", " : "", p->sizes[i]);
+    printf("], \"fps_points\": [");
+    for (size_t i = 0; i < p->size_count; i++)
+        printf(isfinite(p->fps_points[i]) ? "%s%.2f" : "%snull", i ? ", " : "", p->fps_points[i]);
+    printf("], \"budget_level\": \"%s\", \"levels\": [", p->levels[p->budget_level].name);
+    for (size_t l = 0; l < p->level_count; l++) {
+        const asp_eval_paper_level *lv = &p->levels[l];
+        printf("%s{\"level\": %u, \"name\": \"%s\", \"primitives\": %zu, \"texels\": %llu, \"error\": %.9g, "
+               "\"normalised_error\": %.6g, \"cb_seconds\": %.4f, \"dpc_seconds\": %.4f, \"fps\": [",
+               l ? ", " : "", lv->level, lv->name, lv->primitives, (unsigned long long)lv->texels, lv->error,
+               lv->error_norm, lv->t_basis, lv->t_construct);
+        for (size_t i = 0; i < p->size_count; i++)
+            printf(isfinite(lv->fps[i]) ? "%s%.2f" : "%snull", i ? ", " : "", lv->fps[i]);
+        printf("]}");
+    }
+    printf("], \"texture_methods\": ");
+    if (!texture_methods) {
+        printf("null}\n");
+        return;
+    }
+    printf("[");
+    static const char *names[4] = {"constant", "linear", "gaussian", "linear_affine"};
+    for (int k = 0; k < 3; k++) {
+        printf("%s{\"texel_size\": %g, \"texels\": %llu", k ? ", " : "", p->t54_texel_size[k],
+               (unsigned long long)p->t54_texels[k]);
+        for (int m = 0; m < 4; m++)
+            printf(", \"%s\": %.4f", names[m], p->t54_seconds[k][m]);
+        printf("}");
+    }
+    printf("]}\n");
+}
+
+int cmd_bench_paper(int argc, char **argv, struct cli_env *env)
+{
+    const char *sizes_text = NULL, *texture = NULL;
+    size_t frames = 10, max_prims = 2000, budget = 500, points = 0;
+    int no_t54 = 0, markdown = 0;
+    const struct cli_option opts[] = {
+        {"sizes", 's', CLI_STRING, &sizes_text, "LIST", "screen sizes of the frame rates (default 128,256,512)"},
+        {"frames", 0, CLI_SIZE, &frames, "N", "timed frames per figure, median (default 10)"},
+        {"max-primitives", 'p', CLI_SIZE, &max_prims, "N", "Table 5.2 levels with at most N primitives (2000)"},
+        {"budget", 'b', CLI_SIZE, &budget, "N", "Table 1/5.3/5.4 level: the finest with at most N (500)"},
+        {"no-texture-methods", 0, CLI_FLAG, &no_t54, NULL, "leave out Table 5.4 (12 extra builds)"},
+        {"points", 'n', CLI_SIZE, &points, "N", "samples of a mesh or synthetic MODEL"},
+        {"texture", 0, CLI_STRING, &texture, "IMG", "texture of a mesh MODEL without material textures"},
+        {"markdown", 0, CLI_FLAG, &markdown, NULL, "print Markdown tables"},
+        {0},
+    };
+    int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
+    if (rc)
+        return rc > 0 ? 0 : 2;
+    if (npos != 1)
+        return cli_usage_error(env, "expected one MODEL, got %d; see 'amgsplat bench-paper -h'", npos);
+    if (frames < 1 || frames > 1000)
+        return cli_usage_error(env, "--frames expects 1..1000, got %zu", frames);
+    if (max_prims < 1 || budget < 1)
+        return cli_usage_error(env, "--max-primitives and --budget expect at least 1");
+    uint32_t sizes[MAX_SIZES] = {128, 256, 512};
+    size_t nsizes = 3;
+    if (sizes_text) {
+        double v[MAX_SIZES];
+        int k = cli_parse_doubles(sizes_text, v, MAX_SIZES);
+        if (k < 1)
+            return cli_usage_error(env, "--sizes expects up to %d comma-separated sides, got '%s'", MAX_SIZES,
+                                   sizes_text);
+        for (int i = 0; i < k; i++) {
+            if (!(v[i] >= 16 && v[i] <= 4096) || v[i] != floor(v[i]))
+                return cli_usage_error(env, "--sizes expects whole sides in 16..4096 pixels, got '%s'", sizes_text);
+            sizes[i] = (uint32_t)v[i];
+        }
+        nsizes = (size_t)k;
+    }
+    asp_error err = {0};
+    asp_cloud *cloud = NULL;
+    rc = asp_eval_load_model(argv[0], points, texture, &env->ctx, &cloud, &err);
+    asp_eval_paper *p = NULL;
+    if (!rc) {
+        asp_eval_paper_desc desc = {.sizes = sizes, .size_count = nsizes, .frames = frames,
+                                    .max_primitives = max_prims, .budget = budget, .skip_texture_methods = no_t54,
+                                    .ctx = &env->ctx};
+        rc = asp_eval_paper_run(cloud, &desc, &p, &err);
+    }
+    asp_cloud_destroy(cloud);
+    asp_amg_shutdown();
+    cli_progress_end(env);
+    if (rc)
+        return cli_fail(env, &err);
+    if (env->json) {
+        print_json(p, argv[0], !no_t54);
+    } else {
+        if (!env->quiet)
+            printf("%s: %zu points; frame rates on %s\n", argv[0], p->points, p->gl_renderer);
+        table1(p, argv[0], markdown);
+        table52(p, markdown);
+        table53(p, argv[0], markdown);
+        if (!no_t54)
+            table54(p, markdown);
+    }
+    asp_eval_paper_destroy(p);
+    return 0;
+}

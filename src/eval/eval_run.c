@@ -1,0 +1,496 @@
+/*
+ * The measuring stick of the evaluation: render the reference (all points as
+ * blended, normalised splats, seed 001 section 5, tolerance 0) and every
+ * representation from the same cameras, and compare images (journal section 6
+ * asks for an image difference metric). The representations are a table of
+ * (name, create function); the point-hierarchy cut to a level's primitive
+ * count is the comparison of thesis Fig. 1.1.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amgsplat/eval.h"
+#include "amgsplat/hier.h"
+#include "amgsplat/render.h"
+#include "util/banned.h"
+
+void asp_eval_result_destroy(asp_eval_result *res)
+{
+    if (!res)
+        return;
+    asp_context ctx = res->ctx;
+    asp_free(&ctx, res->rows);
+    asp_free(&ctx, res->ssim);
+    asp_free(&ctx, res->psnr);
+    asp_image_release(&res->sheet);
+    asp_free(&ctx, res);
+}
+
+size_t asp_eval_ssim_wins(const asp_eval_result *res, size_t a, size_t b)
+{
+    size_t wins = 0;
+    for (size_t v = 0; v < res->views; v++)
+        wins += res->ssim[a * res->views + v] > res->ssim[b * res->views + v];
+    return wins;
+}
+
+#ifndef ASP_HAVE_GL
+
+int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_result **out, asp_error *err)
+{
+    (void)cloud;
+    (void)desc;
+    (void)out;
+    return asp_error_set(err, ASP_EUNSUPPORTED, "cannot evaluate: this build has no OpenGL renderer (ASP_WITH_GL)");
+}
+
+#else
+
+enum { MAX_SIZES = 8, MAX_VIEWS = 256, MAX_FRAMES = 1000, MAX_REPS = 17 };
+
+/* Identical images have infinite PSNR; a finite stand-in keeps means and CSV numbers usable. */
+#define PSNR_IDENTICAL 99.0
+
+/*
+ * A representation: the point hierarchy cut per view to the level's primitive
+ * count (prim = 0, drawn by the shared splat renderer), or the level's domain
+ * primitives drawn with one method (journal section 4, thesis 4.4).
+ */
+struct rep {
+    char name[32];
+    int prim;
+    asp_prim_render_method method;
+};
+
+
+struct eval_state {
+    const asp_context *ctx;
+    const asp_cloud *cloud;
+    asp_gl_context *gl;
+    asp_hier *hier;
+    asp_renderer *splat; /* the reference at tolerance 0; the cut at the bisected tolerance */
+    asp_dps *dps;
+    asp_index *cut;      /* scratch of the tolerance bisection */
+    size_t cut_cap;
+    float center[3], radius;
+    float elevation;
+    size_t views, frames;
+    struct rep reps[MAX_REPS];
+    size_t nreps;
+};
+
+static int create_prim(struct eval_state *s, const struct rep *rep, const asp_dps_level *lv, asp_renderer **out,
+                       asp_error *err)
+{
+    asp_prim_renderer_desc pd = {.options = {.method = rep->method}};
+    memcpy(pd.origin, s->cloud->origin, sizeof pd.origin);
+    return asp_prim_renderer_create(s->gl, lv, &pd, out, err);
+}
+
+static void view_camera(const struct eval_state *s, size_t v, asp_camera *cam)
+{
+    asp_camera_init(cam);
+    cam->azimuth = (float)(360.0 * (double)v / (double)s->views);
+    cam->elevation = v % 2 ? -s->elevation : s->elevation;
+    asp_camera_fit(cam, s->center, s->radius, 1.0f);
+}
+
+static int cut_count(const struct eval_state *s, asp_hier_view *hv, double tau, size_t *count, asp_error *err)
+{
+    hv->tau = (float)tau;
+    return asp_hier_select(s->hier, hv, s->cut, s->cut_cap, count, err);
+}
+
+/*
+ * Tolerance whose cut is closest to target splats for this camera and size.
+ * The count never grows with tau (asp_hier_select), so bisect tau on a log
+ * scale between 0 (every visible point) and a tau that leaves at most target.
+ */
+static int cut_tolerance(const struct eval_state *s, const asp_camera *cam, uint32_t size, size_t target, float *tau,
+                         asp_error *err)
+{
+    asp_hier_view hv;
+    memset(&hv, 0, sizeof hv);
+    asp_camera_view_matrix(cam, hv.view);
+    asp_camera_projection_matrix(cam, hv.proj);
+    asp_camera_eye(cam, hv.eye);
+    hv.width = hv.height = size;
+    size_t n = 0;
+    int rc = cut_count(s, &hv, 0, &n, err);
+    if (rc)
+        return rc;
+    double best_tau = 0, lo = 0, hi = 1;
+    size_t best_diff = n > target ? n - target : target - n;
+    if (n <= target) {
+        *tau = 0;
+        return 0;
+    }
+    for (int i = 0; i < 40; i++) { // grow hi until the cut is small enough
+        if ((rc = cut_count(s, &hv, hi, &n, err)))
+            return rc;
+        size_t diff = n > target ? n - target : target - n;
+        if (diff < best_diff) {
+            best_diff = diff;
+            best_tau = hi;
+        }
+        if (n <= target)
+            break;
+        lo = hi;
+        hi *= 4;
+    }
+    for (int i = 0; i < 40 && best_diff; i++) {
+        double mid = lo > 0 ? sqrt(lo * hi) : hi / 2;
+        if ((rc = cut_count(s, &hv, mid, &n, err)))
+            return rc;
+        size_t diff = n > target ? n - target : target - n;
+        if (diff < best_diff || (diff == best_diff && mid < best_tau)) {
+            best_diff = diff;
+            best_tau = mid;
+        }
+        if (n > target)
+            lo = mid;
+        else
+            hi = mid;
+        if (hi - lo < 1e-7 * hi)
+            break;
+    }
+    *tau = (float)best_tau;
+    return 0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median time of s->frames finished frames (one untimed warm-up frame first). */
+static int frame_time(struct eval_state *s, asp_renderer *r, const asp_camera *cam, const asp_render_desc *rd,
+                      double *ms, asp_error *err)
+{
+    asp_render_desc d = *rd;
+    d.flags |= ASP_RENDER_WAIT;
+    double t[MAX_FRAMES];
+    int rc = asp_render_frame(s->gl, r, cam, &d, err);
+    for (size_t i = 0; !rc && i < s->frames; i++) {
+        double t0 = asp_time_now();
+        rc = asp_render_frame(s->gl, r, cam, &d, err);
+        t[i] = (asp_time_now() - t0) * 1e3;
+    }
+    if (rc)
+        return rc;
+    qsort(t, s->frames, sizeof *t, cmp_double);
+    *ms = s->frames % 2 ? t[s->frames / 2] : 0.5 * (t[s->frames / 2 - 1] + t[s->frames / 2]);
+    return 0;
+}
+
+static int compare(const asp_image *img, const asp_image *ref, double *psnr, double *ssim, double *iou,
+                   asp_error *err)
+{
+    int rc = asp_image_psnr(img, ref, psnr, err);
+    if (!rc)
+        rc = asp_image_ssim(img, ref, ssim, err);
+    if (!rc)
+        rc = asp_image_silhouette_iou(img, ref, NULL, iou, err);
+    if (!rc && !isfinite(*psnr))
+        *psnr = PSNR_IDENTICAL;
+    return rc;
+}
+
+struct sheet {
+    asp_image *tiles; /* rows x cols; NULL when no sheet is made */
+    size_t cols, rows;
+};
+
+static int keep_tile(const struct eval_state *s, struct sheet *sh, size_t row, size_t col, asp_image *img)
+{
+    if (!sh->tiles)
+        return 0;
+    (void)s;
+    asp_image *t = &sh->tiles[row * sh->cols + col];
+    asp_image_release(t);
+    *t = *img; // takes the pixels
+    memset(img, 0, sizeof *img);
+    return 0;
+}
+
+/* One row: every view of representation rep at level lv (NULL: the reference), figures into row. */
+static int measure(struct eval_state *s, const struct rep *rep, const asp_dps_level *lv, uint32_t size,
+                   const asp_image *refs, asp_image *ref_out, struct sheet *sh, size_t sheet_row, size_t sheet_col,
+                   asp_eval_row *row, double *ssim_views, double *psnr_views, asp_error *err)
+{
+    asp_renderer *r = s->splat;
+    int rc = 0;
+    if (rep && rep->prim && (rc = create_prim(s, rep, lv, &r, err)))
+        return rc;
+    int cut = r == s->splat;
+    size_t target = lv ? lv->prim_count : s->cloud->count;
+    asp_render_desc rd = {.width = size, .height = size};
+    double drawn = 0, psnr_sum = 0, ssim_sum = 0, iou_sum = 0;
+    row->psnr_min = row->ssim_min = row->iou_min = INFINITY;
+    for (size_t v = 0; v < s->views && !rc; v++) {
+        asp_camera cam;
+        view_camera(s, v, &cam);
+        float tau = 0;
+        if (cut && lv)
+            rc = cut_tolerance(s, &cam, size, target, &tau, err);
+        if (!rc && cut)
+            rc = asp_renderer_set_lod(r, tau, 0, err);
+        asp_image img = {0};
+        if (!rc)
+            rc = asp_render_to_image(s->gl, r, &cam, &rd, &img, err);
+        if (!rc && v == 0)
+            rc = frame_time(s, r, &cam, &rd, &row->frame_ms, err);
+        drawn += (double)asp_renderer_count(r);
+        double psnr = PSNR_IDENTICAL, ssim = 1, iou = 1;
+        if (!rc && refs)
+            rc = compare(&img, &refs[v], &psnr, &ssim, &iou, err);
+        if (!rc) {
+            psnr_views[v] = psnr;
+            ssim_views[v] = ssim;
+            psnr_sum += psnr;
+            ssim_sum += ssim;
+            iou_sum += iou;
+            row->psnr_min = psnr < row->psnr_min ? psnr : row->psnr_min;
+            row->ssim_min = ssim < row->ssim_min ? ssim : row->ssim_min;
+            row->iou_min = iou < row->iou_min ? iou : row->iou_min;
+        }
+        if (!rc && v == 0 && sh->tiles && size == sh->tiles[0].width) {
+            asp_image copy = {0};
+            rc = asp_image_init(&copy, img.width, img.height, err);
+            if (!rc) {
+                memcpy(copy.pixels, img.pixels, (size_t)img.width * img.height * 4);
+                rc = keep_tile(s, sh, sheet_row, sheet_col, &copy);
+            }
+            asp_image_release(&copy);
+        }
+        if (!rc && ref_out)
+            ref_out[v] = img; // the caller keeps the reference images
+        else
+            asp_image_release(&img);
+    }
+    if (r != s->splat)
+        asp_renderer_destroy(r);
+    if (rc)
+        return rc;
+    snprintf(row->representation, sizeof row->representation, "%s", rep ? rep->name : "reference");
+    row->size = size;
+    row->primitives = target;
+    row->drawn = drawn / (double)s->views;
+    row->texels = lv && !cut ? lv->texels : 0; // splats have no texture
+    row->psnr_mean = psnr_sum / (double)s->views;
+    row->ssim_mean = ssim_sum / (double)s->views;
+    row->iou_mean = iou_sum / (double)s->views;
+    return 0;
+}
+
+static int check_desc(const asp_eval_desc *d, const uint32_t *sizes, size_t nsizes, asp_error *err)
+{
+    if (d->views > MAX_VIEWS)
+        return asp_error_set(err, ASP_EINVAL, "views must be 1..%d, got %zu", MAX_VIEWS, d->views);
+    if (nsizes == 0 || nsizes > MAX_SIZES)
+        return asp_error_set(err, ASP_EINVAL, "expected 1..%d image sizes, got %zu", MAX_SIZES, nsizes);
+    for (size_t i = 0; i < nsizes; i++)
+        if (sizes[i] < 16 || sizes[i] > 2048)
+            return asp_error_set(err, ASP_EINVAL, "image size %u is outside 16..2048", sizes[i]);
+    if (d->methods && d->method_count > MAX_REPS - 1)
+        return asp_error_set(err, ASP_EINVAL, "at most %d rendering methods, got %zu", MAX_REPS - 1, d->method_count);
+    for (size_t i = 0; d->methods && i < d->method_count; i++)
+        if (!asp_prim_render_method_name(d->methods[i]))
+            return asp_error_set(err, ASP_EINVAL, "unknown rendering method %d", (int)d->methods[i]);
+    if (d->frames > MAX_FRAMES)
+        return asp_error_set(err, ASP_EINVAL, "frames must be at most %d, got %zu", MAX_FRAMES, d->frames);
+    if (!(d->elevation >= -90 && d->elevation <= 90))
+        return asp_error_set(err, ASP_EINVAL, "elevation must be in -90..90 degrees, got %g", (double)d->elevation);
+    return 0;
+}
+
+/* Levels 1 .. L with at most max primitives (level 0 is the points themselves); at least the coarsest. */
+static size_t pick_levels(const asp_amg *amg, size_t max, size_t *levels)
+{
+    size_t n = 0, count = asp_amg_level_count(amg);
+    for (size_t l = 1; l < count && n < 64; l++)
+        if (asp_amg_level_size(amg, l) <= max)
+            levels[n++] = l;
+    if (n == 0)
+        levels[n++] = count - 1;
+    return n;
+}
+
+static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result *res, asp_error *err)
+{
+    double t0 = asp_time_now();
+    asp_amg *amg = NULL;
+    int rc = asp_amg_decompose(s->cloud, d->amg, s->ctx, &amg, err);
+    res->t_decompose = asp_time_now() - t0;
+    size_t levels[64], n = 0;
+    if (!rc) {
+        n = pick_levels(amg, d->max_primitives ? d->max_primitives : 2000, levels);
+        t0 = asp_time_now();
+        rc = asp_prim_build(amg, s->cloud, levels, n, d->prim, NULL, s->ctx, &s->dps, err);
+        res->t_build = asp_time_now() - t0;
+    }
+    asp_amg_destroy(amg);
+    if (!rc)
+        rc = asp_hier_build(s->cloud, NULL, s->ctx, &s->hier, err);
+    if (!rc)
+        rc = asp_render_bounding_sphere(s->cloud, s->center, &s->radius, err);
+    if (!rc) {
+        s->cut_cap = asp_hier_select_bound(s->hier);
+        s->cut = asp_alloc(s->ctx, s->cut_cap * sizeof *s->cut);
+        if (!s->cut)
+            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for a cut of %zu splats", s->cut_cap);
+    }
+    if (!rc)
+        rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.ctx = s->ctx}, &s->gl, err);
+    if (!rc)
+        rc = asp_splat_renderer_create_hier(s->gl, s->hier, &(asp_splat_renderer_desc){0}, &s->splat, err);
+    if (!rc)
+        snprintf(res->gl_renderer, sizeof res->gl_renderer, "%s", asp_gl_context_renderer(s->gl));
+    return rc;
+}
+
+static void state_release(struct eval_state *s)
+{
+    asp_renderer_destroy(s->splat);
+    asp_gl_context_destroy(s->gl);
+    asp_hier_destroy(s->hier);
+    asp_dps_destroy(s->dps);
+    asp_free(s->ctx, s->cut);
+}
+
+static int run_size(struct eval_state *s, uint32_t size, asp_eval_result *res, size_t *row, struct sheet *sh,
+                    asp_error *err)
+{
+    asp_image *refs = asp_calloc(s->ctx, s->views, sizeof *refs);
+    if (!refs)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu reference images", s->views);
+    size_t r0 = *row;
+    int rc = measure(s, NULL, NULL, size, NULL, refs, sh, 0, 0, &res->rows[r0], res->ssim + r0 * s->views,
+                     res->psnr + r0 * s->views, err);
+    if (!rc) {
+        snprintf(res->rows[r0].level_name, sizeof res->rows[r0].level_name, "points");
+        (*row)++;
+    }
+    for (size_t k = 0; k < s->nreps && !rc; k++)
+        for (size_t l = 0; l < s->dps->level_count && !rc; l++) {
+            const asp_dps_level *lv = &s->dps->levels[l];
+            size_t r = *row;
+            rc = measure(s, &s->reps[k], lv, size, refs, NULL, sh, k, l + 1, &res->rows[r], res->ssim + r * s->views,
+                         res->psnr + r * s->views, err);
+            if (rc)
+                break;
+            res->rows[r].level = lv->level;
+            uint32_t coarse = s->dps->amg_levels - 1 - lv->level;
+            if (coarse)
+                snprintf(res->rows[r].level_name, sizeof res->rows[r].level_name, "L-%u", coarse);
+            else
+                snprintf(res->rows[r].level_name, sizeof res->rows[r].level_name, "L");
+            (*row)++;
+            rc = asp_progress(s->ctx, "render", (double)*row / (double)res->row_count);
+        }
+    for (size_t v = 0; v < s->views; v++)
+        asp_image_release(&refs[v]);
+    asp_free(s->ctx, refs);
+    return rc;
+}
+
+static int make_sheet(struct eval_state *s, struct sheet *sh, asp_eval_result *res, asp_error *err)
+{
+    // every row starts with the reference; tiles never rendered stay transparent
+    const asp_image *ref = &sh->tiles[0];
+    for (size_t i = 1; i < sh->rows * sh->cols; i++) {
+        if (sh->tiles[i].pixels)
+            continue;
+        int rc = asp_image_init(&sh->tiles[i], ref->width, ref->height, err);
+        if (rc)
+            return rc;
+        if (i % sh->cols == 0)
+            memcpy(sh->tiles[i].pixels, ref->pixels, (size_t)ref->width * ref->height * 4);
+    }
+    (void)s;
+    res->sheet_cols = (uint32_t)sh->cols;
+    res->sheet_rows = (uint32_t)sh->rows;
+    return asp_image_contact_sheet(sh->tiles, sh->rows * sh->cols, (uint32_t)sh->cols, &res->sheet, err);
+}
+
+int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_result **out, asp_error *err)
+{
+    static const uint32_t default_sizes[3] = {128, 256, 512};
+    asp_eval_desc d = desc ? *desc : (asp_eval_desc){0};
+    const uint32_t *sizes = d.sizes ? d.sizes : default_sizes;
+    size_t nsizes = d.sizes ? d.size_count : 3;
+    int rc = check_desc(&d, sizes, nsizes, err);
+    if (rc)
+        return rc;
+    if (!cloud || cloud->count < 3)
+        return asp_error_set(err, ASP_EDEGENERATE, "cannot evaluate a model of %zu points (at least 3)",
+                             cloud ? cloud->count : (size_t)0);
+    struct eval_state s = {.ctx = d.ctx, .cloud = cloud, .elevation = d.elevation ? d.elevation : 20.0f,
+                           .views = d.views ? d.views : 16, .frames = d.frames ? d.frames : 5};
+    asp_eval_result *res = asp_calloc(d.ctx, 1, sizeof *res);
+    if (!res)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for the evaluation result");
+    if (d.ctx)
+        res->ctx = *d.ctx;
+    res->views = s.views;
+    res->points = cloud->count;
+    struct sheet sh = {0};
+    static const asp_prim_render_method default_methods[4] = {ASP_PRIM_RENDER_NORMALIZED, ASP_PRIM_RENDER_PREFIX,
+                                                              ASP_PRIM_RENDER_OVERLAP, ASP_PRIM_RENDER_TWO_PASS};
+    const asp_prim_render_method *methods = d.methods ? d.methods : default_methods;
+    size_t nmethods = d.methods ? d.method_count : 4;
+    snprintf(s.reps[0].name, sizeof s.reps[0].name, "points");
+    s.nreps = 1;
+    for (size_t i = 0; i < nmethods; i++, s.nreps++) {
+        s.reps[s.nreps].prim = 1;
+        s.reps[s.nreps].method = methods[i];
+        snprintf(s.reps[s.nreps].name, sizeof s.reps[s.nreps].name, "dp-%s", asp_prim_render_method_name(methods[i]));
+    }
+    rc = prepare(&s, &d, res, err);
+    if (!rc) {
+        res->level_count = s.dps->level_count;
+        res->row_count = nsizes * (1 + s.nreps * s.dps->level_count);
+        res->rows = asp_calloc(d.ctx, res->row_count, sizeof *res->rows);
+        res->ssim = asp_calloc(d.ctx, res->row_count * s.views, sizeof *res->ssim);
+        res->psnr = asp_calloc(d.ctx, res->row_count * s.views, sizeof *res->psnr);
+        sh.cols = 1 + s.dps->level_count;
+        sh.rows = s.nreps;
+        sh.tiles = asp_calloc(d.ctx, sh.cols * sh.rows, sizeof *sh.tiles);
+        if (!res->rows || !res->ssim || !res->psnr || !sh.tiles)
+            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu result rows", res->row_count);
+    }
+    uint32_t sheet_size = d.sheet_size;
+    if (!sheet_size)
+        for (size_t i = 0; i < nsizes; i++)
+            sheet_size = !sheet_size || sizes[i] < sheet_size ? sizes[i] : sheet_size;
+    double t_render = asp_time_now();
+    size_t row = 0;
+    for (size_t i = 0; i < nsizes && !rc; i++) {
+        // the sheet is made at sheet_size only; tiles[0].width tells measure() which size that is
+        if (sh.tiles && sizes[i] == sheet_size && !sh.tiles[0].pixels)
+            rc = asp_image_init(&sh.tiles[0], sheet_size, sheet_size, err);
+        if (!rc)
+            rc = run_size(&s, sizes[i], res, &row, &sh, err);
+    }
+    res->t_render = asp_time_now() - t_render;
+    if (!rc && sh.tiles && sh.tiles[0].pixels)
+        rc = make_sheet(&s, &sh, res, err);
+    if (sh.tiles) {
+        for (size_t i = 0; i < sh.rows * sh.cols; i++)
+            asp_image_release(&sh.tiles[i]);
+        asp_free(d.ctx, sh.tiles);
+    }
+    state_release(&s);
+    if (rc) {
+        asp_eval_result_destroy(res);
+        return rc;
+    }
+    res->row_count = row;
+    *out = res;
+    return 0;
+}
+
+#endif

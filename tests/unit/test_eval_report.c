@@ -1,0 +1,102 @@
+/* Evaluation results: CSV and JSON files, SSIM win counts and charts from a hand-made result. */
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "harness.h"
+#include "amgsplat/eval.h"
+
+static asp_eval_result *make_result(void)
+{
+    asp_eval_result *r = asp_calloc(NULL, 1, sizeof *r);
+    r->row_count = 3;
+    r->views = 4;
+    r->rows = asp_calloc(NULL, 3, sizeof *r->rows);
+    r->ssim = asp_calloc(NULL, 12, sizeof *r->ssim);
+    r->psnr = asp_calloc(NULL, 12, sizeof *r->psnr);
+    const char *names[3] = {"reference", "points", "dp-normalized"};
+    for (int i = 0; i < 3; i++) {
+        asp_eval_row *row = &r->rows[i];
+        snprintf(row->representation, sizeof row->representation, "%s", names[i]);
+        snprintf(row->level_name, sizeof row->level_name, i ? "L" : "points");
+        row->size = 64;
+        row->primitives = i ? 8 : 1000;
+        row->ssim_mean = i == 0 ? 1 : i == 1 ? 0.5 : 0.9;
+        row->frame_ms = 1.5;
+    }
+    const double pts[4] = {0.5, 0.6, 0.95, 0.4}, dp[4] = {0.9, 0.9, 0.9, 0.9};
+    for (int v = 0; v < 4; v++) {
+        r->ssim[v] = 1;
+        r->ssim[4 + v] = pts[v];
+        r->ssim[8 + v] = dp[v];
+    }
+    return r;
+}
+
+static char *slurp(const char *path)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return NULL;
+    static char buf[65536];
+    size_t n = fread(buf, 1, sizeof buf - 1, fp);
+    buf[n] = 0;
+    fclose(fp);
+    return buf;
+}
+
+static void test_wins(void)
+{
+    asp_eval_result *r = make_result();
+    CHECK(asp_eval_ssim_wins(r, 2, 1) == 3); /* dp beats the cut in 3 of 4 views */
+    CHECK(asp_eval_ssim_wins(r, 1, 2) == 1);
+    CHECK(asp_eval_ssim_wins(r, 0, 2) == 4);
+    asp_eval_result_destroy(r);
+    asp_eval_result_destroy(NULL);
+}
+
+static void test_csv_json(void)
+{
+    asp_eval_result *r = make_result();
+    char csv[64], json[64];
+    snprintf(csv, sizeof csv, "/tmp/asp_eval_report_%d.csv", (int)getpid());
+    snprintf(json, sizeof json, "/tmp/asp_eval_report_%d.json", (int)getpid());
+    asp_error err = {0};
+    CHECK_OK(asp_eval_save_csv(r, csv, &err), &err);
+    char *text = slurp(csv);
+    CHECK(text && strncmp(text, "representation,level,level_name,size,primitives,drawn,texels,psnr_mean", 70) == 0);
+    size_t lines = 0;
+    for (const char *p = text; p && *p; p++)
+        lines += *p == '\n';
+    CHECK(lines == 4);
+    CHECK(text && strstr(text, "\ndp-normalized,0,L,64,8,") != NULL);
+    CHECK_OK(asp_eval_save_json(r, "m\"x", json, &err), &err);
+    text = slurp(json);
+    CHECK(text && strstr(text, "\"model\": \"m\\\"x\"") != NULL);
+    CHECK(text && strstr(text, "\"ssim_views\": [0.500000, 0.600000, 0.950000, 0.400000]") != NULL);
+    unlink(csv);
+    unlink(json);
+    /* an unwritable path fails with ASP_EIO and names it */
+    CHECK(asp_eval_save_csv(r, "/nonexistent-dir/x.csv", &err) == ASP_EIO);
+    CHECK(strstr(err.msg, "/nonexistent-dir/x.csv") != NULL);
+    asp_eval_result_destroy(r);
+}
+
+static void test_chart(void)
+{
+    asp_eval_result *r = make_result();
+    asp_image img = {0};
+    asp_error err = {0};
+    CHECK_OK(asp_eval_chart(r, 64, 0, &img, &err), &err);
+    CHECK(img.width > 0);
+    asp_image_release(&img);
+    CHECK_OK(asp_eval_chart(r, 64, 1, &img, &err), &err);
+    asp_image_release(&img);
+    CHECK(asp_eval_chart(r, 128, 0, &img, &err) == ASP_EINVAL);
+    CHECK(strstr(err.msg, "128") != NULL);
+    CHECK(asp_eval_chart(r, 64, 2, &img, &err) == ASP_EINVAL);
+    CHECK(img.pixels == NULL);
+    asp_eval_result_destroy(r);
+}
+
+TEST_MAIN(TEST_CASE(test_wins), TEST_CASE(test_csv_json), TEST_CASE(test_chart))
