@@ -62,7 +62,8 @@ void asp_amg_csr_check_stiffness(const asp_amg_csr *a, asp_amg_matrix_check *out
  * default is the thesis's surface variation: on the octahedron the journal's
  * moment classifier with alpha = 0.01, beta = 100 is only about 5x lower on
  * the creases than on the faces (surface variation: about 30x), too little for
- * AMG to keep the faces apart (docs/cli/decompose.md).
+ * AMG to keep the faces apart; with beta = 1e4 it works as well
+ * (docs/cli/decompose.md).
  */
 typedef enum asp_amg_classifier_kind {
     ASP_AMG_CLASSIFIER_VARIATION = 0, /* thesis eq. 2.2: sigma = l2 / (l0 + l1 + l2), weighted as C = G(sigma) */

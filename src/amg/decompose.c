@@ -111,6 +111,7 @@ static int check_cloud(const asp_cloud *cloud, asp_error *err)
     return 0;
 }
 
+#ifdef ASP_HAVE_HYPRE
 /*
  * The decomposition keeps the whole input point set, so domain primitives can
  * be built from an .amg alone (thesis 2.6: the AMG output is stored and only
@@ -150,6 +151,7 @@ static int stage(const asp_context *ctx, const char *name, double f, asp_error *
         asp_error_set(err, rc, "decomposition canceled during %s", name);
     return rc;
 }
+#endif
 
 int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out,
                       asp_error *err)

@@ -1,0 +1,89 @@
+# amgsplat render on a .dps (domain primitives, journal section 4): every method draws the octahedron's
+# 8 primitives, the options change the pixels they should, and bad options or files fail cleanly.
+# (Named render_prim so that ASan runs it with the slow unwinding that MPI's leak suppressions need.)
+source "$(dirname "$0")/common.sh"
+
+# png.py FILE EXPR: decodes an 8-bit RGBA PNG (any row filter) and evaluates EXPR with w, h, px(x, y) -> (r,g,b,a).
+cat >"$T/png.py" <<'PY'
+import struct, sys, zlib
+data = open(sys.argv[1], 'rb').read()
+assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
+pos, idat = 8, b''
+while pos < len(data):
+    n, t = struct.unpack('>I4s', data[pos:pos + 8])
+    body = data[pos + 8:pos + 8 + n]
+    if t == b'IHDR':
+        w, h, depth, ctype = struct.unpack('>IIBB', body[:10])
+        assert depth == 8 and ctype == 6, 'expected 8-bit RGBA'
+    elif t == b'IDAT':
+        idat += body
+    pos += 12 + n
+raw, stride, rows, prev = zlib.decompress(idat), 4 * w, [], bytearray(4 * w)
+for y in range(h):
+    f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+    for i in range(stride):
+        a = line[i - 4] if i >= 4 else 0
+        b = prev[i]
+        c = prev[i - 4] if i >= 4 else 0
+        if f == 1: line[i] = (line[i] + a) & 255
+        elif f == 2: line[i] = (line[i] + b) & 255
+        elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
+        elif f == 4:
+            p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+            line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+    rows.append(line); prev = line
+px = lambda x, y: tuple(rows[y][4 * x:4 * x + 4])
+if not eval(sys.argv[2]):
+    sys.exit('assertion failed: %s (w=%d h=%d, centre %s, corner %s)' % (sys.argv[2], w, h, px(w // 2, h // 2), px(0, 0)))
+PY
+check() { python3 "$T/png.py" "$1" "$2" || fail "$1: $2"; }
+
+"$AMGSPLAT" synth octahedron -o "$T/o.ply" -q
+"$AMGSPLAT" decompose "$T/o.ply" -o "$T/o.amg" -q
+"$AMGSPLAT" build "$T/o.amg" -o "$T/o.dps" --primitives 8 -q >/dev/null
+
+# the default method (normalized) from +z: the centre is covered, the corners are not
+"$AMGSPLAT" render "$T/o.dps" -o "$T/n.png" --size 48x48 --view 0,0 --transparent --json >"$T/json"
+check "$T/n.png" "w == 48 and h == 48 and px(24, 24)[3] == 255 and px(0, 0)[3] == 0 and px(47, 47)[3] == 0"
+python3 -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d['renderer'] == 'prim' and d['method'] == 'normalized' and d['points'] == 8 and d['primitives'] == 8, d
+assert d['level'] > 5 and d['tolerance'] == 0, d  # the 8-domain level is among the coarsest
+" "$T/json" || fail "json: $(cat "$T/json")"
+
+# every method draws something where the octahedron is
+for m in normalized prefix overlap two-pass dark-backface dark-backface-soft blend-all no-blend polygons; do
+  "$AMGSPLAT" render "$T/o.dps" -o "$T/$m.png" --size 48x48 --view 30,20 --method "$m" -q
+  check "$T/$m.png" "px(24, 24)[:3] != (255, 255, 255) and px(0, 0) == (255, 255, 255, 255)"
+done
+
+# --outline draws green edges (journal Fig. 12b); --color-by domain changes the colours
+"$AMGSPLAT" render "$T/o.dps" -o "$T/out.png" --size 48x48 --method polygons --outline -q
+check "$T/out.png" "sum(px(x, y)[:3] == (0, 255, 0) for x in range(w) for y in range(h)) > 20"
+check "$T/normalized.png" "sum(px(x, y)[:3] == (0, 255, 0) for x in range(w) for y in range(h)) == 0"
+"$AMGSPLAT" render "$T/o.dps" -o "$T/dom.png" --size 48x48 --view 30,20 --color-by domain -q
+cmp -s "$T/dom.png" "$T/normalized.png" && fail "--color-by domain changed nothing"
+
+# --transparency 0.5 over a transparent background: half the opacity
+"$AMGSPLAT" render "$T/o.dps" -o "$T/half.png" --size 48x48 --view 0,0 --transparent --transparency 0.5 -q
+check "$T/half.png" "126 <= px(24, 24)[3] <= 129"
+
+# a contact sheet, and the same bytes twice
+"$AMGSPLAT" render "$T/o.dps" -o "$T/sheet.png" --size 24x24 --views 4 --method prefix -q
+check "$T/sheet.png" "w == 48 and h == 48"
+"$AMGSPLAT" render "$T/o.dps" -o "$T/sheet2.png" --size 24x24 --views 4 --method prefix -q
+cmp -s "$T/sheet.png" "$T/sheet2.png" || fail "two identical renders differ"
+
+# usage errors (exit 2) and input errors (exit 1)
+expect_fail 2 "unknown rendering method 'bogus'" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --method bogus
+expect_fail 2 "need a .dps input" "$AMGSPLAT" render "$T/o.ply" -o "$T/x.png" --method overlap
+expect_fail 2 "--renderer is for point inputs" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --renderer splat
+expect_fail 2 "--alpha-ref expects" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --alpha-ref 2
+expect_fail 2 "--transparency expects" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --transparency 0
+expect_fail 2 "--color-by on a .dps input expects domain" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --color-by strict
+expect_fail 1 "has no level 'L-3'" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --level L-3
+head -c 2000 "$T/o.dps" >"$T/cut.dps"
+expect_fail 1 "cut.dps" "$AMGSPLAT" render "$T/cut.dps" -o "$T/x.png"
+[[ ! -e "$T/x.png" ]] || fail "a failed render left an output file"
+echo "render_prim: ok"

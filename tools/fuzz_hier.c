@@ -1,0 +1,37 @@
+/*
+ * libFuzzer target for the point-hierarchy file reader (asp_hier_load_memory):
+ * arbitrary bytes must give a clean error or a consistent hierarchy, never a
+ * crash, leak or huge allocation (STYLE.md section 11).
+ *   ./fuzz_hier -max_total_time=300 -rss_limit_mb=2048 corpus
+ * Seed the corpus with a small saved hierarchy (asp_hier_save).
+ */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amgsplat/hier.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    asp_hier *h = NULL;
+    asp_error err = {0};
+    int rc = asp_hier_load_memory(data, size, "fuzz.hier", NULL, &h, &err);
+    if (rc == 0) {
+        if (!h)
+            abort();
+        /* every node's child and point ranges must lie inside the arrays */
+        size_t n = asp_hier_node_count(h), points = asp_hier_point_count(h);
+        const asp_hier_node *nodes = asp_hier_nodes(h);
+        for (size_t i = 0; i < n; i++) {
+            if (nodes[i].child_count && (size_t)nodes[i].first_child + nodes[i].child_count > n)
+                abort();
+            if ((size_t)nodes[i].first_point + nodes[i].point_count > points)
+                abort();
+        }
+        asp_hier_destroy(h);
+        return 0;
+    }
+    if (h || err.msg[0] == '\0')
+        abort();
+    return 0;
+}
