@@ -11,6 +11,7 @@ packages=(
   libglfw3-dev                     # viewer windows
   libassimp-dev                    # mesh formats
   libstb-dev                       # PNG/JPEG read and write
+  zlib1g-dev                       # CRC-32 of the .amg and .dps files
   libflann-dev                     # k-NN baseline for bench/bench_knn.c
   xvfb xauth                       # viewer test under a virtual display
   glmark2-data                     # ships the Stanford bunny (demo model)

@@ -12,6 +12,7 @@
 
 #include "amg/internal.h"
 #include "util/atomic_file.h"
+#include "util/checksum.h"
 #include "util/banned.h"
 
 #define AMG_MAGIC "ASPAMG\r\n"
@@ -35,25 +36,6 @@ static unsigned stored_attrs(const asp_amg *amg)
     return a;
 }
 
-/* CRC-32 (IEEE 802.3, reflected 0xEDB88320); the table lives on the caller's stack, no global state. */
-static void crc_table(uint32_t t[256])
-{
-    for (uint32_t i = 0; i < 256; i++) {
-        uint32_t c = i;
-        for (int k = 0; k < 8; k++)
-            c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-        t[i] = c;
-    }
-}
-
-static uint32_t crc_update(const uint32_t t[256], uint32_t crc, const void *data, size_t len)
-{
-    const uint8_t *p = data;
-    crc = ~crc;
-    for (size_t i = 0; i < len; i++)
-        crc = t[(crc ^ p[i]) & 0xFF] ^ (crc >> 8);
-    return ~crc;
-}
 
 static int host_is_little_endian(void)
 {
@@ -63,7 +45,6 @@ static int host_is_little_endian(void)
 
 typedef struct writer {
     FILE *fp;
-    uint32_t table[256];
     uint32_t crc;
     int failed;
 } writer;
@@ -72,7 +53,7 @@ static void put(writer *w, const void *data, size_t len)
 {
     if (w->failed || len == 0)
         return;
-    w->crc = crc_update(w->table, w->crc, data, len);
+    w->crc = asp__crc32(w->crc, data, len);
     if (fwrite(data, 1, len, w->fp) != len)
         w->failed = 1;
 }
@@ -100,8 +81,7 @@ int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err)
     int rc = asp__atomic_open(&f, path, err);
     if (rc)
         return rc;
-    writer w = {f.fp, {0}, 0, 0};
-    crc_table(w.table);
+    writer w = {f.fp, 0, 0};
     const size_t n = amg->cloud->count;
     /* header: 64 bytes */
     put(&w, AMG_MAGIC, 8);
@@ -255,10 +235,9 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
         return asp_error_set(r->err, ASP_EFORMAT,
                              "cannot read '%s': truncated or padded: the header promises %llu bytes, the file has %zu",
                              r->path, (unsigned long long)(payload + AMG_HEADER + 4), r->size);
-    uint32_t table[256], stored;
-    crc_table(table);
+    uint32_t stored;
     memcpy(&stored, r->buf + r->size - 4, 4);
-    if (crc_update(table, 0, r->buf, r->size - 4) != stored)
+    if (asp__crc32(0, r->buf, r->size - 4) != stored)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': checksum mismatch (file corrupted)", r->path);
     /* sizes come from a checksummed file, but a crafted one must still not make us allocate wildly */
     if (n < 1 || n > payload / 28 || n > (uint64_t)INT32_MAX)

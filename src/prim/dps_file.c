@@ -11,36 +11,17 @@
 
 #include "prim/internal.h"
 #include "util/atomic_file.h"
+#include "util/checksum.h"
 #include "util/banned.h"
 
 #define DPS_MAGIC "ASPDPS\r\n"
 enum { DPS_VERSION = 1, DPS_HEADER = 64, DPS_PARAMS = 128, DPS_LEVEL = 96, DPS_PRIM = 124, DPS_SIDE = 16384 };
 
-/* CRC-32 (IEEE 802.3, reflected 0xEDB88320); the table lives with the caller, no global state. */
-static void crc_table(uint32_t t[256])
-{
-    for (uint32_t i = 0; i < 256; i++) {
-        uint32_t c = i;
-        for (int k = 0; k < 8; k++)
-            c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-        t[i] = c;
-    }
-}
-
-static uint32_t crc_update(const uint32_t t[256], uint32_t crc, const void *data, size_t len)
-{
-    const uint8_t *p = data;
-    crc = ~crc;
-    for (size_t i = 0; i < len; i++)
-        crc = t[(crc ^ p[i]) & 0xFF] ^ (crc >> 8);
-    return ~crc;
-}
 
 /* ---- writing: explicit little-endian bytes, so the format does not depend on the host ---- */
 
 typedef struct writer {
     FILE *fp;
-    uint32_t table[256];
     uint32_t crc;
     int failed;
 } writer;
@@ -49,7 +30,7 @@ static void put(writer *w, const void *data, size_t len)
 {
     if (w->failed || len == 0)
         return;
-    w->crc = crc_update(w->table, w->crc, data, len);
+    w->crc = asp__crc32(w->crc, data, len);
     if (fwrite(data, 1, len, w->fp) != len)
         w->failed = 1;
 }
@@ -128,8 +109,7 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
     int rc = asp__atomic_open(&f, path, err);
     if (rc)
         return rc;
-    writer w = {f.fp, {0}, 0, 0};
-    crc_table(w.table);
+    writer w = {f.fp, 0, 0};
     size_t slen = strnlen(dps->source, sizeof dps->source - 1);
     uint64_t payload = DPS_PARAMS + 4 + slen;
     for (size_t i = 0; i < dps->level_count; i++)
@@ -389,11 +369,9 @@ static int parse(reader *r, const asp_context *ctx, asp_dps *dps, asp_error *err
                  total - DPS_HEADER - 4);
         return bad(r, err, msg);
     }
-    uint32_t table[256];
-    crc_table(table);
     const uint8_t *end = r->p + payload;
     uint32_t stored = (uint32_t)end[0] | (uint32_t)end[1] << 8 | (uint32_t)end[2] << 16 | (uint32_t)end[3] << 24;
-    uint32_t crc = crc_update(table, 0, r->base, total - 4);
+    uint32_t crc = asp__crc32(0, r->base, total - 4);
     if (crc != stored) {
         snprintf(msg, sizeof msg, "checksum mismatch (stored 0x%08x, computed 0x%08x): the file is damaged", stored,
                  crc);

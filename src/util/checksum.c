@@ -1,0 +1,22 @@
+/*
+ * CRC-32 through zlib (see checksum.h); zlib takes uInt lengths, so long
+ * buffers go in chunks.
+ */
+#include <limits.h>
+#include <zlib.h>
+
+#include "util/checksum.h"
+#include "util/banned.h"
+
+uint32_t asp__crc32(uint32_t crc, const void *data, size_t len)
+{
+    const unsigned char *p = data;
+    uLong c = crc;
+    while (len > 0) {
+        uInt chunk = len > (size_t)UINT_MAX ? UINT_MAX : (uInt)len;
+        c = crc32(c, p, chunk);
+        p += chunk;
+        len -= chunk;
+    }
+    return (uint32_t)c;
+}

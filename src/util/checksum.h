@@ -1,0 +1,14 @@
+/*
+ * CRC-32 (IEEE 802.3) for the checksummed binary formats (.amg, .dps), from
+ * zlib rather than a hand-rolled table. Chaining works like zlib's crc32():
+ * start with 0 and pass the previous value back in.
+ */
+#ifndef ASP_UTIL_CHECKSUM_H
+#define ASP_UTIL_CHECKSUM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+uint32_t asp__crc32(uint32_t crc, const void *data, size_t len);
+
+#endif
