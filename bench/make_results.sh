@@ -93,6 +93,7 @@ for m, c in claims:
     w("| %s | %d | %s | %d | %d / %d | %s |" % (m, c["size"], c["level_name"], c["primitives"], c["wins"], c["views"],
       "yes" if ok else "**no**"))
 w("\n%d of %d cases hold.\n" % (len(claims) - fails, len(claims)))
+w(open(os.path.join(os.path.dirname(dest), "..", "bench", "results_remarks.md")).read())
 w("\nRenderer: `%s`. Frame rates on a CPU rasteriser are not the seeds' GeForce4 figures; compare them with"
   " each other, not with the papers.\n" % gl)
 open(dest, "w").write("\n".join(L) + "\n")
