@@ -314,7 +314,11 @@ typedef struct asp_viewer_desc {
     float distance;          /* eye distance in bounding-sphere radii; 0 = the sphere fills the view */
     unsigned amg_color;      /* .amg input: first colour mode, an asp_amg_color_mode (amg.h; 0 = classifier),
                                 or 3 = the points' own colours (refused when they have none) */
-    const char *amg_level;   /* .amg input: first level, "L", "L-2" or an index; NULL = "L" */
+    const char *amg_level;   /* .amg input: first level, "L", "L-2" or an index; NULL = "L";
+                                .dps input: the level drawn, a name or index in the file; NULL = its finest */
+    unsigned prim_method;    /* .dps input: first blending method, an asp_prim_render_method (0 = normalized) */
+    float prim_alpha_ref;    /* .dps input: first alpha reference as asp_prim_render_options.alpha_ref
+                                (0 = 0.1, < 0 = exactly 0, at most 1) */
     uint8_t background[4];   /* sRGB; alpha 0 = default opaque white */
     size_t frames;           /* 0 = interactive until closed; N = scripted: draw N frames, then return */
     const char *screenshot;  /* scripted: PNG written from the last frame's back buffer; may be NULL */
@@ -339,7 +343,7 @@ typedef struct asp_viewer_stats {
 } asp_viewer_stats;
 
 /**
- * Name of renderer kind i of the viewer ("disc", then "splat", "square" ...
+ * Name of renderer kind i of the viewer ("disc", then "splat", "square", "prim" ...
  * in the order the 1..9 keys pick them), or NULL when i is past the end. Every
  * name listed is built in; a kind may still fail to draw a given input, in
  * which case the viewer skips it. Thread safe.
@@ -348,7 +352,7 @@ const char *asp_viewer_renderer_name(size_t i);
 
 /**
  * Checks desc without opening anything: sizes, renderer name, tolerance,
- * view, colour mode, keys (each must be a viewer key), and that screenshot
+ * view, colour mode, .dps method and alpha reference, keys (each must be a viewer key), and that screenshot
  * ends in .png and is given only with frames > 0. Returns 0 or ASP_EINVAL
  * naming the bad value, e.g. "unknown renderer 'x' (expected disc, splat)".
  * Thread safe.
@@ -356,8 +360,10 @@ const char *asp_viewer_renderer_name(size_t i);
 int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err);
 
 /**
- * Opens a window on path (.ply/.xyz/.pts/.txt points, or an .amg
- * decomposition coloured by classifier or domains) and runs the viewer:
+ * Opens a window on path (.ply/.xyz/.pts/.txt points, an .amg decomposition
+ * coloured by classifier or domains, or a .dps level of domain primitives
+ * drawn by the "prim" renderer, its method, alpha reference, outlines and
+ * domain colours on keys, its source points on p) and runs the viewer:
  * orbit with the left mouse button, zoom with the wheel or the right button,
  * pan with the middle button or shift + left; keys switch renderers, the
  * tolerance, lighting, colour mode and level (docs/cli/view.md lists them).

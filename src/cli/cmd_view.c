@@ -13,11 +13,13 @@
 
 static const char usage[] =
     "usage: amgsplat view FILE [--size WxH] [--view AZ,EL[,DIST]] [--renderer NAME] [--tau PX]\n"
-    "                     [--color MODE] [--level L] [--unlit] [--background R,G,B] [--verbose]\n"
+    "                     [--color MODE] [--level L] [--method NAME] [--alpha-ref X] [--unlit]\n"
+    "                     [--background R,G,B] [--verbose]\n"
     "       amgsplat view FILE --frames N [--screenshot OUT.png] [--keys KEYS] [options above]\n"
     "\n"
-    "Opens a window on a point file (.ply, .xyz, .pts, .txt) or an AMG decomposition (.amg,\n"
-    "coloured by classifier or domains). Left drag orbits, the wheel or right drag zooms, middle\n"
+    "Opens a window on a point file (.ply, .xyz, .pts, .txt), an AMG decomposition (.amg,\n"
+    "coloured by classifier or domains) or domain primitives (.dps, one level at a time, blended\n"
+    "by --method as in amgsplat render). Left drag orbits, the wheel or right drag zooms, middle\n"
     "drag or shift + left drag pans; press h in the window for the keys (docs/cli/view.md).\n"
     "With --frames N the viewer draws N frames, pressing KEYS one per frame, saves the last\n"
     "frame to OUT.png and exits (needs a display: run under xvfb-run without one).";
@@ -33,6 +35,8 @@ struct view_opts {
     const char *background;
     const char *screenshot;
     const char *keys;
+    const char *method;
+    double alpha_ref;
     size_t frames;
     double tau;
     int unlit;
@@ -46,7 +50,7 @@ static void log_line(void *user, const char *line)
         fprintf(stderr, "%s\n", line);
 }
 
-static int parse_into(struct cli_env *env, const struct view_opts *o, asp_viewer_desc *d)
+static int parse_into(struct cli_env *env, const char *path, const struct view_opts *o, asp_viewer_desc *d)
 {
     if (o->size && (cli_parse_size2(o->size, &d->width, &d->height) != 0 || d->width == 0 || d->height == 0 ||
                     d->width > 16384 || d->height > 16384))
@@ -84,6 +88,22 @@ static int parse_into(struct cli_env *env, const struct view_opts *o, asp_viewer
             d->background[i] = (uint8_t)c[i];
         }
         d->background[3] = 255;
+    }
+    size_t n = strlen(path);
+    int dps = n >= 4 && strcmp(path + n - 4, ".dps") == 0;
+    if ((o->method || o->alpha_ref != -1) && !dps)
+        return cli_usage_error(env, "--method and --alpha-ref need a .dps input (amgsplat build makes one)");
+    if (o->method) {
+        asp_prim_render_method m;
+        asp_error merr = {0, ""};
+        if (asp_prim_render_method_parse(o->method, &m, &merr))
+            return cli_usage_error(env, "--method: %s", merr.msg);
+        d->prim_method = (unsigned)m;
+    }
+    if (o->alpha_ref != -1) {
+        if (!(o->alpha_ref >= 0 && o->alpha_ref <= 1))
+            return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
+        d->prim_alpha_ref = o->alpha_ref > 0 ? (float)o->alpha_ref : -1.0f; // the library's "exactly 0"
     }
     d->renderer = o->renderer;
     d->amg_level = o->level;
@@ -129,14 +149,16 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
 #else
 int cmd_view(int argc, char **argv, struct cli_env *env)
 {
-    struct view_opts o = {0};
+    struct view_opts o = {.alpha_ref = -1}; // -1: not given
     const struct cli_option opts[] = {
         {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "first view as in 'amgsplat render' (default 30,20)"},
         {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "first renderer (default disc; 'h' in the window lists them)"},
         {"tau", 0, CLI_DOUBLE, &o.tau, "PX", "screen tolerance of the hierarchy renderers in pixels (default 0)"},
         {"color", 0, CLI_STRING, &o.color, "MODE", ".amg: classifier (default), domains, strict or input"},
-        {"level", 0, CLI_STRING, &o.level, "L", ".amg: level for domain colours: L, L-2 or an index (default L)"},
+        {"level", 0, CLI_STRING, &o.level, "L", ".amg: level for domain colours: L, L-2 or an index (default L); .dps: level drawn (default the finest in the file)"},
+        {"method", 0, CLI_STRING, &o.method, "NAME", ".dps: how primitives blend (default normalized; m cycles)"},
+        {"alpha-ref", 0, CLI_DOUBLE, &o.alpha_ref, "X", ".dps: alpha reference, 0..1 (default 0.1; ',' '.' step it)"},
         {"unlit", 0, CLI_FLAG, &o.unlit, NULL, "start with lighting off"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B", "background colour, 0..255 (default 255,255,255)"},
         {"verbose", 'v', CLI_FLAG, &o.verbose, NULL, "print frame time and primitive count once a second"},
@@ -152,7 +174,7 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
     if (npos != 1)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat view -h'", npos);
     asp_viewer_desc desc = {.log = log_line, .log_user = env, .ctx = &env->ctx};
-    if (parse_into(env, &o, &desc))
+    if (parse_into(env, argv[0], &o, &desc))
         return 2;
     asp_error err = {0, ""};
     asp_viewer_stats stats;

@@ -1,8 +1,10 @@
 /*
  * The interactive viewer behind `amgsplat view`: a GLFW window, an orbit
  * camera driven by the mouse, keys that switch renderers (opaque discs,
- * Pajarola et al. 2003 section 5; splats and squares, seed 004 3.2.6), the
- * screen tolerance and the .amg colouring, and a scripted mode for tests.
+ * Pajarola et al. 2003 section 5; splats and squares, seed 004 3.2.6; the
+ * textured domain primitives of a .dps level, journal section 4), the screen
+ * tolerance, the .amg colouring, the .dps blending options, and a scripted
+ * mode for tests.
  */
 #include <math.h>
 #include <stdarg.h>
@@ -27,20 +29,23 @@ typedef struct renderer_kind {
     unsigned inputs; /* asp__viewer_input_bits it draws */
     int has_lod;     /* draws a cut of the point hierarchy: tau matters (asp_renderer_set_lod) */
     int (*create)(viewer *v, asp_renderer **out, asp_error *err);
+    const char *noun; /* what asp_renderer_count counts, for the title */
 } renderer_kind;
 
 static int make_disc(viewer *v, asp_renderer **out, asp_error *err);
 static int make_splat(viewer *v, asp_renderer **out, asp_error *err);
 static int make_square(viewer *v, asp_renderer **out, asp_error *err);
+static int make_prim(viewer *v, asp_renderer **out, asp_error *err);
 
 enum { INPUT_CLOUDS = ASP__VIEWER_INPUT_POINTS | ASP__VIEWER_INPUT_AMG };
 
 static const renderer_kind renderer_kinds[] = {
-    {"disc", INPUT_CLOUDS, 0, make_disc},
-    {"splat", INPUT_CLOUDS, 1, make_splat},
-    {"square", INPUT_CLOUDS, 1, make_square},
+    {"disc", INPUT_CLOUDS, 0, make_disc, "points"},
+    {"splat", INPUT_CLOUDS, 1, make_splat, "splats"},
+    {"square", INPUT_CLOUDS, 1, make_square, "splats"},
+    {"prim", ASP__VIEWER_INPUT_DPS, 0, make_prim, "primitives"},
 };
-enum { N_RENDERER_KINDS = sizeof renderer_kinds / sizeof renderer_kinds[0] };
+enum { N_RENDERER_KINDS = sizeof renderer_kinds / sizeof renderer_kinds[0], KIND_DISC = 0, KIND_PRIM = 3 };
 
 const char *asp_viewer_renderer_name(size_t i)
 {
@@ -87,6 +92,11 @@ int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err)
         return asp_error_set(err, ASP_EINVAL,
                              "view %g,%g,%g is invalid (expected EL in -90..90 and DIST >= 0 radii)", desc->azimuth,
                              desc->elevation, desc->distance);
+    if (!asp_prim_render_method_name((asp_prim_render_method)desc->prim_method))
+        return asp_error_set(err, ASP_EINVAL, "unknown .dps method %u (expected 0..%u)", desc->prim_method,
+                             (unsigned)ASP_PRIM_RENDER_POLYGONS);
+    if (!(desc->prim_alpha_ref <= 1))
+        return asp_error_set(err, ASP_EINVAL, "alpha reference %g is not a number <= 1", desc->prim_alpha_ref);
     int rc = asp__viewer_scene_check_desc(desc, err);
     if (rc)
         return rc;
@@ -124,6 +134,7 @@ struct viewer {
     asp_hier *hier;        /* point hierarchy of scene.cloud, built when a renderer first needs it */
     float tolerance;
     int unlit;
+    asp_prim_render_options prim; /* .dps: options of the prim renderer, kept while the points are shown */
     asp_camera cam;
     int quit;
     int dirty;             /* something changed: draw a frame */
@@ -321,9 +332,28 @@ static int make_square(viewer *v, asp_renderer **out, asp_error *err)
                                            out, err);
 }
 
+static int make_prim(viewer *v, asp_renderer **out, asp_error *err)
+{
+    const asp_dps_level *level = asp__viewer_scene_dps_level(&v->scene);
+    if (!level)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "renderer 'prim' draws .dps input only");
+    return asp_prim_renderer_create(v->gl, level, &(asp_prim_renderer_desc){.options = v->prim}, out, err);
+}
+
+/* A .dps whose source points were loaded (p) can be drawn by the point renderers too. */
 static int kind_accepts(const viewer *v, size_t k)
 {
-    return (renderer_kinds[k].inputs & v->scene.kind->bit) != 0;
+    if (renderer_kinds[k].inputs & v->scene.kind->bit)
+        return 1;
+    return v->scene.cloud && (renderer_kinds[k].inputs & ASP__VIEWER_INPUT_POINTS);
+}
+
+static size_t first_accepted(const viewer *v)
+{
+    for (size_t k = 0; k < N_RENDERER_KINDS; k++)
+        if (kind_accepts(v, k))
+            return k;
+    return 0;
 }
 
 /* Makes renderer kind k for the scene; replaces the current one only on success. */
@@ -426,10 +456,101 @@ static void change_tolerance(viewer *v, int dir)
     }
 }
 
+static int is_dps(const viewer *v)
+{
+    return v->scene.kind->bit == ASP__VIEWER_INPUT_DPS;
+}
+
+/* Applies v->prim to the prim renderer when it is the one drawing; restores old on failure. */
+static void set_prim_options(viewer *v, const asp_prim_render_options *old)
+{
+    asp_error e = {0, ""};
+    if (v->kind == KIND_PRIM && asp_prim_renderer_set_options(v->r, &v->prim, &e)) {
+        vlog(v, "cannot change the .dps options: %s", e.msg);
+        v->prim = *old;
+    }
+}
+
+/* The alpha reference as the renderer resolves it (asp_prim_render_options.alpha_ref). */
+static double alpha_ref_of(const asp_prim_render_options *o)
+{
+    return o->alpha_ref == 0 ? 0.1 : o->alpha_ref < 0 ? 0.0 : o->alpha_ref;
+}
+
+/* m, ',', '.', o and c on a .dps: blending options of journal section 4 / thesis 4.4 */
+static void prim_action(viewer *v, enum asp__viewer_action a)
+{
+    if (!is_dps(v)) {
+        vlog(v, "methods, alpha reference and outlines apply to .dps input only");
+        return;
+    }
+    asp_prim_render_options old = v->prim;
+    switch (a) {
+    case ASP__VIEWER_NEXT_METHOD: {
+        unsigned m = (unsigned)v->prim.method + 1;
+        if (!asp_prim_render_method_name((asp_prim_render_method)m))
+            m = 0;
+        v->prim.method = (asp_prim_render_method)m;
+        vlog(v, "method %s", asp_prim_render_method_name(v->prim.method));
+        break;
+    }
+    case ASP__VIEWER_ALPHA_DOWN:
+    case ASP__VIEWER_ALPHA_UP: {
+        // on the 0.05 grid, so repeated steps land on the same values as --alpha-ref
+        double x = round(alpha_ref_of(&v->prim) / 0.05) + (a == ASP__VIEWER_ALPHA_UP ? 1 : -1);
+        x = x < 0 ? 0 : x > 20 ? 1 : x * 0.05;
+        v->prim.alpha_ref = x > 0 ? (float)x : -1.0f; // -1: exactly 0
+        vlog(v, "alpha reference %.2f", x);
+        break;
+    }
+    case ASP__VIEWER_OUTLINE:
+        v->prim.flags ^= ASP_PRIM_RENDER_OUTLINE;
+        vlog(v, "outlines %s", v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? "on" : "off");
+        break;
+    case ASP__VIEWER_COLOR_MODE:
+        v->prim.flags ^= ASP_PRIM_RENDER_COLOR_BY_DOMAIN;
+        vlog(v, "%s", v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? "a colour per domain" : "texture colours");
+        break;
+    default: return;
+    }
+    if (v->kind != KIND_PRIM)
+        vlog(v, "(the primitives are hidden: p shows them with these options)");
+    set_prim_options(v, &old);
+}
+
+/* p on a .dps: the source points (loaded once, drawn as discs) or the primitives again */
+static void toggle_points(viewer *v)
+{
+    if (!is_dps(v)) {
+        vlog(v, "p applies to .dps input only");
+        return;
+    }
+    size_t to = KIND_PRIM;
+    if (v->kind == KIND_PRIM) {
+        char note[LOG_CAP] = "";
+        asp_error e = {0, ""};
+        int rc = v->scene.kind->action(&v->scene, ASP__VIEWER_POINTS, note, sizeof note, &e);
+        if (rc <= 0) {
+            vlog(v, "%s", rc < 0 ? e.msg : note);
+            return;
+        }
+        to = KIND_DISC;
+    }
+    asp_error e = {0, ""};
+    if (switch_renderer(v, to, &e))
+        vlog(v, "renderer '%s' unavailable: %s", renderer_kinds[to].name, e.msg);
+    else
+        vlog(v, "showing the %s", to == KIND_PRIM ? "primitives" : "source points");
+}
+
 static void scene_action(viewer *v, enum asp__viewer_action a)
 {
+    if (a == ASP__VIEWER_COLOR_MODE && is_dps(v)) {
+        prim_action(v, a);
+        return;
+    }
     if (!v->scene.kind->action) {
-        vlog(v, "colour modes and levels apply to .amg input only");
+        vlog(v, "colour modes and levels apply to .amg and .dps input only");
         return;
     }
     char note[160] = "";
@@ -442,6 +563,13 @@ static void scene_action(viewer *v, enum asp__viewer_action a)
     if (rc == 0) {
         if (note[0])
             vlog(v, "%s", note);
+        return;
+    }
+    if (is_dps(v)) {
+        // a new level: only the prim renderer draws it (the source points stay)
+        if (v->kind == KIND_PRIM && switch_renderer(v, KIND_PRIM, &e))
+            vlog(v, "cannot draw the new level: %s", e.msg);
+        vlog(v, "%s, %zu primitives", v->scene.status, asp__viewer_scene_dps_level(&v->scene)->prim_count);
         return;
     }
     // the points' colours changed: upload them again
@@ -470,6 +598,11 @@ static void apply(viewer *v, const action *a)
     case ASP__VIEWER_COLOR_MODE:
     case ASP__VIEWER_LEVEL_FINER:
     case ASP__VIEWER_LEVEL_COARSER: scene_action(v, a->what); break;
+    case ASP__VIEWER_NEXT_METHOD:
+    case ASP__VIEWER_ALPHA_DOWN:
+    case ASP__VIEWER_ALPHA_UP:
+    case ASP__VIEWER_OUTLINE: prim_action(v, a->what); break;
+    case ASP__VIEWER_POINTS: toggle_points(v); break;
     case ASP__VIEWER_SCREENSHOT: v->screenshot_wanted = 1; break;
     case ASP__VIEWER_HELP: print_help(v); break;
     case ASP__VIEWER_PRINT_VIEW: print_view(v); break;
@@ -557,13 +690,17 @@ static void update_title(viewer *v, double now, int force)
     v->title_stale = 0;
     const char *base = strrchr(v->path, '/');
     base = base ? base + 1 : v->path;
-    char tau[32] = "";
+    char tau[96] = "";
     if (renderer_kinds[v->kind].has_lod)
         snprintf(tau, sizeof tau, " | tau %g px", v->tolerance);
+    else if (v->kind == KIND_PRIM)
+        snprintf(tau, sizeof tau, " | %s, alpha-ref %.2f%s%s", asp_prim_render_method_name(v->prim.method),
+                 alpha_ref_of(&v->prim), v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? ", outline" : "",
+                 v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? ", domain colours" : "");
     char *title = v->stats.title;
     snprintf(title, sizeof v->stats.title, "amgsplat view: %s | %s | %zu %s | %.1f ms (%.0f fps)%s | %s%s%s", base,
              renderer_kinds[v->kind].name, v->r ? asp_renderer_count(v->r) : 0,
-             renderer_kinds[v->kind].has_lod ? "splats" : "points", v->last_ms,
+             renderer_kinds[v->kind].noun, v->last_ms,
              v->last_ms > 0 ? 1000.0 / v->last_ms : 0.0, tau, v->unlit ? "unlit" : "lit",
              v->scene.status[0] ? " | " : "", v->scene.status);
     glfwSetWindowTitle(v->window, title);
@@ -584,7 +721,7 @@ static void account_frame(viewer *v, double ms, double now)
             snprintf(lod, sizeof lod, ", tau %g px, cut %.2f ms", v->tolerance, 1000.0 * rs.select_seconds);
         vlog(v, "%zu frames in %.1f s: %.2f ms per frame drawn, %zu %s (%s%s)", v->window_frames,
              now - v->window_start, v->window_ms / (double)v->window_frames, rs.count,
-             renderer_kinds[v->kind].has_lod ? "splats" : "points", renderer_kinds[v->kind].name, lod);
+             renderer_kinds[v->kind].noun, renderer_kinds[v->kind].name, lod);
         v->window_start = now;
         v->window_frames = 0;
         v->window_ms = 0;
@@ -706,10 +843,12 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, asp_viewer_sta
     v.path = path;
     v.tolerance = desc->tolerance;
     v.unlit = (desc->flags & ASP_VIEWER_UNLIT) != 0;
-    v.kind = desc->renderer ? find_renderer(desc->renderer) : 0;
+    v.prim.method = (asp_prim_render_method)desc->prim_method;
+    v.prim.alpha_ref = desc->prim_alpha_ref;
     rc = asp__viewer_scene_load(&v.scene, path, desc, err);
     if (rc)
         return rc;
+    v.kind = desc->renderer ? find_renderer(desc->renderer) : first_accepted(&v);
     rc = open_window(&v, err);
     if (!rc) {
         uint32_t w = 0, h = 0;

@@ -1,7 +1,7 @@
 /*
  * Private to the viewer files (src/render/viewer*.c): the key table, the
  * camera interaction math (no GL, unit-tested alone), the input kinds (points,
- * .amg; .dps plugs in here) and the scene they load.
+ * .amg, .dps domain primitives) and the scene they load.
  */
 #ifndef ASP_RENDER_VIEWER_INTERNAL_H
 #define ASP_RENDER_VIEWER_INTERNAL_H
@@ -29,7 +29,13 @@ enum asp__viewer_action {
     ASP__VIEWER_ORBIT_UP,
     ASP__VIEWER_ORBIT_DOWN,
     ASP__VIEWER_ZOOM_IN,
-    ASP__VIEWER_ZOOM_OUT
+    ASP__VIEWER_ZOOM_OUT,
+    /* .dps input (journal section 4): renderer options and the source points */
+    ASP__VIEWER_NEXT_METHOD,
+    ASP__VIEWER_ALPHA_DOWN,
+    ASP__VIEWER_ALPHA_UP,
+    ASP__VIEWER_OUTLINE,
+    ASP__VIEWER_POINTS
 };
 
 /* One printable key of the viewer; the table ends with key 0. */
@@ -83,7 +89,8 @@ float asp__viewer_tolerance_step(float tau, int dir);
 /* Input kinds as bits, so a renderer lists the kinds it draws. */
 enum asp__viewer_input_bits {
     ASP__VIEWER_INPUT_POINTS = 1 << 0, /* .ply, .xyz, .pts, .txt */
-    ASP__VIEWER_INPUT_AMG = 1 << 1     /* .amg decomposition, drawn as coloured points */
+    ASP__VIEWER_INPUT_AMG = 1 << 1,    /* .amg decomposition, drawn as coloured points */
+    ASP__VIEWER_INPUT_DPS = 1 << 2     /* .dps domain primitives; cloud is NULL until p loads the source */
 };
 
 struct asp__viewer_input_kind;
@@ -91,8 +98,9 @@ struct asp__viewer_input_kind;
 /* What was loaded, in the form the renderers take. */
 typedef struct asp__viewer_scene {
     const struct asp__viewer_input_kind *kind;
+    const char *path;        /* the input as given (not owned) */
     asp_context ctx;
-    asp_cloud *cloud;        /* points to draw (cloud-local frame); owned */
+    asp_cloud *cloud;        /* points to draw (cloud-local frame); owned; NULL for .dps until p */
     float center[3], radius; /* bounding sphere of what is drawn, cloud-local frame */
     void *data;              /* kind-specific state, owned */
     char status[96];         /* kind-specific title text, e.g. "domains level 3 (L-2), 40 domains" */
@@ -105,13 +113,20 @@ typedef struct asp__viewer_input_kind {
     /* Fills s (zeroed on entry; ctx set). On failure releases what it made. */
     int (*load)(asp__viewer_scene *s, const char *path, const asp_viewer_desc *desc, asp_error *err);
     /*
-     * A kind-specific action (colour mode, level); NULL if none. Returns 1 when
-     * s->cloud changed (renderers must be made again), 0 when nothing changed
-     * (note explains why), or a negative ASP_E* with s unchanged.
+     * A kind-specific action (colour mode, level, source points); NULL if none.
+     * Returns 1 when what is drawn changed (renderers must be made again; for
+     * ASP__VIEWER_POINTS: s->cloud holds the source points), 0 when nothing
+     * changed (note explains why), or a negative ASP_E* with s unchanged.
      */
     int (*action)(asp__viewer_scene *s, enum asp__viewer_action a, char *note, size_t note_cap, asp_error *err);
     void (*release)(asp__viewer_scene *s);
 } asp__viewer_input_kind;
+
+/*
+ * .dps input: the level drawn now (a level of the loaded file, valid until
+ * the next action or release), or NULL for other kinds.
+ */
+const asp_dps_level *asp__viewer_scene_dps_level(const asp__viewer_scene *s);
 
 /* The kind for path by extension (case-insensitive); never NULL (points is the fallback). */
 const asp__viewer_input_kind *asp__viewer_input_for(const char *path);

@@ -2,7 +2,8 @@
  * The viewer's input kinds, one row each in a table: point files and .amg
  * decompositions, the latter coloured by the classifier (journal 2.1, Fig. 1b)
  * or by the domains of one level (journal 2.3 Fig. 5c-d; strict domains,
- * thesis 2.5). A new input (.dps domain primitives) is a new row.
+ * thesis 2.5), and .dps domain primitives (journal section 4), one level at a
+ * time, with their source points loaded on demand.
  */
 #include <ctype.h>
 #include <stdio.h>
@@ -10,6 +11,7 @@
 
 #include "amgsplat/amg.h"
 #include "amgsplat/io.h"
+#include "amgsplat/prim.h"
 #include "render/viewer_internal.h"
 #include "util/banned.h"
 
@@ -174,12 +176,192 @@ static int amg_action(asp__viewer_scene *s, enum asp__viewer_action act, char *n
     return rc ? rc : 1;
 }
 
+
+/* ---- .dps domain primitives ---- */
+
+struct dps_state {
+    asp_dps *dps;
+    size_t level;     /* index into dps->levels (finest first) */
+    int source_tried; /* p already tried to load the source and failed: say so again without retrying */
+};
+
+static void dps_status(asp__viewer_scene *s)
+{
+    const struct dps_state *d = s->data;
+    asp_dps_summary rows[64];
+    const char *name = "?";
+    if (d->dps->level_count <= 64) { // files hold at most the AMG's levels
+        asp_dps_summarize(d->dps, rows);
+        name = rows[d->level].name;
+    }
+    snprintf(s->status, sizeof s->status, "level %u (%s)", d->dps->levels[d->level].level, name);
+}
+
+static void dps_release(asp__viewer_scene *s)
+{
+    struct dps_state *d = s->data;
+    if (d)
+        asp_dps_destroy(d->dps);
+    asp_free(&s->ctx, d);
+    asp_cloud_destroy(s->cloud);
+}
+
+/* --level: "L", "L-2" (names of asp_dps_summarize) or an AMG level index, as amgsplat render takes it. */
+static int dps_pick_level(const asp_dps *dps, const char *path, const char *want, size_t *out, asp_error *err)
+{
+    asp_dps_summary rows[64];
+    if (dps->level_count > 64)
+        return asp_error_set(err, ASP_EFORMAT, "cannot view '%s': %zu levels, expected at most 64", path,
+                             dps->level_count);
+    asp_dps_summarize(dps, rows);
+    char list[160] = "";
+    size_t len = 0;
+    for (size_t i = 0; i < dps->level_count; i++) {
+        char index[16];
+        snprintf(index, sizeof index, "%u", rows[i].level);
+        if (strcmp(want, rows[i].name) == 0 || strcmp(want, index) == 0) {
+            *out = i;
+            return 0;
+        }
+        if (len < sizeof list)
+            len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", rows[i].name);
+    }
+    return asp_error_set(err, ASP_EINVAL, "cannot view '%s': it has no level '%s' (it holds %s)", path, want, list);
+}
+
+static int dps_load(asp__viewer_scene *s, const char *path, const asp_viewer_desc *desc, asp_error *err)
+{
+    struct dps_state *d = asp_calloc(&s->ctx, 1, sizeof *d);
+    if (!d)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for '%s'", path);
+    s->data = d;
+    int rc = asp_dps_load(path, &s->ctx, &d->dps, err);
+    if (!rc && d->dps->level_count == 0)
+        rc = asp_error_set(err, ASP_EDEGENERATE, "cannot view '%s': it holds no level", path);
+    if (!rc && desc->amg_level)
+        rc = dps_pick_level(d->dps, path, desc->amg_level, &d->level, err);
+    if (!rc) {
+        // the world frame (origin 0), as amgsplat render frames a .dps
+        asp_error inner = {0, ""};
+        rc = asp_prim_level_bounding_sphere(&d->dps->levels[d->level], NULL, s->center, &s->radius, &inner);
+        if (rc)
+            asp_error_set(err, rc, "cannot view '%s': %s", path, inner.msg);
+    }
+    if (rc) {
+        dps_release(s);
+        s->data = NULL;
+        return rc;
+    }
+    dps_status(s);
+    return 0;
+}
+
+static int has_extension(const char *path, const char *ext);
+
+/*
+ * The source points of the .dps, into the primitives' frame (origin 0) so the
+ * camera is shared. The name is tried as stored, then next to the .dps file.
+ */
+static int dps_load_source(asp__viewer_scene *s, const char *dps_path, char *note, size_t cap)
+{
+    struct dps_state *d = s->data;
+    const char *src = d->dps->source;
+    if (!src[0] || !(has_extension(src, ".amg") || has_extension(src, ".ply"))) {
+        snprintf(note, cap, "no source points to show: the .dps names %s%s%s (p needs an .amg or .ply)",
+                 src[0] ? "'" : "no source file", src, src[0] ? "'" : "");
+        return 0;
+    }
+    char alt[512] = "";
+    const char *slash = strrchr(dps_path, '/');
+    if (src[0] != '/' && slash)
+        snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - dps_path), dps_path, src);
+    const char *tries[2] = {src, alt};
+    asp_error e = {0, ""};
+    asp_cloud *cloud = NULL;
+    for (int t = 0; t < 2 && !cloud; t++) {
+        const char *name = tries[t];
+        if (!name[0])
+            continue;
+        asp_error inner = {0, ""};
+        int rc;
+        if (has_extension(name, ".amg")) {
+            asp_amg *amg = NULL;
+            rc = asp_amg_load(name, &s->ctx, &amg, &inner);
+            if (!rc)
+                rc = asp_cloud_clone(asp_amg_cloud(amg), &cloud, &inner);
+            asp_amg_destroy(amg);
+        } else {
+            rc = asp_cloud_load(name, &s->ctx, &cloud, &inner);
+        }
+        if (rc && (t == 0 || !e.code))
+            e = inner;
+    }
+    if (!cloud) {
+        snprintf(note, cap, "cannot show the source points: %s", e.msg);
+        return 0;
+    }
+    for (size_t i = 0; i < cloud->count; i++)
+        for (int k = 0; k < 3; k++)
+            cloud->positions[3 * i + k] = (float)(cloud->positions[3 * i + k] + cloud->origin[k]);
+    memset(cloud->origin, 0, sizeof cloud->origin);
+    s->cloud = cloud;
+    return 1;
+}
+
+static int dps_action(asp__viewer_scene *s, enum asp__viewer_action act, char *note, size_t cap, asp_error *err)
+{
+    (void)err;
+    struct dps_state *d = s->data;
+    switch (act) {
+    case ASP__VIEWER_LEVEL_FINER:
+        if (d->level == 0) {
+            snprintf(note, cap, "already at the finest level in the file (%u)", d->dps->levels[0].level);
+            return 0;
+        }
+        d->level--;
+        dps_status(s);
+        return 1;
+    case ASP__VIEWER_LEVEL_COARSER:
+        if (d->level + 1 >= d->dps->level_count) {
+            snprintf(note, cap, "already at the coarsest level in the file (%u)", d->dps->levels[d->level].level);
+            return 0;
+        }
+        d->level++;
+        dps_status(s);
+        return 1;
+    case ASP__VIEWER_POINTS:
+        if (s->cloud)
+            return 1;
+        if (d->source_tried) {
+            snprintf(note, cap, "no source points to show (see above)");
+            return 0;
+        }
+        {
+            int got = dps_load_source(s, s->path, note, cap);
+            d->source_tried = !got;
+            return got;
+        }
+    default:
+        return 0;
+    }
+}
+
+const asp_dps_level *asp__viewer_scene_dps_level(const asp__viewer_scene *s)
+{
+    if (!s->kind || s->kind->bit != ASP__VIEWER_INPUT_DPS)
+        return NULL;
+    const struct dps_state *d = s->data;
+    return &d->dps->levels[d->level];
+}
+
 /* ---- the table ---- */
 
 static const char *const amg_extensions[] = {".amg", NULL};
+static const char *const dps_extensions[] = {".dps", NULL};
 
 static const asp__viewer_input_kind input_kinds[] = {
     {"amg", ASP__VIEWER_INPUT_AMG, amg_extensions, amg_load, amg_action, amg_release},
+    {"dps", ASP__VIEWER_INPUT_DPS, dps_extensions, dps_load, dps_action, dps_release},
     // last: asp_cloud_load knows the point formats and names the expected ones for anything else
     {"points", ASP__VIEWER_INPUT_POINTS, NULL, points_load, NULL, points_release},
 };
@@ -223,6 +405,7 @@ int asp__viewer_scene_load(asp__viewer_scene *s, const char *path, const asp_vie
     if (desc->ctx)
         t.ctx = *desc->ctx;
     t.kind = asp__viewer_input_for(path);
+    t.path = path;
     int rc = t.kind->load(&t, path, desc, err);
     if (rc)
         return rc;

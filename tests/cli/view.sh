@@ -110,7 +110,8 @@ view "$T/sphere.ply" --frames 4 --keys nnn --screenshot "$T/cycle.png" --size 16
 [[ "$(field "$T/cycle.json" renderer)" == disc ]] || fail "n x 3 ends at $(field "$T/cycle.json" renderer)"
 [[ "$(metric "$T/cycle.png" "$T/ref0.png" psnr)" == inf ]] || fail "disc after a cycle differs from render"
 view "$T/sphere.ply" --frames 2 --keys 4+ --size 64x48 2>"$T/r4.err"
-grep -qF "no renderer 4" "$T/r4.err" && grep -qF "applies to the hierarchy renderers" "$T/r4.err" || fail "4, + on disc: $(cat "$T/r4.err")"
+grep -qF "renderer 'prim' unavailable: renderer 'prim' cannot draw points input" "$T/r4.err" &&
+  grep -qF "applies to the hierarchy renderers" "$T/r4.err" || fail "4, + on disc: $(cat "$T/r4.err")"
 
 # l turns lighting off: same silhouette, flat colours (the rim is no darker than the centre's colour)
 view "$T/sphere.ply" --frames 1 --keys l --screenshot "$T/unlit.png" --size 160x120 --view 0,0 -q
@@ -135,7 +136,7 @@ grep -qF "wrote 'sphere-004.png' (64x48)" "$T/i.err" || fail "interactive s: $(c
 
 # h prints every key; v prints the view in the form --view takes
 view "$T/sphere.ply" --frames 2 --keys hv --size 64x48 --view 12,-34,5 2>"$T/h.err" >/dev/null
-for k in q r l n + - c '[' ']' s v h a d w x z o 1; do
+for k in q r l n + - c '[' ']' s v h a d w x z Z 1 4 m , . o p; do
   grep -q "^  [$k]  " "$T/h.err" || fail "help lacks key $k: $(cat "$T/h.err")"
 done
 grep -qF "view: --view 12.0,-34.0,5.000" "$T/h.err" || fail "v key: $(cat "$T/h.err")"
@@ -159,7 +160,93 @@ view "$T/oct.amg" --frames 2 --color domains --keys '[' --screenshot "$T/lm1k.pn
 [[ "$(metric "$T/lm1.png" "$T/lm1k.png" psnr)" == "inf" ]] || fail "[ differs from --level L-1"
 # colour keys on a plain point file are explained, not fatal
 view "$T/sphere.ply" --frames 1 --keys c --size 64x48 2>"$T/c.err"
-grep -qF ".amg input only" "$T/c.err" || fail "c on points: $(cat "$T/c.err")"
+grep -qF ".amg and .dps input only" "$T/c.err" || fail "c on points: $(cat "$T/c.err")"
+view "$T/sphere.ply" --frames 2 --keys mp --size 64x48 2>"$T/mp.err"
+grep -qF "apply to .dps input only" "$T/mp.err" && grep -qF "p applies to .dps input only" "$T/mp.err" ||
+  fail "m, p on points: $(cat "$T/mp.err")"
+
+# .dps input: the octahedron's coarsest level L has its 8 faces as domains (decompose --stats), L-1 9.
+"$AMGSPLAT" synth octahedron -o "$T/o.ply" -q
+mpi_asan="${ASAN_OPTIONS:-}:fast_unwind_on_malloc=0"
+ASAN_OPTIONS="$mpi_asan" "$AMGSPLAT" decompose "$T/o.ply" -o "$T/o.amg" -q
+ASAN_OPTIONS="$mpi_asan" "$AMGSPLAT" build "$T/o.amg" -o "$T/o.dps" --level 'L-1..L' -q >/dev/null
+# the scripted view of level L equals the headless render of the same method and view
+view "$T/o.dps" --frames 3 --screenshot "$T/dps.png" --method prefix --level L --size 160x120 --view 30,20 --json \
+  -q >"$T/dps.json"
+"$AMGSPLAT" render "$T/o.dps" -o "$T/dps_ref.png" --method prefix --level L --samples 0 --size 160x120 --view 30,20 -q
+at_least "$(metric "$T/dps.png" "$T/dps_ref.png" ssim)" 0.9 "view .dps vs render .dps"
+check "$T/dps.png" "0.1 < fg < 0.7"
+python3 - "$T/dps.json" <<'PY' || fail "bad .dps --json: $(cat "$T/dps.json")"
+import json, re, sys
+j = json.load(open(sys.argv[1]))
+assert j['renderer'] == 'prim' and j['count'] == 8, j
+assert re.fullmatch(r'amgsplat view: o\.dps \| prim \| 8 primitives \| [0-9.]+ ms \([0-9]+ fps\) \| prefix, alpha-ref 0\.10 \| lit \| level 10 \(L\)', j['title']), j['title']
+PY
+# default: the finest level in the file (L-1, 9 primitives), method normalized; --alpha-ref shows in the title
+view "$T/o.dps" --frames 1 --alpha-ref 0.3 --size 64x48 --json -q >"$T/dps0.json"
+[[ "$(field "$T/dps0.json" count)" == 9 && "$(field "$T/dps0.json" title)" == *"| normalized, alpha-ref 0.30 | lit | level 9 (L-1)" ]] ||
+  fail "default .dps view: $(cat "$T/dps0.json")"
+# m cycles to the next method: the picture and the title change; ] steps to level L (8 primitives);
+# o draws the outlines (green edges); c colours by domain; , and . step the alpha reference by 0.05
+view "$T/o.dps" --frames 2 --keys m --method prefix --level L --screenshot "$T/dps_m.png" --size 160x120 --view 30,20 \
+  --json 2>"$T/dps_m.err" >"$T/dps_m.json"
+grep -qx "method overlap" "$T/dps_m.err" || fail "m key: $(cat "$T/dps_m.err")"
+[[ "$(field "$T/dps_m.json" title)" == *"| overlap, alpha-ref 0.10 |"* ]] || fail "m title: $(cat "$T/dps_m.json")"
+"$AMGSPLAT" render "$T/o.dps" -o "$T/dps_ov.png" --method overlap --level L --samples 0 --size 160x120 --view 30,20 -q
+at_least "$(metric "$T/dps_m.png" "$T/dps_ov.png" ssim)" 0.9 "m key vs render --method overlap"
+view "$T/o.dps" --frames 2 --keys ']' --method prefix --screenshot "$T/dps_l.png" --size 160x120 --view 30,20 \
+  --json 2>"$T/dps_l.err" >"$T/dps_l.json"
+grep -qF "level 10 (L), 8 primitives" "$T/dps_l.err" && [[ "$(field "$T/dps_l.json" count)" == 8 ]] ||
+  fail "] key: $(cat "$T/dps_l.err" "$T/dps_l.json")"
+# (framed on L-1's bounding sphere, so close to, not equal to the --level L view)
+at_least "$(metric "$T/dps_l.png" "$T/dps.png" ssim)" 0.9 "] vs --level L"
+view "$T/o.dps" --frames 3 --keys '[]' --method prefix --level L --screenshot "$T/dps_l3.png" --size 160x120 \
+  --view 30,20 2>"$T/dps_l3.err"
+grep -qF "level 9 (L-1), 9 primitives" "$T/dps_l3.err" || fail "[ key: $(cat "$T/dps_l3.err")"
+[[ "$(metric "$T/dps_l3.png" "$T/dps.png" psnr)" == inf ]] || fail "[ then ] differs from --level L"
+view "$T/o.dps" --frames 3 --keys ']]' --size 64x48 2>"$T/dps_l2.err"
+grep -qF "already at the coarsest level in the file (10)" "$T/dps_l2.err" || fail "] at L: $(cat "$T/dps_l2.err")"
+view "$T/o.dps" --frames 2 --keys o --method prefix --level L --screenshot "$T/dps_o.png" --size 160x120 --view 30,20 \
+  --json -q >"$T/dps_o.json"
+[[ "$(field "$T/dps_o.json" title)" == *"prefix, alpha-ref 0.10, outline |"* ]] || fail "o title: $(cat "$T/dps_o.json")"
+check "$T/dps_o.png" "sum(1 for x in range(w) for y in range(h) if px(x, y)[1] > 200 and px(x, y)[0] < 80 and px(x, y)[2] < 80) > 50"
+check "$T/dps.png" "sum(1 for x in range(w) for y in range(h) if px(x, y)[1] > 200 and px(x, y)[0] < 80 and px(x, y)[2] < 80) == 0"
+"$AMGSPLAT" render "$T/o.dps" -o "$T/dps_oref.png" --method prefix --level L --outline --samples 0 --size 160x120 --view 30,20 -q
+at_least "$(metric "$T/dps_o.png" "$T/dps_oref.png" ssim)" 0.9 "o key vs render --outline"
+view "$T/o.dps" --frames 2 --keys c --method prefix --level L --screenshot "$T/dps_c.png" --size 160x120 --view 30,20 \
+  --json -q >"$T/dps_c.json"
+[[ "$(field "$T/dps_c.json" title)" == *", domain colours |"* ]] || fail "c title: $(cat "$T/dps_c.json")"
+ssim=$(metric "$T/dps_c.png" "$T/dps.png" ssim)
+awk -v s="$ssim" 'BEGIN { exit !(s < 0.98) }' || fail "c on .dps changed nothing (SSIM $ssim)"
+view "$T/o.dps" --frames 6 --keys ',,,..' --size 64x48 --json 2>"$T/dps_a.err" >"$T/dps_a.json"
+[[ "$(grep -c '^alpha reference' "$T/dps_a.err")" == 5 ]] && grep -qx "alpha reference 0.00" "$T/dps_a.err" ||
+  fail "alpha keys: $(cat "$T/dps_a.err")"
+[[ "$(field "$T/dps_a.json" title)" == *"alpha-ref 0.10 |"* ]] || fail "alpha keys title: $(cat "$T/dps_a.json")"
+# p shows the source points (the .amg the .dps names) with the disc renderer, then the primitives again
+view "$T/o.dps" --frames 2 --keys p --level L --screenshot "$T/dps_p.png" --size 160x120 --view 30,20 \
+  --json 2>"$T/dps_p.err" >"$T/dps_p.json"
+[[ "$(field "$T/dps_p.json" renderer)" == disc && "$(field "$T/dps_p.json" count)" == 16000 ]] ||
+  fail "p key: $(cat "$T/dps_p.json")"
+grep -qx "showing the source points" "$T/dps_p.err" || fail "p key: $(cat "$T/dps_p.err")"
+at_least "$(metric "$T/dps_p.png" "$T/dps.png" iou)" 0.9 "source points vs primitives silhouette"
+view "$T/o.dps" --frames 3 --keys pp --level L --screenshot "$T/dps_pp.png" --method prefix --size 160x120 --view 30,20 \
+  --json -q >"$T/dps_pp.json"
+[[ "$(field "$T/dps_pp.json" renderer)" == prim && "$(metric "$T/dps_pp.png" "$T/dps.png" psnr)" == inf ]] ||
+  fail "pp does not return to the primitives: $(cat "$T/dps_pp.json")"
+# a .dps whose source is gone: p explains and the primitives stay
+mkdir -p "$T/lone" && cp "$T/o.dps" "$T/lone/moved.dps"
+mv "$T/o.amg" "$T/o.amg.away"
+view "$T/lone/moved.dps" --frames 3 --keys pp --size 64x48 --json 2>"$T/lone.err" >"$T/lone.json"
+mv "$T/o.amg.away" "$T/o.amg"
+grep -qF "cannot show the source points: cannot open" "$T/lone.err" && grep -qF "no source points to show" "$T/lone.err" &&
+  [[ "$(field "$T/lone.json" renderer)" == prim ]] || fail "p without a source: $(cat "$T/lone.err" "$T/lone.json")"
+# .dps errors: unknown level or method, .dps options on other input, the prim renderer on points
+expect_fail 1 "has no level 'L-5'" view "$T/o.dps" --frames 1 --level L-5
+expect_fail 2 "--method:" "$AMGSPLAT" view "$T/o.dps" --method blob
+expect_fail 2 "--alpha-ref expects" "$AMGSPLAT" view "$T/o.dps" --alpha-ref 1.5
+expect_fail 2 "need a .dps input" "$AMGSPLAT" view "$T/sphere.ply" --method prefix
+expect_fail 1 "renderer 'prim' cannot draw points input" view "$T/sphere.ply" --frames 1 --renderer prim
+expect_fail 1 "renderer 'disc' cannot draw dps input" view "$T/o.dps" --frames 1 --renderer disc
 
 # Errors: a missing or bad file exits 1 naming it (before any window opens); bad options exit 2.
 expect_fail 1 "cannot open '$T/missing.ply'" view "$T/missing.ply" --frames 1

@@ -141,6 +141,14 @@ static void test_key_table(void)
     CHECK(asp__viewer_key_find('s')->action == ASP__VIEWER_SCREENSHOT);
     CHECK(asp__viewer_key_find(']')->action == ASP__VIEWER_LEVEL_COARSER);
     CHECK(asp__viewer_key_find('2')->action == ASP__VIEWER_PICK_RENDERER && asp__viewer_key_find('2')->arg == 1);
+    // .dps keys; zoom out moved from o to Z when o became the outline toggle
+    CHECK(asp__viewer_key_find('o')->action == ASP__VIEWER_OUTLINE);
+    CHECK(asp__viewer_key_find('Z')->action == ASP__VIEWER_ZOOM_OUT);
+    CHECK(asp__viewer_key_find('m')->action == ASP__VIEWER_NEXT_METHOD);
+    CHECK(asp__viewer_key_find(',')->action == ASP__VIEWER_ALPHA_DOWN);
+    CHECK(asp__viewer_key_find('.')->action == ASP__VIEWER_ALPHA_UP);
+    CHECK(asp__viewer_key_find('p')->action == ASP__VIEWER_POINTS);
+    CHECK(strcmp(asp_viewer_renderer_name(3), "prim") == 0);
     CHECK(asp__viewer_key_find('Q') == NULL && asp__viewer_key_find(0x263A) == NULL);
     CHECK(strcmp(asp_viewer_renderer_name(0), "disc") == 0);
     size_t n = 0;
@@ -172,6 +180,10 @@ static void test_desc_check(void)
     expect_invalid(&(asp_viewer_desc){.set_view = 1, .elevation = 91}, "expected EL in -90..90");
     expect_invalid(&(asp_viewer_desc){.width = 20000, .height = 10}, "20000x10");
     expect_invalid(&(asp_viewer_desc){.amg_color = 4}, "colour mode 4");
+    expect_invalid(&(asp_viewer_desc){.prim_method = 9}, "unknown .dps method 9");
+    expect_invalid(&(asp_viewer_desc){.prim_alpha_ref = 1.5f}, "alpha reference 1.5");
+    expect_invalid(&(asp_viewer_desc){.prim_alpha_ref = NAN}, "alpha reference");
+    CHECK_OK(asp_viewer_desc_check(&(asp_viewer_desc){.prim_method = 8, .prim_alpha_ref = -1}, &err), &err);
 }
 
 TEST_MAIN(TEST_CASE(test_orbit_follows_drag), TEST_CASE(test_pan_keeps_point_under_cursor),
