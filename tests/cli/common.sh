@@ -16,3 +16,6 @@ expect_fail() {
   [[ $st -eq $want ]] || fail "'$*' exited $st, expected $want; stderr: $(cat "$T/err")"
   grep -qF -- "$text" "$T/err" || fail "'$*' stderr lacks '$text': $(cat "$T/err")"
 }
+
+# check FILE EXPR: asserts a Python expression over a PNG's pixels (see png_check.py).
+check() { python3 "$(dirname "${BASH_SOURCE[0]}")/png_check.py" "$1" "$2" || fail "$1: $2"; }

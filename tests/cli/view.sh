@@ -11,36 +11,6 @@ source "$(dirname "$0")/common.sh"
 [[ -n "${DISPLAY:-}" ]] || fail "no xvfb-run and no DISPLAY: install xvfb (scripts/bootstrap.sh) to run the viewer tests"
 view() { "$AMGSPLAT" view "$@"; }
 
-# png.py FILE EXPR: decodes an 8-bit RGBA PNG and evaluates EXPR with w, h, px(x, y) -> (r, g, b, a)
-# and fg = the fraction of pixels that are not the white background.
-cat >"$T/png.py" <<'PY'
-import struct, sys, zlib
-data = open(sys.argv[1], 'rb').read()
-assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
-pos, idat = 8, b''
-while pos < len(data):
-    n, t = struct.unpack('>I4s', data[pos:pos + 8])
-    if t == b'IHDR':
-        w, h, depth, ctype = struct.unpack('>IIBB', data[pos + 8:pos + 18])
-        assert depth == 8 and ctype == 6, 'expected 8-bit RGBA'
-    elif t == b'IDAT':
-        idat += data[pos + 8:pos + 8 + n]
-    pos += 12 + n
-raw, s, rows, prev = zlib.decompress(idat), 4 * w, [], bytearray(4 * w)
-for y in range(h):
-    f, line = raw[y * (s + 1)], bytearray(raw[y * (s + 1) + 1:(y + 1) * (s + 1)])
-    for i in range(s):
-        a, b, c = (line[i - 4] if i >= 4 else 0), prev[i], (prev[i - 4] if i >= 4 else 0)
-        p = a + b - c
-        pred = [0, a, b, (a + b) // 2, a if abs(p - a) <= abs(p - b) and abs(p - a) <= abs(p - c) else b if abs(p - b) <= abs(p - c) else c][f]
-        line[i] = (line[i] + pred) & 255
-    rows.append(line); prev = line
-px = lambda x, y: tuple(rows[y][4 * x:4 * x + 4])
-fg = sum(px(x, y)[:3] != (255, 255, 255) for x in range(w) for y in range(h)) / (w * h)
-if not eval(sys.argv[2]):
-    sys.exit('assertion failed: %s (w=%d h=%d fg=%.4f centre %s)' % (sys.argv[2], w, h, fg, px(w // 2, h // 2)))
-PY
-check() { python3 "$T/png.py" "$1" "$2" || fail "$1: $2"; }
 # metric A B NAME: prints psnr, ssim or iou (of the non-white silhouettes) from imgdiff
 metric() { "$AMGSPLAT" imgdiff "$1" "$2" --background 255,255,255 | awk -v m="$3" '$1 == m { print $2 }'; }
 # field FILE.json NAME: one value of a --json result
