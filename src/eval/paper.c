@@ -26,13 +26,13 @@ void asp_eval_paper_destroy(asp_eval_paper *p)
 
 enum { MAX_SIZES = 8, MAX_FRAMES = 1000 };
 
+#ifdef ASP_HAVE_GL
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);
 }
 
-#ifdef ASP_HAVE_GL
 /*
  * Frames per second of r: median of frames finished frames, the model filling
  * a square view of side size (journal Table 2 measures at 128, 256 and 512).
