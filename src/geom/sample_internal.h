@@ -15,36 +15,6 @@
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846 /* C11 without XSI does not define it */
-
-/*
- * Attributes of the surface point with barycentric weights w[3] in triangle t:
- * position (relative to the mesh origin), unit normal (interpolated vertex
- * normals, Schwarz 2004 3.1.6; the face normal if they cancel), uv (zero
- * without UVs) and RGBA in 0..255 (texture through the uv 3.1.7, else vertex
- * colours, else the material colour). Any output pointer may be NULL.
- */
-void asp__surface_point(const asp_mesh *m, size_t t, const double w[3], double pos[3], double nrm[3], double uv[2],
-                        float rgba[4]);
-
-/* 1 when the mesh has a colour source worth storing (texture with UVs, vertex colours, a file material colour). */
-int asp__mesh_has_color(const asp_mesh *m);
-
-/* Method kernels behind asp_sample_mesh: desc has its defaults resolved; they fill positions..labels and radii. */
-int asp__sample_vertices(const asp_mesh *m, const asp_sample_desc *d, const asp_context *ctx, asp_cloud **out,
-                         asp_sample_stats *st, asp_error *err);
-int asp__sample_area(const asp_mesh *m, const asp_sample_desc *d, const asp_context *ctx, asp_cloud **out,
-                     asp_sample_stats *st, asp_error *err);
-int asp__sample_voxel(const asp_mesh *m, const asp_sample_desc *d, const asp_context *ctx, asp_cloud **out,
-                      asp_sample_stats *st, asp_error *err);
-
-/* Creates the output cloud with the attributes the mesh and desc call for (colours, uvs, labels). */
-int asp__sample_cloud_create(const asp_mesh *m, const asp_sample_desc *d, size_t count, const asp_context *ctx,
-                             asp_cloud **out, asp_error *err);
-
-/* Stores one sample: rounds the colour, normalises the normal. */
-void asp__sample_store(asp_cloud *c, size_t i, const double pos[3], const double nrm[3], const double uv[2],
-                       const float rgba[4], uint32_t label);
-
 #endif
 
 /* splitmix64 finaliser: decorrelates (seed, index) pairs into per-triangle offsets. */
