@@ -36,26 +36,17 @@ static unsigned stored_attrs(const asp_amg *amg)
     return a;
 }
 
-
 static int host_is_little_endian(void)
 {
     const uint16_t one = 1;
     return *(const uint8_t *)&one == 1;
 }
 
-typedef struct writer {
-    FILE *fp;
-    uint32_t crc;
-    int failed;
-} writer;
+typedef asp__crc_writer writer;
 
 static void put(writer *w, const void *data, size_t len)
 {
-    if (w->failed || len == 0)
-        return;
-    w->crc = asp__crc32(w->crc, data, len);
-    if (fwrite(data, 1, len, w->fp) != len)
-        w->failed = 1;
+    asp__crc_put(w, data, len);
 }
 
 static void put_u64(writer *w, uint64_t v) { put(w, &v, 8); }

@@ -17,22 +17,13 @@
 #define DPS_MAGIC "ASPDPS\r\n"
 enum { DPS_VERSION = 1, DPS_HEADER = 64, DPS_PARAMS = 128, DPS_LEVEL = 96, DPS_PRIM = 124, DPS_SIDE = 16384 };
 
-
 /* ---- writing: explicit little-endian bytes, so the format does not depend on the host ---- */
 
-typedef struct writer {
-    FILE *fp;
-    uint32_t crc;
-    int failed;
-} writer;
+typedef asp__crc_writer writer;
 
 static void put(writer *w, const void *data, size_t len)
 {
-    if (w->failed || len == 0)
-        return;
-    w->crc = asp__crc32(w->crc, data, len);
-    if (fwrite(data, 1, len, w->fp) != len)
-        w->failed = 1;
+    asp__crc_put(w, data, len);
 }
 
 static void le32(uint8_t *b, uint32_t v)

@@ -20,3 +20,12 @@ uint32_t asp__crc32(uint32_t crc, const void *data, size_t len)
     }
     return (uint32_t)c;
 }
+
+void asp__crc_put(asp__crc_writer *w, const void *data, size_t len)
+{
+    if (w->failed || len == 0)
+        return;
+    w->crc = asp__crc32(w->crc, data, len);
+    if (fwrite(data, 1, len, w->fp) != len)
+        w->failed = 1;
+}

@@ -8,7 +8,21 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 uint32_t asp__crc32(uint32_t crc, const void *data, size_t len);
+
+/*
+ * A file writer that keeps the running CRC-32 of everything written and
+ * remembers the first write failure, so format writers check once at the end.
+ */
+typedef struct asp__crc_writer {
+    FILE *fp;
+    uint32_t crc;
+    int failed;
+} asp__crc_writer;
+
+/* Appends len bytes (nothing after a failure). */
+void asp__crc_put(asp__crc_writer *w, const void *data, size_t len);
 
 #endif
