@@ -23,7 +23,8 @@ static const char usage[] =
     "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict] [--level L-3] ...\n"
     "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
     "                      dark-backface-soft|blend-all|no-blend|polygons] [--level L] [--alpha-ref X]\n"
-    "                      [--transparency X] [--depth-window X] [--outline] [--color-by domain] ...\n"
+    "                      [--transparency X] [--depth-window X] [--crease-angle DEG|off] [--outline]\n"
+    "                      [--color-by domain] ...\n"
     "\n"
     "Renders a point set (PLY, XYZ) or the points of an AMG decomposition (.amg) headlessly through\n"
     "EGL (a GPU, or Mesa llvmpipe without one) to a PNG. Renderers: disc (opaque discs in the tangent\n"
@@ -61,6 +62,7 @@ struct render_opts {
     double alpha_ref;
     double transparency;
     double depth_window;
+    const char *crease_angle;
     int outline;
     int no_normal_map;
     /* parsed */
@@ -287,11 +289,11 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
 static int parse_prim_options(struct cli_env *env, struct render_opts *o)
 {
     int given = o->method || o->alpha_ref >= 0 || o->transparency >= 0 || o->depth_window >= 0 || o->outline ||
-                o->no_normal_map;
+                o->no_normal_map || o->crease_angle;
     if (!o->dps_input) {
         if (given)
-            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline and "
-                                        "--no-normal-map need a .dps input (amgsplat build makes one)");
+            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --crease-angle, "
+                                        "--outline and --no-normal-map need a .dps input (amgsplat build makes one)");
         return 0;
     }
     asp_prim_render_options *p = &o->prim;
@@ -318,6 +320,16 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
         p->depth_window = o->depth_window > 0 ? (float)o->depth_window : -1.0f; // 0 = no window
     } else if (o->depth_window != -1) {
         return cli_usage_error(env, "--depth-window expects world units >= 0, got %g", o->depth_window);
+    }
+    if (o->crease_angle) {
+        double deg = 0;
+        if (strcmp(o->crease_angle, "off") == 0)
+            p->crease_angle = -1.0f;
+        else if (cli_parse_doubles(o->crease_angle, &deg, 1) == 1 && deg > 0 && deg < 180)
+            p->crease_angle = (float)deg;
+        else
+            return cli_usage_error(env, "--crease-angle expects degrees in (0, 180) or 'off', got '%s'",
+                                   o->crease_angle);
     }
     p->flags = (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
                (o->no_normal_map ? ASP_PRIM_RENDER_NO_NORMAL_MAP : 0u);
@@ -460,6 +472,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"alpha-ref", 0, CLI_DOUBLE, &o.alpha_ref, "X", ".dps: alpha test of the locks and the front layer, 0..1 (default 0.1)"},
         {"transparency", 0, CLI_DOUBLE, &o.transparency, "X", ".dps: global opacity scaling alpha, (0, 1] (default 1)"},
         {"depth-window", 0, CLI_DOUBLE, &o.depth_window, "X", ".dps: depth offset / window in world units (default: half the mean primitive radius)"},
+        {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", ".dps: clip flat primitives meeting at a crease sharper than DEG degrees (default 60; off = as the seeds)"},
         {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},

@@ -10,14 +10,14 @@
 #include "render/internal.h"
 
 /* Storage-buffer bindings of the primitive shaders. */
-enum { ASP__PRIM_BIND_PRIMS = 0, ASP__PRIM_BIND_NEIGHBOURS = 1 };
+enum { ASP__PRIM_BIND_PRIMS = 0, ASP__PRIM_BIND_NEIGHBOURS = 1, ASP__PRIM_BIND_CLIPS = 2 };
 
 /* Texture units of the primitive shaders. */
 enum { ASP__PRIM_UNIT_ATLAS = 0, ASP__PRIM_UNIT_NORMALS = 1, ASP__PRIM_UNIT_FRONT_DEPTH = 2,
        ASP__PRIM_UNIT_FRONT_ID = 3, ASP__PRIM_UNIT_ACCUM = 4 };
 
 /*
- * One primitive as the shaders read it (std430, 96 bytes): centre relative to
+ * One primitive as the shaders read it (std430, 112 bytes): centre relative to
  * the renderer's origin, the half-extent vectors half_u axis_u and half_v
  * axis_v, the unit normal, the atlas rectangle in texture coordinates
  * (u0, v0, du, dv) and (neighbour first, neighbour count, packed sRGB domain
@@ -26,6 +26,7 @@ enum { ASP__PRIM_UNIT_ATLAS = 0, ASP__PRIM_UNIT_NORMALS = 1, ASP__PRIM_UNIT_FRON
 typedef struct asp__prim_gpu {
     float c[4], u[4], v[4], n[4], uv[4];
     uint32_t info[4];
+    uint32_t clip[4]; /* crease records: first, count (asp__prim_creases), 0, 0 */
 } asp__prim_gpu;
 
 /* What a fragment of the main program does (uniform u_pass). */
@@ -50,7 +51,7 @@ extern const char *const asp__prim_resolve_fragment_src;
 
 /* Uniform names shared by the programs; a program lacking one gets location -1 (ignored by GL). */
 enum { PU_VIEW, PU_PROJ, PU_LIGHT, PU_LIT, PU_NORMAL_MAP, PU_DOMAIN_COLORS, PU_PASS, PU_SELECT, PU_ALPHA_REF,
-       PU_TRANSPARENCY, PU_WINDOW, PU_OFFSET, PU_OUTLINE_COLOR, PU_CORNERS, PU_NORMALIZE, PU_COUNT };
+       PU_TRANSPARENCY, PU_WINDOW, PU_OFFSET, PU_OUTLINE_COLOR, PU_CORNERS, PU_NORMALIZE, PU_CREASE_COS, PU_COUNT };
 extern const char *const asp__prim_uniform_names[PU_COUNT];
 
 /* A run of consecutive entries of the frame's draw order, drawn with one state. */
@@ -98,6 +99,8 @@ typedef struct asp__prim_renderer {
     asp__gl_program programs[ASP__PROG_COUNT];
     GLint uniforms[ASP__PROG_COUNT][PU_COUNT];
     asp__gl_buffer prim_buffer, neighbour_buffer, order_buffer, identity_buffer;
+    asp__gl_buffer clip_buffer;  /* crease records (asp__prim_creases) */
+    size_t crease_total;
     asp__gl_vertex_array vao;    /* a_id from order_buffer */
     asp__gl_vertex_array identity_vao; /* a_id = 0 .. count-1 */
     asp__gl_vertex_array empty_vao;    /* the resolve triangle */
@@ -109,6 +112,19 @@ extern const asp__renderer_vtable asp__prim_vtable;
 
 /* Draws one frame with r->opt into the currently bound draw framebuffer. */
 int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err);
+
+/*
+ * Finds the pairs of primitives of lv that cross at a sharp crease (more than
+ * 20 degrees, along a line inside both rectangles where both textures' alpha
+ * exceeds 0.1, consistent sides; prim_creases.c) in the frame centred on origin. Writes per primitive
+ * first[i], count[i] (n entries each) into *entries, 8 floats per record:
+ * the other's support plane (nx, ny, nz, d) oriented so i's kept side is
+ * >= 0, cos of their angle, the other's id, 0, 0; *total records (the array
+ * has at least one, zeroed). Free *entries with asp_free(ctx). Returns 0 or
+ * ASP_ENOMEM.
+ */
+int asp__prim_creases(const asp_dps_level *lv, const double origin[3], const asp_context *ctx, uint32_t *first,
+                      uint32_t *count, float **entries, size_t *total, asp_error *err);
 
 /* Frees the offscreen targets. */
 void asp__prim_targets_release(asp__prim_targets *t);

@@ -5,6 +5,7 @@
  * polygons of journal Fig. 12b, and normalized (Pajarola et al. 2003 5.3-5.4)
  * and prefix (thesis 4.4, Fig. 4.4-4.5) on programmable hardware.
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -191,6 +192,10 @@ static void set_uniforms(asp__prim_renderer *r, const asp__frame *f)
         glProgramUniform1i(id, u[PU_CORNERS], 0);
         glProgramUniform1i(id, u[PU_SELECT], ASP__SELECT_ALL);
         glProgramUniform1f(id, u[PU_TRANSPARENCY], o->transparency);
+        // cos of the crease angle; -2 (below any cosine) turns clipping off
+        glProgramUniform1f(id, u[PU_CREASE_COS],
+                           o->crease_angle > 0 ? (float)cos(o->crease_angle * 3.14159265358979323846 / 180.0)
+                                               : -2.0f);
     }
 }
 
@@ -443,6 +448,7 @@ int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err)
     set_uniforms(r, f);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_PRIMS, r->prim_buffer.id);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_NEIGHBOURS, r->neighbour_buffer.id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_CLIPS, r->clip_buffer.id);
     glBindTextureUnit(ASP__PRIM_UNIT_ATLAS, r->atlas);
     glBindTextureUnit(ASP__PRIM_UNIT_NORMALS, r->normal_atlas ? r->normal_atlas : r->atlas);
     int normalize = r->opt.method == ASP_PRIM_RENDER_NORMALIZED || r->opt.method == ASP_PRIM_RENDER_PREFIX;

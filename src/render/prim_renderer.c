@@ -120,6 +120,8 @@ static int check_options(const asp_prim_render_options *o, asp_error *err)
         return asp_error_set(err, ASP_EINVAL, "transparency %g is outside 0..1 (1 = opaque)", (double)o->transparency);
     if (isnan(o->depth_window) || isinf(o->depth_window))
         return asp_error_set(err, ASP_EINVAL, "depth window %g is not finite", (double)o->depth_window);
+    if (isnan(o->crease_angle))
+        return asp_error_set(err, ASP_EINVAL, "crease angle is not a number (expected degrees, or < 0 for none)");
     return 0;
 }
 
@@ -130,6 +132,8 @@ static void resolve_options(const asp__prim_renderer *r, const asp_prim_render_o
     o->alpha_ref = in->alpha_ref > 0 ? in->alpha_ref : in->alpha_ref < 0 ? 0.0f : 0.1f;
     o->transparency = in->transparency > 0 ? in->transparency : 1.0f;
     o->depth_window = in->depth_window > 0 ? in->depth_window : in->depth_window < 0 ? 0.0f : r->default_window;
+    float angle = in->crease_angle == 0 ? ASP_PRIM_CREASE_ANGLE_DEFAULT : in->crease_angle;
+    o->crease_angle = angle < 0 || angle >= 180 ? -1.0f : angle;
     const uint8_t *c = in->outline_color;
     if (!(c[0] || c[1] || c[2] || c[3])) {
         static const uint8_t green[4] = {0, 255, 0, 255};
@@ -216,8 +220,9 @@ static void prim_destroy(asp_renderer *base)
     asp__prim_targets_release(&r->t);
     for (int i = 0; i < ASP__PROG_COUNT; i++)
         asp__gl_program_destroy(&r->programs[i]);
-    GLuint bufs[4] = {r->prim_buffer.id, r->neighbour_buffer.id, r->order_buffer.id, r->identity_buffer.id};
-    for (int i = 0; i < 4; i++)
+    GLuint bufs[5] = {r->prim_buffer.id, r->neighbour_buffer.id, r->order_buffer.id, r->identity_buffer.id,
+                      r->clip_buffer.id};
+    for (int i = 0; i < 5; i++)
         if (bufs[i])
             glDeleteBuffers(1, &bufs[i]);
     GLuint vaos[3] = {r->vao.id, r->identity_vao.id, r->empty_vao.id};
@@ -351,6 +356,24 @@ static int upload(asp__prim_renderer *r, const asp_dps_level *lv, const double o
     if (!g)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu primitive records", n);
     r->default_window = (float)(0.5 * fill_prims(r, lv, origin, g));
+    // crease planes: per primitive a range of (plane, cos angle, other id) records, 32 bytes each
+    uint32_t *first = r->order, *count = (uint32_t *)r->keys; // scratch, both hold >= n uint32
+    float *creases = NULL;
+    size_t crease_total = 0;
+    int rc = asp__prim_creases(lv, origin, &gl->actx, first, count, &creases, &crease_total, err);
+    if (rc) {
+        asp_free(&gl->actx, g);
+        return rc;
+    }
+    for (size_t i = 0; i < n; i++) {
+        g[i].clip[0] = first[i];
+        g[i].clip[1] = count[i];
+    }
+    r->crease_total = crease_total;
+    glCreateBuffers(1, &r->clip_buffer.id);
+    glNamedBufferStorage(r->clip_buffer.id, (GLsizeiptr)(8 * (crease_total ? crease_total : 1) * sizeof(float)),
+                         creases, 0);
+    asp_free(&gl->actx, creases);
     glCreateBuffers(1, &r->prim_buffer.id);
     glNamedBufferStorage(r->prim_buffer.id, (GLsizeiptr)(n * sizeof *g), g, 0);
     asp_free(&gl->actx, g);

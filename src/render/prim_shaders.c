@@ -8,11 +8,12 @@
 #include "render/prim_internal.h"
 #include "util/banned.h"
 
-/* The primitive and neighbour buffers (prim_internal.h asp__prim_gpu). */
+/* The primitive, neighbour and crease-plane buffers (prim_internal.h asp__prim_gpu, clip_buffer). */
 #define PRIM_GLSL                                                                    \
-    "struct prim { vec4 c; vec4 u; vec4 v; vec4 n; vec4 uv; uvec4 info; };\n"       \
+    "struct prim { vec4 c; vec4 u; vec4 v; vec4 n; vec4 uv; uvec4 info; uvec4 clip; };\n" \
     "layout(std430, binding = 0) readonly buffer Prims { prim prims[]; };\n"        \
-    "layout(std430, binding = 1) readonly buffer Neighbours { uint nbrs[]; };\n"
+    "layout(std430, binding = 1) readonly buffer Neighbours { uint nbrs[]; };\n"    \
+    "layout(std430, binding = 2) readonly buffer Clips { vec4 clips[]; };\n" /* 2 per record */
 
 /*
  * u_corners 0: triangle-strip order, counter-clockwise seen from the normal
@@ -28,6 +29,7 @@ const char *const asp__prim_vertex_src =
     "uniform int u_corners;\n"
     "out vec2 v_uv;\n"
     "out vec3 v_eye;\n"
+    "out vec3 v_local;\n"
     "flat out uint v_id;\n"
     "flat out vec3 v_normal;\n"
     "flat out vec3 v_domain;\n"
@@ -43,6 +45,7 @@ const char *const asp__prim_vertex_src =
     "    v_uv = p.uv.xy + (0.5 * k + 0.5) * p.uv.zw;\n"
     "    vec4 e = u_view * vec4(w, 1.0);\n"
     "    v_eye = e.xyz;\n"
+    "    v_local = w;\n"
     "    v_id = a_id;\n"
     "    v_normal = mat3(u_view) * p.n.xyz;\n"
     "    v_domain = srgb_to_linear(unpackUnorm4x8(p.info.z).rgb);\n"
@@ -60,6 +63,7 @@ const char *const asp__prim_vertex_src =
     "#version 450 core\n" PRIM_GLSL                                                         \
     "in vec2 v_uv;\n"                                                                       \
     "in vec3 v_eye;\n"                                                                      \
+    "in vec3 v_local;\n"                                                                    \
     "flat in uint v_id;\n"                                                                  \
     "flat in vec3 v_normal;\n"                                                              \
     "flat in vec3 v_domain;\n"                                                              \
@@ -67,6 +71,7 @@ const char *const asp__prim_vertex_src =
     "uniform mat4 u_proj;\n"                                                                \
     "uniform float u_alpha_ref;\n"                                                          \
     "uniform float u_offset;\n"                                                             \
+    "uniform float u_crease_cos;\n"                                                         \
     "float window_depth(vec3 e) {\n"                                                        \
     "    vec4 c = u_proj * vec4(e, 1.0);\n"                                                 \
     "    return 0.5 * (c.z / c.w) + 0.5;\n"                                                 \
@@ -74,8 +79,21 @@ const char *const asp__prim_vertex_src =
     "float eye_distance_z(float depth) {\n"                                                 \
     "    return u_proj[3][2] / ((2.0 * depth - 1.0) + u_proj[2][2]);\n"                     \
     "}\n"                                                                                   \
+    /* sharp creases: drop the part of this primitive beyond the support plane of a */  \
+    /* primitive it crosses at more than the crease angle (prim_creases.c) */        \
+    "void crease_clip() {\n"                                                                \
+    "    if (u_crease_cos < -1.0)\n"                                                        \
+    "        return;\n"                                                                     \
+    "    uvec4 range = prims[v_id].clip;\n"                                                \
+    "    for (uint k = range.x; k < range.x + range.y; k++) {\n"                           \
+    "        vec4 pl = clips[2u * k];\n"                                                   \
+    "        if (clips[2u * k + 1u].x < u_crease_cos && dot(pl.xyz, v_local) + pl.w < 0.0)\n" \
+    "            discard;\n"                                                                \
+    "    }\n"                                                                               \
+    "}\n"                                                                                   \
     /* the alpha test of the thesis (4.4.4): lock only where alpha > reference */           \
     "float alpha_tested() {\n"                                                              \
+    "    crease_clip();\n"                                                                  \
     "    float a = texture(u_atlas, v_uv).a;\n"                                             \
     "    if (!(a > u_alpha_ref))\n"                                                         \
     "        discard;\n"                                                                    \
@@ -154,6 +172,7 @@ static const char main_fragment[] =
     "        o_color = u_outline_color;\n"
     "        return;\n"
     "    }\n"
+    "    crease_clip();\n"
     "    vec4 tex = texture(u_atlas, v_uv);\n"
     "    float a = tex.a;\n"
     "    if (u_pass == 1) {\n"
@@ -235,4 +254,5 @@ const char *const asp__prim_resolve_fragment_src =
 
 const char *const asp__prim_uniform_names[PU_COUNT] = {
     "u_view", "u_proj", "u_light", "u_lit", "u_normal_map", "u_domain_colors", "u_pass", "u_select",
-    "u_alpha_ref", "u_transparency", "u_window", "u_offset", "u_outline_color", "u_corners", "u_normalize"};
+    "u_alpha_ref", "u_transparency", "u_window", "u_offset", "u_outline_color", "u_corners", "u_normalize",
+    "u_crease_cos"};
