@@ -507,6 +507,11 @@ static void prim_action(viewer *v, enum asp__viewer_action a)
         v->prim.flags ^= ASP_PRIM_RENDER_OUTLINE;
         vlog(v, "outlines %s", v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? "on" : "off");
         break;
+    case ASP__VIEWER_CREASES:
+        // the zero value is the default angle; -1 turns clipping off (render.h)
+        v->prim.crease_angle = v->prim.crease_angle < 0 ? 0.0f : -1.0f;
+        vlog(v, "crease clipping %s", v->prim.crease_angle < 0 ? "off" : "on");
+        break;
     case ASP__VIEWER_COLOR_MODE:
         v->prim.flags ^= ASP_PRIM_RENDER_COLOR_BY_DOMAIN;
         vlog(v, "%s", v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? "a colour per domain" : "texture colours");
@@ -601,7 +606,8 @@ static void apply(viewer *v, const action *a)
     case ASP__VIEWER_NEXT_METHOD:
     case ASP__VIEWER_ALPHA_DOWN:
     case ASP__VIEWER_ALPHA_UP:
-    case ASP__VIEWER_OUTLINE: prim_action(v, a->what); break;
+    case ASP__VIEWER_OUTLINE:
+    case ASP__VIEWER_CREASES: prim_action(v, a->what); break;
     case ASP__VIEWER_POINTS: toggle_points(v); break;
     case ASP__VIEWER_SCREENSHOT: v->screenshot_wanted = 1; break;
     case ASP__VIEWER_HELP: print_help(v); break;
@@ -694,8 +700,9 @@ static void update_title(viewer *v, double now, int force)
     if (renderer_kinds[v->kind].has_lod)
         snprintf(tau, sizeof tau, " | tau %g px", v->tolerance);
     else if (v->kind == KIND_PRIM)
-        snprintf(tau, sizeof tau, " | %s, alpha-ref %.2f%s%s", asp_prim_render_method_name(v->prim.method),
-                 alpha_ref_of(&v->prim), v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? ", outline" : "",
+        snprintf(tau, sizeof tau, " | %s, alpha-ref %.2f%s%s%s", asp_prim_render_method_name(v->prim.method),
+                 alpha_ref_of(&v->prim), v->prim.crease_angle < 0 ? ", no creases" : "",
+                 v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? ", outline" : "",
                  v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? ", domain colours" : "");
     char *title = v->stats.title;
     snprintf(title, sizeof v->stats.title, "amgsplat view: %s | %s | %zu %s | %.1f ms (%.0f fps)%s | %s%s%s", base,

@@ -35,6 +35,7 @@ enum asp__viewer_action {
     ASP__VIEWER_ALPHA_DOWN,
     ASP__VIEWER_ALPHA_UP,
     ASP__VIEWER_OUTLINE,
+    ASP__VIEWER_CREASES,
     ASP__VIEWER_POINTS
 };
 
