@@ -214,6 +214,45 @@ typedef struct asp_estimate_desc {
  */
 int asp_cloud_estimate(asp_cloud *cloud, const asp_estimate_desc *desc, asp_error *err);
 
+/* ---- sharp creases (src/geom/crease.c) ---- */
+
+/** Crease detection options; the zero value means 60 degrees, k = 16, 2 supporting neighbours. */
+typedef struct asp_crease_desc {
+    float angle_deg;    /* normals further apart than this mark a crease; 0 = 60; else in (0, 90) */
+    size_t k;           /* neighbours examined per point; 0 = 16; clamped to count - 1 */
+    size_t min_support; /* neighbours needed on each side; 0 = 2 */
+    const asp_context *ctx; /* threads and allocator; NULL = defaults */
+} asp_crease_desc;
+
+/**
+ * Clip planes for the splats of points near sharp creases (Pauly et al. 2003,
+ * Zwicker et al. 2004, Botsch et al. 2005: a splat that straddles a crease is
+ * cut along the other surface's plane, so it neither covers the neighbouring
+ * face nor sticks out of a silhouette). Per point, its k nearest neighbours
+ * are split by unoriented normal angle into the point's own side S (within
+ * angle_deg of n_i, the point included) and the others O; O is clustered
+ * into at most two surfaces by normal, and each surface with at least
+ * min_support members gives the plane through its mean position with its mean
+ * normal, oriented so that S's mean position is on the kept side.
+ *
+ * dst: 8 * cloud->count floats, two planes (nx, ny, nz, d) per point in the
+ * cloud's local frame (positions as stored, relative to cloud->origin). A
+ * fragment x of point i's disc or splat is KEPT where n . x + d >= 0 for both
+ * planes; a plane of four zeros means no clip (points away from creases get
+ * two of them, as do thin two-sided sheets: opposite normals count as equal).
+ * *clipped (may be NULL) = the number of points with at least one plane.
+ * Normals need not be unit length; points with a zero normal get no planes.
+ * Returns 0; ASP_EINVAL (NULL cloud or dst, cloud without normals: "crease
+ * clipping needs normals", bad desc values); ASP_EDEGENERATE (fewer than 2
+ * points); ASP_EFORMAT (a non-finite position or normal, naming the point);
+ * ASP_ENOMEM; ASP_ECANCELED (progress callback of desc->ctx, stage "knn").
+ * All points equal gives no planes. On failure dst and *clipped are
+ * unchanged. Parallel over points with asp_context_threads(desc->ctx)
+ * threads; bit-identical for any thread count. Thread-safe.
+ */
+int asp_crease_clip_planes(const asp_cloud *cloud, const asp_crease_desc *desc, float *dst, size_t *clipped,
+                           asp_error *err);
+
 #ifdef __cplusplus
 }
 #endif

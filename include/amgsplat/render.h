@@ -190,6 +190,8 @@ typedef struct asp_renderer asp_renderer;
 typedef struct asp_disc_renderer_desc {
     float radius_scale;        /* multiplies every disc radius; 0 = 1 */
     uint8_t default_color[4];  /* sRGB colour of points when the cloud has none; all 0 = light grey 200,200,200 */
+    const float *clip_planes;  /* 8 floats per point (asp_crease_clip_planes in geom.h), NULL = none;
+                                  only read during create */
 } asp_disc_renderer_desc;
 
 /**
@@ -200,13 +202,19 @@ typedef struct asp_disc_renderer_desc {
  *  - normals: each disc faces the eye;
  *  - radii: one radius for all, asp_render_default_radius(cloud);
  *  - colours: desc->default_color (light grey).
+ * With desc->clip_planes, the disc of point i keeps only the samples x (in
+ * the cloud's local frame) with n . x + d >= 0 for both of its planes
+ * (clip_planes[8 i .. 8 i + 7] = two (nx, ny, nz, d); four zeros = no clip),
+ * so discs end at sharp creases (Botsch et al. 2005 clip lines); the test is
+ * per sample, like the disc test, so multisampled edges stay exact.
  * Positions are used relative to cloud->origin (the renderer works in the
  * cloud's local frame; put the camera there too). cloud is only read during
  * the call. Makes gl current.
  * Returns 0; ASP_EDEGENERATE for an empty cloud or when radii are missing and
- * cannot be estimated (all points equal); ASP_EFORMAT if a position, normal or
- * radius is not finite (names the point); ASP_EUNSUPPORTED for more than
- * 2^31-1 points; ASP_EGL (out of GPU memory, shader failure); ASP_ENOMEM.
+ * cannot be estimated (all points equal); ASP_EFORMAT if a position, normal,
+ * radius or clip plane value is not finite (names the point);
+ * ASP_EUNSUPPORTED for more than 2^31-1 points; ASP_EGL (out of GPU memory,
+ * shader failure); ASP_ENOMEM.
  * *out is unchanged on failure; free the result with asp_renderer_destroy.
  */
 int asp_disc_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_disc_renderer_desc *desc,
@@ -447,6 +455,8 @@ typedef struct asp_splat_renderer_desc {
     uint8_t default_color[4]; /* sRGB colour when the cloud has no colours; all 0 = light grey 200,200,200 */
     asp_hier_desc hier;      /* hierarchy build options for asp_splat_renderer_create */
     const asp_context *ctx;  /* threads and allocator of the hierarchy build; NULL = defaults */
+    const float *clip_planes; /* 8 floats per INPUT point, by input point index (asp_crease_clip_planes in
+                                 geom.h), NULL = none; only read during create */
 } asp_splat_renderer_desc;
 
 /**
@@ -463,7 +473,13 @@ typedef struct asp_splat_renderer_desc {
  * are in the cloud's local frame, as for the disc renderer; cloud is only read
  * during the call. asp_renderer_count gives the splats drawn in the last
  * frame (before the first frame: the number of input points). Makes gl current.
- * Returns 0; ASP_EINVAL (a negative or non-finite option); the errors of
+ * With desc->clip_planes, the splat of input point i keeps only the samples x
+ * (local frame) with n . x + d >= 0 for both planes of clip_planes[8 i ..
+ * 8 i + 7] (four zeros = no clip), in the depth pass and the blend pass (and
+ * in opaque mode), so splats end at sharp creases (Botsch et al. 2005 clip
+ * lines); node splats of coarser cuts (tolerance > 0) are never clipped.
+ * Returns 0; ASP_EINVAL (a negative or non-finite option); ASP_EFORMAT (a
+ * non-finite clip plane value, naming the point); the errors of
  * asp_hier_build (ASP_EDEGENERATE for an empty cloud, ASP_EINVAL for
  * non-finite values); ASP_EUNSUPPORTED (more than 2^31 - 1 splats); ASP_EGL;
  * ASP_ENOMEM. *out is unchanged on failure; free it with asp_renderer_destroy.
@@ -475,7 +491,9 @@ int asp_splat_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const 
  * Like asp_splat_renderer_create on an existing hierarchy, which the renderer
  * keeps a reference to: hier must outlive it (desc->hier and desc->ctx are
  * not used). Colours come from the splats when the hierarchy has them
- * (ASP_HIER_HAS_COLORS), else desc->default_color.
+ * (ASP_HIER_HAS_COLORS), else desc->default_color. desc->clip_planes, if
+ * given, holds 8 * asp_hier_point_count(hier) floats indexed by the input
+ * point index of the hierarchy's source cloud (asp_hier_splat.index).
  */
 int asp_splat_renderer_create_hier(asp_gl_context *gl, const asp_hier *hier, const asp_splat_renderer_desc *desc,
                                    asp_renderer **out, asp_error *err);
@@ -605,7 +623,15 @@ typedef struct asp_prim_render_options {
                             < 0 = none */
     unsigned flags;      /* asp_prim_render_flags */
     uint8_t outline_color[4]; /* sRGB; all 0 = green 0,255,0 (journal Fig. 12b) */
+    float crease_angle;  /* degrees: two quasi-flat primitives (curvature < 0.01) whose domains meet
+                            where their support planes cross, with normals more than this apart, meet
+                            at a sharp crease, and each is clipped by the other's plane (beyond the
+                            seeds, docs/render-methods.md); 0 = ASP_PRIM_CREASE_ANGLE_DEFAULT;
+                            < 0 or >= 180 = never clip, exactly the seeds' methods */
 } asp_prim_render_options;
+
+/** Default crease angle (degrees) of asp_prim_render_options.crease_angle. */
+#define ASP_PRIM_CREASE_ANGLE_DEFAULT 60.0f
 
 /** Options of asp_prim_renderer_create; the zero value means defaults. */
 typedef struct asp_prim_renderer_desc {
@@ -643,7 +669,8 @@ int asp_prim_renderer_set_options(asp_renderer *r, const asp_prim_render_options
 
 /**
  * Fills *out with r's options as resolved (defaults filled in: alpha_ref,
- * transparency, depth_window in world units, outline colour). Returns 0 or
+ * transparency, depth_window in world units, outline colour, crease_angle in
+ * degrees or -1 when clipping is off). Returns 0 or
  * ASP_EUNSUPPORTED if r is not a domain-primitive renderer.
  */
 int asp_prim_renderer_options(const asp_renderer *r, asp_prim_render_options *out, asp_error *err);

@@ -2,9 +2,10 @@
  * Opaque oriented discs (journal section 1; Pajarola et al. 2003 section 5.1:
  * each surfel is a triangle in its tangent plane, shaped per fragment; here
  * the equilateral triangle around the disc of radius r, with fragments outside
- * the disc discarded, as the alpha test of their section 5.3 first pass). One
- * instanced draw, one vertex buffer binding per cloud attribute (STYLE.md
- * section 6), GL 4.5 DSA.
+ * the disc discarded, as the alpha test of their section 5.3 first pass),
+ * optionally cut by two clip planes per disc at sharp creases (Botsch et al.
+ * 2005 section 4.2, Zwicker et al. 2004 section 5). One instanced draw, one
+ * vertex buffer binding per cloud attribute (STYLE.md section 6), GL 4.5 DSA.
  */
 #include <math.h>
 #include <stdio.h>
@@ -24,6 +25,8 @@ static const char *vertex_src =
     "layout(location = 1) in vec3 a_normal;\n"
     "layout(location = 2) in vec4 a_color;\n"
     "layout(location = 3) in float a_radius;\n"
+    "layout(location = 4) in vec4 a_clip0;\n"
+    "layout(location = 5) in vec4 a_clip1;\n"
     "uniform mat4 u_view;\n"
     "uniform mat4 u_proj;\n"
     "uniform vec3 u_eye;\n"
@@ -33,12 +36,19 @@ static const char *vertex_src =
     "uniform vec4 u_default_color;\n"
     "uniform float u_default_radius;\n"
     "uniform float u_radius_scale;\n"
+    "uniform int u_has_clip;\n"
     "out vec2 v_local;\n"
     "flat out vec3 v_normal;\n"
     "flat out vec3 v_color;\n"
+    "flat out vec3 v_clip0;\n"
+    "flat out vec3 v_clip1;\n"
     "const vec2 corners[3] = vec2[3](vec2(-1.7320508, -1.0), vec2(1.7320508, -1.0), vec2(0.0, 2.0));\n"
     "vec3 srgb_to_linear(vec3 c) {\n"
     "    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));\n"
+    "}\n"
+    // plane (n, d) on the disc p(q) = c + r (q.x t + q.y b) as the line n.p(q) + d = dot(line, vec3(q, 1))
+    "vec3 clip_line(vec4 pl, vec3 c, vec3 t, vec3 b, float r) {\n"
+    "    return vec3(r * dot(pl.xyz, t), r * dot(pl.xyz, b), dot(pl.xyz, c) + pl.w);\n"
     "}\n"
     "void main() {\n"
     "    vec2 corner = corners[gl_VertexID];\n"
@@ -50,6 +60,8 @@ static const char *vertex_src =
     "    float r = (u_has_radii != 0 ? a_radius : u_default_radius) * u_radius_scale;\n"
     "    vec3 p = a_position + r * (corner.x * t + corner.y * b);\n"
     "    v_local = corner;\n"
+    "    v_clip0 = u_has_clip != 0 ? clip_line(a_clip0, a_position, t, b, r) : vec3(0.0, 0.0, 1.0);\n"
+    "    v_clip1 = u_has_clip != 0 ? clip_line(a_clip1, a_position, t, b, r) : vec3(0.0, 0.0, 1.0);\n"
     "    v_normal = mat3(u_view) * n;\n"
     "    v_color = srgb_to_linear(u_has_colors != 0 ? a_color.rgb : u_default_color.rgb);\n"
     "    gl_Position = u_proj * (u_view * vec4(p, 1.0));\n"
@@ -61,24 +73,33 @@ static const char *vertex_src =
  * discard samples the disc covers and let the background through. So the disc
  * test is made at each sample position (interpolateAtSample) and becomes the
  * sample mask; exact coverage at the cost of a loop, not per-sample shading.
+ * The clip planes are tested at the same positions: each plane, restricted to
+ * the disc's plane, is a line in the disc coordinates v_local (the local-frame
+ * position is affine in them), so the test is one dot product per plane.
  */
 static const char *fragment_src =
     "#version 450 core\n"
     "in vec2 v_local;\n"
     "flat in vec3 v_normal;\n"
     "flat in vec3 v_color;\n"
+    "flat in vec3 v_clip0;\n"
+    "flat in vec3 v_clip1;\n"
     "uniform vec3 u_light;\n"
     "uniform int u_unlit;\n"
     "layout(location = 0) out vec4 o_color;\n"
+    "bool inside(vec2 q) {\n"
+    "    vec3 h = vec3(q, 1.0);\n"
+    "    return dot(q, q) <= 1.0 && dot(v_clip0, h) >= 0.0 && dot(v_clip1, h) >= 0.0;\n"
+    "}\n"
     "void main() {\n"
     "    int mask = 0;\n"
     "    if (gl_NumSamples > 1) {\n"
     "        for (int i = 0; i < gl_NumSamples; i++) {\n"
     "            vec2 q = interpolateAtSample(v_local, i);\n"
-    "            if (dot(q, q) <= 1.0)\n"
+    "            if (inside(q))\n"
     "                mask |= 1 << i;\n"
     "        }\n"
-    "    } else if (dot(v_local, v_local) <= 1.0) {\n"
+    "    } else if (inside(v_local)) {\n"
     "        mask = -1;\n"
     "    }\n"
     "    if (mask == 0)\n"
@@ -90,13 +111,16 @@ static const char *fragment_src =
     "}\n";
 
 enum { U_VIEW, U_PROJ, U_EYE, U_HAS_NORMALS, U_HAS_COLORS, U_HAS_RADII, U_DEFAULT_COLOR, U_DEFAULT_RADIUS,
-       U_RADIUS_SCALE, U_LIGHT, U_UNLIT, U_COUNT };
+       U_RADIUS_SCALE, U_LIGHT, U_UNLIT, U_HAS_CLIP, U_COUNT };
 static const char *uniform_names[U_COUNT] = {"u_view", "u_proj", "u_eye", "u_has_normals", "u_has_colors",
                                              "u_has_radii", "u_default_color", "u_default_radius",
-                                             "u_radius_scale", "u_light", "u_unlit"};
+                                             "u_radius_scale", "u_light", "u_unlit", "u_has_clip"};
 
-/* Attribute locations equal buffer binding indices. */
-enum { A_POSITION, A_NORMAL, A_COLOR, A_RADIUS, A_COUNT };
+/*
+ * Attribute locations equal buffer binding indices, except the clip planes:
+ * one buffer at binding A_CLIP feeds locations A_CLIP (plane 0) and A_CLIP + 1.
+ */
+enum { A_POSITION, A_NORMAL, A_COLOR, A_RADIUS, A_CLIP, A_COUNT };
 
 typedef struct disc_renderer {
     asp_renderer base; // first, so an asp_renderer * is a disc_renderer *
@@ -158,6 +182,22 @@ static void upload(disc_renderer *d, int attr, const void *data, size_t bytes, G
     d->has[attr] = 1;
 }
 
+/* The clip planes: 32 bytes per point, two vec4 attributes at offsets 0 and 16 of one binding. */
+static void upload_clip(disc_renderer *d, const float *planes, size_t n)
+{
+    GLuint vao = d->vao.id;
+    glCreateBuffers(1, &d->buffers[A_CLIP].id);
+    glNamedBufferStorage(d->buffers[A_CLIP].id, (GLsizeiptr)(8 * n * sizeof(float)), planes, 0);
+    glVertexArrayVertexBuffer(vao, A_CLIP, d->buffers[A_CLIP].id, 0, 8 * sizeof(float));
+    glVertexArrayBindingDivisor(vao, A_CLIP, 1);
+    for (GLuint k = 0; k < 2; k++) {
+        glVertexArrayAttribFormat(vao, A_CLIP + k, 4, GL_FLOAT, GL_FALSE, k * 4 * sizeof(float));
+        glVertexArrayAttribBinding(vao, A_CLIP + k, A_CLIP);
+        glEnableVertexArrayAttrib(vao, A_CLIP + k);
+    }
+    d->has[A_CLIP] = 1;
+}
+
 static void set_static_uniforms(disc_renderer *d)
 {
     GLuint p = d->program.id;
@@ -165,6 +205,7 @@ static void set_static_uniforms(disc_renderer *d)
     glProgramUniform1i(p, u[U_HAS_NORMALS], d->has[A_NORMAL]);
     glProgramUniform1i(p, u[U_HAS_COLORS], d->has[A_COLOR]);
     glProgramUniform1i(p, u[U_HAS_RADII], d->has[A_RADIUS]);
+    glProgramUniform1i(p, u[U_HAS_CLIP], d->has[A_CLIP]);
     glProgramUniform4fv(p, u[U_DEFAULT_COLOR], 1, d->default_color);
     glProgramUniform1f(p, u[U_DEFAULT_RADIUS], d->default_radius);
     glProgramUniform1f(p, u[U_RADIUS_SCALE], d->radius_scale);
@@ -181,6 +222,11 @@ static int check_input(const asp_cloud *cloud, const asp_disc_renderer_desc *des
     if (!(desc->radius_scale >= 0) || !isfinite(desc->radius_scale))
         return asp_error_set(err, ASP_EINVAL, "disc radius scale %g is not a finite non-negative number",
                              (double)desc->radius_scale);
+    if (desc->clip_planes)
+        for (size_t i = 0; i < 8 * cloud->count; i++)
+            if (!isfinite(desc->clip_planes[i]))
+                return asp_error_set(err, ASP_EFORMAT, "point %zu: clip plane %zu value %zu is not finite", i / 8,
+                                     i % 8 / 4, i % 4);
     return asp_cloud_validate(cloud, err);
 }
 
@@ -229,6 +275,8 @@ int asp_disc_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const a
         upload(d, A_COLOR, cloud->colors, 4 * n, 4, GL_UNSIGNED_BYTE, GL_TRUE, 4);
     if (cloud->radii)
         upload(d, A_RADIUS, cloud->radii, n * sizeof(float), 1, GL_FLOAT, GL_FALSE, sizeof(float));
+    if (desc->clip_planes)
+        upload_clip(d, desc->clip_planes, n);
     set_static_uniforms(d);
     // out of GPU memory shows up here as GL_OUT_OF_MEMORY from glNamedBufferStorage
     char what[80];

@@ -10,7 +10,8 @@
 #include "render/internal.h"
 
 /* Shader storage bindings shared by the hierarchy renderers' vertex shaders. */
-enum { ASP__LOD_BIND_SPLATS = 0, ASP__LOD_BIND_IDS = 1, ASP__LOD_BIND_CONES = 2 };
+enum { ASP__LOD_BIND_SPLATS = 0, ASP__LOD_BIND_IDS = 1, ASP__LOD_BIND_CONES = 2,
+       ASP__LOD_BIND_CLIPS = 3 /* splat renderer only: 2 clip planes per point splat */ };
 
 /*
  * GLSL declarations of the buffers, and a function reading splat `id` into

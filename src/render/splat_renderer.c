@@ -4,6 +4,8 @@
  * ellipse, visibility splatting with an epsilon-z-buffer (5.3, Fig. 15),
  * additive blending of (psi * colour, psi) (eq. 10), per-pixel normalisation
  * (5.4, eq. 9) and Gouraud lighting with normal-cone offsets (5.2, Fig. 14).
+ * Point splats may be cut by two clip planes at sharp creases (Botsch et al.
+ * 2005 section 4.2, Zwicker et al. 2004 section 5).
  */
 #include <math.h>
 #include <stdio.h>
@@ -34,14 +36,29 @@ static const char *vertex_src =
     "uniform vec4 u_default_color;\n"
     "uniform int u_lighting;\n"
     "uniform int u_unoriented;\n"
+    "uniform int u_has_clip;\n"
+    "layout(std430, binding = 3) readonly buffer Clips { vec4 clips[]; };\n"
     "out vec2 v_local;\n"
     "out vec3 v_color;\n"
     "out vec3 v_normal;\n"
+    "flat out vec3 v_clip0;\n"
+    "flat out vec3 v_clip1;\n"
     "const vec2 corners[3] = vec2[3](vec2(-1.7320508, -1.0), vec2(1.7320508, -1.0), vec2(0.0, 2.0));\n"
+    // plane (n, d) on the ellipse p(q) = c + q.x a u + q.y b v as the line n.p(q) + d = dot(line, vec3(q, 1))
+    "vec3 clip_line(vec4 pl, splat s, float a, float b) {\n"
+    "    return vec3(a * dot(pl.xyz, s.u), b * dot(pl.xyz, s.v), dot(pl.xyz, s.c) + pl.w);\n"
+    "}\n"
     "void main() {\n"
     "    uint id = ids[gl_InstanceID];\n"
     "    splat s = read_splat(id);\n"
     "    float a = s.a * u_radius_scale, b = s.b * u_radius_scale;\n"
+    "    v_clip0 = vec3(0.0, 0.0, 1.0);\n"
+    "    v_clip1 = vec3(0.0, 0.0, 1.0);\n"
+    "    if (u_has_clip != 0 && id >= u_node_count) {\n"
+    "        uint k = 2u * (id - u_node_count);\n"
+    "        v_clip0 = clip_line(clips[k], s, a, b);\n"
+    "        v_clip1 = clip_line(clips[k + 1u], s, a, b);\n"
+    "    }\n"
     "    vec2 q = corners[gl_VertexID] * (1.05 * u_support);\n"
     "    vec3 off = q.x * a * s.u + q.y * b * s.v;\n"
     "    vec3 p = s.c + off;\n"
@@ -67,22 +84,29 @@ static const char *vertex_src =
 /*
  * The support test per sample when multisampling (as the disc renderer: the
  * shader runs at the pixel centre, which may lie outside a small splat), so
- * both passes cover exactly the same samples.
+ * both passes cover exactly the same samples. The clip planes are lines in
+ * the ellipse coordinates v_local (the position is affine in them), tested at
+ * the same positions, so both passes also clip the same samples.
  */
-#define COVERAGE_GLSL                                                   \
-    "int coverage() {\n"                                                \
-    "    float s2 = u_support * u_support;\n"                           \
-    "    int mask = 0;\n"                                               \
-    "    if (gl_NumSamples > 1) {\n"                                    \
-    "        for (int i = 0; i < gl_NumSamples; i++) {\n"               \
-    "            vec2 q = interpolateAtSample(v_local, i);\n"           \
-    "            if (dot(q, q) <= s2)\n"                                \
-    "                mask |= 1 << i;\n"                                 \
-    "        }\n"                                                       \
-    "    } else if (dot(v_local, v_local) <= s2) {\n"                   \
-    "        mask = -1;\n"                                              \
-    "    }\n"                                                           \
-    "    return mask;\n"                                                \
+#define COVERAGE_GLSL                                                                            \
+    "flat in vec3 v_clip0;\n"                                                                    \
+    "flat in vec3 v_clip1;\n"                                                                    \
+    "bool inside(vec2 q, float s2) {\n"                                                          \
+    "    vec3 h = vec3(q, 1.0);\n"                                                               \
+    "    return dot(q, q) <= s2 && dot(v_clip0, h) >= 0.0 && dot(v_clip1, h) >= 0.0;\n"          \
+    "}\n"                                                                                        \
+    "int coverage() {\n"                                                                         \
+    "    float s2 = u_support * u_support;\n"                                                    \
+    "    int mask = 0;\n"                                                                        \
+    "    if (gl_NumSamples > 1) {\n"                                                             \
+    "        for (int i = 0; i < gl_NumSamples; i++) {\n"                                        \
+    "            if (inside(interpolateAtSample(v_local, i), s2))\n"                             \
+    "                mask |= 1 << i;\n"                                                          \
+    "        }\n"                                                                                \
+    "    } else if (inside(v_local, s2)) {\n"                                                    \
+    "        mask = -1;\n"                                                                       \
+    "    }\n"                                                                                    \
+    "    return mask;\n"                                                                         \
     "}\n"
 
 /* Pass 1 (section 5.3): depth only, the alpha test shaping the ellipse. */
@@ -175,11 +199,11 @@ static const char *resolve_fragment_src[2] = {
     "layout(binding = 2) uniform sampler2DMS u_depth;\n" RESOLVE_GLSL};
 
 enum { U_VIEW, U_PROJ, U_EYE, U_LIGHT, U_EPSILON, U_SUPPORT, U_RADIUS_SCALE, U_NODE_COUNT, U_HAS_COLORS,
-       U_DEFAULT_COLOR, U_LIGHTING, U_KA, U_KB, U_KN, U_OPAQUE, U_UNORIENTED, U_COUNT };
+       U_DEFAULT_COLOR, U_LIGHTING, U_KA, U_KB, U_KN, U_OPAQUE, U_UNORIENTED, U_HAS_CLIP, U_COUNT };
 static const char *uniform_names[U_COUNT] = {"u_view", "u_proj", "u_eye", "u_light", "u_epsilon", "u_support",
                                              "u_radius_scale", "u_node_count", "u_has_colors", "u_default_color",
                                              "u_lighting", "u_ka", "u_kb", "u_kn", "u_opaque",
-                                             "u_unoriented"};
+                                             "u_unoriented", "u_has_clip"};
 enum { PROG_DEPTH, PROG_BLEND, PROG_COUNT };
 
 /* The float accumulation target of passes 1 and 2, kept while size and samples stay. */
@@ -198,6 +222,8 @@ typedef struct splat_renderer {
     asp__gl_program resolve[2]; // single-sample, multisample; built when first needed
     GLint resolve_light[2], resolve_pixel_light[2];
     asp__gl_vertex_array vao; // no attributes: everything comes from storage buffers
+    asp__gl_buffer clips;     // 2 planes per point splat in hierarchy order; one zero plane pair without clipping
+    int has_clip;
     accum_target acc;
     float ka, kb, kn, epsilon, support, radius_scale;
     asp_splat_lighting lighting;
@@ -279,6 +305,8 @@ static void splat_destroy(asp_renderer *base)
         asp__gl_program_destroy(&s->resolve[i]);
     if (s->vao.id)
         glDeleteVertexArrays(1, &s->vao.id);
+    if (s->clips.id)
+        glDeleteBuffers(1, &s->clips.id);
     asp_context actx = base->gl->actx;
     asp__lod_release(&actx, &s->lod);
     asp_free(&actx, s);
@@ -422,6 +450,7 @@ static int splat_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
         return rc;
     if (s->lod.count == 0)
         return 0; // everything culled: the background stays
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_CLIPS, s->clips.id);
     if (s->mode == ASP_SPLAT_OPAQUE) {
         set_frame_uniforms(s, PROG_BLEND, f, 0.0f, 1);
         draw_splats(s, PROG_BLEND);
@@ -450,6 +479,7 @@ static void set_static_uniforms(splat_renderer *s)
         glProgramUniform1f(p, u[U_KB], s->kb);
         glProgramUniform1f(p, u[U_KN], s->kn);
         glProgramUniform1i(p, u[U_UNORIENTED], (asp_hier_flags(s->lod.hier) & ASP_HIER_UNORIENTED) != 0);
+        glProgramUniform1i(p, u[U_HAS_CLIP], s->has_clip);
     }
 }
 
@@ -474,6 +504,42 @@ static int check_desc(const asp_splat_renderer_desc *d, asp_error *err)
     return 0;
 }
 
+static int check_clip_planes(const float *planes, size_t points, asp_error *err)
+{
+    for (size_t i = 0; planes && i < 8 * points; i++)
+        if (!isfinite(planes[i]))
+            return asp_error_set(err, ASP_EFORMAT, "point %zu: clip plane %zu value %zu is not finite", i / 8,
+                                 i % 8 / 4, i % 4);
+    return 0;
+}
+
+/*
+ * The clip planes in hierarchy order (point splat node_count + j reads pair
+ * j), from planes indexed by input point; without planes one zero pair, so
+ * the storage binding is never empty. gl must be current.
+ */
+static int upload_clips(splat_renderer *s, const float *planes, asp_error *err)
+{
+    asp_gl_context *gl = s->base.gl;
+    size_t n = planes ? s->lod.points : 1;
+    float *buf = asp_calloc(&gl->actx, n, 8 * sizeof(float));
+    if (!buf)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for the clip planes of %zu splats", n);
+    if (planes) {
+        const asp_hier_splat *sp = asp_hier_splats(s->lod.hier) + s->lod.nodes;
+        for (size_t j = 0; j < n; j++)
+            // a loaded hierarchy's index is checked on load; stay safe anyway: no clip for a stray index
+            if (sp[j].index < n)
+                memcpy(buf + 8 * j, planes + 8 * (size_t)sp[j].index, 8 * sizeof(float));
+    }
+    asp__gl_clear_errors(gl);
+    glCreateBuffers(1, &s->clips.id);
+    glNamedBufferStorage(s->clips.id, (GLsizeiptr)(n * 8 * sizeof(float)), buf, 0);
+    asp_free(&gl->actx, buf);
+    s->has_clip = planes != NULL;
+    return asp__gl_check(gl, "upload the splat clip planes", err);
+}
+
 static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hier, const asp_splat_renderer_desc *desc,
                   asp_renderer **out, asp_error *err)
 {
@@ -481,6 +547,8 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     if (!desc)
         desc = &zero_desc;
     int rc = check_desc(desc, err);
+    if (!rc && desc->clip_planes)
+        rc = check_clip_planes(desc->clip_planes, cloud ? cloud->count : asp_hier_point_count(hier), err);
     if (rc)
         return rc;
     rc = asp__gl_ensure_current(gl, err);
@@ -514,6 +582,8 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
                                     err);
     if (!rc)
         rc = asp__lod_upload(gl, &s->lod, "splat", err);
+    if (!rc)
+        rc = upload_clips(s, desc->clip_planes, err);
     if (rc) {
         splat_destroy(&s->base);
         return rc;
