@@ -19,6 +19,7 @@
 
 #include "amgsplat/amg.h"
 #include "amgsplat/eval.h"
+#include "amgsplat/geom.h"
 #include "amgsplat/prim.h"
 #include "amgsplat/render.h"
 #include "amgsplat/sample.h"
@@ -133,15 +134,38 @@ static void build_primitives(void)
     CHECK_MSG(dps_built, "building the octahedron's primitives failed (status %d)", status);
 }
 
+/* Opaque discs of cloud, clipped at its creases (asp_crease_clip_planes, 60 degrees) when clip. */
+static asp_renderer *disc_renderer(const asp_cloud *cloud, int clip)
+{
+    asp_error err = {0, ""};
+    float *planes = NULL;
+    if (clip) {
+        planes = malloc(8 * cloud->count * sizeof *planes);
+        CHECK(planes != NULL);
+        if (!planes)
+            return NULL;
+        size_t clipped = 0;
+        CHECK_OK(asp_crease_clip_planes(cloud, NULL, planes, &clipped, &err), ep(&err));
+        CHECK(clipped > cloud->count / 10); // the points within a disc radius of an edge (about 18%)
+    }
+    asp_renderer *disc = NULL;
+    CHECK_OK(asp_disc_renderer_create(gl, cloud, &(asp_disc_renderer_desc){.clip_planes = planes}, &disc, &err),
+             ep(&err));
+    free(planes);
+    return disc;
+}
+
 /*
- * Issue 5 asks for SSIM >= 0.95 against the disc render of the 16,000 points.
- * That is above what another point render of the same octahedron reaches: a
- * second sampling (another seed) drawn the same way scores about 0.92 mean,
- * 0.90 worst view, because disc edges are jagged and SSIM weighs edges
- * heavily. So the bar here is relative to that floor: normalized and prefix
- * within 0.02 of it, every other method but blend-all and polygons within
- * 0.09, and normalized and prefix above overlap (journal Fig. 11, thesis
- * 5.3.1: the seeds' too-bright and too-dark spots).
+ * Issue 5: every method but blend-all renders the octahedron with SSIM >= 0.95
+ * against the opaque-disc render of its 16,000 points. The discs are clipped
+ * at the creases (docs/render-methods.md "Crease clipping"): plain discs
+ * overhang every crease and silhouette edge in jagged scallops, so a second
+ * sampling of the same octahedron drawn the same way scored only 0.920 mean
+ * (0.903 worst view) against them, and no representation could reach 0.95.
+ * Clipped, the second sampling scores 0.99: the reference now shows the
+ * surface, not the sampling. The primitives are clipped likewise (the
+ * renderer's default); with clipping off (the seeds exactly) they are
+ * reported too, and must stay above 0.80.
  */
 static void test_octahedron_methods(void)
 {
@@ -165,8 +189,7 @@ static void test_octahedron_methods(void)
     CHECK_OK(asp_render_bounding_sphere(oct, center, &radius, &err), ep(&err));
     static asp_image ref[VIEWS], img[VIEWS];
     asp_render_desc rd = {.width = SIZE, .height = SIZE, .background = {255, 255, 255, 255}};
-    asp_renderer *disc = NULL;
-    CHECK_OK(asp_disc_renderer_create(gl, oct, NULL, &disc, &err), ep(&err));
+    asp_renderer *disc = disc_renderer(oct, 1);
     for (size_t v = 0; disc && v < VIEWS; v++) {
         asp_camera cam;
         view_camera(&cam, v, center, radius);
@@ -174,16 +197,21 @@ static void test_octahedron_methods(void)
     }
     asp_renderer_destroy(disc);
     save_sheet(ref, "octahedron-discs");
-    double floor_worst = 0, floor_mean = 0;
-    disc = NULL;
-    CHECK_OK(asp_disc_renderer_create(gl, other, NULL, &disc, &err), ep(&err));
-    if (disc)
-        floor_mean = views_ssim(disc, ref, img, center, radius, &rd, &floor_worst);
-    asp_renderer_destroy(disc);
-    release_views(img);
-    fprintf(stderr, "octahedron %-19s SSIM mean %.4f, worst view %.4f\n", "discs, another seed", floor_mean,
-            floor_worst);
-    CHECK_MSG(floor_mean > 0.88, "another sampling of the octahedron scores %.4f", floor_mean);
+    // the floor: the same surface sampled with another seed, clipped and plain
+    double floor_mean[2] = {0}, floor_worst[2] = {0};
+    for (int clip = 1; clip >= 0; clip--) {
+        disc = disc_renderer(other, clip);
+        if (disc)
+            floor_mean[clip] = views_ssim(disc, ref, img, center, radius, &rd, &floor_worst[clip]);
+        asp_renderer_destroy(disc);
+        if (!clip)
+            save_sheet(img, "octahedron-discs-unclipped");
+        release_views(img);
+        fprintf(stderr, "octahedron %-26s SSIM mean %.4f, worst view %.4f\n",
+                clip ? "discs, another seed" : "discs unclipped, another", floor_mean[clip], floor_worst[clip]);
+    }
+    CHECK_MSG(floor_mean[1] > 0.98, "another sampling of the octahedron scores %.4f", floor_mean[1]);
+    CHECK(floor_mean[0] < floor_mean[1]);
 
     asp_renderer *r = NULL;
     asp_prim_renderer_desc pd = {.origin = {oct->origin[0], oct->origin[1], oct->origin[2]}};
@@ -191,23 +219,28 @@ static void test_octahedron_methods(void)
     CHECK(r && asp_renderer_count(r) == 8 && strcmp(asp_renderer_name(r), "prim") == 0);
     double means[16] = {0};
     for (unsigned m = 0; r && asp_prim_render_method_name(m); m++) {
-        asp_prim_render_options o = {.method = (asp_prim_render_method)m};
-        CHECK_OK(asp_prim_renderer_set_options(r, &o, &err), ep(&err));
-        double worst = 0, mean = views_ssim(r, ref, img, center, radius, &rd, &worst);
-        means[m] = mean;
         const char *name = asp_prim_render_method_name(m);
-        fprintf(stderr, "octahedron %-19s SSIM mean %.4f, worst view %.4f\n", name, mean, worst);
-        char sheet[64];
-        snprintf(sheet, sizeof sheet, "octahedron-%s", name);
-        save_sheet(img, sheet);
-        release_views(img);
-        if (m == ASP_PRIM_RENDER_NORMALIZED || m == ASP_PRIM_RENDER_PREFIX)
-            CHECK_MSG(mean >= floor_mean - 0.02 && worst >= floor_worst - 0.03,
-                      "%s: SSIM mean %.4f, worst %.4f; another sampling %.4f, %.4f", name, mean, worst, floor_mean,
-                      floor_worst);
-        else if (m != ASP_PRIM_RENDER_BLEND_ALL && m != ASP_PRIM_RENDER_POLYGONS)
-            CHECK_MSG(mean >= floor_mean - 0.09, "%s: SSIM mean %.4f; another sampling %.4f", name, mean, floor_mean);
+        for (int clip = 1; clip >= 0; clip--) {
+            asp_prim_render_options o = {.method = (asp_prim_render_method)m, .crease_angle = clip ? 0.0f : -1.0f};
+            CHECK_OK(asp_prim_renderer_set_options(r, &o, &err), ep(&err));
+            double worst = 0, mean = views_ssim(r, ref, img, center, radius, &rd, &worst);
+            char label[64], sheet[64];
+            snprintf(label, sizeof label, "%s%s", name, clip ? "" : ", creases off");
+            fprintf(stderr, "octahedron %-26s SSIM mean %.4f, worst view %.4f\n", label, mean, worst);
+            snprintf(sheet, sizeof sheet, "octahedron-%s%s", name, clip ? "" : "-unclipped");
+            save_sheet(img, sheet);
+            release_views(img);
+            if (!clip) {
+                if (m != ASP_PRIM_RENDER_BLEND_ALL && m != ASP_PRIM_RENDER_POLYGONS)
+                    CHECK_MSG(mean >= 0.80, "%s: SSIM mean %.4f", label, mean);
+                continue;
+            }
+            means[m] = mean;
+            if (m != ASP_PRIM_RENDER_BLEND_ALL)
+                CHECK_MSG(mean >= 0.95, "%s: SSIM mean %.4f (worst view %.4f), expected >= 0.95", label, mean, worst);
+        }
     }
+    // the per-pixel division removes the seeds' light seams (journal Fig. 11, thesis 5.3.1)
     CHECK(means[ASP_PRIM_RENDER_NORMALIZED] > means[ASP_PRIM_RENDER_OVERLAP]);
     CHECK(means[ASP_PRIM_RENDER_PREFIX] > means[ASP_PRIM_RENDER_OVERLAP]);
     // nothing limits visibility in blend-all: the far faces show through (thesis Fig. 4.3)
