@@ -117,6 +117,10 @@ typedef struct asp_eval_desc {
     size_t method_count;       /* entries of methods (0 with methods != NULL: points only); at most 16 */
     const asp_amg_desc *amg;   /* decomposition options; NULL = defaults */
     const asp_prim_desc *prim; /* primitive options; NULL = defaults */
+    float crease_angle;        /* degrees in (0, 90): the reference's and the cuts' point splats are clipped at
+                                  creases (asp_crease_clip_planes; skipped for a cloud without normals) and the
+                                  primitives use it as asp_prim_render_options.crease_angle; 0 = 60; < 0 = no
+                                  clipping anywhere (the seeds' renders) */
     const asp_context *ctx;    /* threads, allocator, progress (stages "decompose", "primitives", "render") */
 } asp_eval_desc;
 
@@ -147,6 +151,8 @@ typedef struct asp_eval_result {
     size_t level_count;        /* AMG levels evaluated */
     double t_decompose, t_build, t_render; /* seconds */
     char gl_renderer[128];     /* GL_RENDERER of the context used */
+    float crease_angle;        /* the crease angle used, degrees; -1 = no clipping */
+    size_t clipped_points;     /* points whose reference splat was clipped at a crease */
     asp_image sheet;           /* contact sheet of view 0 at sheet_size: one row per representation,
                                   the reference first, then the levels; width 0 when not made */
     uint32_t sheet_cols, sheet_rows;

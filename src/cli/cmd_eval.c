@@ -17,7 +17,7 @@
 static const char usage[] =
     "usage: amgsplat eval MODEL [-o DIR] [--views 16] [--sizes 128,256] [--max-primitives 1000]\n"
     "                     [--methods normalized,prefix,overlap,two-pass | all | none] [--frames 5]\n"
-    "                     [--points N] [--texture IMG] [--elevation 20]\n"
+    "                     [--points N] [--texture IMG] [--elevation 20] [--crease-angle DEG|off]\n"
     "\n"
     "Renders the reference (the full point set as blended, normalised splats at tolerance 0) and,\n"
     "from the same cameras, every representation: the domain primitives of every AMG level with at\n"
@@ -28,7 +28,9 @@ static const char usage[] =
     "checker-plane) or a mesh (sampled to --points points, default 100000). 512 x 512 views take\n"
     "about four times as long as 256 x 256 on a CPU rasteriser: ask for them with --sizes. Writes into DIR\n"
     "(default eval-<model name>): eval.csv, eval.json, ssim-<size>.png, frametime-<size>.png and\n"
-    "sheet.png (view 0: one row per representation, the reference first, then the levels).";
+    "sheet.png (view 0: one row per representation, the reference first, then the levels).\n"
+    "Sharp creases: the reference's splats and the primitives are clipped where flat parts meet at\n"
+    "more than --crease-angle degrees (default 60; 'off' compares the seeds' unclipped renders).";
 
 enum { MAX_SIZES = 8, MAX_METHODS = 16 };
 
@@ -163,7 +165,7 @@ static int save_outputs(const asp_eval_result *res, const char *model, const cha
 
 int cmd_eval(int argc, char **argv, struct cli_env *env)
 {
-    const char *out_dir = NULL, *sizes_text = NULL, *methods_text = NULL, *texture = NULL;
+    const char *out_dir = NULL, *sizes_text = NULL, *methods_text = NULL, *texture = NULL, *crease_text = NULL;
     size_t views = 16, max_prims = 1000, frames = 5, points = 0;
     double elevation = 20;
     const struct cli_option opts[] = {
@@ -177,6 +179,7 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
         {"points", 'n', CLI_SIZE, &points, "N", "samples of a mesh or synthetic MODEL"},
         {"texture", 0, CLI_STRING, &texture, "IMG", "texture of a mesh MODEL without material textures"},
         {"elevation", 0, CLI_DOUBLE, &elevation, "DEG", "views alternate +DEG and -DEG (default 20)"},
+        {"crease-angle", 0, CLI_STRING, &crease_text, "DEG|off", "clip reference splats and primitives at creases (default 60)"},
         {0},
     };
     int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -192,6 +195,11 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--max-primitives expects at least 1");
     if (!(elevation >= -90 && elevation <= 90) || elevation == 0)
         return cli_usage_error(env, "--elevation expects degrees in -90..90, not 0, got %g", elevation);
+    double crease = 0;
+    if (crease_text && strcmp(crease_text, "off") == 0)
+        crease = -1;
+    else if (crease_text && (cli_parse_doubles(crease_text, &crease, 1) != 1 || !(crease > 0 && crease < 90)))
+        return cli_usage_error(env, "--crease-angle expects degrees in (0, 90) or 'off', got '%s'", crease_text);
     uint32_t sizes[MAX_SIZES] = {128, 256};
     size_t nsizes = 2;
     if (sizes_text && parse_sizes(env, sizes_text, sizes, &nsizes))
@@ -219,7 +227,8 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
         return cli_fail(env, &err);
     }
     asp_eval_desc desc = {.views = views, .sizes = sizes, .size_count = nsizes, .max_primitives = max_prims,
-                          .frames = frames, .elevation = (float)elevation, .ctx = &env->ctx,
+                          .frames = frames, .elevation = (float)elevation, .crease_angle = (float)crease,
+                          .ctx = &env->ctx,
                           .methods = methods_text ? methods : NULL, .method_count = nmethods};
     double t0 = asp_time_now();
     asp_eval_result *res = NULL;

@@ -76,6 +76,7 @@ struct render_opts {
     int dps_input;
     asp_amg_color_mode color_mode;
     asp_prim_render_options prim;
+    double point_crease; /* point inputs: crease angle of the clip planes, degrees; 0 = no clipping */
     const asp_context *ctx;
 };
 
@@ -85,6 +86,7 @@ struct scene {
     asp_amg *amg;
     asp_dps *dps;
     const asp_dps_level *dps_level; /* the level drawn, inside dps */
+    float *clip_planes; /* point inputs with --crease-angle: 8 per point (asp_crease_clip_planes) */
     float center[3];
     float radius;
     size_t count;
@@ -161,11 +163,25 @@ static int load_scene(const char *path, const struct render_opts *o, const struc
     if (rc)
         return rc;
     s->count = s->cloud->count;
+    if (o->point_crease > 0) {
+        // sharp features: each disc or splat cut by its neighbours' planes across a crease
+        s->clip_planes = asp_alloc(&env->ctx, 8 * s->cloud->count * sizeof(float));
+        if (!s->clip_planes)
+            return asp_error_set(err, ASP_ENOMEM, "out of memory for the crease planes of %zu points", s->count);
+        rc = asp_crease_clip_planes(s->cloud, &(asp_crease_desc){.angle_deg = (float)o->point_crease, .ctx = &env->ctx},
+                                    s->clip_planes, NULL, err);
+        if (rc) {
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "%s", err->msg);
+            return asp_error_set(err, rc, "cannot clip '%s' at creases: %s", path, msg);
+        }
+    }
     return asp_render_bounding_sphere(s->cloud, s->center, &s->radius, err);
 }
 
-static void scene_release(struct scene *s)
+static void scene_release(const struct cli_env *env, struct scene *s)
 {
+    asp_free(&env->ctx, s->clip_planes);
     asp_cloud_destroy(s->cloud);
     asp_amg_destroy(s->amg);
     asp_dps_destroy(s->dps);
@@ -175,7 +191,7 @@ static void scene_release(struct scene *s)
 static int make_disc(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
                      asp_error *err)
 {
-    asp_disc_renderer_desc desc = {.radius_scale = (float)o->radius_scale};
+    asp_disc_renderer_desc desc = {.radius_scale = (float)o->radius_scale, .clip_planes = s->clip_planes};
     return asp_disc_renderer_create(gl, s->cloud, &desc, r, err);
 }
 
@@ -187,7 +203,7 @@ static int make_splat(asp_gl_context *gl, const struct scene *s, const struct re
                                     .epsilon = o->epsilon > 0 ? (float)o->epsilon : -1.0f, // 0 = no offset
                                     .tolerance = (float)o->tolerance, .radius_scale = (float)o->radius_scale,
                                     .lighting = o->light_mode, .mode = o->opaque ? ASP_SPLAT_OPAQUE : ASP_SPLAT_BLEND,
-                                    .ctx = o->ctx};
+                                    .clip_planes = s->clip_planes, .ctx = o->ctx};
     return asp_splat_renderer_create(gl, s->cloud, &desc, r, err);
 }
 
@@ -289,11 +305,20 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
 static int parse_prim_options(struct cli_env *env, struct render_opts *o)
 {
     int given = o->method || o->alpha_ref >= 0 || o->transparency >= 0 || o->depth_window >= 0 || o->outline ||
-                o->no_normal_map || o->crease_angle;
+                o->no_normal_map;
     if (!o->dps_input) {
         if (given)
-            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --crease-angle, "
-                                        "--outline and --no-normal-map need a .dps input (amgsplat build makes one)");
+            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline and "
+                                        "--no-normal-map need a .dps input (amgsplat build makes one)");
+        double deg = 0;
+        if (!o->crease_angle || strcmp(o->crease_angle, "off") == 0)
+            return 0;
+        if (cli_parse_doubles(o->crease_angle, &deg, 1) != 1 || !(deg > 0 && deg < 90))
+            return cli_usage_error(env, "--crease-angle expects degrees in (0, 90) or 'off' for points, got '%s'",
+                                   o->crease_angle);
+        if (o->renderer && strcmp(o->renderer, "square") == 0)
+            return cli_usage_error(env, "--crease-angle: the square renderer does not clip (use disc or splat)");
+        o->point_crease = deg;
         return 0;
     }
     asp_prim_render_options *p = &o->prim;
@@ -472,7 +497,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"alpha-ref", 0, CLI_DOUBLE, &o.alpha_ref, "X", ".dps: alpha test of the locks and the front layer, 0..1 (default 0.1)"},
         {"transparency", 0, CLI_DOUBLE, &o.transparency, "X", ".dps: global opacity scaling alpha, (0, 1] (default 1)"},
         {"depth-window", 0, CLI_DOUBLE, &o.depth_window, "X", ".dps: depth offset / window in world units (default: half the mean primitive radius)"},
-        {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", ".dps: clip flat primitives meeting at a crease sharper than DEG degrees (default 60; off = as the seeds)"},
+        {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", "cut at creases sharper than DEG: .dps primitives (default 60; off = as the seeds); points: discs, splats (default off)"},
         {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
@@ -546,6 +571,6 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         asp_image_release(&tiles[i]);
     asp_renderer_destroy(r);
     asp_gl_context_destroy(gl);
-    scene_release(&s);
+    scene_release(env, &s);
     return status;
 }

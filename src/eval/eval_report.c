@@ -66,6 +66,7 @@ int asp_eval_save_json(const asp_eval_result *res, const char *model, const char
     fprintf(fp, ", \"points\": %zu, \"views\": %zu, \"levels\": %zu, \"gl_renderer\": ", res->points, res->views,
             res->level_count);
     json_str(fp, res->gl_renderer);
+    fprintf(fp, ", \"crease_angle\": %g, \"clipped_points\": %zu", (double)res->crease_angle, res->clipped_points);
     fprintf(fp, ", \"decompose_seconds\": %.4f, \"build_seconds\": %.4f, \"render_seconds\": %.4f,\n \"rows\": [",
             res->t_decompose, res->t_build, res->t_render);
     for (size_t i = 0; i < res->row_count; i++) {

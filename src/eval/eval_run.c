@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "amgsplat/eval.h"
+#include "amgsplat/geom.h"
 #include "amgsplat/hier.h"
 #include "amgsplat/render.h"
 #include "util/banned.h"
@@ -76,6 +77,7 @@ struct eval_state {
     size_t cut_cap;
     float center[3], radius;
     float elevation;
+    float crease_angle;  /* resolved: degrees, or -1 for none */
     size_t views, frames;
     struct rep reps[MAX_REPS];
     size_t nreps;
@@ -84,7 +86,7 @@ struct eval_state {
 static int create_prim(struct eval_state *s, const struct rep *rep, const asp_dps_level *lv, asp_renderer **out,
                        asp_error *err)
 {
-    asp_prim_renderer_desc pd = {.options = {.method = rep->method}};
+    asp_prim_renderer_desc pd = {.options = {.method = rep->method, .crease_angle = s->crease_angle}};
     memcpy(pd.origin, s->cloud->origin, sizeof pd.origin);
     return asp_prim_renderer_create(s->gl, lv, &pd, out, err);
 }
@@ -302,6 +304,9 @@ static int check_desc(const asp_eval_desc *d, const uint32_t *sizes, size_t nsiz
             return asp_error_set(err, ASP_EINVAL, "unknown rendering method %d", (int)d->methods[i]);
     if (d->frames > MAX_FRAMES)
         return asp_error_set(err, ASP_EINVAL, "frames must be at most %d, got %zu", MAX_FRAMES, d->frames);
+    if (isnan(d->crease_angle) || d->crease_angle >= 90)
+        return asp_error_set(err, ASP_EINVAL, "crease angle must be below 90 degrees (or < 0 for none), got %g",
+                             (double)d->crease_angle);
     if (!(d->elevation >= -90 && d->elevation <= 90))
         return asp_error_set(err, ASP_EINVAL, "elevation must be in -90..90 degrees, got %g", (double)d->elevation);
     return 0;
@@ -345,8 +350,20 @@ static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result
     }
     if (!rc)
         rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.ctx = s->ctx}, &s->gl, err);
+    // the reference's splats cut at creases, so its sharp edges are the surface's, not the sampling's
+    float *planes = NULL;
+    if (!rc && s->crease_angle > 0 && s->cloud->normals) {
+        planes = asp_alloc(s->ctx, 8 * s->cloud->count * sizeof(float));
+        if (!planes)
+            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the crease planes of %zu points", s->cloud->count);
+        if (!rc)
+            rc = asp_crease_clip_planes(s->cloud, &(asp_crease_desc){.angle_deg = s->crease_angle, .ctx = s->ctx},
+                                        planes, &res->clipped_points, err);
+    }
     if (!rc)
-        rc = asp_splat_renderer_create_hier(s->gl, s->hier, &(asp_splat_renderer_desc){0}, &s->splat, err);
+        rc = asp_splat_renderer_create_hier(s->gl, s->hier, &(asp_splat_renderer_desc){.clip_planes = planes},
+                                            &s->splat, err);
+    asp_free(s->ctx, planes);
     if (!rc)
         snprintf(res->gl_renderer, sizeof res->gl_renderer, "%s", asp_gl_context_renderer(s->gl));
     return rc;
@@ -429,7 +446,8 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_res
         return asp_error_set(err, ASP_EDEGENERATE, "cannot evaluate a model of %zu points (at least 3)",
                              cloud ? cloud->count : (size_t)0);
     struct eval_state s = {.ctx = d.ctx, .cloud = cloud, .elevation = d.elevation ? d.elevation : 20.0f,
-                           .views = d.views ? d.views : 16, .frames = d.frames ? d.frames : 5};
+                           .views = d.views ? d.views : 16, .frames = d.frames ? d.frames : 5,
+                           .crease_angle = d.crease_angle == 0 ? 60.0f : d.crease_angle < 0 ? -1.0f : d.crease_angle};
     asp_eval_result *res = asp_calloc(d.ctx, 1, sizeof *res);
     if (!res)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the evaluation result");
@@ -437,6 +455,7 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_res
         res->ctx = *d.ctx;
     res->views = s.views;
     res->points = cloud->count;
+    res->crease_angle = s.crease_angle;
     struct sheet sh = {0};
     static const asp_prim_render_method default_methods[4] = {ASP_PRIM_RENDER_NORMALIZED, ASP_PRIM_RENDER_PREFIX,
                                                               ASP_PRIM_RENDER_OVERLAP, ASP_PRIM_RENDER_TWO_PASS};

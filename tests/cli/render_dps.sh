@@ -26,6 +26,17 @@ for m in normalized prefix overlap two-pass dark-backface dark-backface-soft ble
   check "$T/$m.png" "px(24, 24)[:3] != (255, 255, 255) and px(0, 0) == (255, 255, 255, 255)"
 done
 
+# crease clipping (default 60 degrees): the 8 support rectangles are cut to the 8 faces, so the
+# polygon soup covers the octahedron only (23.6% of the image) instead of the rectangles (41.6%)
+"$AMGSPLAT" render "$T/o.dps" -o "$T/pc.png" --size 64x64 --method polygons -q
+"$AMGSPLAT" render "$T/o.dps" -o "$T/pu.png" --size 64x64 --method polygons --crease-angle off -q
+"$AMGSPLAT" render "$T/o.dps" -o "$T/nc.png" --size 64x64 --method normalized --crease-angle 45 -q
+check "$T/pc.png" "0.20 < fg < 0.27"
+check "$T/pu.png" "fg > 0.35"
+check "$T/nc.png" "0.20 < fg < 0.27"
+expect_fail 2 "--crease-angle expects" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --crease-angle 180
+expect_fail 2 "--crease-angle expects" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --crease-angle soft
+
 # --outline draws green edges (journal Fig. 12b); --color-by domain changes the colours
 "$AMGSPLAT" render "$T/o.dps" -o "$T/out.png" --size 48x48 --method polygons --outline -q
 check "$T/out.png" "sum(px(x, y)[:3] == (0, 255, 0) for x in range(w) for y in range(h)) > 20"
