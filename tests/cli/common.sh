@@ -7,6 +7,9 @@ rm -rf "$T"
 mkdir -p "$T"
 
 fail() { echo "FAIL: $*" >&2; exit 1; }
+# Pipes into grep use `grep PATTERN >/dev/null`, never `grep -q`: -q exits at the first match, the
+# writer may then die of SIGPIPE, and pipefail turns that into a failure (it did, once the render
+# usage text grew).
 
 # expect_fail STATUS SUBSTRING cmd...: the command must exit with STATUS and print SUBSTRING on stderr.
 expect_fail() {

@@ -1,7 +1,7 @@
 # amgsplat estimate: outward normals and positive radii on a raw sphere scan, viewpoint
 # orientation, kept attributes, JSON, and clean failures with the documented exit codes.
 source "$(dirname "$0")/common.sh"
-"$AMGSPLAT" estimate -h | grep -q "usage: amgsplat estimate" || fail "help"
+"$AMGSPLAT" estimate -h | grep "usage: amgsplat estimate" >/dev/null || fail "help"
 
 # a raw scan: 4000 random points on a sphere of radius 2 around (10, -5, 3), positions only
 python3 - "$T/scan.xyz" <<'PY'
@@ -73,7 +73,7 @@ sys.path.insert(0, sys.argv[2]); import ply
 v = ply.read(sys.argv[1])
 assert all(p["nx"] * (p["x"] - 10) + p["ny"] * (p["y"] + 5) + p["nz"] * (p["z"] - 3) < 0 for p in v)
 PY
-"$AMGSPLAT" estimate "$T/scan.xyz" -o "$T/human.ply" --radii | grep -q "4000 points, normals none, radii estimated" ||
+"$AMGSPLAT" estimate "$T/scan.xyz" -o "$T/human.ply" --radii | grep "4000 points, normals none, radii estimated" >/dev/null ||
   fail "human output"
 
 # failures

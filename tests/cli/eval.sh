@@ -4,13 +4,13 @@
 source "$(dirname "$0")/common.sh"
 A="$AMGSPLAT"
 
-"$A" eval -h | grep -q "usage: amgsplat eval" || fail "help"
+"$A" eval -h | grep "usage: amgsplat eval" >/dev/null || fail "help"
 
 "$A" eval octahedron -o "$T/oct" --views 4 --sizes 64,128 --max-primitives 120 --frames 2 -q --json > "$T/run.json"
 for f in eval.csv eval.json ssim-64.png ssim-128.png frametime-64.png frametime-128.png sheet.png; do
   [[ -s "$T/oct/$f" ]] || fail "missing $f"
 done
-head -c 8 "$T/oct/ssim-128.png" | od -c | grep -q "P   N   G" || fail "chart is not a PNG"
+head -c 8 "$T/oct/ssim-128.png" | od -c | grep "P   N   G" >/dev/null || fail "chart is not a PNG"
 [[ "$(head -1 "$T/oct/eval.csv")" == \
    "representation,level,level_name,size,primitives,drawn,texels,psnr_mean,psnr_min,ssim_mean,ssim_min,iou_mean,iou_min,frame_ms" ]] \
   || fail "CSV header: $(head -1 "$T/oct/eval.csv")"

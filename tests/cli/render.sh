@@ -123,7 +123,7 @@ printf 'not an amg file' >"$T/bad.amg"
 expect_fail 1 "bad.amg" "$AMGSPLAT" render "$T/bad.amg" -o "$T/x.png"
 
 # usage errors: exit 2, nothing written
-"$AMGSPLAT" render -h | grep -q "usage: amgsplat render" || fail "-h"
+"$AMGSPLAT" render -h | grep "usage: amgsplat render" >/dev/null || fail "-h"
 expect_fail 2 "missing -o" "$AMGSPLAT" render "$T/sphere.ply"
 expect_fail 2 "must end in .png" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.jpg"
 expect_fail 2 "--size expects WxH" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --size 0x10

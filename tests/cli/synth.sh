@@ -1,6 +1,6 @@
 # amgsplat synth: every shape writes a readable file with the documented counts; bad input fails cleanly.
 source "$(dirname "$0")/common.sh"
-"$AMGSPLAT" synth -h | grep -q "usage: amgsplat synth" || fail "help"
+"$AMGSPLAT" synth -h | grep "usage: amgsplat synth" >/dev/null || fail "help"
 "$AMGSPLAT" synth octahedron -o "$T/oct.ply" --json >"$T/j"
 python3 - "$T/j" "$T/oct.ply" <<'PY' || fail "octahedron: $(cat "$T/j")"
 import json, sys, struct
@@ -25,7 +25,7 @@ for i in range(16000):
     counts[rec["label"]] += 1
 assert counts == [2000] * 8, counts
 PY
-"$AMGSPLAT" synth checker-plane -o "$T/checker.ply" | grep -q "262144 points" || fail "checker-plane count"
+"$AMGSPLAT" synth checker-plane -o "$T/checker.ply" | grep "262144 points" >/dev/null || fail "checker-plane count"
 "$AMGSPLAT" synth checker-plane --grid 64 --squares 4 -o "$T/small.xyz" -q
 [[ $(wc -l <"$T/small.xyz") -eq 4096 ]] || fail "checker-plane 64x64 as xyz"
 for s in cube sphere torus; do
