@@ -18,9 +18,9 @@
 #include "amgsplat/hier.h"
 #include "amgsplat/render.h"
 #include "amgsplat/sample.h"
+#include "gl_harness.h"
 #include "harness.h"
 
-static asp_gl_context *gl;
 
 static asp_error *ep(asp_error *e)
 {
@@ -443,19 +443,6 @@ static void test_bad_planes(void)
     CHECK(r == NULL);
     free(planes);
     asp_cloud_destroy(c);
-}
-
-static void setup(void)
-{
-    asp_error err = {0, ""};
-    int rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.flags = ASP_GL_CONTEXT_DEBUG}, &gl, ep(&err));
-    CHECK_MSG(rc == 0, "no headless GL: %s", err.msg);
-}
-
-static void teardown(void)
-{
-    asp_gl_context_destroy(gl);
-    gl = NULL;
 }
 
 TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_single_disc), TEST_CASE(test_octahedron), TEST_CASE(test_hier_and_opaque),

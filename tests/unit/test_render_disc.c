@@ -11,10 +11,10 @@
 
 #include "amgsplat/eval.h"
 #include "amgsplat/render.h"
+#include "gl_harness.h"
 #include "harness.h"
 
 static const double deg = 3.14159265358979323846 / 180.0;
-static asp_gl_context *gl;
 
 /* Passes an error through a call, as CHECK_OK tests its pointer for NULL (-Waddress). */
 static asp_error *ep(asp_error *e)
@@ -509,19 +509,6 @@ static void test_bad_input(void)
     }
     asp_cloud_destroy(c);
     asp_renderer_destroy(NULL);
-}
-
-static void setup(void)
-{
-    asp_error err = {0, ""};
-    int rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.flags = ASP_GL_CONTEXT_DEBUG}, &gl, ep(&err));
-    CHECK_MSG(rc == 0, "no headless GL: %s", err.msg);
-}
-
-static void teardown(void)
-{
-    asp_gl_context_destroy(gl);
-    gl = NULL;
 }
 
 TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_context), TEST_CASE(test_debug_errors_collected),

@@ -12,9 +12,9 @@
 
 #include "amgsplat/prim.h"
 #include "amgsplat/render.h"
+#include "gl_harness.h"
 #include "harness.h"
 
-static asp_gl_context *gl;
 
 static asp_error *ep(asp_error *e)
 {
@@ -193,18 +193,6 @@ static void test_bad_option(void)
     }
     asp_renderer_destroy(r);
     asp_image_release(&lv.atlas);
-}
-
-static void setup(void)
-{
-    asp_error err = {0, ""};
-    int rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.flags = ASP_GL_CONTEXT_DEBUG}, &gl, ep(&err));
-    CHECK_MSG(rc == 0, "no headless GL: %s", err.msg);
-}
-
-static void teardown(void)
-{
-    asp_gl_context_destroy(gl);
 }
 
 TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_roof), TEST_CASE(test_bad_option), TEST_CASE(teardown))
