@@ -121,11 +121,7 @@ enum { VIEWS = 16, SIZE = 256 };
 
 static void view_camera(asp_camera *cam, size_t i, const float center[3], float radius)
 {
-    // the views of `amgsplat render --views 16 --view 30,20` (tests/unit/test_render_octahedron.c)
-    asp_camera_init(cam);
-    cam->azimuth = 30.0f + 360.0f * (float)i / VIEWS;
-    cam->elevation = i % 2 ? -20.0f : 20.0f;
-    asp_camera_fit(cam, center, radius, 1.0f);
+    test_view_camera(cam, i, VIEWS, center, radius);
 }
 
 static void render_views(asp_renderer *r, const float center[3], float radius, asp_image *img)
@@ -141,16 +137,7 @@ static void render_views(asp_renderer *r, const float center[3], float radius, a
 
 static void save_sheet(const asp_image *tiles, const char *name)
 {
-    const char *dir = getenv("ASP_TEST_CREASE_OUT");
-    if (!dir)
-        return;
-    asp_image sheet = {0};
-    asp_error err;
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s.png", dir, name);
-    if (asp_image_contact_sheet(tiles, VIEWS, 0, &sheet, &err) == 0)
-        asp_image_save_png(&sheet, path, &err);
-    asp_image_release(&sheet);
+    test_save_sheet(tiles, VIEWS, "ASP_TEST_CREASE_OUT", name);
 }
 
 /*

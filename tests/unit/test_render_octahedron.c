@@ -23,9 +23,9 @@
 #include "amgsplat/prim.h"
 #include "amgsplat/render.h"
 #include "amgsplat/sample.h"
+#include "gl_harness.h"
 #include "harness.h"
 
-static asp_gl_context *gl;
 
 static asp_error *ep(asp_error *e)
 {
@@ -38,25 +38,12 @@ enum { VIEWS = 16, SIZE = 256 };
 
 static void view_camera(asp_camera *cam, size_t i, const float center[3], float radius)
 {
-    // the views of `amgsplat render --views 16 --view 30,20`
-    asp_camera_init(cam);
-    cam->azimuth = 30.0f + 360.0f * (float)i / VIEWS;
-    cam->elevation = i % 2 ? -20.0f : 20.0f;
-    asp_camera_fit(cam, center, radius, 1.0f);
+    test_view_camera(cam, i, VIEWS, center, radius);
 }
 
 static void save_sheet(const asp_image *tiles, const char *name)
 {
-    const char *dir = getenv("ASP_TEST_PRIM_OUT");
-    if (!dir)
-        return;
-    asp_image sheet = {0};
-    asp_error err;
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s.png", dir, name);
-    if (asp_image_contact_sheet(tiles, VIEWS, 0, &sheet, &err) == 0)
-        asp_image_save_png(&sheet, path, &err);
-    asp_image_release(&sheet);
+    test_save_sheet(tiles, VIEWS, "ASP_TEST_PRIM_OUT", name);
 }
 
 /* Mean SSIM of r against ref over the 16 views; fills img (released by the caller). */
@@ -252,19 +239,11 @@ static void test_octahedron_methods(void)
     asp_cloud_destroy(other);
 }
 
-static void setup(void)
+static void cleanup(void)
 {
-    asp_error err = {0, ""};
-    int rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.flags = ASP_GL_CONTEXT_DEBUG}, &gl, ep(&err));
-    CHECK_MSG(rc == 0, "no headless GL: %s", err.msg);
-}
-
-static void teardown(void)
-{
-    asp_gl_context_destroy(gl);
-    gl = NULL;
     if (dps_path[sizeof dps_path - 2] != 'X')
         unlink(dps_path);
 }
 
-TEST_MAIN(TEST_CASE(build_primitives), TEST_CASE(setup), TEST_CASE(test_octahedron_methods), TEST_CASE(teardown))
+TEST_MAIN(TEST_CASE(build_primitives), TEST_CASE(setup), TEST_CASE(test_octahedron_methods), TEST_CASE(teardown),
+          TEST_CASE(cleanup))
