@@ -37,6 +37,15 @@ typedef struct rect {
  */
 #define FLAT_MAX 0.01
 
+/*
+ * At a true crease a domain's basis function has nearly all its weight on its
+ * own side: what reaches across is the partition-of-unity overlap, a band of
+ * about a point spacing where Psi falls from 1 to 0. If the cut would remove
+ * more than this share of the texture's alpha, the planes meet somewhere the
+ * domains do not (a fillet between them, say) and the pair is left alone.
+ */
+#define CUT_MASS_MAX 0.05
+
 /* Samples along a crossing line, and how many must lie where both basis functions are above ALPHA_MIN. */
 enum { LINE_SAMPLES = 33, SAMPLES_NEEDED = 2 };
 #define ALPHA_MIN 0.1 /* the default alpha reference (thesis Fig. 4.13) */
@@ -60,6 +69,28 @@ static double alpha_at(const rect *r, const asp_image *atlas, const double x[3])
 static double dot3(const double *a, const double *b)
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* The share of r's texture alpha (over its texel centres) on the negative side of plane. */
+static double cut_mass(const rect *r, const asp_image *atlas, const float plane[4])
+{
+    const asp_prim *p = r->prim;
+    double total = 0, cut = 0;
+    for (uint32_t j = 0; j < p->tex_h; j++) {
+        double t = r->hv * (-1.0 + (2.0 * j + 1.0) / p->tex_h);
+        const uint8_t *row = atlas->pixels + ((size_t)(p->tex_y + j) * atlas->width + p->tex_x) * 4;
+        for (uint32_t i = 0; i < p->tex_w; i++) {
+            double a = row[4 * i + 3];
+            if (a == 0)
+                continue;
+            double s = r->hu * (-1.0 + (2.0 * i + 1.0) / p->tex_w), side = plane[3];
+            for (int k = 0; k < 3; k++)
+                side += plane[k] * (r->c[k] + s * r->u[k] + t * r->v[k]);
+            total += a;
+            cut += side < 0 ? a : 0;
+        }
+    }
+    return total > 0 ? cut / total : 1.0;
 }
 
 /*
@@ -135,6 +166,8 @@ static int crease_of(const rect *a, const rect *b, const asp_image *atlas, float
     for (int k = 0; k < 3; k++)
         plane[k] = (float)(sign * b->n[k]);
     plane[3] = (float)(-sign * hb);
+    if (!(cut_mass(a, atlas, plane) <= CUT_MASS_MAX))
+        return 0;
     *cosine = (float)c;
     return 1;
 }

@@ -21,7 +21,10 @@ static asp_error *ep(asp_error *e)
     return e;
 }
 
-enum { TW = 16, TH = 16, SIZE = 96 };
+enum { TW = 64, TH = 16, SIZE = 256 };
+
+#define OVER 0.12        /* how far each rectangle reaches past the ridge, in runs */
+#define OVER_ALPHA 60    /* alpha of the overhang: the basis function's tail, above the 0.1 alpha test */
 
 static const uint8_t colors[2][3] = {{220, 30, 30}, {30, 200, 30}};
 
@@ -31,7 +34,7 @@ static const uint8_t colors[2][3] = {{220, 30, 30}, {30, 200, 30}};
  * unit run from the ridge, with a rectangle reaching `over` past the ridge.
  */
 static void make_roof(asp_dps_level *lv, asp_prim prims[2], uint32_t nbrs[2], double theta_deg, double over,
-                      float curvature)
+                      float curvature, int over_alpha)
 {
     memset(lv, 0, sizeof *lv);
     double t = theta_deg * 3.14159265358979323846 / 180.0, c = cos(t), s = sin(t);
@@ -74,7 +77,13 @@ static void make_roof(asp_dps_level *lv, asp_prim prims[2], uint32_t nbrs[2], do
             uint8_t *q = lv->atlas.pixels + 4 * ((size_t)j * lv->atlas.width + i);
             int k = i < TW + 2 ? 0 : 1;
             memcpy(q, colors[k], 3);
-            q[3] = 255;
+            // texel column c of primitive k, clamped into its texture (the padding repeats the edge)
+            int col = (int)i - k * (TW + 2) - 1;
+            col = col < 0 ? 0 : col >= TW ? TW - 1 : col;
+            // run from the ridge at the column centre: A's axis_u points to the ridge, B's away from it
+            double u = -1.0 + (2.0 * col + 1.0) / TW; // -1..1 across the rectangle
+            double run = k == 0 ? 1.0 - (u + 1.0) * 0.5 * (1.0 + over) : -over + (u + 1.0) * 0.5 * (1.0 + over);
+            q[3] = (uint8_t)(run < 0 ? over_alpha : 255);
         }
 }
 
@@ -107,11 +116,11 @@ static int color_at(const asp_camera *cam, const asp_image *img, float x, float 
     return -1;
 }
 
-/* The colours left and right of the ridge, at a quarter of the overhang (0.3 run): a point on each face. */
+/* The colours left and right of the ridge, half an overhang from it: a point on each face. */
 static void sides(const asp_camera *cam, const asp_image *img, double theta_deg, int *left, int *right)
 {
     double t = theta_deg * 3.14159265358979323846 / 180.0;
-    float x = 0.15f * (float)cos(t), z = -0.15f * (float)sin(t);
+    float x = 0.5f * (float)OVER * (float)cos(t), z = -0.5f * (float)OVER * (float)sin(t);
     *left = color_at(cam, img, -x, 0.2f, z);
     *right = color_at(cam, img, x, 0.2f, z);
 }
@@ -132,12 +141,14 @@ static void test_roof(void)
         {20, 0.0f, 0, 0, "40 degree ridge, default angle 60"},
         {20, 0.0f, 30, 1, "40 degree ridge, angle 30"},
         {8, 0.0f, 10, 0, "16 degree ridge: below the 20 degree floor"},
+        // about 11% of A's alpha past the ridge: more than a basis function's tail, so no crease
+        {45, 0.0f, 0, 0, "90 degree ridge with an opaque overhang"},
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
         asp_dps_level lv;
         asp_prim prims[2];
         uint32_t nbrs[2];
-        make_roof(&lv, prims, nbrs, cases[c].theta, 0.6, cases[c].curvature);
+        make_roof(&lv, prims, nbrs, cases[c].theta, OVER, cases[c].curvature, c == 7 ? 255 : OVER_ALPHA);
         asp_error err = {0, ""};
         asp_renderer *r = NULL;
         CHECK_OK(asp_prim_renderer_create(gl, &lv, NULL, &r, &err), ep(&err));
@@ -183,7 +194,7 @@ static void test_bad_option(void)
     asp_dps_level lv;
     asp_prim prims[2];
     uint32_t nbrs[2];
-    make_roof(&lv, prims, nbrs, 45, 0.6, 0);
+    make_roof(&lv, prims, nbrs, 45, OVER, 0, OVER_ALPHA);
     asp_error err = {0, ""};
     asp_renderer *r = NULL;
     CHECK_OK(asp_prim_renderer_create(gl, &lv, NULL, &r, &err), ep(&err));
