@@ -116,8 +116,8 @@ int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err);
 /*
  * Finds the pairs of primitives of lv that cross at a sharp crease (more than
  * 20 degrees, along a line inside both rectangles where both textures' alpha
- * exceeds 0.1, consistent sides, the cut removing at most 5% of the alpha;
- * prim_creases.c) in the frame centred on origin. Writes per primitive
+ * exceeds 0.1, consistent sides, the cut removing an alpha-weighted area of at
+ * most one texel times its length; prim_creases.c) in the frame centred on origin. Writes per primitive
  * first[i], count[i] (n entries each) into *entries, 8 floats per record:
  * the other's support plane (nx, ny, nz, d) oriented so i's kept side is
  * >= 0, cos of their angle, the other's id, 0, 0; *total records (the array

@@ -24,7 +24,7 @@ static asp_error *ep(asp_error *e)
 enum { TW = 64, TH = 16, SIZE = 256 };
 
 #define OVER 0.12        /* how far each rectangle reaches past the ridge, in runs */
-#define OVER_ALPHA 60    /* alpha of the overhang: the basis function's tail, above the 0.1 alpha test */
+#define OVER_ALPHA 30    /* alpha of the overhang: a basis function's tail, just above the 0.1 alpha test */
 
 static const uint8_t colors[2][3] = {{220, 30, 30}, {30, 200, 30}};
 
