@@ -276,13 +276,32 @@ int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err);
 
 /**
  * Reads a .amg file (version 2; version 1 files, which lack the point
- * attributes, are refused with a message to decompose again). Returns 0,
- * ASP_EIO (cannot open/read), ASP_EFORMAT
- * (not an .amg file, unsupported version, truncated, checksum mismatch,
- * inconsistent counts: the message names the file and what was expected),
- * ASP_ENOMEM. The caller frees *out with asp_amg_destroy.
+ * attributes, are refused with a message to decompose again): reads the whole
+ * file and parses it with asp_amg_load_memory. Returns 0, ASP_EINVAL (path or
+ * out NULL), ASP_EIO (cannot open/read), ASP_EFORMAT (as
+ * asp_amg_load_memory), ASP_EUNSUPPORTED (big-endian host), ASP_ENOMEM. The
+ * caller frees *out with asp_amg_destroy; on failure *out is unchanged.
+ * Thread-safe (no shared state).
  */
 int asp_amg_load(const char *path, const asp_context *ctx, asp_amg **out, asp_error *err);
+
+/**
+ * Parses the bytes of a .amg file (size bytes at data, borrowed for the call;
+ * data may be NULL when size is 0) into a new decomposition (*out, freed by the
+ * caller with asp_amg_destroy). name is the file name used in messages (NULL =
+ * "<memory>"). Every count and offset is checked against the bytes left before
+ * it sizes an allocation, so a forged count costs no more memory than a few
+ * times size. Returns 0, ASP_EINVAL (out NULL), ASP_EUNSUPPORTED (big-endian
+ * host), ASP_ENOMEM, or ASP_EFORMAT for anything damaged (bad magic or
+ * version, truncated or padded, checksum mismatch, a count the file cannot
+ * hold, non-finite values, level sizes not decreasing, a prolongation row that
+ * is empty, has columns out of order or out of range, or is not a partition of
+ * unity), with a message naming the file, the byte offset or level and row,
+ * the field and what was expected. On failure *out is unchanged and nothing
+ * stays allocated. Thread-safe (no shared state).
+ */
+int asp_amg_load_memory(const void *data, size_t size, const char *name, const asp_context *ctx, asp_amg **out,
+                        asp_error *err);
 
 /* ---- seeing it ---- */
 

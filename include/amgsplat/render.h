@@ -123,6 +123,16 @@ void asp_gl_context_framebuffer_size(const asp_gl_context *gl, uint32_t *width, 
  * points away from the azimuth direction, so no singularity). Perspective
  * projection with vertical field of view fov_y. Caller-owned plain struct.
  */
+/** Which world axis points up for the orbit camera; the zero value is +y (OpenGL, PLY from most meshes). */
+typedef enum asp_up_axis {
+    ASP_UP_Y = 0, /* azimuth 0 looks from +z */
+    ASP_UP_Z = 1, /* scanners, CAD, 3DS: azimuth 0 looks from -y (the "front" view of z-up tools) */
+    ASP_UP_X = 2, /* azimuth 0 looks from +z */
+    ASP_UP_NEG_Y = 3, /* the negative axes: the positive one's frame turned 180 degrees about its view axis */
+    ASP_UP_NEG_Z = 4,
+    ASP_UP_NEG_X = 5
+} asp_up_axis;
+
 typedef struct asp_camera {
     float target[3];
     float azimuth;    /* degrees */
@@ -131,9 +141,10 @@ typedef struct asp_camera {
     float fov_y;      /* vertical field of view, degrees, in (0, 180) */
     float aspect;     /* viewport width / height, > 0 */
     float z_near, z_far;
+    asp_up_axis up;   /* world axis shown upright at elevation 0; azimuth turns around it */
 } asp_camera;
 
-/** Defaults: target 0, azimuth 0, elevation 0, distance 3, fov_y 40, aspect 1, near 0.01, far 100. */
+/** Defaults: target 0, azimuth 0, elevation 0, distance 3, fov_y 40, aspect 1, near 0.01, far 100, up +y. */
 void asp_camera_init(asp_camera *cam);
 
 /**
@@ -320,6 +331,7 @@ typedef struct asp_viewer_desc {
     float azimuth;           /* degrees (asp_camera conventions) */
     float elevation;         /* degrees, -90..90 */
     float distance;          /* eye distance in bounding-sphere radii; 0 = the sphere fills the view */
+    asp_up_axis up;          /* world axis shown upright (asp_camera.up); the zero value is +y */
     unsigned amg_color;      /* .amg input: first colour mode, an asp_amg_color_mode (amg.h; 0 = classifier),
                                 or 3 = the points' own colours (refused when they have none) */
     const char *amg_level;   /* .amg input: first level, "L", "L-2" or an index; NULL = "L";

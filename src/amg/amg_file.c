@@ -7,8 +7,10 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/types.h>
 
 #include "amg/internal.h"
 #include "util/atomic_file.h"
@@ -142,19 +144,28 @@ int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err)
     return asp__atomic_commit(&f, err);
 }
 
-/* Bounds-checked reader over the file in memory; every failure names the byte offset. */
+/*
+ * Bounds-checked reader over the file bytes; every failure names the file and
+ * the byte offset. Offsets are size_t and every count is compared with the
+ * bytes left (by division, so nothing overflows) before it sizes an allocation.
+ */
 typedef struct reader {
     const uint8_t *buf;
-    size_t size, at;
+    size_t size, at; /* size excludes the CRC trailer once it has been checked */
     const char *path;
     asp_error *err;
 } reader;
 
+static size_t left(const reader *r)
+{
+    return r->size - r->at;
+}
+
 static int take(reader *r, void *dst, size_t len, const char *what)
 {
-    if (len > r->size - r->at)
+    if (len > left(r))
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': byte %zu: truncated in %s (%zu bytes needed, %zu left)",
-                             r->path, r->at, what, len, r->size - r->at);
+                             r->path, r->at, what, len, left(r));
     memcpy(dst, r->buf + r->at, len);
     r->at += len;
     return 0;
@@ -165,45 +176,121 @@ static int bad(reader *r, const char *what)
     return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': byte %zu: %s", r->path, r->at, what);
 }
 
-static int read_file(const char *path, const asp_context *ctx, uint8_t **buf, size_t *size, asp_error *err)
+/* The options block (128 bytes): what produced the hierarchy (docs/cli/decompose.md). */
+static int read_options(reader *r, asp_amg_desc *d)
 {
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
-    long end = -1;
-    if (fseek(fp, 0, SEEK_END) == 0)
-        end = ftell(fp);
-    if (end < 0 || fseek(fp, 0, SEEK_SET) != 0) {
-        fclose(fp);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': not a seekable file", path);
+    uint64_t u64[3], lim[2], reserved;
+    uint32_t u32[4];
+    double f[5];
+    int rc;
+    if ((rc = take(r, &d->epsilon, 8, "options")) || (rc = take(r, u64, 24, "options")) ||
+        (rc = take(r, u32, 16, "options")) || (rc = take(r, f, 40, "options")) || (rc = take(r, lim, 16, "options")) ||
+        (rc = take(r, &d->weak_coupling, 8, "options")) || (rc = take(r, &d->crease_cut, 8, "options")) ||
+        (rc = take(r, &reserved, 8, "options")))
+        return rc;
+    if (u32[0] > ASP_AMG_CLASSIFIER_MOMENT || u32[1] > ASP_AMG_COARSEN_HMIS || u32[2] > ASP_AMG_INTERP_EXTENDED_I)
+        return bad(r, "unknown classifier, coarsening or interpolation code");
+    /* drop_tol drives every product P^l (journal 2.3): a NaN would silently empty the basis */
+    if (!isfinite(d->epsilon) || !(f[4] < 0.01))
+        return bad(r, "options: non-finite epsilon or drop tolerance not below 0.01");
+    d->k_min = (size_t)u64[0];
+    d->k_max = (size_t)u64[1];
+    d->fan_k = (size_t)u64[2];
+    d->classifier = (asp_amg_classifier_kind)u32[0];
+    d->coarsen = (asp_amg_coarsen)u32[1];
+    d->interp = (asp_amg_interp)u32[2];
+    d->alpha = f[0];
+    d->beta = f[1];
+    d->strong_threshold = f[2];
+    d->trunc_factor = f[3];
+    d->drop_tol = f[4];
+    d->max_levels = (size_t)lim[0];
+    d->max_coarse = (size_t)lim[1];
+    return 0;
+}
+
+/*
+ * Level l's prolongation P^l (journal 2.3): rows x cols, every row non-empty
+ * with increasing columns and weights in [0,1] summing to 1 (a partition of
+ * unity, which the basis products rely on).
+ */
+static int read_prolongation(reader *r, size_t l, size_t rows, size_t cols, const asp_context *ctx, asp_amg_csr **out)
+{
+    uint64_t nnz;
+    int rc;
+    char msg[200];
+    if ((rc = take(r, &nnz, 8, "a prolongation")) != 0)
+        return rc;
+    /* 8 bytes per row pointer, 12 per entry: compare by division so a forged count cannot overflow */
+    const size_t avail = left(r), ptr_bytes = 8 * (rows + 1);
+    if (nnz < rows || nnz > avail / 12 || ptr_bytes > avail - 12 * (size_t)nnz) {
+        r->at -= 8;
+        snprintf(msg, sizeof msg, "level %zu: prolongation entry count %llu, expected %zu..%zu for %zu rows in the %zu "
+                 "bytes left", l, (unsigned long long)nnz, rows, avail >= ptr_bytes ? (avail - ptr_bytes) / 12 : 0,
+                 rows, avail);
+        return bad(r, msg);
     }
-    uint8_t *b = asp_alloc(ctx, (size_t)end + 1);
-    if (!b) {
-        fclose(fp);
-        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory for %ld bytes", path, end);
+    asp_amg_csr *p;
+    if ((rc = asp_amg_csr_create(rows, cols, (size_t)nnz, ctx, &p, r->err)) != 0)
+        return rc;
+    for (size_t q = 0; q <= rows; q++) {
+        uint64_t v;
+        memcpy(&v, r->buf + r->at, 8);
+        r->at += 8;
+        p->row_ptr[q] = (size_t)v;
+        /* row pointers are checked before any column is touched: entries beyond nnz are never read */
+        if (q == 0 ? v != 0 : (v <= p->row_ptr[q - 1] || v > nnz || (q == rows && v != nnz))) {
+            asp_amg_csr_destroy(p);
+            r->at -= 8;
+            snprintf(msg, sizeof msg,
+                     "level %zu: row pointer %zu of P is %llu, expected increasing from 0 to %llu (no empty row)", l, q,
+                     (unsigned long long)v, (unsigned long long)nnz);
+            return bad(r, msg);
+        }
     }
-    if (fread(b, 1, (size_t)end, fp) != (size_t)end) {
-        int e = errno;
-        fclose(fp);
-        asp_free(ctx, b);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, strerror(e));
+    memcpy(p->col, r->buf + r->at, 4 * (size_t)nnz);
+    r->at += 4 * (size_t)nnz;
+    memcpy(p->val, r->buf + r->at, 8 * (size_t)nnz);
+    r->at += 8 * (size_t)nnz;
+    for (size_t q = 0; q < rows; q++) {
+        double sum = 0;
+        for (size_t k = p->row_ptr[q]; k < p->row_ptr[q + 1]; k++) {
+            const int bad_col = p->col[k] >= cols || (k > p->row_ptr[q] && p->col[k] <= p->col[k - 1]);
+            if (bad_col || !(p->val[k] >= 0 && p->val[k] <= 1)) {
+                if (bad_col)
+                    rc = asp_error_set(r->err, ASP_EFORMAT,
+                                       "cannot read '%s': level %zu: row %zu of P has column %u, expected increasing "
+                                       "columns below %zu", r->path, l, q, (unsigned)p->col[k], cols);
+                else
+                    rc = asp_error_set(r->err, ASP_EFORMAT,
+                                       "cannot read '%s': level %zu: row %zu of P has weight %g, expected one in [0,1]",
+                                       r->path, l, q, p->val[k]);
+                asp_amg_csr_destroy(p);
+                return rc;
+            }
+            sum += p->val[k];
+        }
+        if (fabs(sum - 1) > 1e-6) {
+            asp_amg_csr_destroy(p);
+            return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': level %zu: row %zu of P sums to %g, expected 1",
+                                 r->path, l, q, sum);
+        }
     }
-    fclose(fp);
-    *buf = b;
-    *size = (size_t)end;
+    *out = p;
     return 0;
 }
 
 static int parse(reader *r, const asp_context *ctx, asp_amg *a)
 {
-    char magic[8];
-    uint32_t version, header, u32[4];
+    char magic[8], msg[200];
+    uint32_t version, header, u32[2];
     uint64_t n, nlevels, payload, u64;
     double origin[3];
     int rc;
     if (r->size < AMG_HEADER + 4)
-        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': %zu bytes is too short for an .amg file",
-                             r->path, r->size);
+        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': %zu bytes is too short for an .amg file (header %d bytes)",
+                             r->path, r->size, AMG_HEADER + 4);
+    /* the size was checked: the header fields cannot fail */
     take(r, magic, 8, "the header");
     if (memcmp(magic, AMG_MAGIC, 8) != 0)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': not an .amg file (bad magic)", r->path);
@@ -222,28 +309,44 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
     take(r, &nlevels, 8, "the header");
     take(r, &payload, 8, "the header");
     take(r, origin, 24, "the header");
-    if (payload > r->size || r->size - AMG_HEADER - 4 != payload)
+    if (payload != r->size - AMG_HEADER - 4)
         return asp_error_set(r->err, ASP_EFORMAT,
-                             "cannot read '%s': truncated or padded: the header promises %llu bytes, the file has %zu",
-                             r->path, (unsigned long long)(payload + AMG_HEADER + 4), r->size);
+                             "cannot read '%s': truncated or padded: the header promises %llu payload bytes, the file has %zu",
+                             r->path, (unsigned long long)payload, r->size - AMG_HEADER - 4);
     uint32_t stored;
     memcpy(&stored, r->buf + r->size - 4, 4);
     if (asp__crc32(0, r->buf, r->size - 4) != stored)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': checksum mismatch (file corrupted)", r->path);
+    r->size -= 4; /* the trailer is not payload */
     /* sizes come from a checksummed file, but a crafted one must still not make us allocate wildly */
-    if (n < 1 || n > payload / 28 || n > (uint64_t)INT32_MAX)
-        return bad(r, "point count does not fit the file");
-    if (nlevels < 1 || nlevels > 100)
-        return bad(r, "level count outside 1..100");
+    if (n < 1 || n > payload / 28 || n > (uint64_t)INT32_MAX) {
+        r->at = 16;
+        snprintf(msg, sizeof msg, "point count %llu, expected 1..%llu (28 bytes per point in a %llu-byte payload)",
+                 (unsigned long long)n, (unsigned long long)(payload / 28 < INT32_MAX ? payload / 28 : INT32_MAX),
+                 (unsigned long long)payload);
+        return bad(r, msg);
+    }
+    if (nlevels < 1 || nlevels > 100) {
+        r->at = 24;
+        snprintf(msg, sizeof msg, "level count %llu, expected 1..100", (unsigned long long)nlevels);
+        return bad(r, msg);
+    }
     /* the attribute bit set sits after the fixed per-point arrays; read it first to size the cloud */
     uint32_t attrs = 0;
     r->at = AMG_HEADER + 28 * (size_t)n;
     if ((rc = take(r, &attrs, 4, "the attribute set")) != 0)
         return rc;
+    r->at -= 4;
     if (attrs & ~(uint32_t)amg_attrs)
         return bad(r, "unknown point attribute bits");
-    if (payload < 28 * n + 8 + attr_bytes(attrs) * n)
-        return bad(r, "point attributes do not fit the file");
+    /* per-point data, options and one size per level must fit before anything per point is allocated */
+    if (payload < 28 * n + 8 + attr_bytes(attrs) * n + AMG_OPTIONS + 8 * nlevels) {
+        snprintf(msg, sizeof msg, "point attributes 0x%x of %llu points and %llu levels need %llu payload bytes, the "
+                 "file has %llu", (unsigned)attrs, (unsigned long long)n, (unsigned long long)nlevels,
+                 (unsigned long long)(28 * n + 8 + attr_bytes(attrs) * n + AMG_OPTIONS + 8 * nlevels),
+                 (unsigned long long)payload);
+        return bad(r, msg);
+    }
     r->at = AMG_HEADER;
     if ((rc = asp_cloud_create((size_t)n, ASP_ATTR_NORMALS | attrs, ctx, &a->cloud, r->err)) != 0)
         return rc;
@@ -255,7 +358,8 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
     a->prolong = asp_calloc(ctx, (size_t)nlevels, sizeof *a->prolong);
     a->nlevels = (size_t)nlevels;
     if (!a->classifier || !a->tangent || !a->level_size || !a->prolong)
-        return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory", r->path);
+        return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory for %llu points", r->path,
+                             (unsigned long long)n);
     asp_cloud *c = a->cloud;
     if ((rc = take(r, c->positions, 12 * (size_t)n, "positions")) ||
         (rc = take(r, a->tangent, 12 * (size_t)n, "tangent normals")) ||
@@ -284,90 +388,98 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
             !isfinite(a->classifier[i]))
             return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': point %zu: non-finite tangent normal or classifier",
                                  r->path, i);
-    asp_amg_desc *d = &a->desc;
-    take(r, &d->epsilon, 8, "options");
-    take(r, &u64, 8, "options");
-    d->k_min = (size_t)u64;
-    take(r, &u64, 8, "options");
-    d->k_max = (size_t)u64;
-    take(r, &u64, 8, "options");
-    d->fan_k = (size_t)u64;
-    take(r, u32, 16, "options");
-    if (u32[0] > ASP_AMG_CLASSIFIER_MOMENT || u32[1] > ASP_AMG_COARSEN_HMIS || u32[2] > ASP_AMG_INTERP_EXTENDED_I)
-        return bad(r, "unknown classifier, coarsening or interpolation code");
-    d->classifier = (asp_amg_classifier_kind)u32[0];
-    d->coarsen = (asp_amg_coarsen)u32[1];
-    d->interp = (asp_amg_interp)u32[2];
-    take(r, &d->alpha, 8, "options");
-    take(r, &d->beta, 8, "options");
-    take(r, &d->strong_threshold, 8, "options");
-    take(r, &d->trunc_factor, 8, "options");
-    take(r, &d->drop_tol, 8, "options");
-    take(r, &u64, 8, "options");
-    d->max_levels = (size_t)u64;
-    take(r, &u64, 8, "options");
-    d->max_coarse = (size_t)u64;
-    if ((rc = take(r, &d->weak_coupling, 8, "options")) || (rc = take(r, &d->crease_cut, 8, "options")) ||
-        (rc = take(r, &u64, 8, "options")))
+    if ((rc = read_options(r, &a->desc)) != 0)
         return rc;
-    if (!(d->drop_tol < 0.01))
-        return bad(r, "invalid drop tolerance");
     for (size_t l = 0; l < a->nlevels; l++) {
         if ((rc = take(r, &u64, 8, "level sizes")) != 0)
             return rc;
-        if (u64 < 1 || u64 > n || (l == 0 && u64 != n))
-            return bad(r, "level size outside 1..point count (level 0 must equal it)");
+        /* each coarsening step makes fewer unknowns (hierarchy.c stops when it does not, journal 2.3) */
+        uint64_t hi = l ? a->level_size[l - 1] - 1 : n;
+        if (u64 < 1 || u64 > hi || (l == 0 && u64 != n)) {
+            r->at -= 8;
+            snprintf(msg, sizeof msg, "level %zu: size %llu, expected %s%llu", l, (unsigned long long)u64,
+                     l ? "1.." : "the point count ", (unsigned long long)hi);
+            return bad(r, msg);
+        }
         a->level_size[l] = (size_t)u64;
     }
-    for (size_t l = 1; l < a->nlevels; l++) {
-        size_t rows = a->level_size[l - 1], cols = a->level_size[l];
-        uint64_t nnz;
-        if ((rc = take(r, &nnz, 8, "a prolongation")) != 0)
+    for (size_t l = 1; l < a->nlevels; l++)
+        if ((rc = read_prolongation(r, l, a->level_size[l - 1], a->level_size[l], ctx, &a->prolong[l])) != 0)
             return rc;
-        if (nnz > (r->size - r->at) / 12 || nnz < rows)
-            return bad(r, "prolongation size does not fit the file");
-        asp_amg_csr *p;
-        if ((rc = asp_amg_csr_create(rows, cols, (size_t)nnz, ctx, &p, r->err)) != 0)
-            return rc;
-        a->prolong[l] = p;
-        if ((rc = take(r, p->row_ptr, 8 * (rows + 1), "a prolongation")) ||
-            (rc = take(r, p->col, 4 * (size_t)nnz, "a prolongation")) ||
-            (rc = take(r, p->val, 8 * (size_t)nnz, "a prolongation")))
-            return rc;
-        if (p->row_ptr[0] != 0 || p->row_ptr[rows] != nnz)
-            return bad(r, "prolongation row pointers do not span its entries");
-        for (size_t q = 0; q < rows; q++) {
-            if (p->row_ptr[q + 1] <= p->row_ptr[q])
-                return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': level %zu: row %zu of P is empty or unordered",
-                                     r->path, l, q);
-            double sum = 0;
-            for (size_t k = p->row_ptr[q]; k < p->row_ptr[q + 1]; k++) {
-                if (p->col[k] >= cols || (k > p->row_ptr[q] && p->col[k] <= p->col[k - 1]))
-                    return asp_error_set(r->err, ASP_EFORMAT,
-                                         "cannot read '%s': level %zu: row %zu of P has a bad column", r->path, l, q);
-                if (!(p->val[k] >= 0 && p->val[k] <= 1))
-                    return asp_error_set(r->err, ASP_EFORMAT,
-                                         "cannot read '%s': level %zu: row %zu of P has a weight outside [0,1]", r->path,
-                                         l, q);
-                sum += p->val[k];
-            }
-            if (fabs(sum - 1) > 1e-6)
-                return asp_error_set(r->err, ASP_EFORMAT,
-                                     "cannot read '%s': level %zu: row %zu of P sums to %g, expected 1", r->path, l, q,
-                                     sum);
-        }
+    if (r->at != r->size) {
+        snprintf(msg, sizeof msg, "%zu unexpected bytes after the last level", left(r));
+        return bad(r, msg);
     }
-    if (r->at != r->size - 4)
-        return bad(r, "unexpected bytes after the last level");
-    a->info.epsilon = d->epsilon;
-    a->info.k_min = d->k_min;
-    a->info.k_max = d->k_max;
-    a->info.fan_k = d->fan_k;
+    a->info.epsilon = a->desc.epsilon;
+    a->info.k_min = a->desc.k_min;
+    a->info.k_max = a->desc.k_max;
+    a->info.fan_k = a->desc.fan_k;
+    return 0;
+}
+
+int asp_amg_load_memory(const void *data, size_t size, const char *name, const asp_context *ctx, asp_amg **out,
+                        asp_error *err)
+{
+    static const uint8_t empty[1];
+    const char *nm = name ? name : "<memory>";
+    if (!out)
+        return asp_error_set(err, ASP_EINVAL, "asp_amg_load_memory needs an output");
+    if (!host_is_little_endian())
+        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': .amg files are little-endian only", nm);
+    asp_amg *a;
+    int rc = asp__amg_alloc(ctx, &a, err);
+    if (rc)
+        return rc;
+    reader r = {data ? data : empty, data ? size : 0, 0, nm, err};
+    rc = parse(&r, ctx, a);
+    if (rc) {
+        asp_amg_destroy(a);
+        return rc;
+    }
+    *out = a;
+    return 0;
+}
+
+/* The whole file in one buffer (through ctx); size_t sizes, a file too large for memory is ASP_ENOMEM. */
+static int read_file(const char *path, const asp_context *ctx, uint8_t **buf, size_t *size, asp_error *err)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+    off_t end = -1;
+    if (fseeko(fp, 0, SEEK_END) == 0)
+        end = ftello(fp);
+    if (end < 0 || fseeko(fp, 0, SEEK_SET) != 0) {
+        fclose(fp);
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': not a seekable file", path);
+    }
+    if ((uint64_t)end >= SIZE_MAX) {
+        fclose(fp);
+        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': %llu bytes do not fit in memory", path,
+                             (unsigned long long)end);
+    }
+    const size_t n = (size_t)end;
+    uint8_t *b = asp_alloc(ctx, n + 1);
+    if (!b) {
+        fclose(fp);
+        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory for %zu bytes", path, n);
+    }
+    if (fread(b, 1, n, fp) != n) {
+        int e = ferror(fp) ? errno : 0;
+        fclose(fp);
+        asp_free(ctx, b);
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, e ? strerror(e) : "the file shrank while reading");
+    }
+    fclose(fp);
+    *buf = b;
+    *size = n;
     return 0;
 }
 
 int asp_amg_load(const char *path, const asp_context *ctx, asp_amg **out, asp_error *err)
 {
+    if (!path || !out)
+        return asp_error_set(err, ASP_EINVAL, "asp_amg_load needs a path and an output");
     if (!host_is_little_endian())
         return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': .amg files are little-endian only", path);
     uint8_t *buf = NULL;
@@ -375,16 +487,7 @@ int asp_amg_load(const char *path, const asp_context *ctx, asp_amg **out, asp_er
     int rc = read_file(path, ctx, &buf, &size, err);
     if (rc)
         return rc;
-    asp_amg *a;
-    rc = asp__amg_alloc(ctx, &a, err);
-    if (!rc) {
-        reader r = {buf, size, 0, path, err};
-        rc = parse(&r, ctx, a);
-        if (rc)
-            asp_amg_destroy(a);
-        else
-            *out = a;
-    }
+    rc = asp_amg_load_memory(buf, size, path, ctx, out, err);
     asp_free(ctx, buf);
     return rc;
 }

@@ -70,6 +70,8 @@ void cli_progress_end(struct cli_env *env);
 
 /* Parses "a,b[,c]" doubles into out (up to max); returns how many, -1 on junk. */
 int cli_parse_doubles(const char *s, double *out, int max);
+/* Parses --up: "y", "z", "x", "-y", "-z" or "-x" ("+y" = "y"); returns 0 or -1. */
+int cli_parse_up(const char *s, asp_up_axis *out);
 /* Parses "WxH"; returns 0 or -1. */
 int cli_parse_size2(const char *s, unsigned *w, unsigned *h);
 /* Writes s as a JSON string literal (quotes and escapes). */

@@ -63,6 +63,7 @@ struct render_opts {
     double transparency;
     double depth_window;
     const char *crease_angle;
+    const char *up;
     int outline;
     int no_normal_map;
     /* parsed */
@@ -76,6 +77,7 @@ struct render_opts {
     int dps_input;
     asp_amg_color_mode color_mode;
     asp_prim_render_options prim;
+    asp_up_axis up_axis;
     double point_crease; /* point inputs: crease angle of the clip planes, degrees; 0 = no clipping */
     const asp_context *ctx;
 };
@@ -365,6 +367,8 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
 {
     if (!o->output)
         return cli_usage_error(env, "missing -o OUT.png");
+    if (o->up && cli_parse_up(o->up, &o->up_axis) != 0)
+        return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
     if (!ends_with_ci(o->output, ".png"))
         return cli_usage_error(env, "output '%s' must end in .png", o->output);
     if (o->size && (cli_parse_size2(o->size, &o->width, &o->height) != 0 || o->width == 0 || o->height == 0 ||
@@ -425,6 +429,7 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const struct scene 
         asp_camera cam;
         asp_camera_init(&cam);
         cam.fov_y = (float)o->fov;
+        cam.up = o->up_axis;
         cam.azimuth = (float)(o->az + 360.0 * (double)i / (double)o->views);
         cam.elevation = (float)(i % 2 ? -o->el : o->el);
         asp_camera_fit(&cam, s->center, s->radius, (float)o->width / (float)o->height);
@@ -505,6 +510,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
         {"samples", 0, CLI_SIZE, &o.samples, "N", "multisamples per pixel, 0..64 (default 4)"},
         {"fov", 0, CLI_DOUBLE, &o.fov, "DEG", "vertical field of view (default 40)"},
+        {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y (default), z (scans, CAD), x, -y, -z or -x"},
         {"radius-scale", 0, CLI_DOUBLE, &o.radius_scale, "X", "multiply every disc, ellipse or square size by X (default 1)"},
         {0},
     };

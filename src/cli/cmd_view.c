@@ -29,6 +29,7 @@ static const char *const color_modes[] = {"classifier", "domains", "strict", "in
 struct view_opts {
     const char *size;
     const char *view;
+    const char *up;
     const char *renderer;
     const char *color;
     const char *level;
@@ -66,6 +67,8 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
         d->elevation = (float)v[1];
         d->distance = (float)v[2];
     }
+    if (o->up && cli_parse_up(o->up, &d->up) != 0)
+        return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
     if (!(o->tau >= 0) || !isfinite(o->tau))
         return cli_usage_error(env, "--tau expects pixels >= 0, got %g", o->tau);
     d->tolerance = (float)o->tau;
@@ -153,6 +156,7 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
     const struct cli_option opts[] = {
         {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "first view as in 'amgsplat render' (default 30,20)"},
+        {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y (default), z (scans, CAD), x, -y, -z or -x"},
         {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "first renderer (default disc; 'h' in the window lists them)"},
         {"tau", 0, CLI_DOUBLE, &o.tau, "PX", "screen tolerance of the hierarchy renderers in pixels (default 0)"},
         {"color", 0, CLI_STRING, &o.color, "MODE", ".amg: classifier (default), domains, strict or input"},

@@ -239,6 +239,24 @@ void cli_progress_end(struct cli_env *env)
     }
 }
 
+int cli_parse_up(const char *s, asp_up_axis *out)
+{
+    int neg = s[0] == '-';
+    if (s[0] == '+' || s[0] == '-')
+        s++;
+    asp_up_axis a;
+    if (strcmp(s, "y") == 0 || strcmp(s, "Y") == 0)
+        a = ASP_UP_Y;
+    else if (strcmp(s, "z") == 0 || strcmp(s, "Z") == 0)
+        a = ASP_UP_Z;
+    else if (strcmp(s, "x") == 0 || strcmp(s, "X") == 0)
+        a = ASP_UP_X;
+    else
+        return -1;
+    *out = neg ? (asp_up_axis)(a + ASP_UP_NEG_Y) : a;
+    return 0;
+}
+
 int cli_parse_doubles(const char *s, double *out, int max)
 {
     int n = 0;

@@ -1,5 +1,5 @@
 /*
- * Orbit camera: y-up azimuth/elevation around a target, perspective
+ * Orbit camera: azimuth/elevation around a target and an up axis (y, z or x), perspective
  * projection, and fitting a bounding sphere to the view. Pure math, no GL, so
  * it is unit-tested without a context. Matrices follow OpenGL conventions
  * (column-major, eye looks down -z, NDC z in -1..1).
@@ -33,6 +33,23 @@ static void orbit_axes(const asp_camera *cam, double back[3], double up[3])
     up[0] = -sin(el) * sin(az);
     up[1] = cos(el);
     up[2] = -sin(el) * cos(az);
+    // the y-up frame turned so its y lands on the chosen axis (right-handed rotations)
+    asp_up_axis axis = cam->up >= ASP_UP_NEG_Y && cam->up <= ASP_UP_NEG_X ? cam->up - ASP_UP_NEG_Y : cam->up;
+    for (int k = 0; k < 2; k++) {
+        double *v = k ? up : back;
+        if (axis != cam->up) { // a negative axis: first 180 degrees about z, y -> -y
+            v[0] = -v[0];
+            v[1] = -v[1];
+        }
+        double x = v[0], y = v[1], z = v[2];
+        if (axis == ASP_UP_Z) { // 90 degrees about +x: y -> z, z -> -y
+            v[1] = -z;
+            v[2] = y;
+        } else if (axis == ASP_UP_X) { // -90 degrees about +z: y -> x, x -> -y
+            v[0] = y;
+            v[1] = -x;
+        }
+    }
 }
 
 void asp_camera_eye(const asp_camera *cam, float eye[3])

@@ -92,6 +92,9 @@ int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err)
         return asp_error_set(err, ASP_EINVAL,
                              "view %g,%g,%g is invalid (expected EL in -90..90 and DIST >= 0 radii)", desc->azimuth,
                              desc->elevation, desc->distance);
+    if ((unsigned)desc->up > ASP_UP_NEG_X)
+        return asp_error_set(err, ASP_EINVAL, "unknown up axis %u (expected 0..5: y, z, x, -y, -z, -x)",
+                             (unsigned)desc->up);
     if (!asp_prim_render_method_name((asp_prim_render_method)desc->prim_method))
         return asp_error_set(err, ASP_EINVAL, "unknown .dps method %u (expected 0..%u)", desc->prim_method,
                              (unsigned)ASP_PRIM_RENDER_POLYGONS);
@@ -189,6 +192,7 @@ static void reset_view(viewer *v)
     const asp_viewer_desc *d = v->desc;
     float aspect = v->cam.aspect > 0 ? v->cam.aspect : 1.0f;
     asp_camera_init(&v->cam);
+    v->cam.up = d->up;
     v->cam.azimuth = d->set_view ? d->azimuth : 30.0f;
     v->cam.elevation = d->set_view ? d->elevation : 20.0f;
     // the same framing as amgsplat render, so a scripted view matches its --view

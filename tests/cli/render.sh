@@ -104,6 +104,21 @@ ssim=$("$AMGSPLAT" imgdiff "$T/oc.png" "$T/os.png" --json | python3 -c "import j
 python3 -c "import sys; sys.exit(not $ssim > 0.97)" || fail "clipped discs vs clipped splats SSIM $ssim"
 expect_fail 2 "square renderer does not clip" "$AMGSPLAT" render "$T/o.ply" -o "$T/x.png" --renderer square --crease-angle 60
 expect_fail 2 "--crease-angle expects" "$AMGSPLAT" render "$T/o.ply" -o "$T/x.png" --crease-angle 95
+# --up: a column along z stands upright with --up z (tall foreground box), lies inclined without it
+python3 -c "
+import math
+for i in range(4000):
+    t = i * 2.399963; z = -1 + 2 * i / 3999.0
+    print('%g %g %g %g %g 0' % (0.1 * math.cos(t), 0.1 * math.sin(t), z, math.cos(t), math.sin(t)))
+" >"$T/column.xyz"
+"$AMGSPLAT" render "$T/column.xyz" -o "$T/colz.png" --up z --size 96x96 --samples 0 -q
+"$AMGSPLAT" render "$T/column.xyz" -o "$T/coly.png" --size 96x96 --samples 0 -q
+box="(lambda xs, ys: (max(xs) - min(xs) + 1, max(ys) - min(ys) + 1))([x for x in range(w) for y in range(h) if px(x, y)[:3] != (255, 255, 255)], [y for x in range(w) for y in range(h) if px(x, y)[:3] != (255, 255, 255)])"
+check "$T/colz.png" "(lambda b: b[1] > 4 * b[0])($box)"
+check "$T/coly.png" "(lambda b: b[1] < 2 * b[0])($box)"
+"$AMGSPLAT" render "$T/column.xyz" -o "$T/colnz.png" --up -z --size 96x96 --samples 0 -q
+check "$T/colnz.png" "(lambda b: b[1] > 4 * b[0])($box)"
+expect_fail 2 "--up expects" "$AMGSPLAT" render "$T/column.xyz" -o "$T/x.png" --up w
 printf '0 0 0\n1 0 0\n0 1 0\n1 1 0\n' >"$T/plain.xyz"
 expect_fail 1 "needs normals" "$AMGSPLAT" render "$T/plain.xyz" -o "$T/x.png" --crease-angle 60
 # decompose starts MPI, whose leaks the ASan build's suppressions match only with full stacks (CMakeLists.txt)

@@ -194,5 +194,56 @@ static void test_clip_inside_sphere(void)
     CHECK_NEAR(cam.z_far, 1.01 * 12.0, 1e-5);
 }
 
+/*
+ * The up axis: at elevation 0 the chosen axis is image up, elevation raises
+ * the eye along it, azimuth turns around it, and the frame stays orthonormal
+ * and right-handed. Azimuth 0 looks from +z (y up, x up) or from -y (z up,
+ * the front view of z-up tools).
+ */
+static void test_up_axis(void)
+{
+    static const struct {
+        asp_up_axis up;
+        float axis[3], front[3]; /* image up, and the eye direction at azimuth 0 */
+    } cases[] = {
+        {ASP_UP_Y, {0, 1, 0}, {0, 0, 1}},
+        {ASP_UP_Z, {0, 0, 1}, {0, -1, 0}},
+        {ASP_UP_X, {1, 0, 0}, {0, 0, 1}},
+        {ASP_UP_NEG_Y, {0, -1, 0}, {0, 0, 1}},
+        {ASP_UP_NEG_Z, {0, 0, -1}, {0, -1, 0}},
+        {ASP_UP_NEG_X, {-1, 0, 0}, {0, 0, 1}},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        asp_camera cam;
+        asp_camera_init(&cam);
+        cam.up = cases[c].up;
+        float eye[3], m[16];
+        asp_camera_eye(&cam, eye);
+        for (int k = 0; k < 3; k++)
+            CHECK_NEAR(eye[k], cam.distance * cases[c].front[k], 1e-5);
+        asp_camera_view_matrix(&cam, m);
+        double u[4];
+        mul_point(m, cases[c].axis, u);
+        CHECK_MSG(u[1] > 0.999, "up axis %d is not image up: %g %g %g", (int)cases[c].up, u[0], u[1], u[2]);
+        // right-handed: right x up = back (rows 0, 1, 2 of the rotation)
+        double x[3] = {m[0], m[4], m[8]}, y[3] = {m[1], m[5], m[9]}, z[3] = {m[2], m[6], m[10]};
+        CHECK_NEAR(x[1] * y[2] - x[2] * y[1], z[0], 1e-6);
+        CHECK_NEAR(x[2] * y[0] - x[0] * y[2], z[1], 1e-6);
+        CHECK_NEAR(x[0] * y[1] - x[1] * y[0], z[2], 1e-6);
+        // elevation 90 puts the eye on the up axis; any azimuth keeps it at the same height
+        cam.elevation = 90;
+        asp_camera_eye(&cam, eye);
+        for (int k = 0; k < 3; k++)
+            CHECK_NEAR(eye[k], cam.distance * cases[c].axis[k], 1e-5);
+        cam.elevation = 30;
+        for (float az = 0; az < 360; az += 45) {
+            cam.azimuth = az;
+            asp_camera_eye(&cam, eye);
+            double h = eye[0] * cases[c].axis[0] + eye[1] * cases[c].axis[1] + eye[2] * cases[c].axis[2];
+            CHECK_NEAR(h, cam.distance * 0.5, 1e-5);
+        }
+    }
+}
+
 TEST_MAIN(TEST_CASE(test_defaults), TEST_CASE(test_view_frame), TEST_CASE(test_project_known_points),
-          TEST_CASE(test_fit_sphere_in_frustum), TEST_CASE(test_clip_inside_sphere))
+          TEST_CASE(test_fit_sphere_in_frustum), TEST_CASE(test_clip_inside_sphere), TEST_CASE(test_up_axis))
