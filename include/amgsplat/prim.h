@@ -219,14 +219,31 @@ int asp_prim_neighbours(const asp_amg_csr *dom, double fraction, const asp_conte
 int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err);
 
 /**
- * Reads a .dps file into a new asp_dps (*out). Returns 0, ASP_EIO, ASP_ENOMEM,
- * ASP_EFORMAT for anything damaged (wrong magic or version, truncated, checksum
- * mismatch, counts the file cannot hold, a texture rectangle outside its atlas,
- * a neighbour index out of range, a non-finite value), with a message naming
- * the file, the level and primitive, and what was expected. Sizes are checked
- * against the file length before any allocation. On failure *out is unchanged.
+ * Reads a .dps file into a new asp_dps (*out): reads the whole file and parses
+ * it with asp_dps_load_memory. Returns 0, ASP_EINVAL (path or out NULL),
+ * ASP_EIO (cannot open/read), ASP_ENOMEM, or ASP_EFORMAT as
+ * asp_dps_load_memory. On failure *out is unchanged. Thread-safe.
  */
 int asp_dps_load(const char *path, const asp_context *ctx, asp_dps **out, asp_error *err);
+
+/**
+ * Parses the bytes of a .dps file (size bytes at data, borrowed for the call;
+ * data may be NULL when size is 0) into a new asp_dps (*out, freed by the
+ * caller with asp_dps_destroy). name is the file name used in messages (NULL =
+ * "<memory>"). Returns 0, ASP_EINVAL (out NULL), ASP_ENOMEM, or ASP_EFORMAT
+ * for anything damaged (wrong magic or version, truncated or trailing bytes,
+ * checksum mismatch, a count the bytes left cannot hold, levels not increasing
+ * or not below amg_levels, an unknown method/shape/normalisation code, a
+ * texture rectangle outside its atlas, a neighbour index out of range, a
+ * neighbour list not increasing or naming its own primitive, a basis index
+ * not below basis_count, a non-finite value), with a message naming the file,
+ * the byte offset, the level and primitive, the field and what was expected.
+ * Every count is checked against the bytes left before any allocation, so a
+ * forged count costs no more memory than about twice size. On failure *out is
+ * unchanged and nothing stays allocated. Thread-safe (no shared state).
+ */
+int asp_dps_load_memory(const void *data, size_t size, const char *name, const asp_context *ctx, asp_dps **out,
+                        asp_error *err);
 
 /** One row of the thesis Table 5.2 for a level (what `amgsplat info X.dps` prints). */
 typedef struct asp_dps_summary {

@@ -272,8 +272,8 @@ static int read_prolongation(reader *r, size_t l, size_t rows, size_t cols, cons
         }
         if (fabs(sum - 1) > 1e-6) {
             asp_amg_csr_destroy(p);
-            return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': level %zu: row %zu of P sums to %g, expected 1",
-                                 r->path, l, q, sum);
+            return asp_error_set(r->err, ASP_EFORMAT,
+                                 "cannot read '%s': level %zu: row %zu of P sums to %g, expected 1", r->path, l, q, sum);
         }
     }
     *out = p;
@@ -288,8 +288,9 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
     double origin[3];
     int rc;
     if (r->size < AMG_HEADER + 4)
-        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': %zu bytes is too short for an .amg file (header %d bytes)",
-                             r->path, r->size, AMG_HEADER + 4);
+        return asp_error_set(r->err, ASP_EFORMAT,
+                             "cannot read '%s': %zu bytes is too short for an .amg file (expected at least %d)", r->path,
+                             r->size, AMG_HEADER + 4);
     /* the size was checked: the header fields cannot fail */
     take(r, magic, 8, "the header");
     if (memcmp(magic, AMG_MAGIC, 8) != 0)
@@ -311,7 +312,8 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
     take(r, origin, 24, "the header");
     if (payload != r->size - AMG_HEADER - 4)
         return asp_error_set(r->err, ASP_EFORMAT,
-                             "cannot read '%s': truncated or padded: the header promises %llu payload bytes, the file has %zu",
+                             "cannot read '%s': truncated or padded: the header promises %llu payload bytes, the "
+                             "file has %zu",
                              r->path, (unsigned long long)payload, r->size - AMG_HEADER - 4);
     uint32_t stored;
     memcpy(&stored, r->buf + r->size - 4, 4);
@@ -468,7 +470,8 @@ static int read_file(const char *path, const asp_context *ctx, uint8_t **buf, si
         int e = ferror(fp) ? errno : 0;
         fclose(fp);
         asp_free(ctx, b);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, e ? strerror(e) : "the file shrank while reading");
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path,
+                             e ? strerror(e) : "the file shrank while reading");
     }
     fclose(fp);
     *buf = b;

@@ -6,8 +6,10 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/types.h>
 
 #include "prim/internal.h"
 #include "util/atomic_file.h"
@@ -175,6 +177,12 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
 
 /* ---- reading ---- */
 
+/*
+ * The file bytes, consumed front to back. Offsets are size_t; every get_* is
+ * preceded by a check that enough bytes are left, and every count is compared
+ * with the bytes left (by division, so nothing overflows) before it sizes an
+ * allocation.
+ */
 typedef struct reader {
     const uint8_t *base, *p;
     size_t left;
@@ -241,17 +249,41 @@ static int prim_finite(const asp_prim *p)
     return isfinite(s) && p->half_u >= 0 && p->half_v >= 0 && p->texel > 0;
 }
 
+/* "cannot read 'x.dps': byte 1234: <what>" */
 static int bad(reader *r, asp_error *err, const char *what)
 {
+    return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': byte %zu: %s", r->path, (size_t)(r->p - r->base), what);
+}
+
+/* The same for what concerns the whole file (magic, version, size, checksum): no byte offset. */
+static int bad_file(reader *r, asp_error *err, const char *what)
+{
     return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': %s", r->path, what);
+}
+
+/* The primitives' neighbour lists (journal section 4): sorted within each range, never the primitive itself. */
+static int check_neighbours(reader *r, const asp_dps_level *lv, size_t li, asp_error *err)
+{
+    char msg[160];
+    for (size_t k = 0; k < lv->prim_count; k++) {
+        const asp_prim *p = &lv->prims[k];
+        for (size_t q = p->neighbour_first; q < (size_t)p->neighbour_first + p->neighbour_count; q++)
+            if (lv->neighbours[q] == k || (q > p->neighbour_first && lv->neighbours[q] <= lv->neighbours[q - 1])) {
+                snprintf(msg, sizeof msg, "level %zu, primitive %zu: neighbour %u, expected increasing indices other "
+                         "than the primitive's own", li, k, lv->neighbours[q]);
+                return bad(r, err, msg);
+            }
+    }
+    return 0;
 }
 
 static int read_level(reader *r, const asp_dps *dps, size_t li, asp_dps_level *lv, const asp_context *ctx,
                       asp_error *err)
 {
-    char msg[160];
+    char msg[200];
     if (r->left < DPS_LEVEL) {
-        snprintf(msg, sizeof msg, "level %zu: truncated level header", li);
+        snprintf(msg, sizeof msg, "level %zu: truncated level header (%d bytes needed, %zu left)", li, DPS_LEVEL,
+                 r->left);
         return bad(r, err, msg);
     }
     lv->level = get_u32(r);
@@ -262,26 +294,43 @@ static int read_level(reader *r, const asp_dps *dps, size_t li, asp_dps_level *l
     (void)get_u32(r);
     lv->texels = get_u64(r);
     lv->error = get_f64(r), lv->error_norm = get_f64(r), lv->t_basis = get_f64(r), lv->t_construct = get_f64(r);
-    if (lv->level >= dps->amg_levels) {
-        snprintf(msg, sizeof msg, "level %zu: AMG level %u, expected below %u", li, lv->level, dps->amg_levels);
+    /* levels are stored finest first without duplicates (asp_prim_build) */
+    const uint32_t lo = li ? dps->levels[li - 1].level + 1 : 0;
+    if (lv->level < lo || lv->level >= dps->amg_levels) {
+        snprintf(msg, sizeof msg, "level %zu: AMG level %u, expected %u..%u (increasing, below the level count)", li,
+                 lv->level, lo, dps->amg_levels - 1);
         return bad(r, err, msg);
     }
-    if (np == 0 || aw == 0 || ah == 0 || aw > DPS_SIDE || ah > DPS_SIDE || has_n > 1) {
-        snprintf(msg, sizeof msg, "level %zu: %llu primitives in a %ux%u atlas, expected at least one in at most %d",
-                 li, (unsigned long long)np, aw, ah, DPS_SIDE);
+    /* the counts must fit the bytes left before anything is allocated */
+    const size_t avail = r->left;
+    if (np == 0 || np > avail / DPS_PRIM) {
+        snprintf(msg, sizeof msg, "level %zu: primitive count %llu, expected 1..%zu (%d bytes each, %zu bytes left)",
+                 li, (unsigned long long)np, avail / DPS_PRIM, DPS_PRIM, avail);
         return bad(r, err, msg);
     }
-    uint64_t atlas = 4 * (uint64_t)aw * ah;
-    if (np > r->left / DPS_PRIM || nn > r->left / 4 ||
-        np * DPS_PRIM + nn * 4 + atlas * (1 + has_n) > r->left) {
-        snprintf(msg, sizeof msg, "level %zu: truncated: %llu primitives, %llu neighbours and the atlas need more "
-                 "than the %zu bytes left", li, (unsigned long long)np, (unsigned long long)nn, r->left);
+    const size_t after_prims = avail - (size_t)np * DPS_PRIM;
+    if (nn > after_prims / 4) {
+        snprintf(msg, sizeof msg, "level %zu: neighbour count %llu, expected at most %zu (4 bytes each, %zu bytes "
+                 "left after the primitives)", li, (unsigned long long)nn, after_prims / 4, after_prims);
+        return bad(r, err, msg);
+    }
+    if (aw == 0 || ah == 0 || aw > DPS_SIDE || ah > DPS_SIDE || has_n > 1) {
+        snprintf(msg, sizeof msg, "level %zu: %ux%u atlas with normal flag %u, expected sides 1..%d and a flag 0 or 1",
+                 li, aw, ah, has_n, DPS_SIDE);
+        return bad(r, err, msg);
+    }
+    const size_t after_nbrs = after_prims - (size_t)nn * 4, atlas = 4 * (size_t)aw * ah;
+    if (atlas * (1 + has_n) > after_nbrs) {
+        snprintf(msg, sizeof msg, "level %zu: truncated: %ux%u atlas%s of %zu bytes, expected at most the %zu "
+                 "bytes left after the neighbours", li, aw, ah, has_n ? "es (colour and normal)" : "",
+                 atlas * (1 + has_n), after_nbrs);
         return bad(r, err, msg);
     }
     lv->prims = asp_calloc(ctx, (size_t)np, sizeof *lv->prims); /* zeroed padding: records compare with memcmp */
     lv->neighbours = asp_alloc(ctx, (size_t)(nn ? nn : 1) * sizeof *lv->neighbours);
     if (!lv->prims || !lv->neighbours)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", r->path);
+        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory for %llu primitives", r->path,
+                             (unsigned long long)np);
     lv->prim_count = (size_t)np;
     lv->neighbour_total = (size_t)nn;
     uint64_t texels = 0;
@@ -303,6 +352,11 @@ static int read_level(reader *r, const asp_dps *dps, size_t li, asp_dps_level *l
                      p->neighbour_first, p->neighbour_count, (unsigned long long)nn);
             return bad(r, err, msg);
         }
+        if (p->basis >= lv->basis_count) {
+            snprintf(msg, sizeof msg, "level %zu, primitive %zu: basis function %u, expected below %u", li, k,
+                     p->basis, lv->basis_count);
+            return bad(r, err, msg);
+        }
         texels += (uint64_t)p->tex_w * p->tex_h;
     }
     for (size_t k = 0; k < nn; k++) {
@@ -313,39 +367,81 @@ static int read_level(reader *r, const asp_dps *dps, size_t li, asp_dps_level *l
             return bad(r, err, msg);
         }
     }
+    int rc = check_neighbours(r, lv, li, err);
+    if (rc)
+        return rc;
     if (texels != lv->texels) {
         snprintf(msg, sizeof msg, "level %zu: %llu texels recorded, the rectangles hold %llu", li,
                  (unsigned long long)lv->texels, (unsigned long long)texels);
         return bad(r, err, msg);
     }
-    int rc = asp_image_init(&lv->atlas, aw, ah, err);
+    rc = asp_image_init(&lv->atlas, aw, ah, err);
     if (!rc && has_n)
         rc = asp_image_init(&lv->normal_atlas, aw, ah, err);
     if (rc)
         return rc;
-    memcpy(lv->atlas.pixels, r->p, (size_t)atlas);
-    r->p += atlas, r->left -= (size_t)atlas;
+    memcpy(lv->atlas.pixels, r->p, atlas);
+    r->p += atlas, r->left -= atlas;
     if (has_n) {
-        memcpy(lv->normal_atlas.pixels, r->p, (size_t)atlas);
-        r->p += atlas, r->left -= (size_t)atlas;
+        memcpy(lv->normal_atlas.pixels, r->p, atlas);
+        r->p += atlas, r->left -= atlas;
     }
+    return 0;
+}
+
+/* The build parameters (128 bytes) and the source name. */
+static int read_params(reader *r, asp_dps *dps, asp_error *err)
+{
+    char msg[200];
+    asp_prim_desc *d = &dps->desc;
+    d->tau = get_f64(r), d->texel_size = get_f64(r), d->width = get_f64(r);
+    d->neighbour_fraction = get_f64(r), d->merge_flatness = get_f64(r), d->merge_angle = get_f64(r);
+    d->max_texture = get_u32(r);
+    const uint32_t method = get_u32(r), shape = get_u32(r), normalise = get_u32(r);
+    d->unweighted = (int)get_u32(r), d->project_radii = (int)get_u32(r), d->no_extend_color = (int)get_u32(r);
+    d->normal_map = (int)get_u32(r), d->merge = (int)get_u32(r), d->padding = get_u32(r);
+    /* enum values outside their range would index name tables (asp_prim_method_name) */
+    if (method > ASP_PRIM_RADIAL || shape > ASP_PRIM_GAUSSIAN || normalise > ASP_PRIM_NORM_GE1) {
+        snprintf(msg, sizeof msg, "parameters: method %u, shape %u, normalisation %u, expected at most %d, %d, %d",
+                 method, shape, normalise, ASP_PRIM_RADIAL, ASP_PRIM_GAUSSIAN, ASP_PRIM_NORM_GE1);
+        return bad(r, err, msg);
+    }
+    d->method = (asp_prim_method)method;
+    d->shape = (asp_prim_shape)shape;
+    d->normalise = (asp_prim_normalise)normalise;
+    if (!isfinite(d->tau + d->texel_size + d->width + d->neighbour_fraction + d->merge_flatness + d->merge_angle))
+        return bad(r, err, "parameters: a non-finite value, expected finite resolved options");
+    r->p += DPS_PARAMS - 88, r->left -= DPS_PARAMS - 88;
+    uint32_t slen = get_u32(r);
+    if (slen >= sizeof dps->source || slen > r->left) {
+        snprintf(msg, sizeof msg, "source name of %u bytes, expected below %zu and within the %zu bytes left", slen,
+                 sizeof dps->source, r->left);
+        return bad(r, err, msg);
+    }
+    memcpy(dps->source, r->p, slen);
+    dps->source[slen] = 0;
+    r->p += slen, r->left -= slen;
     return 0;
 }
 
 static int parse(reader *r, const asp_context *ctx, asp_dps *dps, asp_error *err)
 {
-    char msg[160];
-    size_t total = r->left;
-    if (total < DPS_HEADER + 4 || memcmp(r->p, DPS_MAGIC, 8) != 0)
-        return bad(r, err, total < 8 || memcmp(r->p, DPS_MAGIC, 6) != 0
-                               ? "not a .dps file (expected the magic 'ASPDPS')"
-                               : "truncated header");
+    char msg[200];
+    const size_t total = r->left;
+    if (total < 8 || memcmp(r->p, DPS_MAGIC, 8) != 0)
+        return bad_file(r, err, total >= 6 && memcmp(r->p, DPS_MAGIC, 6) == 0
+                               ? "unsupported variant of the magic 'ASPDPS'"
+                               : "not a .dps file (expected the magic 'ASPDPS')");
+    if (total < DPS_HEADER + 4) {
+        snprintf(msg, sizeof msg, "truncated header (%zu bytes, expected at least %d)", total, DPS_HEADER + 4);
+        return bad_file(r, err, msg);
+    }
     r->p += 8, r->left -= 8;
     uint32_t version = get_u32(r), hsize = get_u32(r);
     if (version != DPS_VERSION || hsize != DPS_HEADER) {
         snprintf(msg, sizeof msg, "unsupported version %u (header %u bytes), expected version %d", version, hsize,
                  DPS_VERSION);
-        return bad(r, err, msg);
+        return bad_file(r, err, msg);
     }
     uint64_t nl = get_u64(r), payload = get_u64(r);
     dps->source_points = get_u64(r);
@@ -354,57 +450,72 @@ static int parse(reader *r, const asp_context *ctx, asp_dps *dps, asp_error *err
     (void)get_u32(r);
     dps->skipped_levels = get_u32(r);
     (void)get_u32(r);
-    if (payload != total - DPS_HEADER - 4) {
+    const size_t have = total - DPS_HEADER - 4;
+    if (payload != have) {
         snprintf(msg, sizeof msg, "%s: header says %llu payload bytes, the file has %zu",
-                 payload > total - DPS_HEADER - 4 ? "truncated" : "trailing bytes", (unsigned long long)payload,
-                 total - DPS_HEADER - 4);
-        return bad(r, err, msg);
+                 payload > have ? "truncated" : "trailing bytes", (unsigned long long)payload, have);
+        return bad_file(r, err, msg);
     }
-    const uint8_t *end = r->p + payload;
+    /* the CRC-32 trailer covers everything before it, header included */
+    const uint8_t *end = r->base + total - 4;
     uint32_t stored = (uint32_t)end[0] | (uint32_t)end[1] << 8 | (uint32_t)end[2] << 16 | (uint32_t)end[3] << 24;
     uint32_t crc = asp__crc32(0, r->base, total - 4);
     if (crc != stored) {
         snprintf(msg, sizeof msg, "checksum mismatch (stored 0x%08x, computed 0x%08x): the file is damaged", stored,
                  crc);
-        return bad(r, err, msg);
+        return bad_file(r, err, msg);
     }
-    r->left = (size_t)payload;
-    if (nl == 0 || nl > 64 || dps->amg_levels == 0 || !(dps->mean_radius > 0) || r->left < DPS_PARAMS + 4) {
-        snprintf(msg, sizeof msg, "%llu levels of a %u-level decomposition, mean radius %g: expected 1..64 levels",
+    r->left = have;
+    if (nl == 0 || nl > 64 || dps->amg_levels == 0 || !(dps->mean_radius > 0) || !isfinite(dps->mean_radius)) {
+        r->p = r->base + 16;
+        snprintf(msg, sizeof msg, "level count %llu of a %u-level decomposition, mean radius %g: expected 1..64 "
+                 "levels, at least one AMG level and a finite radius above 0",
                  (unsigned long long)nl, dps->amg_levels, dps->mean_radius);
         return bad(r, err, msg);
     }
-    asp_prim_desc *d = &dps->desc;
-    d->tau = get_f64(r), d->texel_size = get_f64(r), d->width = get_f64(r);
-    d->neighbour_fraction = get_f64(r), d->merge_flatness = get_f64(r), d->merge_angle = get_f64(r);
-    d->max_texture = get_u32(r);
-    d->method = (asp_prim_method)get_u32(r);
-    d->shape = (asp_prim_shape)get_u32(r);
-    d->normalise = (asp_prim_normalise)get_u32(r);
-    d->unweighted = (int)get_u32(r), d->project_radii = (int)get_u32(r), d->no_extend_color = (int)get_u32(r);
-    d->normal_map = (int)get_u32(r), d->merge = (int)get_u32(r), d->padding = get_u32(r);
-    r->p += DPS_PARAMS - 88, r->left -= DPS_PARAMS - 88;
-    uint32_t slen = get_u32(r);
-    if (slen >= sizeof dps->source || slen > r->left) {
-        snprintf(msg, sizeof msg, "source name of %u bytes, expected below %zu", slen, sizeof dps->source);
+    if (r->left < DPS_PARAMS + 4 + (size_t)nl * DPS_LEVEL) {
+        snprintf(msg, sizeof msg, "truncated: %llu levels need at least %llu payload bytes, the file has %zu",
+                 (unsigned long long)nl, (unsigned long long)(DPS_PARAMS + 4 + nl * DPS_LEVEL), r->left);
         return bad(r, err, msg);
     }
-    memcpy(dps->source, r->p, slen);
-    dps->source[slen] = 0;
-    r->p += slen, r->left -= slen;
+    int rc = read_params(r, dps, err);
+    if (rc)
+        return rc;
     dps->levels = asp_calloc(ctx, (size_t)nl, sizeof *dps->levels);
     if (!dps->levels)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", r->path);
+        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory for %llu levels", r->path,
+                             (unsigned long long)nl);
     for (size_t i = 0; i < nl; i++) {
         dps->level_count = i + 1;
-        int rc = read_level(r, dps, i, &dps->levels[i], ctx, err);
-        if (rc)
+        if ((rc = read_level(r, dps, i, &dps->levels[i], ctx, err)) != 0)
             return rc;
     }
     if (r->left != 0) {
         snprintf(msg, sizeof msg, "%zu unexpected bytes after the last level", r->left);
         return bad(r, err, msg);
     }
+    return 0;
+}
+
+int asp_dps_load_memory(const void *data, size_t size, const char *name, const asp_context *ctx, asp_dps **out,
+                        asp_error *err)
+{
+    static const uint8_t empty[1];
+    if (!out)
+        return asp_error_set(err, ASP_EINVAL, "asp_dps_load_memory needs an output");
+    asp_dps *dps = asp_calloc(ctx, 1, sizeof *dps);
+    const char *nm = name ? name : "<memory>";
+    if (!dps)
+        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory", nm);
+    dps->ctx = ctx ? *ctx : (asp_context){0};
+    const uint8_t *b = data ? data : empty;
+    reader r = {b, b, data ? size : 0, nm};
+    int rc = parse(&r, ctx, dps, err);
+    if (rc) {
+        asp_dps_destroy(dps);
+        return rc;
+    }
+    *out = dps;
     return 0;
 }
 
@@ -415,41 +526,35 @@ int asp_dps_load(const char *path, const asp_context *ctx, asp_dps **out, asp_er
     FILE *fp = fopen(path, "rb");
     if (!fp)
         return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
-    long size = -1;
-    if (fseek(fp, 0, SEEK_END) == 0)
-        size = ftell(fp);
-    if (size < 0 || fseek(fp, 0, SEEK_SET) != 0) {
+    off_t end = -1;
+    if (fseeko(fp, 0, SEEK_END) == 0)
+        end = ftello(fp);
+    if (end < 0 || fseeko(fp, 0, SEEK_SET) != 0) {
         int e = errno;
         fclose(fp);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, strerror(e));
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, end < 0 ? "not a seekable file" : strerror(e));
     }
-    uint8_t *buf = asp_alloc(ctx, (size_t)size + 1);
+    if ((uint64_t)end >= SIZE_MAX) {
+        fclose(fp);
+        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': %llu bytes do not fit in memory", path,
+                             (unsigned long long)end);
+    }
+    const size_t size = (size_t)end;
+    uint8_t *buf = asp_alloc(ctx, size + 1);
     if (!buf) {
         fclose(fp);
-        return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s' (%ld bytes)", path, size);
+        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory for %zu bytes", path, size);
     }
-    size_t got = fread(buf, 1, (size_t)size, fp);
+    size_t got = fread(buf, 1, size, fp);
     int rerr = ferror(fp);
     fclose(fp);
-    if (rerr || got != (size_t)size) {
+    if (rerr || got != size) {
         asp_free(ctx, buf);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': short read", path);
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': short read (%zu of %zu bytes)", path, got, size);
     }
-    asp_dps *dps = asp_calloc(ctx, 1, sizeof *dps);
-    if (!dps) {
-        asp_free(ctx, buf);
-        return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", path);
-    }
-    dps->ctx = ctx ? *ctx : (asp_context){0};
-    reader r = {buf, buf, (size_t)size, path};
-    int rc = parse(&r, ctx, dps, err);
+    int rc = asp_dps_load_memory(buf, size, path, ctx, out, err);
     asp_free(ctx, buf);
-    if (rc) {
-        asp_dps_destroy(dps);
-        return rc;
-    }
-    *out = dps;
-    return 0;
+    return rc;
 }
 
 void asp_dps_summarize(const asp_dps *dps, asp_dps_summary *rows)

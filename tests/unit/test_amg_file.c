@@ -2,7 +2,10 @@
  * The .amg file: a save/load round trip keeps the whole point set (positions,
  * origin, normals, colours, radii, uvs, labels), tangent normals, classifier
  * and every level's P exactly; truncated, corrupted, foreign, old-version and
- * missing files give a clear error and no crash.
+ * missing files give a clear error and no crash. asp_amg_load_memory gives the
+ * same result as the path loader, and a cut at every byte or a forged count
+ * (with the CRC fixed so the parser sees it) fails cleanly without a large
+ * allocation.
  */
 #include <unistd.h>
 
@@ -162,6 +165,178 @@ static void test_round_trip_and_damage(void)
     asp_cloud_destroy(c);
 }
 
+/* Independent CRC-32 (IEEE, reflected 0xEDB88320), so a forged file can carry a valid checksum. */
+static uint32_t crc32_ieee(const unsigned char *p, size_t n)
+{
+    uint32_t c = 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; i++) {
+        c ^= p[i];
+        for (int k = 0; k < 8; k++)
+            c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+    }
+    return ~c;
+}
+
+static void put_le(unsigned char *p, uint64_t v, int bytes)
+{
+    for (int k = 0; k < bytes; k++)
+        p[k] = (unsigned char)(v >> (8 * k));
+}
+
+static uint64_t get_le(const unsigned char *p, int bytes)
+{
+    uint64_t v = 0;
+    for (int k = 0; k < bytes; k++)
+        v |= (uint64_t)p[k] << (8 * k);
+    return v;
+}
+
+/* Makes b (n bytes) self-consistent: payload size at header byte 32 and the CRC-32 trailer. */
+static void fix_amg(unsigned char *b, size_t n)
+{
+    put_le(b + 32, n - 68, 8);
+    put_le(b + n - 4, crc32_ieee(b, n - 4), 4);
+}
+
+/* An allocator that counts what one load asks for. */
+typedef struct tally {
+    size_t total, largest;
+} tally;
+
+static void *tally_alloc(void *user, size_t size, size_t align)
+{
+    tally *t = user;
+    t->total += size;
+    if (size > t->largest)
+        t->largest = size;
+    return aligned_alloc(align, (size + align - 1) / align * align);
+}
+
+static void tally_free(void *user, void *ptr)
+{
+    (void)user;
+    free(ptr);
+}
+
+/* Loads forged bytes: ASP_EFORMAT naming the file and field, and no allocation beyond a few times the file. */
+static void expect_forged(const unsigned char *b, size_t n, const char *field)
+{
+    tally t = {0, 0};
+    asp_context ctx = {.threads = 1, .allocator = {tally_alloc, tally_free, &t}};
+    asp_error err = {0};
+    asp_amg *a = (asp_amg *)&t; /* a sentinel: must stay unchanged */
+    int rc = asp_amg_load_memory(b, n, "forged.amg", &ctx, &a, &err);
+    CHECK_MSG(rc == ASP_EFORMAT && a == (asp_amg *)&t, "%s: rc %d", field, rc);
+    CHECK_MSG(strstr(err.msg, "forged.amg") && strstr(err.msg, field) && strstr(err.msg, "expected"),
+              "message '%s' lacks the file, '%s' or what was expected", err.msg, field);
+    CHECK_MSG(t.total <= 4 * n + 65536, "%s: %zu bytes allocated for a %zu-byte file", field, t.total, n);
+}
+
+static int same_amg(const asp_amg *x, const asp_amg *y)
+{
+    const asp_cloud *a = asp_amg_cloud(x), *b = asp_amg_cloud(y);
+    size_t n = a->count;
+    int ok = b->count == n && asp_cloud_attrs(a) == asp_cloud_attrs(b) && !memcmp(a->origin, b->origin, 24) &&
+             !memcmp(a->positions, b->positions, 12 * n) && !memcmp(a->normals, b->normals, 12 * n) &&
+             (!a->colors || !memcmp(a->colors, b->colors, 4 * n)) &&
+             !memcmp(asp_amg_tangent_normals(x), asp_amg_tangent_normals(y), 12 * n) &&
+             !memcmp(asp_amg_classifier(x), asp_amg_classifier(y), 4 * n) &&
+             asp_amg_has_input_normals(x) == asp_amg_has_input_normals(y) &&
+             asp_amg_level_count(x) == asp_amg_level_count(y) &&
+             asp_amg_get_info(x)->epsilon == asp_amg_get_info(y)->epsilon;
+    for (size_t l = 0; ok && l < asp_amg_level_count(x); l++)
+        ok = asp_amg_level_size(x, l) == asp_amg_level_size(y, l);
+    for (size_t l = 1; ok && l < asp_amg_level_count(x); l++) {
+        const asp_amg_csr *p = asp_amg_prolongation(x, l), *q = asp_amg_prolongation(y, l);
+        size_t nnz = p->row_ptr[p->rows];
+        ok = p->rows == q->rows && p->cols == q->cols &&
+             !memcmp(p->row_ptr, q->row_ptr, (p->rows + 1) * sizeof(size_t)) &&
+             !memcmp(p->col, q->col, nnz * sizeof *p->col) && !memcmp(p->val, q->val, nnz * sizeof *p->val);
+    }
+    return ok;
+}
+
+/* A small decomposition (60 points) loaded from memory and from its path; every cut and forged count. */
+static void test_memory_cuts_and_forged_counts(void)
+{
+    asp_error errbuf, *err = &errbuf;
+    asp_cloud *c = NULL;
+    asp_amg *amg = NULL;
+    char p3[600];
+    snprintf(p3, sizeof p3, "/tmp/asp_test_amg_mem_%ld.amg", (long)getpid());
+    CHECK_OK(asp_synth(ASP_SYNTH_OCTAHEDRON, &(asp_synth_desc){.points = 60}, NULL, &c, err), err);
+    if (c)
+        CHECK_OK(asp_amg_decompose(c, NULL, NULL, &amg, err), err);
+    if (!amg) {
+        asp_cloud_destroy(c);
+        return;
+    }
+    CHECK_OK(asp_amg_save(amg, p3, err), err);
+    size_t size = 0;
+    unsigned char *bytes = slurp(p3, &size);
+    CHECK(size > 68 && size < 20000);
+    asp_amg *from_path = NULL, *from_mem = NULL;
+    CHECK_OK(asp_amg_load(p3, NULL, &from_path, err), err);
+    CHECK_OK(asp_amg_load_memory(bytes, size, p3, NULL, &from_mem, err), err);
+    CHECK(from_path && from_mem && same_amg(from_path, from_mem) && same_amg(amg, from_mem));
+    asp_amg_destroy(from_path);
+    asp_amg_destroy(from_mem);
+
+    /* a cut at every byte, as is and with the payload size and CRC fixed so the parser itself meets the end */
+    unsigned char *cut = malloc(size);
+    int cut_fail = 0;
+    for (size_t k = 0; k < size && cut; k++) {
+        for (int fixed = 0; fixed < 2; fixed++) {
+            if (fixed && k < 68)
+                continue;
+            memcpy(cut, bytes, k);
+            if (fixed)
+                fix_amg(cut, k);
+            asp_amg *a = NULL;
+            asp_error e = {0};
+            int rc = asp_amg_load_memory(cut, k, "cut.amg", NULL, &a, &e);
+            if (rc != ASP_EFORMAT || a != NULL || !strstr(e.msg, "'cut.amg'")) {
+                if (cut_fail++ < 5)
+                    CHECK_MSG(0, "cut at %zu (fixed %d): rc %d, '%s'", k, fixed, rc, e.msg);
+                asp_amg_destroy(a);
+            }
+        }
+    }
+    CHECK_MSG(cut_fail == 0, "%d cuts did not fail cleanly", cut_fail);
+    free(cut);
+    CHECK(asp_amg_load_memory(NULL, 0, NULL, NULL, &from_mem, err) == ASP_EFORMAT && strstr(err->msg, "<memory>"));
+
+    /* forged counts behind a valid checksum */
+    unsigned char *f = malloc(size);
+    const uint64_t n = get_le(bytes + 16, 8), nlevels = get_le(bytes + 24, 8);
+    const uint32_t attrs = (uint32_t)get_le(bytes + 64 + 28 * n, 4);
+    const uint64_t per_point = (attrs & ASP_ATTR_NORMALS ? 12u : 0u) + (attrs & ASP_ATTR_COLORS ? 4u : 0u) +
+                               (attrs & ASP_ATTR_RADII ? 4u : 0u) + (attrs & ASP_ATTR_UVS ? 8u : 0u) +
+                               (attrs & ASP_ATTR_LABELS ? 4u : 0u);
+    const size_t nnz_at = (size_t)(64 + 28 * n + 8 + per_point * n + 128 + 8 * nlevels);
+    CHECK(nlevels >= 2 && nnz_at + 8 < size);
+    const struct {
+        size_t at;
+        uint64_t value;
+        const char *field;
+    } forged[] = {{16, 1ull << 40, "point count"},        {16, 0, "point count"},
+                  {24, 1ull << 40, "level count"},        {nnz_at, 1ull << 60, "prolongation entry count"},
+                  {nnz_at, (uint64_t)size / 12, "prolongation entry count"},
+                  {nnz_at + 8 + 8 * n, 1ull << 62, "row pointer"},
+                  {nnz_at + 8 + 8, (uint64_t)size, "row pointer"}}; /* row 0 would run past the entries */
+    for (size_t i = 0; f && i < sizeof forged / sizeof forged[0]; i++) {
+        memcpy(f, bytes, size);
+        put_le(f + forged[i].at, forged[i].value, 8);
+        fix_amg(f, size);
+        expect_forged(f, size, forged[i].field);
+    }
+    free(f);
+    free(bytes);
+    remove(p3);
+    asp_amg_destroy(amg);
+    asp_cloud_destroy(c);
+}
+
 /* An input without normals or colours: the file stays small and the normals are the tangent ones. */
 static void test_bare_positions(void)
 {
@@ -209,4 +384,5 @@ static void test_bare_positions(void)
     asp_amg_shutdown(); /* last test: MPI cannot start again in this process */
 }
 
-TEST_MAIN(TEST_CASE(test_round_trip_and_damage), TEST_CASE(test_bare_positions))
+TEST_MAIN(TEST_CASE(test_round_trip_and_damage), TEST_CASE(test_memory_cuts_and_forged_counts),
+          TEST_CASE(test_bare_positions))

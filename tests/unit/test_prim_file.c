@@ -2,6 +2,9 @@
  * The .dps file (issue 4 item 8): a save/load round trip keeps every field and
  * texel; damaged files (truncated, flipped byte, foreign, trailing bytes, a
  * texture rectangle outside its atlas) give a clear error and no result.
+ * asp_dps_load_memory gives the same result as the path loader; a cut at every
+ * byte and forged counts (with the CRC fixed, so the parser sees them) fail
+ * cleanly, naming the file and field, without a large allocation.
  */
 #include <stdio.h>
 #include <unistd.h>
@@ -155,4 +158,172 @@ static void test_round_trip_and_damage(void)
     asp_cloud_destroy(c);
 }
 
-TEST_MAIN(TEST_CASE(test_round_trip_and_damage))
+/* Independent CRC-32 (IEEE, reflected 0xEDB88320), so a forged file can carry a valid checksum. */
+static uint32_t crc32_ieee(const unsigned char *p, size_t n)
+{
+    uint32_t c = 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; i++) {
+        c ^= p[i];
+        for (int k = 0; k < 8; k++)
+            c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+    }
+    return ~c;
+}
+
+static void put_le(unsigned char *p, uint64_t v, int bytes)
+{
+    for (int k = 0; k < bytes; k++)
+        p[k] = (unsigned char)(v >> (8 * k));
+}
+
+/* Makes b (n bytes) self-consistent: payload size at header byte 24 and the CRC-32 trailer. */
+static void fix_dps(unsigned char *b, size_t n)
+{
+    put_le(b + 24, n - 68, 8);
+    put_le(b + n - 4, crc32_ieee(b, n - 4), 4);
+}
+
+static unsigned char *slurp(const char *path, size_t *n)
+{
+    long len = file_size(path);
+    unsigned char *b = len > 0 ? malloc((size_t)len) : NULL;
+    FILE *fp = fopen(path, "rb");
+    *n = 0;
+    if (b && fp && fread(b, 1, (size_t)len, fp) == (size_t)len)
+        *n = (size_t)len;
+    if (fp)
+        fclose(fp);
+    return b;
+}
+
+/* An allocator that counts what one load asks for. */
+typedef struct tally {
+    size_t total;
+} tally;
+
+static void *tally_alloc(void *user, size_t size, size_t align)
+{
+    ((tally *)user)->total += size;
+    return aligned_alloc(align, (size + align - 1) / align * align);
+}
+
+static void tally_free(void *user, void *ptr)
+{
+    (void)user;
+    free(ptr);
+}
+
+static int same_dps(const asp_dps *x, const asp_dps *y)
+{
+    int ok = x->level_count == y->level_count && x->amg_levels == y->amg_levels &&
+             x->skipped_levels == y->skipped_levels && x->source_points == y->source_points &&
+             x->mean_radius == y->mean_radius && !memcmp(&x->desc, &y->desc, sizeof x->desc) &&
+             !strcmp(x->source, y->source);
+    for (size_t i = 0; ok && i < x->level_count; i++) {
+        const asp_dps_level *a = &x->levels[i], *b = &y->levels[i];
+        size_t px = 4 * (size_t)a->atlas.width * a->atlas.height;
+        ok = a->level == b->level && a->basis_count == b->basis_count && a->prim_count == b->prim_count &&
+             a->neighbour_total == b->neighbour_total && a->texels == b->texels && a->error == b->error &&
+             a->atlas.width == b->atlas.width && a->atlas.height == b->atlas.height &&
+             a->normal_atlas.width == b->normal_atlas.width &&
+             !memcmp(a->prims, b->prims, a->prim_count * sizeof *a->prims) &&
+             !memcmp(a->neighbours, b->neighbours, a->neighbour_total * sizeof *a->neighbours) &&
+             !memcmp(a->atlas.pixels, b->atlas.pixels, px) &&
+             (!a->normal_atlas.width || !memcmp(a->normal_atlas.pixels, b->normal_atlas.pixels, px));
+    }
+    return ok;
+}
+
+/* Loads forged bytes: ASP_EFORMAT naming the file and field, and no allocation beyond a few times the file. */
+static void expect_forged(const unsigned char *b, size_t n, const char *field)
+{
+    tally t = {0};
+    asp_context ctx = {.threads = 1, .allocator = {tally_alloc, tally_free, &t}};
+    asp_error err = {0};
+    asp_dps *d = (asp_dps *)&t; /* a sentinel: must stay unchanged */
+    int rc = asp_dps_load_memory(b, n, "forged.dps", &ctx, &d, &err);
+    CHECK_MSG(rc == ASP_EFORMAT && d == (asp_dps *)&t, "%s: rc %d", field, rc);
+    CHECK_MSG(strstr(err.msg, "forged.dps") && strstr(err.msg, field) && strstr(err.msg, "expected"),
+              "message '%s' lacks the file, '%s' or what was expected", err.msg, field);
+    CHECK_MSG(t.total <= 4 * n + 65536, "%s: %zu bytes allocated for a %zu-byte file", field, t.total, n);
+}
+
+/* Memory load = path load; a cut at every byte; forged counts behind a valid checksum. */
+static void test_memory_cuts_and_forged_counts(void)
+{
+    asp_cloud *c = NULL;
+    asp_dps_level lv;
+    if (make_level(&c, &lv))
+        return;
+    /* a small level (coarse texels) keeps the byte-by-byte loop fast under ASan */
+    asp_dps dps = {.level_count = 1, .levels = &lv, .amg_levels = 7, .source_points = c->count, .mean_radius = 0.02,
+                   .desc = {.tau = 0.05, .texel_size = 1, .normal_map = 1}};
+    snprintf(dps.source, sizeof dps.source, "patch.ply");
+    lv.level = 4;
+    char path[256];
+    snprintf(path, sizeof path, "%s/asp_test_prim_mem_%d.dps", ASP_TEST_TMP_DIR, (int)getpid());
+    asp_error err;
+    CHECK_OK(asp_dps_save(&dps, path, &err), &err);
+    size_t size = 0;
+    unsigned char *bytes = slurp(path, &size);
+    CHECK(bytes && size > 68);
+    asp_dps *from_path = NULL, *from_mem = NULL;
+    CHECK_OK(asp_dps_load(path, NULL, &from_path, &err), &err);
+    CHECK_OK(asp_dps_load_memory(bytes, size, path, NULL, &from_mem, &err), &err);
+    CHECK(from_path && from_mem && same_dps(from_path, from_mem) && same_dps(&dps, from_mem));
+    asp_dps_destroy(from_path);
+    asp_dps_destroy(from_mem);
+
+    /* a cut at every byte, as is and with the payload size and CRC fixed so the parser itself meets the end */
+    unsigned char *cut = malloc(size ? size : 1);
+    int cut_fail = 0;
+    for (size_t k = 0; bytes && cut && k < size; k++) {
+        for (int fixed = 0; fixed < 2; fixed++) {
+            if (fixed && k < 68)
+                continue;
+            memcpy(cut, bytes, k);
+            if (fixed)
+                fix_dps(cut, k);
+            asp_dps *d = NULL;
+            asp_error e = {0};
+            int rc = asp_dps_load_memory(cut, k, "cut.dps", NULL, &d, &e);
+            if (rc != ASP_EFORMAT || d != NULL || !strstr(e.msg, "'cut.dps'")) {
+                if (cut_fail++ < 5)
+                    CHECK_MSG(0, "cut at %zu (fixed %d): rc %d, '%s'", k, fixed, rc, e.msg);
+                asp_dps_destroy(d);
+            }
+        }
+    }
+    CHECK_MSG(cut_fail == 0, "%d cuts did not fail cleanly", cut_fail);
+    free(cut);
+    CHECK(asp_dps_load_memory(NULL, 0, NULL, NULL, &from_mem, &err) == ASP_EFORMAT && strstr(err.msg, "<memory>"));
+
+    /* forged counts: header level count, then level 0's primitive and neighbour counts and atlas size */
+    const size_t level_at = 64 + 128 + 4 + strlen("patch.ply");
+    const struct {
+        size_t at;
+        uint64_t value;
+        int bytes;
+        const char *field;
+    } forged[] = {{16, 1ull << 40, 8, "level count"},
+                  {level_at + 8, 1ull << 60, 8, "primitive count"},
+                  {level_at + 8, (uint64_t)size / 124, 8, "primitive count"},
+                  {level_at + 16, 1ull << 61, 8, "neighbour count"},
+                  {level_at + 24, 16000, 4, "atlas"},
+                  {level_at + 24, 1u << 30, 4, "atlas"},
+                  {level_at, 9, 4, "AMG level"}};
+    unsigned char *f = malloc(size ? size : 1);
+    for (size_t i = 0; bytes && f && i < sizeof forged / sizeof forged[0]; i++) {
+        memcpy(f, bytes, size);
+        put_le(f + forged[i].at, forged[i].value, forged[i].bytes);
+        fix_dps(f, size);
+        expect_forged(f, size, forged[i].field);
+    }
+    free(f);
+    free(bytes);
+    remove(path);
+    asp_dps_level_release(&lv, NULL);
+    asp_cloud_destroy(c);
+}
+
+TEST_MAIN(TEST_CASE(test_round_trip_and_damage), TEST_CASE(test_memory_cuts_and_forged_counts))
