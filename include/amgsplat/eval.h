@@ -167,8 +167,8 @@ typedef struct asp_eval_result {
  * filling the view) at each size: the reference (the full point set as
  * blended, normalised splats at tolerance 0, seed 001 section 5), then every
  * representation at every level: the point hierarchy cut to the level's
- * primitive count (thesis Fig. 1.1: the tolerance is bisected per view until
- * the cut is closest to the count), and the domain primitives with each
+ * primitive count (thesis Fig. 1.1: asp_renderer_set_budget, the splats of
+ * largest projected size refined first), and the domain primitives with each
  * rendering method this build has. Each image is compared to the reference
  * of the same camera (PSNR, SSIM, silhouette IoU), and frame times are timed
  * at view 0. Creates its own headless GL context on the calling thread.

@@ -185,9 +185,13 @@ int asp_hier_select(const asp_hier *hier, const asp_hier_view *view, asp_index *
  * starting from the root, repeatedly replaces the splat of largest projected
  * diameter by its visible children (or a leaf by its points), skipping any
  * whose expansion would exceed target, until nothing more fits. Culling as in
- * asp_hier_select. Writes min(result, capacity) ids and the result count
- * (<= target, equal to min(target, visible points) unless the tree's fan-out
- * prevents it) to *count. Ties are broken by splat id: deterministic.
+ * asp_hier_select, except that a node whose children (or a leaf whose points)
+ * are all culled is left out rather than drawn: with no tau to keep monotone
+ * it would only blur past the silhouette. Writes min(result, capacity) ids and
+ * the result count (<= target, equal to min(target, visible points) unless the
+ * tree's fan-out prevents it) to *count; a target of at least the visible
+ * points gives asp_hier_select's tau = 0 cut without its fallback nodes. Ties
+ * are broken by splat id: deterministic.
  * Errors: ASP_EINVAL, ASP_ENOMEM (scratch heap). Thread-safe.
  */
 int asp_hier_select_count(const asp_hier *hier, const asp_hier_view *view, size_t target, asp_index *dst,

@@ -547,6 +547,19 @@ int asp_square_renderer_create_hier(asp_gl_context *gl, const asp_hier *hier, co
  */
 int asp_renderer_set_lod(asp_renderer *r, float tolerance, uint32_t depth_limit, asp_error *err);
 
+/**
+ * Cuts a splat or square renderer's hierarchy to at most splats splats per
+ * frame (0 = off: tau and the depth limit decide again): the splats of
+ * largest projected size are refined first (asp_hier_select_count), so the
+ * count is exact unless the tree's fan-out prevents it (at most 7 fewer with
+ * leaves of 8), or fewer points are visible. This is the cut of thesis Fig. 1.1,
+ * points against the same number of domain primitives (amgsplat eval), and a
+ * fixed budget for weak hardware. Returns 0; ASP_EUNSUPPORTED for a renderer
+ * without a hierarchy (disc), naming it. No GL calls; same thread rules as the
+ * renderer.
+ */
+int asp_renderer_set_budget(asp_renderer *r, size_t splats, asp_error *err);
+
 /** Figures of a renderer's last frame (asp_renderer_stats). */
 typedef struct asp_renderer_stats {
     size_t count;          /* primitives drawn in the last frame (= asp_renderer_count) */
@@ -554,6 +567,7 @@ typedef struct asp_renderer_stats {
     size_t nodes;          /* hierarchy nodes; 0 for renderers without one */
     float tolerance;       /* tau of the last frame; 0 without a hierarchy */
     uint32_t depth_limit;  /* depth limit of the last frame; 0 = none */
+    size_t budget;         /* splat budget (asp_renderer_set_budget); 0 = none, tau decides */
     double select_seconds; /* CPU time of the last cut (asp_hier_select) and its upload */
 } asp_renderer_stats;
 

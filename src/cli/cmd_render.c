@@ -17,8 +17,8 @@
 
 static const char usage[] =
     "usage: amgsplat render IN.ply -o OUT.png [--size WxH] [--view AZ,EL[,DIST]] [--views N]\n"
-    "                      [--renderer disc|splat|square] [--tolerance PX] [--kernel A,B,N] [--epsilon X]\n"
-    "                      [--lighting gouraud|pixel|flat] [--opaque] [--point-size PX]\n"
+    "                      [--renderer disc|splat|square] [--tolerance PX | --budget N] [--kernel A,B,N]\n"
+    "                      [--epsilon X] [--lighting gouraud|pixel|flat] [--opaque] [--point-size PX]\n"
     "                      [--background R,G,B[,A] | --transparent] [--light AZ,EL]\n"
     "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict] [--level L-3] ...\n"
     "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
@@ -51,6 +51,7 @@ struct render_opts {
     const char *level;
     size_t views;
     size_t samples;
+    size_t budget; /* splat, square: splats per view (asp_renderer_set_budget); 0 = tau decides */
     int transparent;
     double fov;
     double radius_scale;
@@ -470,10 +471,10 @@ static void print_json(const struct render_opts *o, const struct scene *s, asp_g
     cli_json_string(stdout, asp_gl_context_renderer(gl));
     printf(", \"gl_backend\": ");
     cli_json_string(stdout, asp_gl_context_backend(gl));
+    int lod = strcmp(renderer, "disc") && strcmp(renderer, "prim");
     printf(", \"primitives\": %zu, \"primitives_min\": %zu, \"primitives_max\": %zu, \"tolerance\": %g, "
-           "\"view_ms\": %.3f",
-           vs->last_count, vs->min_count, vs->max_count,
-           strcmp(renderer, "disc") && strcmp(renderer, "prim") ? o->tolerance : 0.0,
+           "\"budget\": %zu, \"view_ms\": %.3f",
+           vs->last_count, vs->min_count, vs->max_count, lod && !o->budget ? o->tolerance : 0.0, o->budget,
            1e3 * vs->seconds / (double)o->views);
     printf(", \"seconds\": %.3f}\n", seconds);
 }
@@ -491,6 +492,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"views", 0, CLI_SIZE, &o.views, "N", "N views around the object in a contact sheet (default 1)"},
         {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "how points are drawn: disc (default), splat, square"},
         {"tolerance", 0, CLI_DOUBLE, &o.tolerance, "PX", "splat, square: screen tolerance tau in pixels (default 1; 0 = every point)"},
+        {"budget", 0, CLI_SIZE, &o.budget, "N", "splat, square: cut the hierarchy to N splats per view instead of a tolerance"},
         {"kernel", 0, CLI_STRING, &o.kernel, "A,B,N", "splat: kernel exp(-A (r/B)^N) (default 6,1.5,3)"},
         {"epsilon", 0, CLI_DOUBLE, &o.epsilon, "X", "splat: depth offset in splat radii for blending (default 1; 0 = none)"},
         {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
@@ -532,6 +534,9 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
             kind = i;
     if (kind == N_RENDERERS)
         return cli_usage_error(env, "unknown renderer '%s' (expected disc, splat or square)", o.renderer);
+    if (o.budget && strcmp(renderers[kind].name, "splat") != 0 && strcmp(renderers[kind].name, "square") != 0)
+        return cli_usage_error(env, "--budget needs --renderer splat or square (the %s renderer draws every %s)",
+                               renderers[kind].name, o.dps_input ? "primitive" : "point");
 
     double t0 = asp_time_now();
     asp_error err = {0, ""};
@@ -548,6 +553,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.ctx = &env->ctx}, &gl, &err);
     if (!rc)
         rc = renderers[kind].make(gl, &s, &o, &r, &err);
+    if (!rc && o.budget)
+        rc = asp_renderer_set_budget(r, o.budget, &err);
     if (!rc)
         rc = render_views(gl, r, &s, &o, env, tiles, &vs, &err);
     if (!rc && o.views > 1)

@@ -71,10 +71,8 @@ struct eval_state {
     const asp_cloud *cloud;
     asp_gl_context *gl;
     asp_hier *hier;
-    asp_renderer *splat; /* the reference at tolerance 0; the cut at the bisected tolerance */
+    asp_renderer *splat; /* the reference at tolerance 0; the point cut with a splat budget */
     asp_dps *dps;
-    asp_index *cut;      /* scratch of the tolerance bisection */
-    size_t cut_cap;
     float center[3], radius;
     float elevation;
     float crease_angle;  /* resolved: degrees, or -1 for none */
@@ -97,69 +95,6 @@ static void view_camera(const struct eval_state *s, size_t v, asp_camera *cam)
     cam->azimuth = (float)(360.0 * (double)v / (double)s->views);
     cam->elevation = v % 2 ? -s->elevation : s->elevation;
     asp_camera_fit(cam, s->center, s->radius, 1.0f);
-}
-
-static int cut_count(const struct eval_state *s, asp_hier_view *hv, double tau, size_t *count, asp_error *err)
-{
-    hv->tau = (float)tau;
-    return asp_hier_select(s->hier, hv, s->cut, s->cut_cap, count, err);
-}
-
-/*
- * Tolerance whose cut is closest to target splats for this camera and size.
- * The count never grows with tau (asp_hier_select), so bisect tau on a log
- * scale between 0 (every visible point) and a tau that leaves at most target.
- */
-static int cut_tolerance(const struct eval_state *s, const asp_camera *cam, uint32_t size, size_t target, float *tau,
-                         asp_error *err)
-{
-    asp_hier_view hv;
-    memset(&hv, 0, sizeof hv);
-    asp_camera_view_matrix(cam, hv.view);
-    asp_camera_projection_matrix(cam, hv.proj);
-    asp_camera_eye(cam, hv.eye);
-    hv.width = hv.height = size;
-    size_t n = 0;
-    int rc = cut_count(s, &hv, 0, &n, err);
-    if (rc)
-        return rc;
-    double best_tau = 0, lo = 0, hi = 1;
-    size_t best_diff = n > target ? n - target : target - n;
-    if (n <= target) {
-        *tau = 0;
-        return 0;
-    }
-    for (int i = 0; i < 40; i++) { // grow hi until the cut is small enough
-        if ((rc = cut_count(s, &hv, hi, &n, err)))
-            return rc;
-        size_t diff = n > target ? n - target : target - n;
-        if (diff < best_diff) {
-            best_diff = diff;
-            best_tau = hi;
-        }
-        if (n <= target)
-            break;
-        lo = hi;
-        hi *= 4;
-    }
-    for (int i = 0; i < 40 && best_diff; i++) {
-        double mid = lo > 0 ? sqrt(lo * hi) : hi / 2;
-        if ((rc = cut_count(s, &hv, mid, &n, err)))
-            return rc;
-        size_t diff = n > target ? n - target : target - n;
-        if (diff < best_diff || (diff == best_diff && mid < best_tau)) {
-            best_diff = diff;
-            best_tau = mid;
-        }
-        if (n > target)
-            lo = mid;
-        else
-            hi = mid;
-        if (hi - lo < 1e-7 * hi)
-            break;
-    }
-    *tau = (float)best_tau;
-    return 0;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -235,11 +170,11 @@ static int measure(struct eval_state *s, const struct rep *rep, const asp_dps_le
     for (size_t v = 0; v < s->views && !rc; v++) {
         asp_camera cam;
         view_camera(s, v, &cam);
-        float tau = 0;
-        if (cut && lv)
-            rc = cut_tolerance(s, &cam, size, target, &tau, err);
+        // thesis Fig. 1.1: the point hierarchy cut to as many splats as the level has primitives
+        if (cut)
+            rc = asp_renderer_set_budget(r, lv ? target : 0, err);
         if (!rc && cut)
-            rc = asp_renderer_set_lod(r, tau, 0, err);
+            rc = asp_renderer_set_lod(r, 0, 0, err);
         asp_image img = {0};
         if (!rc)
             rc = asp_render_to_image(s->gl, r, &cam, &rd, &img, err);
@@ -342,12 +277,6 @@ static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result
         rc = asp_hier_build(s->cloud, NULL, s->ctx, &s->hier, err);
     if (!rc)
         rc = asp_render_bounding_sphere(s->cloud, s->center, &s->radius, err);
-    if (!rc) {
-        s->cut_cap = asp_hier_select_bound(s->hier);
-        s->cut = asp_alloc(s->ctx, s->cut_cap * sizeof *s->cut);
-        if (!s->cut)
-            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for a cut of %zu splats", s->cut_cap);
-    }
     if (!rc)
         rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.ctx = s->ctx}, &s->gl, err);
     // the reference's splats cut at creases, so its sharp edges are the surface's, not the sampling's
@@ -375,7 +304,6 @@ static void state_release(struct eval_state *s)
     asp_gl_context_destroy(s->gl);
     asp_hier_destroy(s->hier);
     asp_dps_destroy(s->dps);
-    asp_free(s->ctx, s->cut);
 }
 
 static int run_size(struct eval_state *s, uint32_t size, asp_eval_result *res, size_t *row, struct sheet *sh,

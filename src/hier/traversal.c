@@ -308,7 +308,13 @@ int asp_hier_select_count(const asp_hier *hier, const asp_hier_view *view, size_
                     kids[nk++] = (item){projected(&w, hier->splats[id].center, hier->splats[id].a), id, in};
             }
         }
-        if (nk == 0 || cut - 1 + nk > target) {
+        if (nk == 0) {
+            /* the conservative bounds passed but nothing below did: the splat would cover nothing visible
+               (and blur past the silhouette), so leave it out and give its place to another */
+            cut--;
+            continue;
+        }
+        if (cut - 1 + nk > target) {
             emit(&out, it.id);
             continue;
         }

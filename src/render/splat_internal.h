@@ -51,6 +51,7 @@ typedef struct asp__lod {
     float default_color[4];   /* sRGB 0..1 for hierarchies without colours */
     float tolerance;
     uint32_t depth_limit;
+    size_t budget;            /* > 0: cut to this many splats (asp_hier_select_count) instead of tau */
     int cull_backfaces;
     size_t count;             /* splats in the last cut */
     double select_seconds;

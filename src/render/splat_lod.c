@@ -159,13 +159,16 @@ int asp__lod_select(asp__lod_renderer *r, const asp__frame *f, asp_error *err)
     view.cull_backfaces = lod->cull_backfaces;
     double t0 = asp_time_now();
     size_t count = 0;
-    int rc = asp_hier_select(lod->hier, &view, lod->cut, lod->capacity, &count, err);
+    // a count cut leaves fallback nodes out itself (asp_hier_select_count)
+    int rc = lod->budget ? asp_hier_select_count(lod->hier, &view, lod->budget, lod->cut, lod->capacity, &count, err)
+                         : asp_hier_select(lod->hier, &view, lod->cut, lod->capacity, &count, err);
     if (rc)
         return rc;
     // the bound is the point count and a cut never exceeds it; guard anyway
     if (count > lod->capacity)
         count = lod->capacity;
-    count = drop_fallback_nodes(lod, f, count);
+    if (!lod->budget)
+        count = drop_fallback_nodes(lod, f, count);
     if (count)
         glNamedBufferSubData(lod->ids.id, 0, (GLsizeiptr)(count * sizeof *lod->cut), lod->cut);
     lod->select_seconds = asp_time_now() - t0;
@@ -205,6 +208,16 @@ int asp_renderer_set_lod(asp_renderer *r, float tolerance, uint32_t depth_limit,
     return 0;
 }
 
+int asp_renderer_set_budget(asp_renderer *r, size_t splats, asp_error *err)
+{
+    asp__lod_renderer *lr = asp__lod_renderer_of(r);
+    if (!lr)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "the %s renderer has no level of detail to cut to %zu splats",
+                             asp_renderer_name(r), splats);
+    lr->lod.budget = splats;
+    return 0;
+}
+
 void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out)
 {
     memset(out, 0, sizeof *out);
@@ -218,5 +231,6 @@ void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out)
     out->nodes = lr->lod.nodes;
     out->tolerance = lr->lod.tolerance;
     out->depth_limit = lr->lod.depth_limit;
+    out->budget = lr->lod.budget;
     out->select_seconds = lr->lod.select_seconds;
 }

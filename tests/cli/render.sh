@@ -78,6 +78,17 @@ import json, sys
 d = json.load(open(sys.argv[1]))
 assert d['renderer'] == 'splat' and 0 < d['primitives'] < 1000, d
 " "$T/json8" || fail "splat tolerance 40: $(cat "$T/json8")"
+# --budget N: the cut of N splats per view (eval's point representation), exact on a sphere with
+# leaves of 8 up to the fan-out; 0 < N < visible points
+for r in splat square; do
+  "$AMGSPLAT" render "$T/sphere.ply" -o "$T/budget.png" --renderer $r --budget 200 --size 64x64 --views 3 --json >"$T/jsonb"
+  python3 -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d['budget'] == 200 and d['tolerance'] == 0, d
+assert 193 <= d['primitives_min'] <= d['primitives_max'] <= 200, d
+" "$T/jsonb" || fail "$r --budget 200: $(cat "$T/jsonb")"
+done
 for opts in "--lighting pixel" "--lighting flat --kernel 1,1.5,2" "--opaque --epsilon 0" "--samples 4"; do
   # shellcheck disable=SC2086
   "$AMGSPLAT" render "$T/sphere.ply" -o "$T/variant.png" --renderer splat --size 64x64 --view 0,0 --transparent $opts -q
@@ -148,6 +159,7 @@ expect_fail 2 "--views expects 1..256" "$AMGSPLAT" render "$T/sphere.ply" -o "$T
 expect_fail 2 "exclude each other" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --transparent --background 1,2,3
 expect_fail 2 "--background expects" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --background 1,2,300
 expect_fail 2 "unknown renderer 'blob'" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --renderer blob
+expect_fail 2 "--budget needs --renderer splat or square" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --budget 10
 expect_fail 2 "--tolerance expects" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --renderer splat --tolerance -1
 expect_fail 2 "--kernel expects A,B,N" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --renderer splat --kernel 6,1.5
 expect_fail 2 "--kernel expects A,B,N" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --renderer splat --kernel 6,0,3

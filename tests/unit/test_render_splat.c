@@ -340,6 +340,23 @@ static void test_count_and_tau(void)
     CHECK_OK(asp_renderer_set_lod(r, 0, 3, &err), ep(&err));
     CHECK_OK(asp_render_frame(gl, r, &cam, &rd, &err), ep(&err));
     CHECK(asp_renderer_count(r) <= 64 && asp_renderer_count(r) >= 1);
+    // a splat budget overrides tau and the depth limit: exactly the count, short by less than one
+    // expansion (8 children or leaf points) at most; 0 hands the cut back to tau
+    static const size_t budgets[] = {1, 9, 100, 1000, 5000};
+    for (size_t k = 0; k < sizeof budgets / sizeof budgets[0]; k++) {
+        CHECK_OK(asp_renderer_set_budget(r, budgets[k], &err), ep(&err));
+        CHECK_OK(asp_renderer_set_budget(q, budgets[k], &err), ep(&err));
+        CHECK_OK(asp_render_frame(gl, r, &cam, &rd, &err), ep(&err));
+        CHECK_OK(asp_render_frame(gl, q, &cam, &rd, &err), ep(&err));
+        size_t n = asp_renderer_count(r);
+        asp_renderer_stats st;
+        asp_renderer_stats_get(r, &st);
+        CHECK(st.budget == budgets[k] && st.count == n && asp_renderer_count(q) == n);
+        CHECK_MSG(n <= budgets[k] && n + 8 > budgets[k], "budget %zu drew %zu splats", budgets[k], n);
+    }
+    CHECK_OK(asp_renderer_set_budget(r, 0, &err), ep(&err));
+    CHECK_OK(asp_render_frame(gl, r, &cam, &rd, &err), ep(&err));
+    CHECK(asp_renderer_count(r) <= 64); // the depth limit again
     asp_renderer_destroy(r);
     asp_renderer_destroy(q);
 }
@@ -602,6 +619,8 @@ static void test_bad_input(void)
     CHECK_OK(asp_disc_renderer_create(gl, c, NULL, &disc, &err), ep(&err));
     if (disc) {
         CHECK(asp_renderer_set_lod(disc, 1, 0, &err) == ASP_EUNSUPPORTED);
+        CHECK_MSG(strstr(err.msg, "disc") != NULL, "message '%s'", err.msg);
+        CHECK(asp_renderer_set_budget(disc, 10, &err) == ASP_EUNSUPPORTED);
         CHECK_MSG(strstr(err.msg, "disc") != NULL, "message '%s'", err.msg);
         asp_renderer_stats st;
         asp_renderer_stats_get(disc, &st);
