@@ -10,36 +10,13 @@
  */
 #include <math.h>
 #include <stdint.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "amgsplat/amg.h"
-#include "util/checksum.h"
+#include "fuzz_support.h"
 
-enum { HEADER = 64, PAYLOAD_AT = 32 };
-
-/* Counts what one load allocates: more than a few times the input is a forged count the reader trusted. */
-typedef struct budget {
-    size_t limit, total;
-} budget;
-
-static void *budget_alloc(void *user, size_t size, size_t alignment)
-{
-    budget *b = user;
-    b->total += size;
-    if (b->total > b->limit) {
-        fprintf(stderr, "fuzz_amg: %zu bytes allocated in total, limit %zu\n", b->total, b->limit);
-        abort();
-    }
-    return aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
-}
-
-static void budget_free(void *user, void *ptr)
-{
-    (void)user;
-    free(ptr);
-}
+enum { PAYLOAD_AT = 32 }; /* header byte of the payload size */
 
 static void check_csr(const asp_amg_csr *p, size_t rows, size_t cols, int partition)
 {
@@ -97,8 +74,8 @@ static void check(const asp_amg *a)
 
 static void one(const uint8_t *data, size_t size)
 {
-    budget b = {4 * size + (1u << 20), 0};
-    asp_context ctx = {.threads = 1, .allocator = {budget_alloc, budget_free, &b}};
+    fuzz_budget b;
+    asp_context ctx = fuzz_budget_context(&b, size, "fuzz_amg");
     asp_amg *a = NULL;
     asp_error err = {0};
     int rc = asp_amg_load_memory(data, size, "fuzz.amg", &ctx, &a, &err);
@@ -116,22 +93,6 @@ static void one(const uint8_t *data, size_t size)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    one(data, size);
-    if (size < HEADER + 4)
-        return 0;
-    /* the same bytes with a consistent payload size (header byte 32) and CRC-32 trailer (last 4 bytes) */
-    uint8_t *fixed = malloc(size);
-    if (!fixed)
-        return 0;
-    memcpy(fixed, data, size);
-    uint64_t payload = size - HEADER - 4;
-    for (int k = 0; k < 8; k++)
-        fixed[PAYLOAD_AT + k] = (uint8_t)(payload >> (8 * k));
-    uint32_t crc = asp__crc32(0, fixed, size - 4);
-    for (int k = 0; k < 4; k++)
-        fixed[size - 4 + k] = (uint8_t)(crc >> (8 * k));
-    if (memcmp(fixed, data, size) != 0)
-        one(fixed, size);
-    free(fixed);
+    fuzz_with_fixed_trailer(data, size, PAYLOAD_AT, one);
     return 0;
 }

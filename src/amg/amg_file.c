@@ -5,15 +5,14 @@
  * (the thesis stores the AMG output and constructs only the chosen basis, 2.6).
  * Versioned, little-endian, with a CRC-32 over everything before it.
  */
-#include <errno.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/types.h>
 
 #include "amg/internal.h"
 #include "util/atomic_file.h"
+#include "util/byte_io.h"
 #include "util/checksum.h"
 #include "util/banned.h"
 
@@ -44,17 +43,6 @@ static int host_is_little_endian(void)
     return *(const uint8_t *)&one == 1;
 }
 
-typedef asp__crc_writer writer;
-
-static void put(writer *w, const void *data, size_t len)
-{
-    asp__crc_put(w, data, len);
-}
-
-static void put_u64(writer *w, uint64_t v) { put(w, &v, 8); }
-static void put_u32(writer *w, uint32_t v) { put(w, &v, 4); }
-static void put_f64(writer *w, double v) { put(w, &v, 8); }
-
 static uint64_t payload_size(const asp_amg *amg)
 {
     uint64_t n = amg->cloud->count;
@@ -74,125 +62,86 @@ int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err)
     int rc = asp__atomic_open(&f, path, err);
     if (rc)
         return rc;
-    writer w = {f.fp, 0, 0};
+    asp__crc_writer w = {f.fp, 0, 0};
     const size_t n = amg->cloud->count;
     /* header: 64 bytes */
-    put(&w, AMG_MAGIC, 8);
-    put_u32(&w, AMG_VERSION);
-    put_u32(&w, AMG_HEADER);
-    put_u64(&w, n);
-    put_u64(&w, amg->nlevels);
-    put_u64(&w, payload_size(amg));
+    asp__crc_put(&w, AMG_MAGIC, 8);
+    asp__put_u32(&w, AMG_VERSION);
+    asp__put_u32(&w, AMG_HEADER);
+    asp__put_u64(&w, n);
+    asp__put_u64(&w, amg->nlevels);
+    asp__put_u64(&w, payload_size(amg));
     for (int a = 0; a < 3; a++)
-        put_f64(&w, amg->cloud->origin[a]);
-    put(&w, amg->cloud->positions, 3 * n * sizeof(float));
-    put(&w, amg->tangent, 3 * n * sizeof(float));
-    put(&w, amg->classifier, n * sizeof(float));
+        asp__put_f64(&w, amg->cloud->origin[a]);
+    asp__crc_put(&w, amg->cloud->positions, 3 * n * sizeof(float));
+    asp__crc_put(&w, amg->tangent, 3 * n * sizeof(float));
+    asp__crc_put(&w, amg->classifier, n * sizeof(float));
     /* the input's attributes (version 2): a bit set, then one array per bit in this order */
     const unsigned attrs = stored_attrs(amg);
     const asp_cloud *c = amg->cloud;
-    put_u32(&w, attrs);
-    put_u32(&w, 0);
+    asp__put_u32(&w, attrs);
+    asp__put_u32(&w, 0);
     if (attrs & ASP_ATTR_NORMALS)
-        put(&w, c->normals, 3 * n * sizeof(float));
+        asp__crc_put(&w, c->normals, 3 * n * sizeof(float));
     if (attrs & ASP_ATTR_COLORS)
-        put(&w, c->colors, 4 * n);
+        asp__crc_put(&w, c->colors, 4 * n);
     if (attrs & ASP_ATTR_RADII)
-        put(&w, c->radii, n * sizeof(float));
+        asp__crc_put(&w, c->radii, n * sizeof(float));
     if (attrs & ASP_ATTR_UVS)
-        put(&w, c->uvs, 2 * n * sizeof(float));
+        asp__crc_put(&w, c->uvs, 2 * n * sizeof(float));
     if (attrs & ASP_ATTR_LABELS)
-        put(&w, c->labels, n * sizeof(uint32_t));
+        asp__crc_put(&w, c->labels, n * sizeof(uint32_t));
     /* options block: 128 bytes, what produced the hierarchy */
     const asp_amg_desc *d = &amg->desc;
-    put_f64(&w, d->epsilon);
-    put_u64(&w, d->k_min);
-    put_u64(&w, d->k_max);
-    put_u64(&w, d->fan_k);
-    put_u32(&w, (uint32_t)d->classifier);
-    put_u32(&w, (uint32_t)d->coarsen);
-    put_u32(&w, (uint32_t)d->interp);
-    put_u32(&w, 0);
-    put_f64(&w, d->alpha);
-    put_f64(&w, d->beta);
-    put_f64(&w, d->strong_threshold);
-    put_f64(&w, d->trunc_factor);
-    put_f64(&w, d->drop_tol);
-    put_u64(&w, d->max_levels);
-    put_u64(&w, d->max_coarse);
-    put_f64(&w, d->weak_coupling);
-    put_f64(&w, d->crease_cut);
-    put_u64(&w, 0); /* reserved */
+    asp__put_f64(&w, d->epsilon);
+    asp__put_u64(&w, d->k_min);
+    asp__put_u64(&w, d->k_max);
+    asp__put_u64(&w, d->fan_k);
+    asp__put_u32(&w, (uint32_t)d->classifier);
+    asp__put_u32(&w, (uint32_t)d->coarsen);
+    asp__put_u32(&w, (uint32_t)d->interp);
+    asp__put_u32(&w, 0);
+    asp__put_f64(&w, d->alpha);
+    asp__put_f64(&w, d->beta);
+    asp__put_f64(&w, d->strong_threshold);
+    asp__put_f64(&w, d->trunc_factor);
+    asp__put_f64(&w, d->drop_tol);
+    asp__put_u64(&w, d->max_levels);
+    asp__put_u64(&w, d->max_coarse);
+    asp__put_f64(&w, d->weak_coupling);
+    asp__put_f64(&w, d->crease_cut);
+    asp__put_u64(&w, 0); /* reserved */
     for (size_t l = 0; l < amg->nlevels; l++)
-        put_u64(&w, amg->level_size[l]);
+        asp__put_u64(&w, amg->level_size[l]);
     for (size_t l = 1; l < amg->nlevels; l++) {
         const asp_amg_csr *p = amg->prolong[l];
         size_t nnz = p->row_ptr[p->rows];
-        put_u64(&w, nnz);
+        asp__put_u64(&w, nnz);
         for (size_t r = 0; r <= p->rows; r++)
-            put_u64(&w, p->row_ptr[r]);
-        put(&w, p->col, nnz * sizeof *p->col);
-        put(&w, p->val, nnz * sizeof *p->val);
+            asp__put_u64(&w, p->row_ptr[r]);
+        asp__crc_put(&w, p->col, nnz * sizeof *p->col);
+        asp__crc_put(&w, p->val, nnz * sizeof *p->val);
     }
-    uint32_t crc = w.crc;
-    put(&w, &crc, 4);
-    if (w.failed) {
-        int e = errno;
-        asp__atomic_abort(&f);
-        return asp_error_set(err, ASP_EIO, "cannot write '%s': %s", path, strerror(e));
-    }
-    return asp__atomic_commit(&f, err);
-}
-
-/*
- * Bounds-checked reader over the file bytes; every failure names the file and
- * the byte offset. Offsets are size_t and every count is compared with the
- * bytes left (by division, so nothing overflows) before it sizes an allocation.
- */
-typedef struct reader {
-    const uint8_t *buf;
-    size_t size, at; /* size excludes the CRC trailer once it has been checked */
-    const char *path;
-    asp_error *err;
-} reader;
-
-static size_t left(const reader *r)
-{
-    return r->size - r->at;
-}
-
-static int take(reader *r, void *dst, size_t len, const char *what)
-{
-    if (len > left(r))
-        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': byte %zu: truncated in %s (%zu bytes needed, %zu left)",
-                             r->path, r->at, what, len, left(r));
-    memcpy(dst, r->buf + r->at, len);
-    r->at += len;
-    return 0;
-}
-
-static int bad(reader *r, const char *what)
-{
-    return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': byte %zu: %s", r->path, r->at, what);
+    return asp__byte_commit(&w, &f, path, err);
 }
 
 /* The options block (128 bytes): what produced the hierarchy (docs/cli/decompose.md). */
-static int read_options(reader *r, asp_amg_desc *d)
+static int read_options(asp__byte_reader *r, asp_amg_desc *d)
 {
     uint64_t u64[3], lim[2], reserved;
     uint32_t u32[4];
     double f[5];
     int rc;
-    if ((rc = take(r, &d->epsilon, 8, "options")) || (rc = take(r, u64, 24, "options")) ||
-        (rc = take(r, u32, 16, "options")) || (rc = take(r, f, 40, "options")) || (rc = take(r, lim, 16, "options")) ||
-        (rc = take(r, &d->weak_coupling, 8, "options")) || (rc = take(r, &d->crease_cut, 8, "options")) ||
-        (rc = take(r, &reserved, 8, "options")))
+    if ((rc = asp__byte_take(r, &d->epsilon, 8, "options")) || (rc = asp__byte_take(r, u64, 24, "options")) ||
+        (rc = asp__byte_take(r, u32, 16, "options")) || (rc = asp__byte_take(r, f, 40, "options")) ||
+        (rc = asp__byte_take(r, lim, 16, "options")) || (rc = asp__byte_take(r, &d->weak_coupling, 8, "options")) ||
+        (rc = asp__byte_take(r, &d->crease_cut, 8, "options")) || (rc = asp__byte_take(r, &reserved, 8, "options")))
         return rc;
     if (u32[0] > ASP_AMG_CLASSIFIER_MOMENT || u32[1] > ASP_AMG_COARSEN_HMIS || u32[2] > ASP_AMG_INTERP_EXTENDED_I)
-        return bad(r, "unknown classifier, coarsening or interpolation code");
+        return asp__byte_bad(r, "unknown classifier, coarsening or interpolation code");
     /* drop_tol drives every product P^l (journal 2.3): a NaN would silently empty the basis */
     if (!isfinite(d->epsilon) || !(f[4] < 0.01))
-        return bad(r, "options: non-finite epsilon or drop tolerance not below 0.01");
+        return asp__byte_bad(r, "options: non-finite epsilon or drop tolerance not below 0.01");
     d->k_min = (size_t)u64[0];
     d->k_max = (size_t)u64[1];
     d->fan_k = (size_t)u64[2];
@@ -214,29 +163,28 @@ static int read_options(reader *r, asp_amg_desc *d)
  * with increasing columns and weights in [0,1] summing to 1 (a partition of
  * unity, which the basis products rely on).
  */
-static int read_prolongation(reader *r, size_t l, size_t rows, size_t cols, const asp_context *ctx, asp_amg_csr **out)
+static int read_prolongation(asp__byte_reader *r, size_t l, size_t rows, size_t cols, const asp_context *ctx,
+                             asp_amg_csr **out)
 {
     uint64_t nnz;
     int rc;
     char msg[200];
-    if ((rc = take(r, &nnz, 8, "a prolongation")) != 0)
+    if ((rc = asp__byte_take(r, &nnz, 8, "a prolongation")) != 0)
         return rc;
     /* 8 bytes per row pointer, 12 per entry: compare by division so a forged count cannot overflow */
-    const size_t avail = left(r), ptr_bytes = 8 * (rows + 1);
+    const size_t avail = asp__byte_left(r), ptr_bytes = 8 * (rows + 1);
     if (nnz < rows || nnz > avail / 12 || ptr_bytes > avail - 12 * (size_t)nnz) {
         r->at -= 8;
         snprintf(msg, sizeof msg, "level %zu: prolongation entry count %llu, expected %zu..%zu for %zu rows in the %zu "
                  "bytes left", l, (unsigned long long)nnz, rows, avail >= ptr_bytes ? (avail - ptr_bytes) / 12 : 0,
                  rows, avail);
-        return bad(r, msg);
+        return asp__byte_bad(r, msg);
     }
     asp_amg_csr *p;
     if ((rc = asp_amg_csr_create(rows, cols, (size_t)nnz, ctx, &p, r->err)) != 0)
         return rc;
     for (size_t q = 0; q <= rows; q++) {
-        uint64_t v;
-        memcpy(&v, r->buf + r->at, 8);
-        r->at += 8;
+        uint64_t v = asp__get_u64(r);
         p->row_ptr[q] = (size_t)v;
         /* row pointers are checked before any column is touched: entries beyond nnz are never read */
         if (q == 0 ? v != 0 : (v <= p->row_ptr[q - 1] || v > nnz || (q == rows && v != nnz))) {
@@ -245,7 +193,7 @@ static int read_prolongation(reader *r, size_t l, size_t rows, size_t cols, cons
             snprintf(msg, sizeof msg,
                      "level %zu: row pointer %zu of P is %llu, expected increasing from 0 to %llu (no empty row)", l, q,
                      (unsigned long long)v, (unsigned long long)nnz);
-            return bad(r, msg);
+            return asp__byte_bad(r, msg);
         }
     }
     memcpy(p->col, r->buf + r->at, 4 * (size_t)nnz);
@@ -280,7 +228,7 @@ static int read_prolongation(reader *r, size_t l, size_t rows, size_t cols, cons
     return 0;
 }
 
-static int parse(reader *r, const asp_context *ctx, asp_amg *a)
+static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
 {
     char magic[8], msg[200];
     uint32_t version, header, u32[2];
@@ -292,11 +240,11 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
                              "cannot read '%s': %zu bytes is too short for an .amg file (expected at least %d)", r->path,
                              r->size, AMG_HEADER + 4);
     /* the size was checked: the header fields cannot fail */
-    take(r, magic, 8, "the header");
+    asp__byte_take(r, magic, 8, "the header");
     if (memcmp(magic, AMG_MAGIC, 8) != 0)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': not an .amg file (bad magic)", r->path);
-    take(r, &version, 4, "the header");
-    take(r, &header, 4, "the header");
+    asp__byte_take(r, &version, 4, "the header");
+    asp__byte_take(r, &header, 4, "the header");
     if (version == 1)
         return asp_error_set(r->err, ASP_EFORMAT,
                              "cannot read '%s': .amg version 1 lacks the point attributes; decompose the input again "
@@ -305,11 +253,11 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': .amg version %u, expected %d", r->path,
                              (unsigned)version, AMG_VERSION);
     if (header != AMG_HEADER)
-        return bad(r, "unexpected header size");
-    take(r, &n, 8, "the header");
-    take(r, &nlevels, 8, "the header");
-    take(r, &payload, 8, "the header");
-    take(r, origin, 24, "the header");
+        return asp__byte_bad(r, "unexpected header size");
+    asp__byte_take(r, &n, 8, "the header");
+    asp__byte_take(r, &nlevels, 8, "the header");
+    asp__byte_take(r, &payload, 8, "the header");
+    asp__byte_take(r, origin, 24, "the header");
     if (payload != r->size - AMG_HEADER - 4)
         return asp_error_set(r->err, ASP_EFORMAT,
                              "cannot read '%s': truncated or padded: the header promises %llu payload bytes, the "
@@ -326,28 +274,28 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
         snprintf(msg, sizeof msg, "point count %llu, expected 1..%llu (28 bytes per point in a %llu-byte payload)",
                  (unsigned long long)n, (unsigned long long)(payload / 28 < INT32_MAX ? payload / 28 : INT32_MAX),
                  (unsigned long long)payload);
-        return bad(r, msg);
+        return asp__byte_bad(r, msg);
     }
     if (nlevels < 1 || nlevels > 100) {
         r->at = 24;
         snprintf(msg, sizeof msg, "level count %llu, expected 1..100", (unsigned long long)nlevels);
-        return bad(r, msg);
+        return asp__byte_bad(r, msg);
     }
     /* the attribute bit set sits after the fixed per-point arrays; read it first to size the cloud */
     uint32_t attrs = 0;
     r->at = AMG_HEADER + 28 * (size_t)n;
-    if ((rc = take(r, &attrs, 4, "the attribute set")) != 0)
+    if ((rc = asp__byte_take(r, &attrs, 4, "the attribute set")) != 0)
         return rc;
     r->at -= 4;
     if (attrs & ~(uint32_t)amg_attrs)
-        return bad(r, "unknown point attribute bits");
+        return asp__byte_bad(r, "unknown point attribute bits");
     /* per-point data, options and one size per level must fit before anything per point is allocated */
     if (payload < 28 * n + 8 + attr_bytes(attrs) * n + AMG_OPTIONS + 8 * nlevels) {
         snprintf(msg, sizeof msg, "point attributes 0x%x of %llu points and %llu levels need %llu payload bytes, the "
                  "file has %llu", (unsigned)attrs, (unsigned long long)n, (unsigned long long)nlevels,
                  (unsigned long long)(28 * n + 8 + attr_bytes(attrs) * n + AMG_OPTIONS + 8 * nlevels),
                  (unsigned long long)payload);
-        return bad(r, msg);
+        return asp__byte_bad(r, msg);
     }
     r->at = AMG_HEADER;
     if ((rc = asp_cloud_create((size_t)n, ASP_ATTR_NORMALS | attrs, ctx, &a->cloud, r->err)) != 0)
@@ -363,23 +311,23 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
         return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory for %llu points", r->path,
                              (unsigned long long)n);
     asp_cloud *c = a->cloud;
-    if ((rc = take(r, c->positions, 12 * (size_t)n, "positions")) ||
-        (rc = take(r, a->tangent, 12 * (size_t)n, "tangent normals")) ||
-        (rc = take(r, a->classifier, 4 * (size_t)n, "classifier values")) ||
-        (rc = take(r, u32, 8, "the attribute set")))
+    if ((rc = asp__byte_take(r, c->positions, 12 * (size_t)n, "positions")) ||
+        (rc = asp__byte_take(r, a->tangent, 12 * (size_t)n, "tangent normals")) ||
+        (rc = asp__byte_take(r, a->classifier, 4 * (size_t)n, "classifier values")) ||
+        (rc = asp__byte_take(r, u32, 8, "the attribute set")))
         return rc;
     if (attrs & ASP_ATTR_NORMALS)
-        rc = take(r, c->normals, 12 * (size_t)n, "normals");
+        rc = asp__byte_take(r, c->normals, 12 * (size_t)n, "normals");
     else
         memcpy(c->normals, a->tangent, 12 * (size_t)n);
     if (!rc && (attrs & ASP_ATTR_COLORS))
-        rc = take(r, c->colors, 4 * (size_t)n, "colors");
+        rc = asp__byte_take(r, c->colors, 4 * (size_t)n, "colors");
     if (!rc && (attrs & ASP_ATTR_RADII))
-        rc = take(r, c->radii, 4 * (size_t)n, "radii");
+        rc = asp__byte_take(r, c->radii, 4 * (size_t)n, "radii");
     if (!rc && (attrs & ASP_ATTR_UVS))
-        rc = take(r, c->uvs, 8 * (size_t)n, "uvs");
+        rc = asp__byte_take(r, c->uvs, 8 * (size_t)n, "uvs");
     if (!rc && (attrs & ASP_ATTR_LABELS))
-        rc = take(r, c->labels, 4 * (size_t)n, "labels");
+        rc = asp__byte_take(r, c->labels, 4 * (size_t)n, "labels");
     if (rc)
         return rc;
     asp_error verr;
@@ -393,7 +341,7 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
     if ((rc = read_options(r, &a->desc)) != 0)
         return rc;
     for (size_t l = 0; l < a->nlevels; l++) {
-        if ((rc = take(r, &u64, 8, "level sizes")) != 0)
+        if ((rc = asp__byte_take(r, &u64, 8, "level sizes")) != 0)
             return rc;
         /* each coarsening step makes fewer unknowns (hierarchy.c stops when it does not, journal 2.3) */
         uint64_t hi = l ? a->level_size[l - 1] - 1 : n;
@@ -401,7 +349,7 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
             r->at -= 8;
             snprintf(msg, sizeof msg, "level %zu: size %llu, expected %s%llu", l, (unsigned long long)u64,
                      l ? "1.." : "the point count ", (unsigned long long)hi);
-            return bad(r, msg);
+            return asp__byte_bad(r, msg);
         }
         a->level_size[l] = (size_t)u64;
     }
@@ -409,8 +357,8 @@ static int parse(reader *r, const asp_context *ctx, asp_amg *a)
         if ((rc = read_prolongation(r, l, a->level_size[l - 1], a->level_size[l], ctx, &a->prolong[l])) != 0)
             return rc;
     if (r->at != r->size) {
-        snprintf(msg, sizeof msg, "%zu unexpected bytes after the last level", left(r));
-        return bad(r, msg);
+        snprintf(msg, sizeof msg, "%zu unexpected bytes after the last level", asp__byte_left(r));
+        return asp__byte_bad(r, msg);
     }
     a->info.epsilon = a->desc.epsilon;
     a->info.k_min = a->desc.k_min;
@@ -432,50 +380,13 @@ int asp_amg_load_memory(const void *data, size_t size, const char *name, const a
     int rc = asp__amg_alloc(ctx, &a, err);
     if (rc)
         return rc;
-    reader r = {data ? data : empty, data ? size : 0, 0, nm, err};
+    asp__byte_reader r = {data ? data : empty, data ? size : 0, 0, nm, err};
     rc = parse(&r, ctx, a);
     if (rc) {
         asp_amg_destroy(a);
         return rc;
     }
     *out = a;
-    return 0;
-}
-
-/* The whole file in one buffer (through ctx); size_t sizes, a file too large for memory is ASP_ENOMEM. */
-static int read_file(const char *path, const asp_context *ctx, uint8_t **buf, size_t *size, asp_error *err)
-{
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
-    off_t end = -1;
-    if (fseeko(fp, 0, SEEK_END) == 0)
-        end = ftello(fp);
-    if (end < 0 || fseeko(fp, 0, SEEK_SET) != 0) {
-        fclose(fp);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': not a seekable file", path);
-    }
-    if ((uint64_t)end >= SIZE_MAX) {
-        fclose(fp);
-        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': %llu bytes do not fit in memory", path,
-                             (unsigned long long)end);
-    }
-    const size_t n = (size_t)end;
-    uint8_t *b = asp_alloc(ctx, n + 1);
-    if (!b) {
-        fclose(fp);
-        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory for %zu bytes", path, n);
-    }
-    if (fread(b, 1, n, fp) != n) {
-        int e = ferror(fp) ? errno : 0;
-        fclose(fp);
-        asp_free(ctx, b);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path,
-                             e ? strerror(e) : "the file shrank while reading");
-    }
-    fclose(fp);
-    *buf = b;
-    *size = n;
     return 0;
 }
 
@@ -487,7 +398,7 @@ int asp_amg_load(const char *path, const asp_context *ctx, asp_amg **out, asp_er
         return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': .amg files are little-endian only", path);
     uint8_t *buf = NULL;
     size_t size = 0;
-    int rc = read_file(path, ctx, &buf, &size, err);
+    int rc = asp__byte_slurp(path, ctx, &buf, &size, err);
     if (rc)
         return rc;
     rc = asp_amg_load_memory(buf, size, path, ctx, out, err);

@@ -4,15 +4,14 @@
  * texture atlases, the build parameters and the source name. Versioned,
  * little-endian, CRC-32 trailer; the reader trusts no count it has not checked.
  */
-#include <errno.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/types.h>
 
 #include "prim/internal.h"
 #include "util/atomic_file.h"
+#include "util/byte_io.h"
 #include "util/checksum.h"
 #include "util/banned.h"
 
@@ -21,53 +20,6 @@ enum { DPS_VERSION = 1, DPS_HEADER = 64, DPS_PARAMS = 128, DPS_LEVEL = 96, DPS_P
 
 /* ---- writing: explicit little-endian bytes, so the format does not depend on the host ---- */
 
-typedef asp__crc_writer writer;
-
-static void put(writer *w, const void *data, size_t len)
-{
-    asp__crc_put(w, data, len);
-}
-
-static void le32(uint8_t *b, uint32_t v)
-{
-    for (int k = 0; k < 4; k++)
-        b[k] = (uint8_t)(v >> (8 * k));
-}
-
-static void le64(uint8_t *b, uint64_t v)
-{
-    for (int k = 0; k < 8; k++)
-        b[k] = (uint8_t)(v >> (8 * k));
-}
-
-static void put_u32(writer *w, uint32_t v)
-{
-    uint8_t b[4];
-    le32(b, v);
-    put(w, b, 4);
-}
-
-static void put_u64(writer *w, uint64_t v)
-{
-    uint8_t b[8];
-    le64(b, v);
-    put(w, b, 8);
-}
-
-static void put_f32(writer *w, float v)
-{
-    uint32_t u;
-    memcpy(&u, &v, 4);
-    put_u32(w, u);
-}
-
-static void put_f64(writer *w, double v)
-{
-    uint64_t u;
-    memcpy(&u, &v, 8);
-    put_u64(w, u);
-}
-
 static uint64_t level_bytes(const asp_dps_level *lv)
 {
     uint64_t atlas = 4 * (uint64_t)lv->atlas.width * lv->atlas.height;
@@ -75,23 +27,23 @@ static uint64_t level_bytes(const asp_dps_level *lv)
            (lv->normal_atlas.width ? atlas : 0);
 }
 
-static void put_prim(writer *w, const asp_prim *p)
+static void put_prim(asp__crc_writer *w, const asp_prim *p)
 {
     for (int k = 0; k < 3; k++)
-        put_f64(w, p->centre[k]);
+        asp__put_f64(w, p->centre[k]);
     for (int k = 0; k < 3; k++)
-        put_f32(w, p->axis_u[k]);
+        asp__put_f32(w, p->axis_u[k]);
     for (int k = 0; k < 3; k++)
-        put_f32(w, p->axis_v[k]);
+        asp__put_f32(w, p->axis_v[k]);
     for (int k = 0; k < 3; k++)
-        put_f32(w, p->normal[k]);
+        asp__put_f32(w, p->normal[k]);
     const float f[6] = {p->half_u, p->half_v, p->texel, p->error, p->error_norm, p->curvature};
     for (int k = 0; k < 6; k++)
-        put_f32(w, f[k]);
+        asp__put_f32(w, f[k]);
     const uint32_t u[10] = {p->points, p->basis,  p->merged, p->flags,           p->tex_x,
                             p->tex_y,  p->tex_w, p->tex_h,  p->neighbour_first, p->neighbour_count};
     for (int k = 0; k < 10; k++)
-        put_u32(w, u[k]);
+        asp__put_u32(w, u[k]);
 }
 
 int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
@@ -102,142 +54,87 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
     int rc = asp__atomic_open(&f, path, err);
     if (rc)
         return rc;
-    writer w = {f.fp, 0, 0};
+    asp__crc_writer w = {f.fp, 0, 0};
     size_t slen = strnlen(dps->source, sizeof dps->source - 1);
     uint64_t payload = DPS_PARAMS + 4 + slen;
     for (size_t i = 0; i < dps->level_count; i++)
         payload += level_bytes(&dps->levels[i]);
     int normals = dps->level_count && dps->levels[0].normal_atlas.width;
-    put(&w, DPS_MAGIC, 8);
-    put_u32(&w, DPS_VERSION);
-    put_u32(&w, DPS_HEADER);
-    put_u64(&w, dps->level_count);
-    put_u64(&w, payload);
-    put_u64(&w, dps->source_points);
-    put_f64(&w, dps->mean_radius);
-    put_u32(&w, dps->amg_levels);
-    put_u32(&w, normals ? 1u : 0u);
-    put_u32(&w, dps->skipped_levels);
-    put_u32(&w, 0);
+    asp__crc_put(&w, DPS_MAGIC, 8);
+    asp__put_u32(&w, DPS_VERSION);
+    asp__put_u32(&w, DPS_HEADER);
+    asp__put_u64(&w, dps->level_count);
+    asp__put_u64(&w, payload);
+    asp__put_u64(&w, dps->source_points);
+    asp__put_f64(&w, dps->mean_radius);
+    asp__put_u32(&w, dps->amg_levels);
+    asp__put_u32(&w, normals ? 1u : 0u);
+    asp__put_u32(&w, dps->skipped_levels);
+    asp__put_u32(&w, 0);
     /* parameters: 128 bytes */
     const asp_prim_desc *d = &dps->desc;
-    put_f64(&w, d->tau);
-    put_f64(&w, d->texel_size);
-    put_f64(&w, d->width);
-    put_f64(&w, d->neighbour_fraction);
-    put_f64(&w, d->merge_flatness);
-    put_f64(&w, d->merge_angle);
+    asp__put_f64(&w, d->tau);
+    asp__put_f64(&w, d->texel_size);
+    asp__put_f64(&w, d->width);
+    asp__put_f64(&w, d->neighbour_fraction);
+    asp__put_f64(&w, d->merge_flatness);
+    asp__put_f64(&w, d->merge_angle);
     const uint32_t u[10] = {d->max_texture, (uint32_t)d->method, (uint32_t)d->shape, (uint32_t)d->normalise,
                             (uint32_t)d->unweighted, (uint32_t)d->project_radii, (uint32_t)d->no_extend_color,
                             (uint32_t)d->normal_map, (uint32_t)d->merge, d->padding};
     for (int k = 0; k < 10; k++)
-        put_u32(&w, u[k]);
+        asp__put_u32(&w, u[k]);
     for (int k = 0; k < (DPS_PARAMS - 48 - 40) / 8; k++)
-        put_u64(&w, 0);
-    put_u32(&w, (uint32_t)slen);
-    put(&w, dps->source, slen);
+        asp__put_u64(&w, 0);
+    asp__put_u32(&w, (uint32_t)slen);
+    asp__crc_put(&w, dps->source, slen);
     for (size_t i = 0; i < dps->level_count; i++) {
         const asp_dps_level *lv = &dps->levels[i];
-        put_u32(&w, lv->level);
-        put_u32(&w, lv->basis_count);
-        put_u64(&w, lv->prim_count);
-        put_u64(&w, lv->neighbour_total);
-        put_u32(&w, lv->atlas.width);
-        put_u32(&w, lv->atlas.height);
-        put_u32(&w, lv->normal_atlas.width ? 1u : 0u);
-        put_u32(&w, lv->skipped);
-        put_u32(&w, lv->degenerate);
-        put_u32(&w, lv->capped);
-        put_u32(&w, lv->merges);
-        put_u32(&w, 0);
-        put_u64(&w, lv->texels);
-        put_f64(&w, lv->error);
-        put_f64(&w, lv->error_norm);
-        put_f64(&w, lv->t_basis);
-        put_f64(&w, lv->t_construct);
+        asp__put_u32(&w, lv->level);
+        asp__put_u32(&w, lv->basis_count);
+        asp__put_u64(&w, lv->prim_count);
+        asp__put_u64(&w, lv->neighbour_total);
+        asp__put_u32(&w, lv->atlas.width);
+        asp__put_u32(&w, lv->atlas.height);
+        asp__put_u32(&w, lv->normal_atlas.width ? 1u : 0u);
+        asp__put_u32(&w, lv->skipped);
+        asp__put_u32(&w, lv->degenerate);
+        asp__put_u32(&w, lv->capped);
+        asp__put_u32(&w, lv->merges);
+        asp__put_u32(&w, 0);
+        asp__put_u64(&w, lv->texels);
+        asp__put_f64(&w, lv->error);
+        asp__put_f64(&w, lv->error_norm);
+        asp__put_f64(&w, lv->t_basis);
+        asp__put_f64(&w, lv->t_construct);
         for (size_t k = 0; k < lv->prim_count; k++)
             put_prim(&w, &lv->prims[k]);
         for (size_t k = 0; k < lv->neighbour_total; k++)
-            put_u32(&w, lv->neighbours[k]);
-        put(&w, lv->atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
+            asp__put_u32(&w, lv->neighbours[k]);
+        asp__crc_put(&w, lv->atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
         if (lv->normal_atlas.width)
-            put(&w, lv->normal_atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
+            asp__crc_put(&w, lv->normal_atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
     }
-    uint8_t b[4];
-    le32(b, w.crc);
-    if (!w.failed && fwrite(b, 1, 4, w.fp) != 4)
-        w.failed = 1;
-    if (w.failed) {
-        int e = errno;
-        asp__atomic_abort(&f);
-        return asp_error_set(err, ASP_EIO, "cannot write '%s': %s", path, strerror(e));
-    }
-    return asp__atomic_commit(&f, err);
+    return asp__byte_commit(&w, &f, path, err);
 }
 
 /* ---- reading ---- */
 
-/*
- * The file bytes, consumed front to back. Offsets are size_t; every get_* is
- * preceded by a check that enough bytes are left, and every count is compared
- * with the bytes left (by division, so nothing overflows) before it sizes an
- * allocation.
- */
-typedef struct reader {
-    const uint8_t *base, *p;
-    size_t left;
-    const char *path;
-} reader;
-
-static uint32_t get_u32(reader *r)
-{
-    uint32_t v = 0;
-    for (int k = 0; k < 4; k++)
-        v |= (uint32_t)r->p[k] << (8 * k);
-    r->p += 4, r->left -= 4;
-    return v;
-}
-
-static uint64_t get_u64(reader *r)
-{
-    uint64_t v = 0;
-    for (int k = 0; k < 8; k++)
-        v |= (uint64_t)r->p[k] << (8 * k);
-    r->p += 8, r->left -= 8;
-    return v;
-}
-
-static float get_f32(reader *r)
-{
-    uint32_t u = get_u32(r);
-    float f;
-    memcpy(&f, &u, 4);
-    return f;
-}
-
-static double get_f64(reader *r)
-{
-    uint64_t u = get_u64(r);
-    double f;
-    memcpy(&f, &u, 8);
-    return f;
-}
-
-static void get_prim(reader *r, asp_prim *p)
+static void get_prim(asp__byte_reader *r, asp_prim *p)
 {
     for (int k = 0; k < 3; k++)
-        p->centre[k] = get_f64(r);
+        p->centre[k] = asp__get_f64(r);
     for (int k = 0; k < 3; k++)
-        p->axis_u[k] = get_f32(r);
+        p->axis_u[k] = asp__get_f32(r);
     for (int k = 0; k < 3; k++)
-        p->axis_v[k] = get_f32(r);
+        p->axis_v[k] = asp__get_f32(r);
     for (int k = 0; k < 3; k++)
-        p->normal[k] = get_f32(r);
-    p->half_u = get_f32(r), p->half_v = get_f32(r), p->texel = get_f32(r);
-    p->error = get_f32(r), p->error_norm = get_f32(r), p->curvature = get_f32(r);
-    p->points = get_u32(r), p->basis = get_u32(r), p->merged = get_u32(r), p->flags = get_u32(r);
-    p->tex_x = get_u32(r), p->tex_y = get_u32(r), p->tex_w = get_u32(r), p->tex_h = get_u32(r);
-    p->neighbour_first = get_u32(r), p->neighbour_count = get_u32(r);
+        p->normal[k] = asp__get_f32(r);
+    p->half_u = asp__get_f32(r), p->half_v = asp__get_f32(r), p->texel = asp__get_f32(r);
+    p->error = asp__get_f32(r), p->error_norm = asp__get_f32(r), p->curvature = asp__get_f32(r);
+    p->points = asp__get_u32(r), p->basis = asp__get_u32(r), p->merged = asp__get_u32(r), p->flags = asp__get_u32(r);
+    p->tex_x = asp__get_u32(r), p->tex_y = asp__get_u32(r), p->tex_w = asp__get_u32(r), p->tex_h = asp__get_u32(r);
+    p->neighbour_first = asp__get_u32(r), p->neighbour_count = asp__get_u32(r);
 }
 
 static int prim_finite(const asp_prim *p)
@@ -249,20 +146,14 @@ static int prim_finite(const asp_prim *p)
     return isfinite(s) && p->half_u >= 0 && p->half_v >= 0 && p->texel > 0;
 }
 
-/* "cannot read 'x.dps': byte 1234: <what>" */
-static int bad(reader *r, asp_error *err, const char *what)
+/* Like asp__byte_bad for what concerns the whole file (magic, version, size, checksum): no byte offset. */
+static int bad_file(const asp__byte_reader *r, const char *what)
 {
-    return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': byte %zu: %s", r->path, (size_t)(r->p - r->base), what);
-}
-
-/* The same for what concerns the whole file (magic, version, size, checksum): no byte offset. */
-static int bad_file(reader *r, asp_error *err, const char *what)
-{
-    return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': %s", r->path, what);
+    return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': %s", r->path, what);
 }
 
 /* The primitives' neighbour lists (journal section 4): sorted within each range, never the primitive itself. */
-static int check_neighbours(reader *r, const asp_dps_level *lv, size_t li, asp_error *err)
+static int check_neighbours(asp__byte_reader *r, const asp_dps_level *lv, size_t li)
 {
     char msg[160];
     for (size_t k = 0; k < lv->prim_count; k++) {
@@ -271,65 +162,66 @@ static int check_neighbours(reader *r, const asp_dps_level *lv, size_t li, asp_e
             if (lv->neighbours[q] == k || (q > p->neighbour_first && lv->neighbours[q] <= lv->neighbours[q - 1])) {
                 snprintf(msg, sizeof msg, "level %zu, primitive %zu: neighbour %u, expected increasing indices other "
                          "than the primitive's own", li, k, lv->neighbours[q]);
-                return bad(r, err, msg);
+                return asp__byte_bad(r, msg);
             }
     }
     return 0;
 }
 
-static int read_level(reader *r, const asp_dps *dps, size_t li, asp_dps_level *lv, const asp_context *ctx,
-                      asp_error *err)
+static int read_level(asp__byte_reader *r, const asp_dps *dps, size_t li, asp_dps_level *lv, const asp_context *ctx)
 {
     char msg[200];
-    if (r->left < DPS_LEVEL) {
+    if (asp__byte_left(r) < DPS_LEVEL) {
         snprintf(msg, sizeof msg, "level %zu: truncated level header (%d bytes needed, %zu left)", li, DPS_LEVEL,
-                 r->left);
-        return bad(r, err, msg);
+                 asp__byte_left(r));
+        return asp__byte_bad(r, msg);
     }
-    lv->level = get_u32(r);
-    lv->basis_count = get_u32(r);
-    uint64_t np = get_u64(r), nn = get_u64(r);
-    uint32_t aw = get_u32(r), ah = get_u32(r), has_n = get_u32(r);
-    lv->skipped = get_u32(r), lv->degenerate = get_u32(r), lv->capped = get_u32(r), lv->merges = get_u32(r);
-    (void)get_u32(r);
-    lv->texels = get_u64(r);
-    lv->error = get_f64(r), lv->error_norm = get_f64(r), lv->t_basis = get_f64(r), lv->t_construct = get_f64(r);
+    lv->level = asp__get_u32(r);
+    lv->basis_count = asp__get_u32(r);
+    uint64_t np = asp__get_u64(r), nn = asp__get_u64(r);
+    uint32_t aw = asp__get_u32(r), ah = asp__get_u32(r), has_n = asp__get_u32(r);
+    lv->skipped = asp__get_u32(r), lv->degenerate = asp__get_u32(r);
+    lv->capped = asp__get_u32(r), lv->merges = asp__get_u32(r);
+    (void)asp__get_u32(r);
+    lv->texels = asp__get_u64(r);
+    lv->error = asp__get_f64(r), lv->error_norm = asp__get_f64(r);
+    lv->t_basis = asp__get_f64(r), lv->t_construct = asp__get_f64(r);
     /* levels are stored finest first without duplicates (asp_prim_build) */
     const uint32_t lo = li ? dps->levels[li - 1].level + 1 : 0;
     if (lv->level < lo || lv->level >= dps->amg_levels) {
         snprintf(msg, sizeof msg, "level %zu: AMG level %u, expected %u..%u (increasing, below the level count)", li,
                  lv->level, lo, dps->amg_levels - 1);
-        return bad(r, err, msg);
+        return asp__byte_bad(r, msg);
     }
     /* the counts must fit the bytes left before anything is allocated */
-    const size_t avail = r->left;
+    const size_t avail = asp__byte_left(r);
     if (np == 0 || np > avail / DPS_PRIM) {
         snprintf(msg, sizeof msg, "level %zu: primitive count %llu, expected 1..%zu (%d bytes each, %zu bytes left)",
                  li, (unsigned long long)np, avail / DPS_PRIM, DPS_PRIM, avail);
-        return bad(r, err, msg);
+        return asp__byte_bad(r, msg);
     }
     const size_t after_prims = avail - (size_t)np * DPS_PRIM;
     if (nn > after_prims / 4) {
         snprintf(msg, sizeof msg, "level %zu: neighbour count %llu, expected at most %zu (4 bytes each, %zu bytes "
                  "left after the primitives)", li, (unsigned long long)nn, after_prims / 4, after_prims);
-        return bad(r, err, msg);
+        return asp__byte_bad(r, msg);
     }
     if (aw == 0 || ah == 0 || aw > DPS_SIDE || ah > DPS_SIDE || has_n > 1) {
         snprintf(msg, sizeof msg, "level %zu: %ux%u atlas with normal flag %u, expected sides 1..%d and a flag 0 or 1",
                  li, aw, ah, has_n, DPS_SIDE);
-        return bad(r, err, msg);
+        return asp__byte_bad(r, msg);
     }
     const size_t after_nbrs = after_prims - (size_t)nn * 4, atlas = 4 * (size_t)aw * ah;
     if (atlas * (1 + has_n) > after_nbrs) {
         snprintf(msg, sizeof msg, "level %zu: truncated: %ux%u atlas%s of %zu bytes, expected at most the %zu "
                  "bytes left after the neighbours", li, aw, ah, has_n ? "es (colour and normal)" : "",
                  atlas * (1 + has_n), after_nbrs);
-        return bad(r, err, msg);
+        return asp__byte_bad(r, msg);
     }
     lv->prims = asp_calloc(ctx, (size_t)np, sizeof *lv->prims); /* zeroed padding: records compare with memcmp */
     lv->neighbours = asp_alloc(ctx, (size_t)(nn ? nn : 1) * sizeof *lv->neighbours);
     if (!lv->prims || !lv->neighbours)
-        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory for %llu primitives", r->path,
+        return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory for %llu primitives", r->path,
                              (unsigned long long)np);
     lv->prim_count = (size_t)np;
     lv->neighbour_total = (size_t)nn;
@@ -339,160 +231,161 @@ static int read_level(reader *r, const asp_dps *dps, size_t li, asp_dps_level *l
         get_prim(r, p);
         if (!prim_finite(p)) {
             snprintf(msg, sizeof msg, "level %zu, primitive %zu: non-finite or negative geometry", li, k);
-            return bad(r, err, msg);
+            return asp__byte_bad(r, msg);
         }
         if (p->tex_w == 0 || p->tex_h == 0 || p->tex_x > aw || p->tex_w > aw - p->tex_x || p->tex_y > ah ||
             p->tex_h > ah - p->tex_y) {
             snprintf(msg, sizeof msg, "level %zu, primitive %zu: texture %u+%u x %u+%u outside the %ux%u atlas", li,
                      k, p->tex_x, p->tex_w, p->tex_y, p->tex_h, aw, ah);
-            return bad(r, err, msg);
+            return asp__byte_bad(r, msg);
         }
         if ((uint64_t)p->neighbour_first + p->neighbour_count > nn) {
             snprintf(msg, sizeof msg, "level %zu, primitive %zu: neighbours %u+%u beyond the %llu stored", li, k,
                      p->neighbour_first, p->neighbour_count, (unsigned long long)nn);
-            return bad(r, err, msg);
+            return asp__byte_bad(r, msg);
         }
         if (p->basis >= lv->basis_count) {
             snprintf(msg, sizeof msg, "level %zu, primitive %zu: basis function %u, expected below %u", li, k,
                      p->basis, lv->basis_count);
-            return bad(r, err, msg);
+            return asp__byte_bad(r, msg);
         }
         texels += (uint64_t)p->tex_w * p->tex_h;
     }
     for (size_t k = 0; k < nn; k++) {
-        lv->neighbours[k] = get_u32(r);
+        lv->neighbours[k] = asp__get_u32(r);
         if (lv->neighbours[k] >= np) {
             snprintf(msg, sizeof msg, "level %zu: neighbour entry %zu is %u, expected below %llu", li, k,
                      lv->neighbours[k], (unsigned long long)np);
-            return bad(r, err, msg);
+            return asp__byte_bad(r, msg);
         }
     }
-    int rc = check_neighbours(r, lv, li, err);
+    int rc = check_neighbours(r, lv, li);
     if (rc)
         return rc;
     if (texels != lv->texels) {
         snprintf(msg, sizeof msg, "level %zu: %llu texels recorded, the rectangles hold %llu", li,
                  (unsigned long long)lv->texels, (unsigned long long)texels);
-        return bad(r, err, msg);
+        return asp__byte_bad(r, msg);
     }
-    rc = asp_image_init(&lv->atlas, aw, ah, err);
+    rc = asp_image_init(&lv->atlas, aw, ah, r->err);
     if (!rc && has_n)
-        rc = asp_image_init(&lv->normal_atlas, aw, ah, err);
+        rc = asp_image_init(&lv->normal_atlas, aw, ah, r->err);
     if (rc)
         return rc;
-    memcpy(lv->atlas.pixels, r->p, atlas);
-    r->p += atlas, r->left -= atlas;
+    memcpy(lv->atlas.pixels, r->buf + r->at, atlas);
+    r->at += atlas;
     if (has_n) {
-        memcpy(lv->normal_atlas.pixels, r->p, atlas);
-        r->p += atlas, r->left -= atlas;
+        memcpy(lv->normal_atlas.pixels, r->buf + r->at, atlas);
+        r->at += atlas;
     }
     return 0;
 }
 
 /* The build parameters (128 bytes) and the source name. */
-static int read_params(reader *r, asp_dps *dps, asp_error *err)
+static int read_params(asp__byte_reader *r, asp_dps *dps)
 {
     char msg[200];
     asp_prim_desc *d = &dps->desc;
-    d->tau = get_f64(r), d->texel_size = get_f64(r), d->width = get_f64(r);
-    d->neighbour_fraction = get_f64(r), d->merge_flatness = get_f64(r), d->merge_angle = get_f64(r);
-    d->max_texture = get_u32(r);
-    const uint32_t method = get_u32(r), shape = get_u32(r), normalise = get_u32(r);
-    d->unweighted = (int)get_u32(r), d->project_radii = (int)get_u32(r), d->no_extend_color = (int)get_u32(r);
-    d->normal_map = (int)get_u32(r), d->merge = (int)get_u32(r), d->padding = get_u32(r);
+    d->tau = asp__get_f64(r), d->texel_size = asp__get_f64(r), d->width = asp__get_f64(r);
+    d->neighbour_fraction = asp__get_f64(r), d->merge_flatness = asp__get_f64(r), d->merge_angle = asp__get_f64(r);
+    d->max_texture = asp__get_u32(r);
+    const uint32_t method = asp__get_u32(r), shape = asp__get_u32(r), normalise = asp__get_u32(r);
+    d->unweighted = (int)asp__get_u32(r), d->project_radii = (int)asp__get_u32(r);
+    d->no_extend_color = (int)asp__get_u32(r);
+    d->normal_map = (int)asp__get_u32(r), d->merge = (int)asp__get_u32(r), d->padding = asp__get_u32(r);
     /* enum values outside their range would index name tables (asp_prim_method_name) */
     if (method > ASP_PRIM_RADIAL || shape > ASP_PRIM_GAUSSIAN || normalise > ASP_PRIM_NORM_GE1) {
         snprintf(msg, sizeof msg, "parameters: method %u, shape %u, normalisation %u, expected at most %d, %d, %d",
                  method, shape, normalise, ASP_PRIM_RADIAL, ASP_PRIM_GAUSSIAN, ASP_PRIM_NORM_GE1);
-        return bad(r, err, msg);
+        return asp__byte_bad(r, msg);
     }
     d->method = (asp_prim_method)method;
     d->shape = (asp_prim_shape)shape;
     d->normalise = (asp_prim_normalise)normalise;
     if (!isfinite(d->tau + d->texel_size + d->width + d->neighbour_fraction + d->merge_flatness + d->merge_angle))
-        return bad(r, err, "parameters: a non-finite value, expected finite resolved options");
-    r->p += DPS_PARAMS - 88, r->left -= DPS_PARAMS - 88;
-    uint32_t slen = get_u32(r);
-    if (slen >= sizeof dps->source || slen > r->left) {
+        return asp__byte_bad(r, "parameters: a non-finite value, expected finite resolved options");
+    r->at += DPS_PARAMS - 88;
+    uint32_t slen = asp__get_u32(r);
+    if (slen >= sizeof dps->source || slen > asp__byte_left(r)) {
         snprintf(msg, sizeof msg, "source name of %u bytes, expected below %zu and within the %zu bytes left", slen,
-                 sizeof dps->source, r->left);
-        return bad(r, err, msg);
+                 sizeof dps->source, asp__byte_left(r));
+        return asp__byte_bad(r, msg);
     }
-    memcpy(dps->source, r->p, slen);
+    memcpy(dps->source, r->buf + r->at, slen);
     dps->source[slen] = 0;
-    r->p += slen, r->left -= slen;
+    r->at += slen;
     return 0;
 }
 
-static int parse(reader *r, const asp_context *ctx, asp_dps *dps, asp_error *err)
+static int parse(asp__byte_reader *r, const asp_context *ctx, asp_dps *dps)
 {
     char msg[200];
-    const size_t total = r->left;
-    if (total < 8 || memcmp(r->p, DPS_MAGIC, 8) != 0)
-        return bad_file(r, err, total >= 6 && memcmp(r->p, DPS_MAGIC, 6) == 0
-                               ? "unsupported variant of the magic 'ASPDPS'"
-                               : "not a .dps file (expected the magic 'ASPDPS')");
+    const size_t total = r->size;
+    if (total < 8 || memcmp(r->buf, DPS_MAGIC, 8) != 0)
+        return bad_file(r, total >= 6 && memcmp(r->buf, DPS_MAGIC, 6) == 0
+                          ? "unsupported variant of the magic 'ASPDPS'"
+                          : "not a .dps file (expected the magic 'ASPDPS')");
     if (total < DPS_HEADER + 4) {
         snprintf(msg, sizeof msg, "truncated header (%zu bytes, expected at least %d)", total, DPS_HEADER + 4);
-        return bad_file(r, err, msg);
+        return bad_file(r, msg);
     }
-    r->p += 8, r->left -= 8;
-    uint32_t version = get_u32(r), hsize = get_u32(r);
+    r->at += 8;
+    uint32_t version = asp__get_u32(r), hsize = asp__get_u32(r);
     if (version != DPS_VERSION || hsize != DPS_HEADER) {
         snprintf(msg, sizeof msg, "unsupported version %u (header %u bytes), expected version %d", version, hsize,
                  DPS_VERSION);
-        return bad_file(r, err, msg);
+        return bad_file(r, msg);
     }
-    uint64_t nl = get_u64(r), payload = get_u64(r);
-    dps->source_points = get_u64(r);
-    dps->mean_radius = get_f64(r);
-    dps->amg_levels = get_u32(r);
-    (void)get_u32(r);
-    dps->skipped_levels = get_u32(r);
-    (void)get_u32(r);
+    uint64_t nl = asp__get_u64(r), payload = asp__get_u64(r);
+    dps->source_points = asp__get_u64(r);
+    dps->mean_radius = asp__get_f64(r);
+    dps->amg_levels = asp__get_u32(r);
+    (void)asp__get_u32(r);
+    dps->skipped_levels = asp__get_u32(r);
+    (void)asp__get_u32(r);
     const size_t have = total - DPS_HEADER - 4;
     if (payload != have) {
         snprintf(msg, sizeof msg, "%s: header says %llu payload bytes, the file has %zu",
                  payload > have ? "truncated" : "trailing bytes", (unsigned long long)payload, have);
-        return bad_file(r, err, msg);
+        return bad_file(r, msg);
     }
     /* the CRC-32 trailer covers everything before it, header included */
-    const uint8_t *end = r->base + total - 4;
+    const uint8_t *end = r->buf + total - 4;
     uint32_t stored = (uint32_t)end[0] | (uint32_t)end[1] << 8 | (uint32_t)end[2] << 16 | (uint32_t)end[3] << 24;
-    uint32_t crc = asp__crc32(0, r->base, total - 4);
+    uint32_t crc = asp__crc32(0, r->buf, total - 4);
     if (crc != stored) {
         snprintf(msg, sizeof msg, "checksum mismatch (stored 0x%08x, computed 0x%08x): the file is damaged", stored,
                  crc);
-        return bad_file(r, err, msg);
+        return bad_file(r, msg);
     }
-    r->left = have;
+    r->size = total - 4; /* the trailer is not payload */
     if (nl == 0 || nl > 64 || dps->amg_levels == 0 || !(dps->mean_radius > 0) || !isfinite(dps->mean_radius)) {
-        r->p = r->base + 16;
+        r->at = 16;
         snprintf(msg, sizeof msg, "level count %llu of a %u-level decomposition, mean radius %g: expected 1..64 "
                  "levels, at least one AMG level and a finite radius above 0",
                  (unsigned long long)nl, dps->amg_levels, dps->mean_radius);
-        return bad(r, err, msg);
+        return asp__byte_bad(r, msg);
     }
-    if (r->left < DPS_PARAMS + 4 + (size_t)nl * DPS_LEVEL) {
+    if (asp__byte_left(r) < DPS_PARAMS + 4 + (size_t)nl * DPS_LEVEL) {
         snprintf(msg, sizeof msg, "truncated: %llu levels need at least %llu payload bytes, the file has %zu",
-                 (unsigned long long)nl, (unsigned long long)(DPS_PARAMS + 4 + nl * DPS_LEVEL), r->left);
-        return bad(r, err, msg);
+                 (unsigned long long)nl, (unsigned long long)(DPS_PARAMS + 4 + nl * DPS_LEVEL), asp__byte_left(r));
+        return asp__byte_bad(r, msg);
     }
-    int rc = read_params(r, dps, err);
+    int rc = read_params(r, dps);
     if (rc)
         return rc;
     dps->levels = asp_calloc(ctx, (size_t)nl, sizeof *dps->levels);
     if (!dps->levels)
-        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory for %llu levels", r->path,
+        return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory for %llu levels", r->path,
                              (unsigned long long)nl);
     for (size_t i = 0; i < nl; i++) {
         dps->level_count = i + 1;
-        if ((rc = read_level(r, dps, i, &dps->levels[i], ctx, err)) != 0)
+        if ((rc = read_level(r, dps, i, &dps->levels[i], ctx)) != 0)
             return rc;
     }
-    if (r->left != 0) {
-        snprintf(msg, sizeof msg, "%zu unexpected bytes after the last level", r->left);
-        return bad(r, err, msg);
+    if (r->at != r->size) {
+        snprintf(msg, sizeof msg, "%zu unexpected bytes after the last level", asp__byte_left(r));
+        return asp__byte_bad(r, msg);
     }
     return 0;
 }
@@ -509,8 +402,8 @@ int asp_dps_load_memory(const void *data, size_t size, const char *name, const a
         return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory", nm);
     dps->ctx = ctx ? *ctx : (asp_context){0};
     const uint8_t *b = data ? data : empty;
-    reader r = {b, b, data ? size : 0, nm};
-    int rc = parse(&r, ctx, dps, err);
+    asp__byte_reader r = {b, data ? size : 0, 0, nm, err};
+    int rc = parse(&r, ctx, dps);
     if (rc) {
         asp_dps_destroy(dps);
         return rc;
@@ -523,36 +416,12 @@ int asp_dps_load(const char *path, const asp_context *ctx, asp_dps **out, asp_er
 {
     if (!path || !out)
         return asp_error_set(err, ASP_EINVAL, "asp_dps_load needs a path and an output");
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
-    off_t end = -1;
-    if (fseeko(fp, 0, SEEK_END) == 0)
-        end = ftello(fp);
-    if (end < 0 || fseeko(fp, 0, SEEK_SET) != 0) {
-        int e = errno;
-        fclose(fp);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, end < 0 ? "not a seekable file" : strerror(e));
-    }
-    if ((uint64_t)end >= SIZE_MAX) {
-        fclose(fp);
-        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': %llu bytes do not fit in memory", path,
-                             (unsigned long long)end);
-    }
-    const size_t size = (size_t)end;
-    uint8_t *buf = asp_alloc(ctx, size + 1);
-    if (!buf) {
-        fclose(fp);
-        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory for %zu bytes", path, size);
-    }
-    size_t got = fread(buf, 1, size, fp);
-    int rerr = ferror(fp);
-    fclose(fp);
-    if (rerr || got != size) {
-        asp_free(ctx, buf);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': short read (%zu of %zu bytes)", path, got, size);
-    }
-    int rc = asp_dps_load_memory(buf, size, path, ctx, out, err);
+    uint8_t *buf = NULL;
+    size_t size = 0;
+    int rc = asp__byte_slurp(path, ctx, &buf, &size, err);
+    if (rc)
+        return rc;
+    rc = asp_dps_load_memory(buf, size, path, ctx, out, err);
     asp_free(ctx, buf);
     return rc;
 }

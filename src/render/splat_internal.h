@@ -14,10 +14,11 @@ enum { ASP__LOD_BIND_SPLATS = 0, ASP__LOD_BIND_IDS = 1, ASP__LOD_BIND_CONES = 2,
        ASP__LOD_BIND_CLIPS = 3 /* splat renderer only: 2 clip planes per point splat */ };
 
 /*
- * GLSL declarations of the buffers, and a function reading splat `id` into
- * local variables: centre c, colour bits, normal n, axes u, v with semi-axes
- * a, b (asp_hier_splat, 64 bytes = 4 uvec4; uvec4 because the colour bytes
- * read as a float could be a NaN pattern a driver need not preserve).
+ * GLSL declarations of the buffers, a function reading splat `id` into local
+ * variables: centre c, colour bits, normal n, axes u, v with semi-axes a, b
+ * (asp_hier_splat, 64 bytes = 4 uvec4; uvec4 because the colour bytes read as
+ * a float could be a NaN pattern a driver need not preserve), and the
+ * per-frame uniforms that asp__lod_frame_uniforms sets.
  */
 #define ASP__LOD_GLSL                                                                   \
     "layout(std430, binding = 0) readonly buffer Splats { uvec4 splats[]; };\n"         \
@@ -35,7 +36,15 @@ enum { ASP__LOD_BIND_SPLATS = 0, ASP__LOD_BIND_IDS = 1, ASP__LOD_BIND_CONES = 2,
     "}\n"                                                                               \
     "vec3 srgb_to_linear(vec3 c) {\n"                                                   \
     "    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));\n" \
-    "}\n"
+    "}\n"                                                                               \
+    "uniform mat4 u_view;\n"                                                            \
+    "uniform mat4 u_proj;\n"                                                            \
+    "uniform vec3 u_eye;\n"                                                             \
+    "uniform vec3 u_light;\n"
+
+/* The names of the uniforms of ASP__LOD_GLSL, which start every hierarchy renderer's table of locations. */
+#define ASP__LOD_UNIFORM_NAMES "u_view", "u_proj", "u_eye", "u_light"
+enum { ASP__LOD_U_VIEW, ASP__LOD_U_PROJ, ASP__LOD_U_EYE, ASP__LOD_U_LIGHT, ASP__LOD_U_COUNT };
 
 /* The hierarchy on the GPU plus the last cut. */
 typedef struct asp__lod {
@@ -69,13 +78,34 @@ extern const asp__renderer_vtable asp__square_vtable;
 /* r as a hierarchy renderer, or NULL for other kinds. */
 asp__lod_renderer *asp__lod_renderer_of(asp_renderer *r);
 
+/* The options that asp_splat_renderer_desc and asp_square_renderer_desc share, borrowed from the caller's desc. */
+typedef struct asp__lod_desc {
+    const asp_hier_desc *hier;
+    const asp_context *ctx;
+    float tolerance;
+    unsigned flags;
+    const uint8_t *default_color; /* 4 bytes; all 0 means light grey */
+} asp__lod_desc;
+
+/* The shared options of d, an asp_splat_renderer_desc or asp_square_renderer_desc (the fields have the same names). */
+#define ASP__LOD_DESC(d) (&(const asp__lod_desc){&(d)->hier, (d)->ctx, (d)->tolerance, (d)->flags, (d)->default_color})
+
 /*
- * Checks the shared options and builds (cloud != NULL, owned) or borrows
- * (hier) the hierarchy. default_color all 0 means light grey.
+ * Allocates a zeroed renderer of size bytes (a struct that starts with
+ * asp__lod_renderer) drawing through vt, and builds (cloud != NULL, owned) or
+ * borrows (hier) its hierarchy. On failure nothing stays allocated.
  */
-int asp__lod_prepare(asp__lod *lod, const asp_cloud *cloud, const asp_hier *hier, const asp_hier_desc *hdesc,
-                     const asp_context *ctx, float tolerance, unsigned flags, const uint8_t default_color[4],
-                     asp_error *err);
+int asp__lod_renderer_create(asp_gl_context *gl, size_t size, const asp__renderer_vtable *vt, const asp_cloud *cloud,
+                             const asp_hier *hier, const asp__lod_desc *desc, asp__lod_renderer **out, asp_error *err);
+
+/*
+ * The last step of creating r: reports the GL errors of its setup as "cannot
+ * create the <vt->name> renderer" and destroys r (vt->destroy), or hands r out.
+ */
+int asp__lod_renderer_finish(asp__lod_renderer *r, asp_renderer **out, asp_error *err);
+
+/* Releases the hierarchy and the cut and frees r; the renderer's own GL objects go first. */
+void asp__lod_renderer_free(asp__lod_renderer *r);
 
 /* Uploads the splats and cone angles and makes the cut buffers; gl must be current. */
 int asp__lod_upload(asp_gl_context *gl, asp__lod *lod, const char *what, asp_error *err);
@@ -85,6 +115,9 @@ int asp__lod_upload(asp_gl_context *gl, asp__lod *lod, const char *what, asp_err
  * storage buffers; sets lod->count (and base->count).
  */
 int asp__lod_select(asp__lod_renderer *r, const asp__frame *f, asp_error *err);
+
+/* Sets the uniforms of ASP__LOD_GLSL from f; loc holds their locations in ASP__LOD_U_* order. */
+void asp__lod_frame_uniforms(GLuint program, const GLint *loc, const asp__frame *f);
 
 /* Frees GL buffers, the cut and an owned hierarchy. */
 void asp__lod_release(const asp_context *actx, asp__lod *lod);

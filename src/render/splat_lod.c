@@ -34,13 +34,13 @@ int asp__lod_check_option(const char *renderer, const char *name, float v, asp_e
     return 0;
 }
 
-int asp__lod_prepare(asp__lod *lod, const asp_cloud *cloud, const asp_hier *hier, const asp_hier_desc *hdesc,
-                     const asp_context *ctx, float tolerance, unsigned flags, const uint8_t default_color[4],
-                     asp_error *err)
+/* Builds (cloud != NULL, owned) or borrows (hier) the hierarchy and takes the shared options. */
+static int lod_prepare(asp__lod *lod, const asp_cloud *cloud, const asp_hier *hier, const asp__lod_desc *desc,
+                       asp_error *err)
 {
     memset(lod, 0, sizeof *lod);
     if (cloud) {
-        int rc = asp_hier_build(cloud, hdesc, ctx, &lod->owned, err);
+        int rc = asp_hier_build(cloud, desc->hier, desc->ctx, &lod->owned, err);
         if (rc)
             return rc;
         hier = lod->owned;
@@ -63,13 +63,52 @@ int asp__lod_prepare(asp__lod *lod, const asp_cloud *cloud, const asp_hier *hier
                              "cannot render splats: all %zu points are at the same position and have no radius", n);
     }
     lod->has_colors = (asp_hier_flags(hier) & ASP_HIER_HAS_COLORS) != 0;
-    int given = default_color[0] || default_color[1] || default_color[2] || default_color[3];
+    const uint8_t *dc = desc->default_color;
+    int given = dc[0] || dc[1] || dc[2] || dc[3];
     for (int c = 0; c < 4; c++)
-        lod->default_color[c] = given ? default_color[c] / 255.0f : (c < 3 ? 200.0f / 255.0f : 1.0f);
-    lod->tolerance = tolerance;
-    lod->cull_backfaces = (flags & ASP_SPLAT_CULL_BACKFACES) != 0;
+        lod->default_color[c] = given ? dc[c] / 255.0f : (c < 3 ? 200.0f / 255.0f : 1.0f);
+    lod->tolerance = desc->tolerance;
+    lod->cull_backfaces = (desc->flags & ASP_SPLAT_CULL_BACKFACES) != 0;
     lod->count = lod->points;
     return 0;
+}
+
+int asp__lod_renderer_create(asp_gl_context *gl, size_t size, const asp__renderer_vtable *vt, const asp_cloud *cloud,
+                             const asp_hier *hier, const asp__lod_desc *desc, asp__lod_renderer **out, asp_error *err)
+{
+    asp__lod_renderer *r = asp_calloc(&gl->actx, 1, size);
+    if (!r)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for a %s renderer", vt->name);
+    int rc = lod_prepare(&r->lod, cloud, hier, desc, err);
+    if (rc) {
+        asp_free(&gl->actx, r);
+        return rc;
+    }
+    r->base.vt = vt;
+    r->base.gl = gl;
+    r->base.count = r->lod.count;
+    *out = r;
+    return 0;
+}
+
+int asp__lod_renderer_finish(asp__lod_renderer *r, asp_renderer **out, asp_error *err)
+{
+    char what[64];
+    snprintf(what, sizeof what, "create the %s renderer", r->base.vt->name);
+    int rc = asp__gl_check(r->base.gl, what, err);
+    if (rc) {
+        r->base.vt->destroy(&r->base);
+        return rc;
+    }
+    *out = &r->base;
+    return 0;
+}
+
+void asp__lod_renderer_free(asp__lod_renderer *r)
+{
+    const asp_context *actx = &r->base.gl->actx; // in gl, which outlives r
+    asp__lod_release(actx, &r->lod);
+    asp_free(actx, r);
 }
 
 int asp__lod_upload(asp_gl_context *gl, asp__lod *lod, const char *what, asp_error *err)
@@ -178,6 +217,14 @@ int asp__lod_select(asp__lod_renderer *r, const asp__frame *f, asp_error *err)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_IDS, lod->ids.id);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_CONES, lod->cones.id);
     return 0;
+}
+
+void asp__lod_frame_uniforms(GLuint program, const GLint *loc, const asp__frame *f)
+{
+    glProgramUniformMatrix4fv(program, loc[ASP__LOD_U_VIEW], 1, GL_FALSE, f->view);
+    glProgramUniformMatrix4fv(program, loc[ASP__LOD_U_PROJ], 1, GL_FALSE, f->proj);
+    glProgramUniform3fv(program, loc[ASP__LOD_U_EYE], 1, f->eye);
+    glProgramUniform3fv(program, loc[ASP__LOD_U_LIGHT], 1, f->light_eye);
 }
 
 void asp__lod_release(const asp_context *actx, asp__lod *lod)

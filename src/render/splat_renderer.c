@@ -24,10 +24,6 @@
  */
 static const char *vertex_src =
     "#version 450 core\n" ASP__LOD_GLSL
-    "uniform mat4 u_view;\n"
-    "uniform mat4 u_proj;\n"
-    "uniform vec3 u_eye;\n"
-    "uniform vec3 u_light;\n"
     "uniform float u_epsilon;\n"
     "uniform float u_support;\n"
     "uniform float u_radius_scale;\n"
@@ -198,12 +194,11 @@ static const char *resolve_fragment_src[2] = {
     "layout(binding = 1) uniform sampler2DMS u_normal;\n"
     "layout(binding = 2) uniform sampler2DMS u_depth;\n" RESOLVE_GLSL};
 
-enum { U_VIEW, U_PROJ, U_EYE, U_LIGHT, U_EPSILON, U_SUPPORT, U_RADIUS_SCALE, U_NODE_COUNT, U_HAS_COLORS,
-       U_DEFAULT_COLOR, U_LIGHTING, U_KA, U_KB, U_KN, U_OPAQUE, U_UNORIENTED, U_HAS_CLIP, U_COUNT };
-static const char *uniform_names[U_COUNT] = {"u_view", "u_proj", "u_eye", "u_light", "u_epsilon", "u_support",
-                                             "u_radius_scale", "u_node_count", "u_has_colors", "u_default_color",
-                                             "u_lighting", "u_ka", "u_kb", "u_kn", "u_opaque",
-                                             "u_unoriented", "u_has_clip"};
+enum { U_EPSILON = ASP__LOD_U_COUNT, U_SUPPORT, U_RADIUS_SCALE, U_NODE_COUNT, U_HAS_COLORS, U_DEFAULT_COLOR,
+       U_LIGHTING, U_KA, U_KB, U_KN, U_OPAQUE, U_UNORIENTED, U_HAS_CLIP, U_COUNT };
+static const char *uniform_names[U_COUNT] = {ASP__LOD_UNIFORM_NAMES, "u_epsilon", "u_support", "u_radius_scale",
+                                             "u_node_count", "u_has_colors", "u_default_color", "u_lighting", "u_ka",
+                                             "u_kb", "u_kn", "u_opaque", "u_unoriented", "u_has_clip"};
 enum { PROG_DEPTH, PROG_BLEND, PROG_COUNT };
 
 /* The float accumulation target of passes 1 and 2, kept while size and samples stay. */
@@ -307,9 +302,7 @@ static void splat_destroy(asp_renderer *base)
         glDeleteVertexArrays(1, &s->vao.id);
     if (s->clips.id)
         glDeleteBuffers(1, &s->clips.id);
-    asp_context actx = base->gl->actx;
-    asp__lod_release(&actx, &s->lod);
-    asp_free(&actx, s);
+    asp__lod_renderer_free((asp__lod_renderer *)s);
 }
 
 static int lighting_code(const splat_renderer *s, const asp__frame *f)
@@ -326,10 +319,7 @@ static void set_frame_uniforms(splat_renderer *s, int prog, const asp__frame *f,
 {
     GLuint p = s->programs[prog].id;
     const GLint *u = s->uniforms[prog];
-    glProgramUniformMatrix4fv(p, u[U_VIEW], 1, GL_FALSE, f->view);
-    glProgramUniformMatrix4fv(p, u[U_PROJ], 1, GL_FALSE, f->proj);
-    glProgramUniform3fv(p, u[U_EYE], 1, f->eye);
-    glProgramUniform3fv(p, u[U_LIGHT], 1, f->light_eye);
+    asp__lod_frame_uniforms(p, u, f);
     glProgramUniform1f(p, u[U_EPSILON], epsilon);
     glProgramUniform1i(p, u[U_LIGHTING], lighting_code(s, f));
     glProgramUniform1i(p, u[U_OPAQUE], opaque);
@@ -554,18 +544,12 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     rc = asp__gl_ensure_current(gl, err);
     if (rc)
         return rc;
-    splat_renderer *s = asp_calloc(&gl->actx, 1, sizeof *s);
-    if (!s)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for a splat renderer");
-    rc = asp__lod_prepare(&s->lod, cloud, hier, &desc->hier, desc->ctx, desc->tolerance, desc->flags,
-                          desc->default_color, err);
-    if (rc) {
-        asp_free(&gl->actx, s);
+    asp__lod_renderer *lr;
+    rc = asp__lod_renderer_create(gl, sizeof(splat_renderer), &asp__splat_vtable, cloud, hier, ASP__LOD_DESC(desc),
+                                  &lr, err);
+    if (rc)
         return rc;
-    }
-    s->base.vt = &asp__splat_vtable;
-    s->base.gl = gl;
-    s->base.count = s->lod.count;
+    splat_renderer *s = (splat_renderer *)lr;
     s->ka = desc->kernel_a > 0 ? desc->kernel_a : 6.0f;
     s->kb = desc->kernel_b > 0 ? desc->kernel_b : 1.5f;
     s->kn = desc->kernel_n > 0 ? desc->kernel_n : 3.0f;
@@ -593,13 +577,7 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
             s->uniforms[i][j] = glGetUniformLocation(s->programs[i].id, uniform_names[j]);
     glCreateVertexArrays(1, &s->vao.id);
     set_static_uniforms(s);
-    rc = asp__gl_check(gl, "create the splat renderer", err);
-    if (rc) {
-        splat_destroy(&s->base);
-        return rc;
-    }
-    *out = &s->base;
-    return 0;
+    return asp__lod_renderer_finish(lr, out, err);
 }
 
 int asp_splat_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_splat_renderer_desc *desc,

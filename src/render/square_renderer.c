@@ -19,10 +19,6 @@
  */
 static const char *vertex_src =
     "#version 450 core\n" ASP__LOD_GLSL
-    "uniform mat4 u_view;\n"
-    "uniform mat4 u_proj;\n"
-    "uniform vec3 u_eye;\n"
-    "uniform vec3 u_light;\n"
     "uniform float u_px_per_unit;\n"
     "uniform float u_point_size;\n"
     "uniform float u_max_size;\n"
@@ -50,11 +46,10 @@ static const char *fragment_src =
     "    o_color = vec4(v_color, 1.0);\n"
     "}\n";
 
-enum { U_VIEW, U_PROJ, U_EYE, U_LIGHT, U_PX_PER_UNIT, U_POINT_SIZE, U_MAX_SIZE, U_RADIUS_SCALE, U_HAS_COLORS,
-       U_DEFAULT_COLOR, U_UNLIT, U_COUNT };
-static const char *uniform_names[U_COUNT] = {"u_view", "u_proj", "u_eye", "u_light", "u_px_per_unit",
-                                             "u_point_size", "u_max_size", "u_radius_scale", "u_has_colors",
-                                             "u_default_color", "u_unlit"};
+enum { U_PX_PER_UNIT = ASP__LOD_U_COUNT, U_POINT_SIZE, U_MAX_SIZE, U_RADIUS_SCALE, U_HAS_COLORS, U_DEFAULT_COLOR,
+       U_UNLIT, U_COUNT };
+static const char *uniform_names[U_COUNT] = {ASP__LOD_UNIFORM_NAMES, "u_px_per_unit", "u_point_size", "u_max_size",
+                                             "u_radius_scale", "u_has_colors", "u_default_color", "u_unlit"};
 
 typedef struct square_renderer {
     asp_renderer base; // first two members as asp__lod_renderer
@@ -71,9 +66,7 @@ static void square_destroy(asp_renderer *base)
     asp__gl_program_destroy(&q->program);
     if (q->vao.id)
         glDeleteVertexArrays(1, &q->vao.id);
-    asp_context actx = base->gl->actx;
-    asp__lod_release(&actx, &q->lod);
-    asp_free(&actx, q);
+    asp__lod_renderer_free((asp__lod_renderer *)q);
 }
 
 static int square_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
@@ -84,10 +77,7 @@ static int square_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
         return rc;
     GLuint p = q->program.id;
     const GLint *u = q->uniforms;
-    glProgramUniformMatrix4fv(p, u[U_VIEW], 1, GL_FALSE, f->view);
-    glProgramUniformMatrix4fv(p, u[U_PROJ], 1, GL_FALSE, f->proj);
-    glProgramUniform3fv(p, u[U_EYE], 1, f->eye);
-    glProgramUniform3fv(p, u[U_LIGHT], 1, f->light_eye);
+    asp__lod_frame_uniforms(p, u, f);
     glProgramUniform1f(p, u[U_PX_PER_UNIT], f->proj[5] * 0.5f * (float)f->height);
     glProgramUniform1i(p, u[U_UNLIT], (f->flags & ASP_RENDER_UNLIT) ? 1 : 0);
     glEnable(GL_PROGRAM_POINT_SIZE);
@@ -129,18 +119,12 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     if (desc->point_size > range[1])
         return asp_error_set(err, ASP_EINVAL, "square size %g pixels exceeds this GL context's limit of %g",
                              (double)desc->point_size, (double)range[1]);
-    square_renderer *q = asp_calloc(&gl->actx, 1, sizeof *q);
-    if (!q)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for a square renderer");
-    rc = asp__lod_prepare(&q->lod, cloud, hier, &desc->hier, desc->ctx, desc->tolerance, desc->flags,
-                          desc->default_color, err);
-    if (rc) {
-        asp_free(&gl->actx, q);
+    asp__lod_renderer *lr;
+    rc = asp__lod_renderer_create(gl, sizeof(square_renderer), &asp__square_vtable, cloud, hier, ASP__LOD_DESC(desc),
+                                  &lr, err);
+    if (rc)
         return rc;
-    }
-    q->base.vt = &asp__square_vtable;
-    q->base.gl = gl;
-    q->base.count = q->lod.count;
+    square_renderer *q = (square_renderer *)lr;
     q->point_size = desc->point_size;
     q->radius_scale = desc->radius_scale > 0 ? desc->radius_scale : 1.0f;
     q->max_size = range[1];
@@ -161,13 +145,7 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     glProgramUniform1f(p, q->uniforms[U_RADIUS_SCALE], q->radius_scale);
     glProgramUniform1i(p, q->uniforms[U_HAS_COLORS], q->lod.has_colors);
     glProgramUniform4fv(p, q->uniforms[U_DEFAULT_COLOR], 1, q->lod.default_color);
-    rc = asp__gl_check(gl, "create the square renderer", err);
-    if (rc) {
-        square_destroy(&q->base);
-        return rc;
-    }
-    *out = &q->base;
-    return 0;
+    return asp__lod_renderer_finish(lr, out, err);
 }
 
 int asp_square_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_square_renderer_desc *desc,

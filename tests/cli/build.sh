@@ -2,16 +2,8 @@
 # amgsplat build: octahedron primitives (8 faces at the coarsest level), the
 # Table 5.2 output in text and JSON, info on the .dps, several levels, budget,
 # texture methods, merge and normal maps, and the error cases (exit 1 / 2).
-set -euo pipefail
-T="$ASP_TEST_TMP/build"
-rm -rf "$T" && mkdir -p "$T"
+source "$(dirname "$0")/common.sh"
 A="$AMGSPLAT"
-fail() { echo "FAIL: $*" >&2; exit 1; }
-expect_exit() { # code, command...
-    local want=$1; shift
-    set +e; "$@" >"$T/out" 2>"$T/err"; local got=$?; set -e
-    [ "$got" = "$want" ] || { cat "$T/err" >&2; fail "'$*' exited $got, expected $want"; }
-}
 
 "$A" build -h | grep "usage: amgsplat build" >/dev/null || fail "help"
 "$A" help | grep "^  build " >/dev/null || fail "build missing from the command list"
@@ -90,6 +82,12 @@ grep -q "L-99" "$T/err" || fail "bad level: $(cat "$T/err")"
 expect_exit 1 "$A" build "$T/oct.amg" -o "$T/x.dps" --level L --texel-size 1e-3 --max-texture 8192
 grep -q "do not fit" "$T/err" || fail "atlas too large: $(cat "$T/err")"
 [ ! -e "$T/x.dps" ] || fail "output written on failure"
+# a directory or a FIFO named as input: a clear error at once, never a hang on the FIFO
+mkdir "$T/dir.amg" && mkfifo "$T/fifo.amg"
+expect_fail 1 "'$T/dir.amg': is a directory, expected a file" "$A" build "$T/dir.amg" -o "$T/x.dps"
+expect_fail 1 "'$T/fifo.amg': not a regular file" timeout 20 "$A" build "$T/fifo.amg" -o "$T/x.dps"
+mkdir "$T/dir.dps"
+expect_fail 1 "'$T/dir.dps': is a directory, expected a file" "$A" info "$T/dir.dps"
 
 # usage errors: exit 2
 expect_exit 2 "$A" build

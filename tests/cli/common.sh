@@ -20,5 +20,14 @@ expect_fail() {
   grep -qF -- "$text" "$T/err" || fail "'$*' stderr lacks '$text': $(cat "$T/err")"
 }
 
+# expect_exit STATUS cmd...: the command must exit with STATUS; its stdout and stderr are left in
+# $T/out and $T/err for further checks.
+expect_exit() {
+  local want=$1; shift
+  local st=0
+  "$@" >"$T/out" 2>"$T/err" || st=$?
+  [[ $st -eq $want ]] || { cat "$T/err" >&2; fail "'$*' exited $st, expected $want"; }
+}
+
 # check FILE EXPR: asserts a Python expression over a PNG's pixels (see png_check.py).
 check() { python3 "$(dirname "${BASH_SOURCE[0]}")/png_check.py" "$1" "$2" || fail "$1: $2"; }

@@ -1,16 +1,8 @@
 #!/usr/bin/env bash
 # amgsplat decompose: .amg output, --stats/--json, colour export, re-reading
 # an .amg, and the error cases (exit 1 for bad input, 2 for usage).
-set -euo pipefail
-T="$ASP_TEST_TMP/decompose"
-rm -rf "$T" && mkdir -p "$T"
+source "$(dirname "$0")/common.sh"
 A="$AMGSPLAT"
-fail() { echo "FAIL: $*" >&2; exit 1; }
-expect_exit() { # code, command...
-    local want=$1; shift
-    set +e; "$@" >"$T/out" 2>"$T/err"; local got=$?; set -e
-    [ "$got" = "$want" ] || { cat "$T/err" >&2; fail "'$*' exited $got, expected $want"; }
-}
 
 "$A" decompose -h | grep "usage: amgsplat decompose" >/dev/null || fail "help"
 "$A" synth octahedron -o "$T/oct.ply" -q

@@ -11,33 +11,10 @@
 
 #include "amgsplat/amg.h"
 #include "amgsplat/sample.h"
+#include "file_forge.h"
 #include "harness.h"
 
 static char path[512];
-
-static size_t file_size(const char *p)
-{
-    FILE *fp = fopen(p, "rb");
-    if (!fp)
-        return 0;
-    fseek(fp, 0, SEEK_END);
-    long n = ftell(fp);
-    fclose(fp);
-    return n < 0 ? 0 : (size_t)n;
-}
-
-static unsigned char *slurp(const char *p, size_t *n)
-{
-    *n = file_size(p);
-    unsigned char *b = malloc(*n + 1);
-    FILE *fp = fopen(p, "rb");
-    if (fp) {
-        if (fread(b, 1, *n, fp) != *n)
-            *n = 0;
-        fclose(fp);
-    }
-    return b;
-}
 
 static void spit(const char *p, const unsigned char *b, size_t n)
 {
@@ -112,7 +89,7 @@ static void test_round_trip_and_damage(void)
     }
 
     size_t size = 0;
-    unsigned char *bytes = slurp(path, &size);
+    unsigned char *bytes = forge_slurp(path, &size);
     CHECK(size > 1000);
     char bad[600];
     snprintf(bad, sizeof bad, "%s.bad", path);
@@ -165,72 +142,21 @@ static void test_round_trip_and_damage(void)
     asp_cloud_destroy(c);
 }
 
-/* Independent CRC-32 (IEEE, reflected 0xEDB88320), so a forged file can carry a valid checksum. */
-static uint32_t crc32_ieee(const unsigned char *p, size_t n)
+/* asp_amg_load_memory for file_forge.h: *out goes in and comes back, so an unchanged sentinel shows. */
+static int load_amg(const void *data, size_t size, const char *name, const asp_context *ctx, void **out, asp_error *err)
 {
-    uint32_t c = 0xFFFFFFFFu;
-    for (size_t i = 0; i < n; i++) {
-        c ^= p[i];
-        for (int k = 0; k < 8; k++)
-            c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
-    }
-    return ~c;
+    asp_amg *a = *out;
+    int rc = asp_amg_load_memory(data, size, name, ctx, &a, err);
+    *out = a;
+    return rc;
 }
 
-static void put_le(unsigned char *p, uint64_t v, int bytes)
+static void destroy_amg(void *a)
 {
-    for (int k = 0; k < bytes; k++)
-        p[k] = (unsigned char)(v >> (8 * k));
+    asp_amg_destroy(a);
 }
 
-static uint64_t get_le(const unsigned char *p, int bytes)
-{
-    uint64_t v = 0;
-    for (int k = 0; k < bytes; k++)
-        v |= (uint64_t)p[k] << (8 * k);
-    return v;
-}
-
-/* Makes b (n bytes) self-consistent: payload size at header byte 32 and the CRC-32 trailer. */
-static void fix_amg(unsigned char *b, size_t n)
-{
-    put_le(b + 32, n - 68, 8);
-    put_le(b + n - 4, crc32_ieee(b, n - 4), 4);
-}
-
-/* An allocator that counts what one load asks for. */
-typedef struct tally {
-    size_t total, largest;
-} tally;
-
-static void *tally_alloc(void *user, size_t size, size_t align)
-{
-    tally *t = user;
-    t->total += size;
-    if (size > t->largest)
-        t->largest = size;
-    return aligned_alloc(align, (size + align - 1) / align * align);
-}
-
-static void tally_free(void *user, void *ptr)
-{
-    (void)user;
-    free(ptr);
-}
-
-/* Loads forged bytes: ASP_EFORMAT naming the file and field, and no allocation beyond a few times the file. */
-static void expect_forged(const unsigned char *b, size_t n, const char *field)
-{
-    tally t = {0, 0};
-    asp_context ctx = {.threads = 1, .allocator = {tally_alloc, tally_free, &t}};
-    asp_error err = {0};
-    asp_amg *a = (asp_amg *)&t; /* a sentinel: must stay unchanged */
-    int rc = asp_amg_load_memory(b, n, "forged.amg", &ctx, &a, &err);
-    CHECK_MSG(rc == ASP_EFORMAT && a == (asp_amg *)&t, "%s: rc %d", field, rc);
-    CHECK_MSG(strstr(err.msg, "forged.amg") && strstr(err.msg, field) && strstr(err.msg, "expected"),
-              "message '%s' lacks the file, '%s' or what was expected", err.msg, field);
-    CHECK_MSG(t.total <= 4 * n + 65536, "%s: %zu bytes allocated for a %zu-byte file", field, t.total, n);
-}
+static const forge_format amg_format = {"amg", 32, load_amg, destroy_amg}; /* payload size at header byte 32 */
 
 static int same_amg(const asp_amg *x, const asp_amg *y)
 {
@@ -273,7 +199,7 @@ static void test_memory_cuts_and_forged_counts(void)
     }
     CHECK_OK(asp_amg_save(amg, p3, err), err);
     size_t size = 0;
-    unsigned char *bytes = slurp(p3, &size);
+    unsigned char *bytes = forge_slurp(p3, &size);
     CHECK(size > 68 && size < 20000);
     asp_amg *from_path = NULL, *from_mem = NULL;
     CHECK_OK(asp_amg_load(p3, NULL, &from_path, err), err);
@@ -282,34 +208,12 @@ static void test_memory_cuts_and_forged_counts(void)
     asp_amg_destroy(from_path);
     asp_amg_destroy(from_mem);
 
-    /* a cut at every byte, as is and with the payload size and CRC fixed so the parser itself meets the end */
-    unsigned char *cut = malloc(size);
-    int cut_fail = 0;
-    for (size_t k = 0; k < size && cut; k++) {
-        for (int fixed = 0; fixed < 2; fixed++) {
-            if (fixed && k < 68)
-                continue;
-            memcpy(cut, bytes, k);
-            if (fixed)
-                fix_amg(cut, k);
-            asp_amg *a = NULL;
-            asp_error e = {0};
-            int rc = asp_amg_load_memory(cut, k, "cut.amg", NULL, &a, &e);
-            if (rc != ASP_EFORMAT || a != NULL || !strstr(e.msg, "'cut.amg'")) {
-                if (cut_fail++ < 5)
-                    CHECK_MSG(0, "cut at %zu (fixed %d): rc %d, '%s'", k, fixed, rc, e.msg);
-                asp_amg_destroy(a);
-            }
-        }
-    }
-    CHECK_MSG(cut_fail == 0, "%d cuts did not fail cleanly", cut_fail);
-    free(cut);
+    forge_expect_cuts_fail(&amg_format, bytes, size);
     CHECK(asp_amg_load_memory(NULL, 0, NULL, NULL, &from_mem, err) == ASP_EFORMAT && strstr(err->msg, "<memory>"));
 
     /* forged counts behind a valid checksum */
-    unsigned char *f = malloc(size);
-    const uint64_t n = get_le(bytes + 16, 8), nlevels = get_le(bytes + 24, 8);
-    const uint32_t attrs = (uint32_t)get_le(bytes + 64 + 28 * n, 4);
+    const uint64_t n = forge_get_le(bytes + 16, 8), nlevels = forge_get_le(bytes + 24, 8);
+    const uint32_t attrs = (uint32_t)forge_get_le(bytes + 64 + 28 * n, 4);
     const uint64_t per_point = (attrs & ASP_ATTR_NORMALS ? 12u : 0u) + (attrs & ASP_ATTR_COLORS ? 4u : 0u) +
                                (attrs & ASP_ATTR_RADII ? 4u : 0u) + (attrs & ASP_ATTR_UVS ? 8u : 0u) +
                                (attrs & ASP_ATTR_LABELS ? 4u : 0u);
@@ -324,13 +228,8 @@ static void test_memory_cuts_and_forged_counts(void)
                   {nnz_at, (uint64_t)size / 12, "prolongation entry count"},
                   {nnz_at + 8 + 8 * n, 1ull << 62, "row pointer"},
                   {nnz_at + 8 + 8, (uint64_t)size, "row pointer"}}; /* row 0 would run past the entries */
-    for (size_t i = 0; f && i < sizeof forged / sizeof forged[0]; i++) {
-        memcpy(f, bytes, size);
-        put_le(f + forged[i].at, forged[i].value, 8);
-        fix_amg(f, size);
-        expect_forged(f, size, forged[i].field);
-    }
-    free(f);
+    for (size_t i = 0; i < sizeof forged / sizeof forged[0]; i++)
+        forge_expect_refused(&amg_format, bytes, size, forged[i].at, forged[i].value, 8, forged[i].field);
     free(bytes);
     remove(p3);
     asp_amg_destroy(amg);
@@ -373,7 +272,7 @@ static void test_bare_positions(void)
                 const asp_amg_csr *p = asp_amg_prolongation(amg, l);
                 expect += 8 + 8 * (p->rows + 1) + 12 * p->row_ptr[p->rows];
             }
-            CHECK_MSG(file_size(p2) == expect, "size %zu, expected %zu", file_size(p2), expect);
+            CHECK_MSG(forge_file_size(p2) == expect, "size %zu, expected %zu", forge_file_size(p2), expect);
             asp_amg_destroy(back);
         }
     }

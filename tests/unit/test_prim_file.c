@@ -11,6 +11,7 @@
 
 #include "amgsplat/amg.h"
 #include "amgsplat/prim.h"
+#include "file_forge.h"
 #include "harness.h"
 
 #ifndef ASP_TEST_TMP_DIR
@@ -55,21 +56,10 @@ static int make_level(asp_cloud **cloud, asp_dps_level *lv)
     return rc;
 }
 
-static long file_size(const char *path)
-{
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return -1;
-    fseek(fp, 0, SEEK_END);
-    long n = ftell(fp);
-    fclose(fp);
-    return n;
-}
-
 static void copy_damaged(const char *src, const char *dst, long keep, long flip_at, const char *append)
 {
     FILE *in = fopen(src, "rb"), *out = fopen(dst, "wb");
-    long n = file_size(src);
+    long n = (long)forge_file_size(src);
     for (long i = 0; in && out && i < n && i < keep; i++) {
         int ch = fgetc(in);
         fputc(i == flip_at ? ch ^ 0x10 : ch, out);
@@ -128,7 +118,7 @@ static void test_round_trip_and_damage(void)
         CHECK(strcmp(row.name, "L-2") == 0 && row.primitives == 4 && row.neighbour_pairs == 6 && row.normal_map);
         asp_dps_destroy(back);
     }
-    long n = file_size(path);
+    long n = (long)forge_file_size(path);
     snprintf(bad, sizeof bad, "%s.bad.dps", path);
     copy_damaged(path, bad, n - 100, -1, NULL);
     expect_bad(bad, "truncated");
@@ -158,60 +148,21 @@ static void test_round_trip_and_damage(void)
     asp_cloud_destroy(c);
 }
 
-/* Independent CRC-32 (IEEE, reflected 0xEDB88320), so a forged file can carry a valid checksum. */
-static uint32_t crc32_ieee(const unsigned char *p, size_t n)
+/* asp_dps_load_memory for file_forge.h: *out goes in and comes back, so an unchanged sentinel shows. */
+static int load_dps(const void *data, size_t size, const char *name, const asp_context *ctx, void **out, asp_error *err)
 {
-    uint32_t c = 0xFFFFFFFFu;
-    for (size_t i = 0; i < n; i++) {
-        c ^= p[i];
-        for (int k = 0; k < 8; k++)
-            c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
-    }
-    return ~c;
+    asp_dps *d = *out;
+    int rc = asp_dps_load_memory(data, size, name, ctx, &d, err);
+    *out = d;
+    return rc;
 }
 
-static void put_le(unsigned char *p, uint64_t v, int bytes)
+static void destroy_dps(void *d)
 {
-    for (int k = 0; k < bytes; k++)
-        p[k] = (unsigned char)(v >> (8 * k));
+    asp_dps_destroy(d);
 }
 
-/* Makes b (n bytes) self-consistent: payload size at header byte 24 and the CRC-32 trailer. */
-static void fix_dps(unsigned char *b, size_t n)
-{
-    put_le(b + 24, n - 68, 8);
-    put_le(b + n - 4, crc32_ieee(b, n - 4), 4);
-}
-
-static unsigned char *slurp(const char *path, size_t *n)
-{
-    long len = file_size(path);
-    unsigned char *b = len > 0 ? malloc((size_t)len) : NULL;
-    FILE *fp = fopen(path, "rb");
-    *n = 0;
-    if (b && fp && fread(b, 1, (size_t)len, fp) == (size_t)len)
-        *n = (size_t)len;
-    if (fp)
-        fclose(fp);
-    return b;
-}
-
-/* An allocator that counts what one load asks for. */
-typedef struct tally {
-    size_t total;
-} tally;
-
-static void *tally_alloc(void *user, size_t size, size_t align)
-{
-    ((tally *)user)->total += size;
-    return aligned_alloc(align, (size + align - 1) / align * align);
-}
-
-static void tally_free(void *user, void *ptr)
-{
-    (void)user;
-    free(ptr);
-}
+static const forge_format dps_format = {"dps", 24, load_dps, destroy_dps}; /* payload size at header byte 24 */
 
 static int same_dps(const asp_dps *x, const asp_dps *y)
 {
@@ -234,20 +185,6 @@ static int same_dps(const asp_dps *x, const asp_dps *y)
     return ok;
 }
 
-/* Loads forged bytes: ASP_EFORMAT naming the file and field, and no allocation beyond a few times the file. */
-static void expect_forged(const unsigned char *b, size_t n, const char *field)
-{
-    tally t = {0};
-    asp_context ctx = {.threads = 1, .allocator = {tally_alloc, tally_free, &t}};
-    asp_error err = {0};
-    asp_dps *d = (asp_dps *)&t; /* a sentinel: must stay unchanged */
-    int rc = asp_dps_load_memory(b, n, "forged.dps", &ctx, &d, &err);
-    CHECK_MSG(rc == ASP_EFORMAT && d == (asp_dps *)&t, "%s: rc %d", field, rc);
-    CHECK_MSG(strstr(err.msg, "forged.dps") && strstr(err.msg, field) && strstr(err.msg, "expected"),
-              "message '%s' lacks the file, '%s' or what was expected", err.msg, field);
-    CHECK_MSG(t.total <= 4 * n + 65536, "%s: %zu bytes allocated for a %zu-byte file", field, t.total, n);
-}
-
 /* Memory load = path load; a cut at every byte; forged counts behind a valid checksum. */
 static void test_memory_cuts_and_forged_counts(void)
 {
@@ -265,7 +202,7 @@ static void test_memory_cuts_and_forged_counts(void)
     asp_error err;
     CHECK_OK(asp_dps_save(&dps, path, &err), &err);
     size_t size = 0;
-    unsigned char *bytes = slurp(path, &size);
+    unsigned char *bytes = forge_slurp(path, &size);
     CHECK(bytes && size > 68);
     asp_dps *from_path = NULL, *from_mem = NULL;
     CHECK_OK(asp_dps_load(path, NULL, &from_path, &err), &err);
@@ -274,28 +211,7 @@ static void test_memory_cuts_and_forged_counts(void)
     asp_dps_destroy(from_path);
     asp_dps_destroy(from_mem);
 
-    /* a cut at every byte, as is and with the payload size and CRC fixed so the parser itself meets the end */
-    unsigned char *cut = malloc(size ? size : 1);
-    int cut_fail = 0;
-    for (size_t k = 0; bytes && cut && k < size; k++) {
-        for (int fixed = 0; fixed < 2; fixed++) {
-            if (fixed && k < 68)
-                continue;
-            memcpy(cut, bytes, k);
-            if (fixed)
-                fix_dps(cut, k);
-            asp_dps *d = NULL;
-            asp_error e = {0};
-            int rc = asp_dps_load_memory(cut, k, "cut.dps", NULL, &d, &e);
-            if (rc != ASP_EFORMAT || d != NULL || !strstr(e.msg, "'cut.dps'")) {
-                if (cut_fail++ < 5)
-                    CHECK_MSG(0, "cut at %zu (fixed %d): rc %d, '%s'", k, fixed, rc, e.msg);
-                asp_dps_destroy(d);
-            }
-        }
-    }
-    CHECK_MSG(cut_fail == 0, "%d cuts did not fail cleanly", cut_fail);
-    free(cut);
+    forge_expect_cuts_fail(&dps_format, bytes, size);
     CHECK(asp_dps_load_memory(NULL, 0, NULL, NULL, &from_mem, &err) == ASP_EFORMAT && strstr(err.msg, "<memory>"));
 
     /* forged counts: header level count, then level 0's primitive and neighbour counts and atlas size */
@@ -312,14 +228,8 @@ static void test_memory_cuts_and_forged_counts(void)
                   {level_at + 24, 16000, 4, "atlas"},
                   {level_at + 24, 1u << 30, 4, "atlas"},
                   {level_at, 9, 4, "AMG level"}};
-    unsigned char *f = malloc(size ? size : 1);
-    for (size_t i = 0; bytes && f && i < sizeof forged / sizeof forged[0]; i++) {
-        memcpy(f, bytes, size);
-        put_le(f + forged[i].at, forged[i].value, forged[i].bytes);
-        fix_dps(f, size);
-        expect_forged(f, size, forged[i].field);
-    }
-    free(f);
+    for (size_t i = 0; i < sizeof forged / sizeof forged[0]; i++)
+        forge_expect_refused(&dps_format, bytes, size, forged[i].at, forged[i].value, forged[i].bytes, forged[i].field);
     free(bytes);
     remove(path);
     asp_dps_level_release(&lv, NULL);
