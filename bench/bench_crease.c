@@ -11,12 +11,7 @@
 
 #include "amgsplat/geom.h"
 #include "amgsplat/sample.h"
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
+#include "bench_common.h"
 
 static void run(asp_synth_shape shape, const char *name, size_t n, int runs)
 {
@@ -37,9 +32,9 @@ static void run(asp_synth_shape shape, const char *name, size_t n, int runs)
         }
         t[r] = asp_time_now() - t0;
     }
-    qsort(t, (size_t)runs, sizeof *t, cmp_double);
+    double med = bench_median_upper(t, runs);
     printf("%-11s %9zu points  %8zu clipped (%4.1f%%)  median %7.3f s  %6.2f M points/s\n", name, c->count,
-           clipped, 100.0 * (double)clipped / (double)c->count, t[runs / 2], (double)c->count / t[runs / 2] / 1e6);
+           clipped, 100.0 * (double)clipped / (double)c->count, med, (double)c->count / med / 1e6);
     free(planes);
     asp_cloud_destroy(c);
 }

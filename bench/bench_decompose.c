@@ -12,18 +12,7 @@
 #include "amgsplat/amg.h"
 #include "amgsplat/mesh.h"
 #include "amgsplat/sample.h"
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp);
-    return v[n / 2];
-}
+#include "bench_common.h"
 
 int main(int argc, char **argv)
 {
@@ -87,7 +76,7 @@ int main(int argc, char **argv)
            cloud->count, runs, asp_context_threads(&ctx), desc.strong_threshold ? desc.strong_threshold : 0.9,
            desc.crease_cut ? desc.crease_cut : 0.25, levels, coarsest, load[0]);
     for (int s = 0; s < STAGES; s++)
-        printf("  %-11s %8.3f s (median)\n", names[s], median(t[s], runs));
+        printf("  %-11s %8.3f s (median)\n", names[s], bench_median_upper(t[s], runs));
     printf("  peak memory %.0f MB (max RSS, includes sampling)\n", (double)ru.ru_maxrss / 1024.0);
     asp_cloud_destroy(cloud);
     asp_amg_shutdown();

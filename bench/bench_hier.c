@@ -12,6 +12,7 @@
 #include <time.h>
 
 #include "amgsplat/hier.h"
+#include "bench_common.h"
 
 /* process CPU seconds (all threads): shows how much of a wall time was waiting on a loaded machine */
 static double cpu_now(void)
@@ -23,10 +24,7 @@ static uint64_t rng = 0x9e3779b97f4a7c15ULL;
 
 static double rnd(void)
 {
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) / 9007199254740992.0;
+    return bench_urand(&rng);
 }
 
 static asp_cloud *sphere(size_t n, unsigned attrs)
@@ -52,18 +50,6 @@ static asp_cloud *sphere(size_t n, unsigned attrs)
     return c;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 static double last_cpu; /* median CPU seconds of the last time_build */
 
 static double time_build(const asp_cloud *cl, const asp_hier_desc *d, const asp_context *ctx, int runs,
@@ -85,8 +71,8 @@ static double time_build(const asp_cloud *cl, const asp_hier_desc *d, const asp_
         else
             asp_hier_destroy(h);
     }
-    last_cpu = median(c, runs);
-    return median(t, runs);
+    last_cpu = bench_median(c, runs);
+    return bench_median(t, runs);
 }
 
 static void look_at(asp_hier_view *v, const float eye[3], float fovy, uint32_t w, uint32_t h)
@@ -145,7 +131,7 @@ int main(int argc, char **argv)
             asp_hier_select(h, &v, ids, asp_hier_select_bound(h), &count, NULL);
             tt[r] = asp_time_now() - t0;
         }
-        printf("select tau %4.1f px:        %8.4f s  %9zu splats\n", (double)taus[k], median(tt, runs), count);
+        printf("select tau %4.1f px:        %8.4f s  %9zu splats\n", (double)taus[k], bench_median(tt, runs), count);
     }
     size_t count = 0;
     double t0 = asp_time_now();

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "amgsplat/geom.h"
+#include "bench_common.h"
 #include "geom/kdtree_internal.h"
 
 #ifdef ASP_HAVE_FLANN
@@ -24,10 +25,7 @@
 static uint64_t rng_state = 0x2545F4914F6CDD1Dull;
 static double urand(void)
 {
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (double)(rng_state >> 11) / 9007199254740992.0;
+    return bench_urand(&rng_state);
 }
 
 static void make_cube(float *p, size_t n)
@@ -114,18 +112,6 @@ static int make_obj_surface(const char *path, float *p, size_t n)
     return ok;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *t, int n)
-{
-    qsort(t, (size_t)n, sizeof(double), cmp_double);
-    return t[n / 2];
-}
-
 enum { MAX_RUNS = 9 };
 
 typedef struct bench_opts {
@@ -159,8 +145,8 @@ static void time_ours(const float *p, size_t n, const bench_opts *o, const asp__
         tq[r] = t2 - t1;
         asp_kdtree_destroy(t);
     }
-    *build_s = median(tb, o->runs);
-    *query_s = median(tq, o->runs);
+    *build_s = bench_median_upper(tb, o->runs);
+    *query_s = bench_median_upper(tq, o->runs);
 }
 
 /* One table row; the last column is this row's total time over ours (2.00x: twice as slow as ours). */
@@ -215,7 +201,7 @@ static void bench_set(const char *name, const float *p, size_t n, const bench_op
             tq[r] = t2 - t1;
             flann_free_index(fx, &fp);
         }
-        double fb = median(tb, o->runs), fq = median(tq, o->runs);
+        double fb = bench_median_upper(tb, o->runs), fq = bench_median_upper(tq, o->runs);
         /* agreement: the sorted distance lists must match (indices may differ on ties) */
         size_t bad = 0;
         for (size_t i = 0; i < n; i += 97)

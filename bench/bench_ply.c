@@ -11,20 +11,9 @@
 #include <unistd.h>
 
 #include "amgsplat/io.h"
+#include "bench_common.h"
 
 enum { RUNS = 5 };
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v)
-{
-    qsort(v, RUNS, sizeof *v, cmp_double);
-    return v[RUNS / 2];
-}
 
 static asp_cloud *synthetic(size_t n)
 {
@@ -71,7 +60,7 @@ static void run(const char *label, asp_cloud *c, const char *path, asp_ply_encod
     }
     struct stat st;
     double mb = stat(path, &st) == 0 ? (double)st.st_size / 1e6 : 0.0;
-    double w = median(tw), rd = median(tr);
+    double w = bench_median_upper(tw, RUNS), rd = bench_median_upper(tr, RUNS);
     printf("%-22s %10zu %9.1f %9.3f %9.1f %9.3f %9.1f\n", label, c->count, mb, w, mb / w, rd, mb / rd);
     remove(path);
 }

@@ -13,18 +13,7 @@
 #include "amgsplat/mesh.h"
 #include "amgsplat/prim.h"
 #include "amgsplat/sample.h"
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp);
-    return v[n / 2];
-}
+#include "bench_common.h"
 
 /* Whole build of one level and its file; returns seconds, or -1. */
 static double build_once(const asp_amg *amg, const asp_cloud *cloud, size_t level, const asp_prim_desc *d,
@@ -97,7 +86,7 @@ int main(int argc, char **argv)
             if ((t[r] = build_once(amg, cloud, level, &methods[m].d, &ctx, &row)) < 0)
                 return 1;
         printf("| %s | %zu | %llu | %.3f | %.3f | %.3f |\n", methods[m].name, row.primitives,
-               (unsigned long long)row.texels, row.t_basis, row.t_construct, median(t, runs));
+               (unsigned long long)row.texels, row.t_basis, row.t_construct, bench_median_upper(t, runs));
     }
     printf("\n| level | primitives | texels | error | normalised | cb (s) | dpc (s) |\n|---|---|---|---|---|---|---|\n");
     for (size_t l = nl >= 7 ? nl - 7 : 0; l < nl; l++) {

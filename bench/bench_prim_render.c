@@ -22,20 +22,9 @@
 #include "amgsplat/prim.h"
 #include "amgsplat/render.h"
 #include "amgsplat/sample.h"
+#include "bench_common.h"
 
 enum { VIEWS = 16, QSIZE = 256, MAX_LEVELS = 64 };
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 static int ends_with(const char *s, const char *ext)
 {
@@ -90,7 +79,7 @@ static double frame_ms(asp_gl_context *gl, asp_renderer *r, const float c[3], fl
         asp_render_frame(gl, r, &cam, &d, &err);
         t[f] = 1e3 * (asp_time_now() - t0);
     }
-    return median(t, frames);
+    return bench_median(t, frames);
 }
 
 static void timing_table(asp_gl_context *gl, const asp_cloud *cloud, const asp_dps *dps, int frames)

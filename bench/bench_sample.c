@@ -8,20 +8,9 @@
 #include <unistd.h>
 
 #include "amgsplat/amgsplat.h"
+#include "bench_common.h"
 
 enum { RUNS = 3 };
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return v[n / 2];
-}
 
 static int run_method(const asp_mesh *mesh, asp_sample_desc desc, const char *label)
 {
@@ -44,9 +33,9 @@ static int run_method(const asp_mesh *mesh, asp_sample_desc desc, const char *la
         mean_r = st.mean_radius;
         asp_cloud_destroy(c);
     }
-    double t = median(total, RUNS);
-    printf("%-22s %10zu %10.3f %10.3f %10.3f %12.2f %12.3g\n", label, points, median(sample, RUNS),
-           median(radii, RUNS), t, (double)points / t / 1e6, mean_r);
+    double t = bench_median_upper(total, RUNS);
+    printf("%-22s %10zu %10.3f %10.3f %10.3f %12.2f %12.3g\n", label, points, bench_median_upper(sample, RUNS),
+           bench_median_upper(radii, RUNS), t, (double)points / t / 1e6, mean_r);
     return 0;
 }
 
@@ -72,7 +61,7 @@ int main(int argc, char **argv)
         load[r] = asp_time_now() - t0;
     }
     printf("mesh %s: %zu vertices, %zu triangles, area %.6g; load (assimp + normals) %.3f s, median of %d, %d threads\n",
-           path, mesh->vertex_count, mesh->triangle_count, asp_mesh_area(mesh), median(load, RUNS), RUNS,
+           path, mesh->vertex_count, mesh->triangle_count, asp_mesh_area(mesh), bench_median_upper(load, RUNS), RUNS,
            asp_context_threads(NULL));
     printf("%-22s %10s %10s %10s %10s %12s %12s\n", "method", "points", "sample s", "radii s", "total s", "Mpoints/s",
            "mean radius");

@@ -8,58 +8,18 @@
  * drawing, no read-back). Timings never fail anything.
  * usage: bench_splat [points=1000000] [frames=5]
  */
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include "amgsplat/render.h"
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-static asp_cloud *make_sphere(size_t n)
-{
-    asp_cloud *c = NULL;
-    asp_error err;
-    if (asp_cloud_create(n, ASP_ATTR_NORMALS | ASP_ATTR_COLORS | ASP_ATTR_RADII, NULL, &c, &err)) {
-        fprintf(stderr, "bench_splat: %s\n", err.msg);
-        return NULL;
-    }
-    float r = (float)sqrt(4.0 * 3.14159265358979323846 / (double)n);
-    for (size_t i = 0; i < n; i++) {
-        double y = 1.0 - 2.0 * (i + 0.5) / (double)n, rho = sqrt(1.0 - y * y), phi = (double)i * 2.399963229728653;
-        float nrm[3] = {(float)(rho * cos(phi)), (float)y, (float)(rho * sin(phi))};
-        for (int k = 0; k < 3; k++) {
-            c->positions[3 * i + k] = nrm[k];
-            c->normals[3 * i + k] = nrm[k];
-            c->colors[4 * i + k] = (uint8_t)(127.5f + 127.5f * nrm[k]);
-        }
-        c->colors[4 * i + 3] = 255;
-        c->radii[i] = r;
-    }
-    return c;
-}
+#include "bench_common.h"
 
 /* Median frame time of r at size x size, and the splats of the last frame. */
 static int time_frames(asp_gl_context *gl, asp_renderer *r, uint32_t size, int frames, double *seconds,
                        size_t *count, double *select)
 {
     asp_camera cam;
-    asp_camera_init(&cam);
-    cam.azimuth = 30.0f;
-    cam.elevation = 20.0f;
-    const float center[3] = {0, 0, 0};
-    asp_camera_fit(&cam, center, 1.01f, 1.0f);
+    bench_sphere_camera(&cam, 1.01f);
     asp_render_desc desc = {.width = size, .height = size, .flags = ASP_RENDER_WAIT};
     double t[64], sel[64];
     asp_error err;
@@ -80,8 +40,8 @@ static int time_frames(asp_gl_context *gl, asp_renderer *r, uint32_t size, int f
         asp_renderer_stats_get(r, &st);
         sel[f] = st.select_seconds;
     }
-    *seconds = median(t, frames);
-    *select = median(sel, frames);
+    *seconds = bench_median(t, frames);
+    *select = bench_median(sel, frames);
     *count = asp_renderer_count(r);
     return 0;
 }
@@ -95,12 +55,10 @@ int main(int argc, char **argv)
         return 2;
     }
     asp_error err;
-    asp_gl_context *gl = NULL;
-    if (asp_gl_context_create_headless(NULL, &gl, &err)) {
-        fprintf(stderr, "bench_splat: %s\n", err.msg);
+    asp_gl_context *gl = bench_gl_headless("bench_splat");
+    if (!gl)
         return 1;
-    }
-    asp_cloud *c = make_sphere(n);
+    asp_cloud *c = bench_fibonacci_sphere(n, "bench_splat");
     asp_hier *h = NULL;
     double t0 = asp_time_now();
     if (!c || asp_hier_build(c, NULL, NULL, &h, &err)) {
