@@ -1,5 +1,6 @@
 /*
- * amgsplat info: what a point file holds — counts, attributes, bounds, radii.
+ * amgsplat info: what a point file holds — counts, attributes, bounds, radii —
+ * and the levels of a .dps (primitives) or .amg (decomposition) file.
  */
 #include <math.h>
 #include <stdio.h>
@@ -7,6 +8,7 @@
 
 #include "cli/cli.h"
 #include "cli/commands.h"
+#include "amgsplat/amg.h"
 #include "util/banned.h"
 
 static const char usage[] =
@@ -16,7 +18,9 @@ static const char usage[] =
     "radii, texture coordinates, labels and any extra properties with their types), the\n"
     "bounding box in world coordinates and the radius statistics of a point file\n"
     "(.ply, .xyz, .pts, .txt). For a primitive file (.dps, from 'amgsplat build') it prints\n"
-    "per level: primitives, texels, error, normalised error, cb and dpc times, atlas size.";
+    "per level: primitives, texels, error, normalised error, cb and dpc times, atlas size. For a\n"
+    "decomposition (.amg, from 'amgsplat decompose') it prints the points, their attributes and\n"
+    "the unknowns of every AMG level (domains per level: 'amgsplat decompose --stats').";
 
 struct radius_stats {
     double mean, min, max;
@@ -137,6 +141,48 @@ static int info_dps(const char *path, struct cli_env *env)
     return 0;
 }
 
+/* An .amg file (amgsplat decompose): the stored points and the size of every level (journal section 2). */
+static int info_amg(const char *path, struct cli_env *env)
+{
+    asp_amg *amg = NULL;
+    asp_error err = {0};
+    if (asp_amg_load(path, &env->ctx, &amg, &err))
+        return cli_fail(env, &err);
+    const asp_cloud *c = asp_amg_cloud(amg);
+    const size_t nl = asp_amg_level_count(amg);
+    const char *normals = asp_amg_has_input_normals(amg) ? "input" : "tangent planes (unoriented)";
+    cli_progress_end(env);
+    if (env->json) {
+        printf("{\"file\": ");
+        cli_json_string(stdout, path);
+        printf(", \"points\": %zu, \"normals\": \"%s\", \"colors\": %s, \"radii\": %s, \"uvs\": %s, "
+               "\"labels\": %s, \"levels\": [",
+               c->count, asp_amg_has_input_normals(amg) ? "input" : "tangent", c->colors ? "true" : "false",
+               c->radii ? "true" : "false", c->uvs ? "true" : "false", c->labels ? "true" : "false");
+        for (size_t l = 0; l < nl; l++) {
+            char name[32];
+            snprintf(name, sizeof name, l == nl - 1 ? "L" : "L-%zu", nl - 1 - l);
+            printf("%s{\"level\": %zu, \"name\": \"%s\", \"unknowns\": %zu}", l ? ", " : "", l, name,
+                   asp_amg_level_size(amg, l));
+        }
+        printf("]}\n");
+    } else {
+        printf("file        %s\npoints      %zu\nnormals     %s\nattributes ", path, c->count, normals);
+        printf("%s%s%s%s\n", c->colors ? " colours" : "", c->radii ? " radii" : "", c->uvs ? " uvs" : "",
+               c->labels ? " labels" : "");
+        printf("level  name   unknowns  reduction\n");
+        for (size_t l = 0; l < nl; l++) {
+            char name[32];
+            snprintf(name, sizeof name, l == nl - 1 ? "L" : "L-%zu", nl - 1 - l);
+            const size_t n = asp_amg_level_size(amg, l);
+            printf("%5zu  %-5s %9zu  %9.2f\n", l, name, n,
+                   l ? (double)asp_amg_level_size(amg, l - 1) / (double)n : 1.0);
+        }
+    }
+    asp_amg_destroy(amg);
+    return 0;
+}
+
 int cmd_info(int argc, char **argv, struct cli_env *env)
 {
     const struct cli_option opts[] = {{0}};
@@ -148,6 +194,8 @@ int cmd_info(int argc, char **argv, struct cli_env *env)
     size_t len = strlen(argv[0]);
     if (len >= 4 && strcmp(argv[0] + len - 4, ".dps") == 0)
         return info_dps(argv[0], env);
+    if (len >= 4 && strcmp(argv[0] + len - 4, ".amg") == 0)
+        return info_amg(argv[0], env);
     asp_cloud *c = NULL;
     asp_error err = {0};
     if (asp_cloud_load(argv[0], &env->ctx, &c, &err))

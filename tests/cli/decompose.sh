@@ -29,6 +29,19 @@ assert st[-1]["name"] == "L-0"
 assert set(d["seconds"]) == {"neighbours", "classifier", "fans", "assembly", "amg"}
 PY
 
+# info on the .amg: the same level sizes as decompose reported, the points and attributes it keeps
+"$A" info "$T/oct.amg" --json > "$T/info.json"
+"$A" info "$T/oct.amg" > "$T/info.txt"
+python3 - "$T/oct.json" "$T/info.json" "$T/info.txt" <<'PY'
+import json, sys
+d, i = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+txt = open(sys.argv[3]).read().splitlines()
+assert i["points"] == 16000 and i["normals"] == "input" and i["colors"] and i["labels"], i
+assert [l["unknowns"] for l in i["levels"]] == [s["unknowns"] for s in d["level_stats"]], i["levels"]
+assert i["levels"][-1]["name"] == "L" and i["levels"][-2]["name"] == "L-1", i["levels"][-2:]
+assert txt[1].split() == ["points", "16000"] and txt[-1].split()[:3] == [str(len(i["levels"]) - 1), "L", "8"], txt
+PY
+
 # text stats from the saved file, with the thesis threshold
 "$A" decompose "$T/oct.amg" --stats --tau 0.01 > "$T/stats.txt"
 grep -q "^level  name" "$T/stats.txt" || fail "stats header"
