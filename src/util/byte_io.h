@@ -67,7 +67,8 @@ double asp__get_f64(asp__byte_reader *r);
  * Reads the whole file at path into *buf (allocated through ctx with one
  * spare byte, so an empty file still gets a buffer; free with asp_free(ctx,
  * *buf)) and its length into *size. Errors: ASP_EIO (open, seek or read
- * failed), ASP_ENOMEM (the file does not fit in memory); on failure *buf and
+ * failed; a directory, FIFO or other file that is not regular, refused
+ * before opening so that a FIFO never blocks), ASP_ENOMEM (the file does not fit in memory); on failure *buf and
  * *size stay unchanged.
  */
 int asp__byte_slurp(const char *path, const asp_context *ctx, uint8_t **buf, size_t *size, asp_error *err);
