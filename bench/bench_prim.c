@@ -29,7 +29,7 @@ static double build_once(const asp_amg *amg, const asp_cloud *cloud, size_t leve
         return -1;
     }
     double t = asp_time_now() - t0;
-    asp_dps_summarize(dps, row);
+    asp_dps_summarize(dps, row, 1);
     asp_dps_destroy(dps);
     return t;
 }

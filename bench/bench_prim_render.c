@@ -104,7 +104,7 @@ static void timing_table(asp_gl_context *gl, const asp_cloud *cloud, const asp_d
     printf("%-6s %7zu | %10.2f %13s | %10.2f %13s | %10.2f %13s\n", "points", cloud->count, disc_ms[0], "(discs)",
            disc_ms[1], "(discs)", disc_ms[2], "(discs)");
     asp_dps_summary rows[MAX_LEVELS];
-    asp_dps_summarize(dps, rows);
+    asp_dps_summarize(dps, rows, MAX_LEVELS);
     for (size_t l = 0; l < dps->level_count && l < MAX_LEVELS; l++) {
         asp_renderer *r = NULL;
         asp_prim_renderer_desc pd = {.origin = {cloud->origin[0], cloud->origin[1], cloud->origin[2]}};

@@ -188,6 +188,13 @@ void asp_amg_shutdown(void);
  * Extra properties, faces and comments are not kept. Valid until asp_amg_destroy.
  */
 const asp_cloud *asp_amg_cloud(const asp_amg *amg);
+
+/**
+ * Frame (asp_cloud_frame) of the point set the decomposition was made from,
+ * recorded in the .amg file, so render, view and eval frame an .amg exactly as
+ * its source points. Valid until asp_amg_destroy.
+ */
+const asp_frame *asp_amg_frame(const asp_amg *amg);
 /**
  * Tangent-plane normal per point (3 * count floats, unit, unoriented): the
  * eigenvector of the smallest eigenvalue of the neighbourhood's M1 (journal

@@ -129,6 +129,38 @@ int asp_cloud_validate(const asp_cloud *cloud, asp_error *err);
 /** Deep copy. */
 int asp_cloud_clone(const asp_cloud *src, asp_cloud **out, asp_error *err);
 
+/**
+ * The sphere every representation of one point set is framed by: render, view
+ * and eval point the camera at it whatever the file (.ply, .amg, .dps, .hier),
+ * so one --view means one picture. .amg, .dps and .hier files record the frame
+ * of the point set they came from. World coordinates (double, so UTM scans keep
+ * their digits); radius 0 means "not known".
+ */
+typedef struct asp_frame {
+    double center[3]; /* world coordinates: middle of the position bounding box */
+    double radius;    /* largest distance of a point from center plus the largest disc radius */
+} asp_frame;
+
+/**
+ * The disc radius used when a cloud has no radii: 2 * sqrt(A / (pi n)) where
+ * A = xy + yz + zx of the bounding box sides (half the box's surface area:
+ * exact for a plane, 0.95 of a sphere's area) and n the point count. Discs of
+ * radius sqrt(A / (pi n)) would have the surface's total area; the factor 2
+ * closes the gaps of irregular (random) sampling. If A is 0 (colinear points)
+ * the longest side / n is used. Returns 0 for an empty cloud or all points
+ * equal. Pure; thread safe.
+ */
+float asp_cloud_default_radius(const asp_cloud *cloud);
+
+/**
+ * Frame of cloud (asp_frame): centre of the position bounds in world
+ * coordinates, radius = largest distance from it plus the largest radius (the
+ * cloud's radii, else asp_cloud_default_radius). Returns 0; ASP_EDEGENERATE
+ * (empty cloud; all points equal without radii); ASP_EFORMAT (non-finite
+ * values, naming the point). *out is unchanged on failure. Thread safe.
+ */
+int asp_cloud_frame(const asp_cloud *cloud, asp_frame *out, asp_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -105,6 +105,13 @@ size_t asp_hier_leaf_size(const asp_hier *hier);
 /** World position of the local origin (the source cloud's origin). */
 void asp_hier_origin(const asp_hier *hier, double out[3]);
 
+/**
+ * Frame (asp_cloud_frame) of the source point set, recorded in the .hier file,
+ * so a hierarchy is framed exactly as its source points. Valid until
+ * asp_hier_destroy.
+ */
+const asp_frame *asp_hier_frame(const asp_hier *hier);
+
 /** The node array (asp_hier_node_count entries); valid until asp_hier_destroy. */
 const asp_hier_node *asp_hier_nodes(const asp_hier *hier);
 

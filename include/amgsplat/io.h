@@ -148,6 +148,60 @@ int asp_cloud_save(const asp_cloud *cloud, const char *path, const asp_save_desc
  */
 const char *asp_cloud_format_of(const char *path);
 
+/* ------------------------------------------------------------------------ */
+/* The one file recogniser (STYLE.md 9b): every command asks it what a file is */
+/* ------------------------------------------------------------------------ */
+
+/** What a file holds, as far as amgsplat is concerned. */
+typedef enum asp_file_kind {
+    ASP_FILE_UNKNOWN = 0,
+    ASP_FILE_POINTS = 1, /* PLY without faces, XYZ, PTS, TXT point lists */
+    ASP_FILE_MESH = 2,   /* OBJ, PLY with faces, OFF, STL, glTF/GLB, 3DS, ... (assimp; asp_mesh_load) */
+    ASP_FILE_AMG = 3,    /* AMG decomposition (amgsplat decompose) */
+    ASP_FILE_DPS = 4,    /* domain primitives (amgsplat build) */
+    ASP_FILE_HIER = 5,   /* point hierarchy (asp_hier_save) */
+    ASP_FILE_IMAGE = 6   /* PNG, JPEG, BMP, TGA, ... (stb_image) */
+} asp_file_kind;
+
+/** What asp_file_recognise found. */
+typedef struct asp_file_type {
+    asp_file_kind kind;
+    char format[16]; /* lower-case short name: "ply", "xyz", "obj", "off", "stl", "gltf", "glb", "3ds",
+                        "amg", "dps", "hier", "png", "jpeg" ...; "" when unknown */
+    int by_magic;    /* 1: told by the first bytes of the file, 0: by its extension */
+} asp_file_type;
+
+/**
+ * Tells what path holds: magic bytes first (PLY, OFF, GLB, binary 3DS, the
+ * .amg/.dps/.hier magics, PNG, JPEG ...), then the extension, compared
+ * case-insensitively ("BUNNY.PLY", "o.AMG"). A PLY is a mesh when its header
+ * declares a non-empty face element (asp_cloud_load still reads its vertices
+ * as points). Directories, FIFOs and other non-regular files are refused at
+ * once, before any read (no hang).
+ * Returns 0; ASP_EIO ("cannot open 'f': ..." or "cannot read 'f': not a
+ * regular file"); ASP_EUNSUPPORTED ("cannot read 'f.abc': unknown file type
+ * '.abc' (expected ...)" listing what is known). *out is unchanged on failure.
+ * Reads at most a few kilobytes. Reentrant.
+ */
+int asp_file_recognise(const char *path, asp_file_type *out, asp_error *err);
+
+/**
+ * As asp_file_recognise on the first size bytes of a file (head, borrowed)
+ * whose name (for the extension and messages) is name. Never touches the file
+ * system; safe on arbitrary bytes.
+ */
+int asp_file_recognise_memory(const void *head, size_t size, const char *name, asp_file_type *out, asp_error *err);
+
+/**
+ * The kind a path to be written would have, by its extension alone
+ * (case-insensitive), for outputs: 0 and *out filled, or ASP_EUNSUPPORTED
+ * naming the extension. Pure.
+ */
+int asp_file_type_of_name(const char *path, asp_file_type *out, asp_error *err);
+
+/** "unknown", "points", "mesh", "amg", "dps", "hier", "image". Never NULL. */
+const char *asp_file_kind_name(asp_file_kind kind);
+
 #ifdef __cplusplus
 }
 #endif

@@ -123,6 +123,8 @@ typedef struct asp_dps {
     double mean_radius;       /* mean point radius, world units */
     asp_prim_desc desc;       /* parameters used, defaults resolved */
     char source[256];         /* the input file's name (may be empty) */
+    asp_frame frame;          /* the source point set's frame (asp_cloud_frame), for one camera framing;
+                                 radius 0 when unknown */
     asp_context ctx;
 } asp_dps;
 
@@ -259,8 +261,22 @@ typedef struct asp_dps_summary {
     int normal_map;
 } asp_dps_summary;
 
-/** Fills rows[0 .. dps->level_count-1]; prints nothing. Thread-safe. */
-void asp_dps_summarize(const asp_dps *dps, asp_dps_summary *rows);
+/**
+ * Fills rows[0 .. min(level_count, capacity) - 1] and returns dps->level_count
+ * (so a caller can see that rows were left out); prints nothing. Thread-safe.
+ */
+size_t asp_dps_summarize(const asp_dps *dps, asp_dps_summary *rows, size_t capacity);
+
+/** Writes the name of dps->levels[index] ("L", "L-3") to name. Thread-safe. */
+void asp_dps_level_name(const asp_dps *dps, size_t index, char name[16]);
+
+/**
+ * The index into dps->levels of the level text names: its name ("L", "L-3",
+ * as asp_dps_summarize names them) or its AMG level index ("4"). Returns 0, or
+ * ASP_EINVAL "no level 'X' (the file holds L, L-3)" (callers prefix the file
+ * name). *index is unchanged on failure. Thread-safe.
+ */
+int asp_dps_level_parse(const asp_dps *dps, const char *text, size_t *index, asp_error *err);
 
 /** Option names: "affine"/"radial", "linear"/"constant"/"gaussian", "positive"/"ge1". 0 or ASP_EINVAL. */
 int asp_prim_method_parse(const char *name, asp_prim_method *out, asp_error *err);

@@ -157,6 +157,18 @@ void asp_camera_init(asp_camera *cam);
  */
 void asp_camera_fit(asp_camera *cam, const float center[3], float radius, float aspect);
 
+/**
+ * The one camera framing of every representation of a model (points, .amg,
+ * .dps, .hier, and later meshes): fits cam to frame (a world-space sphere,
+ * asp_frame in cloud.h, recorded in the files) seen in a renderer whose local
+ * frame is centred on origin (the cloud's origin, asp_prim_renderer_desc.origin;
+ * NULL = world origin), as asp_camera_fit with aspect. distance_radii > 0 puts
+ * the eye at that many frame radii from the centre instead of fitting. Keeps
+ * azimuth, elevation, fov_y and up. frame->radius must be > 0. Thread safe.
+ */
+void asp_camera_frame(asp_camera *cam, const asp_frame *frame, const double origin[3], float aspect,
+                      float distance_radii);
+
 /** The distance asp_camera_fit would choose for radius with cam's fov_y and aspect. */
 float asp_camera_fit_distance(const asp_camera *cam, float radius);
 

@@ -382,6 +382,8 @@ int asp_amg_load_memory(const void *data, size_t size, const char *name, const a
         return rc;
     asp__byte_reader r = {data ? data : empty, data ? size : 0, 0, nm, err};
     rc = parse(&r, ctx, a);
+    if (!rc && asp_cloud_frame(a->cloud, &a->frame, NULL) != 0) // NEEDSWORK: read the recorded frame
+        memset(&a->frame, 0, sizeof a->frame);
     if (rc) {
         asp_amg_destroy(a);
         return rc;

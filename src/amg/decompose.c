@@ -41,6 +41,7 @@ void asp_amg_destroy(asp_amg *amg)
 }
 
 const asp_cloud *asp_amg_cloud(const asp_amg *amg) { return amg->cloud; }
+const asp_frame *asp_amg_frame(const asp_amg *amg) { return &amg->frame; }
 const float *asp_amg_classifier(const asp_amg *amg) { return amg->classifier; }
 const float *asp_amg_tangent_normals(const asp_amg *amg) { return amg->tangent; }
 int asp_amg_has_input_normals(const asp_amg *amg) { return amg->input_normals; }
@@ -178,6 +179,8 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
         return rc;
     if ((rc = copy_points(cloud, ctx, &a->cloud, err)) != 0)
         goto fail;
+    if (asp_cloud_frame(cloud, &a->frame, NULL) != 0)
+        memset(&a->frame, 0, sizeof a->frame); // nothing to frame: radius 0 ("not known")
     a->input_normals = cloud->normals != NULL;
     a->classifier = asp_alloc(ctx, n * sizeof *a->classifier);
     a->tangent = asp_alloc(ctx, 3 * n * sizeof *a->tangent);

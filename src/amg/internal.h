@@ -19,6 +19,7 @@ struct asp_amg {
     asp_amg_csr **prolong; /* nlevels entries; [0] is NULL */
     asp_amg_desc desc;     /* resolved options */
     asp_amg_info info;
+    asp_frame frame;       /* the source points' frame (asp_cloud_frame) */
 };
 
 /* Neighbourhoods N(x) of journal 2.1: row i of nbr (stride kmax) holds nn[i] indices, nearest first. */

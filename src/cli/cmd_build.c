@@ -210,7 +210,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         rc = asp_dps_save(dps, output, &err);
     asp_dps_summary rows[64];
     if (!rc)
-        asp_dps_summarize(dps, rows);
+        asp_dps_summarize(dps, rows, 64);
     if (!rc && atlas)
         rc = save_atlases(atlas, dps, rows, &err);
     double t_total = asp_time_now() - t0;

@@ -107,7 +107,7 @@ static int info_dps(const char *path, struct cli_env *env)
         return cli_fail(env, &err);
     asp_dps_summary rows[64];
     size_t nl = dps->level_count < 64 ? dps->level_count : 64;
-    asp_dps_summarize(&(asp_dps){.level_count = nl, .levels = dps->levels, .amg_levels = dps->amg_levels}, rows);
+    asp_dps_summarize(dps, rows, 64);
     cli_progress_end(env);
     if (env->json) {
         printf("{\"file\": ");

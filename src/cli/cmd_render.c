@@ -132,25 +132,11 @@ static int load_dps(const char *path, const struct render_opts *o, const struct 
     int rc = asp_dps_load(path, &env->ctx, &s->dps, err);
     if (rc)
         return rc;
-    asp_dps_summary rows[64];
-    size_t n = s->dps->level_count < 64 ? s->dps->level_count : 64;
-    asp_dps_summarize(s->dps, rows); // level_count rows; files hold at most the AMG's levels (< 64)
     size_t pick = 0;
-    if (o->level) {
-        pick = SIZE_MAX;
-        for (size_t i = 0; i < n; i++) {
-            char index[16];
-            snprintf(index, sizeof index, "%u", rows[i].level);
-            if (strcmp(o->level, rows[i].name) == 0 || strcmp(o->level, index) == 0)
-                pick = i;
-        }
-        if (pick == SIZE_MAX) {
-            char list[160] = "";
-            size_t len = 0;
-            for (size_t i = 0; i < n && len < sizeof list; i++)
-                len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", rows[i].name);
-            return asp_error_set(err, ASP_EINVAL, "'%s' has no level '%s' (it holds %s)", path, o->level, list);
-        }
+    if (o->level && asp_dps_level_parse(s->dps, o->level, &pick, err)) {
+        char msg[sizeof err->msg];
+        snprintf(msg, sizeof msg, "%s", err->msg);
+        return asp_error_set(err, ASP_EINVAL, "'%s' has %s", path, msg);
     }
     s->dps_level = &s->dps->levels[pick];
     s->count = s->dps_level->prim_count;

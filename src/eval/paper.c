@@ -187,7 +187,12 @@ int asp_eval_paper_run(const asp_cloud *cloud, const asp_eval_paper_desc *desc, 
     }
     if (!rc) {
         asp_dps_summary rows[64];
-        asp_dps_summarize(dps, rows);
+        if (asp_dps_summarize(dps, rows, 64) > 64) // AMG hierarchies stop far below 64 levels
+            rc = asp_error_set(err, ASP_EUNSUPPORTED, "%zu levels, at most 64 are tabulated", dps->level_count);
+    }
+    if (!rc) {
+        asp_dps_summary rows[64];
+        asp_dps_summarize(dps, rows, 64);
         p->budget_level = 0;
         for (size_t l = 0; l < p->level_count; l++) {
             // the thesis lists the coarsest level first

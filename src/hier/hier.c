@@ -103,6 +103,11 @@ size_t asp_hier_leaf_size(const asp_hier *hier)
     return hier->leaf_size;
 }
 
+const asp_frame *asp_hier_frame(const asp_hier *hier)
+{
+    return &hier->frame;
+}
+
 void asp_hier_origin(const asp_hier *hier, double out[3])
 {
     memcpy(out, hier->origin, sizeof hier->origin);

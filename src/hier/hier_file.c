@@ -357,6 +357,9 @@ static int load(reader *r, const asp_context *ctx, asp_hier **out, asp_error *er
     }
     if ((rc = validate(h, r->name, err)) != 0)
         goto fail;
+    for (int i = 0; i < 3; i++) // NEEDSWORK: read the recorded frame; the root sphere is close
+        h->frame.center[i] = h->origin[i] + h->nodes[0].sphere[i];
+    h->frame.radius = h->nodes[0].sphere[3];
     *out = h;
     return 0;
 fail:

@@ -34,6 +34,7 @@ struct asp_hier {
     asp_hier_node *nodes;   /* node_count */
     asp_hier_splat *splats; /* node_count + point_count */
     double *cov;            /* ASP_HIER_COV * node_count */
+    asp_frame frame;        /* the source points' frame (asp_cloud_frame) */
 };
 
 /* Advises the kernel to back a large block with huge pages (Linux; otherwise a no-op). */

@@ -573,6 +573,8 @@ int asp_hier_build(const asp_cloud *cloud, const asp_hier_desc *desc, const asp_
         goto fail;
     h->leaf_size = d.leaf_size;
     memcpy(h->origin, cloud->origin, sizeof h->origin);
+    if (asp_cloud_frame(cloud, &h->frame, NULL) != 0)
+        memset(&h->frame, 0, sizeof h->frame); // all points equal without radii: nothing to frame, radius 0
     for (size_t i = 0; i < s.nta; i++)
         if (s.ta[i].child_count)
             convert(&h->nodes[i], &s.ta[i], s.ta[i].first_child);

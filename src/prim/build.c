@@ -512,6 +512,7 @@ int asp_prim_build(const asp_amg *amg, const asp_cloud *attrs, const size_t *lev
     dps->mean_radius = src.mean_radius;
     dps->desc = d;
     snprintf(dps->source, sizeof dps->source, "%s", source ? source : "");
+    dps->frame = *asp_amg_frame(amg);
     *out = dps;
     asp_free(ctx, lv_sorted);
     asp_free(ctx, own_radii);

@@ -426,18 +426,24 @@ int asp_dps_load(const char *path, const asp_context *ctx, asp_dps **out, asp_er
     return rc;
 }
 
-void asp_dps_summarize(const asp_dps *dps, asp_dps_summary *rows)
+void asp_dps_level_name(const asp_dps *dps, size_t index, char name[16])
 {
-    for (size_t i = 0; i < dps->level_count; i++) {
+    uint32_t top = dps->amg_levels ? dps->amg_levels - 1 : 0;
+    uint32_t level = dps->levels[index].level;
+    if (level >= top)
+        snprintf(name, 16, "L");
+    else
+        snprintf(name, 16, "L-%u", top - level);
+}
+
+size_t asp_dps_summarize(const asp_dps *dps, asp_dps_summary *rows, size_t capacity)
+{
+    for (size_t i = 0; i < dps->level_count && i < capacity; i++) {
         const asp_dps_level *lv = &dps->levels[i];
         asp_dps_summary *s = &rows[i];
         memset(s, 0, sizeof *s);
         s->level = lv->level;
-        uint32_t top = dps->amg_levels ? dps->amg_levels - 1 : 0;
-        if (lv->level == top)
-            snprintf(s->name, sizeof s->name, "L");
-        else
-            snprintf(s->name, sizeof s->name, "L-%u", top - lv->level);
+        asp_dps_level_name(dps, i, s->name);
         s->primitives = lv->prim_count;
         s->texels = lv->texels;
         s->error = lv->error, s->error_norm = lv->error_norm;
@@ -447,4 +453,23 @@ void asp_dps_summarize(const asp_dps *dps, asp_dps_summary *rows)
         s->neighbour_pairs = lv->neighbour_total / 2;
         s->normal_map = lv->normal_atlas.width > 0;
     }
+    return dps->level_count;
+}
+
+int asp_dps_level_parse(const asp_dps *dps, const char *text, size_t *index, asp_error *err)
+{
+    char list[160] = "";
+    size_t len = 0;
+    for (size_t i = 0; i < dps->level_count; i++) {
+        char name[16], number[16];
+        asp_dps_level_name(dps, i, name);
+        snprintf(number, sizeof number, "%u", dps->levels[i].level);
+        if (strcmp(text, name) == 0 || strcmp(text, number) == 0) {
+            *index = i;
+            return 0;
+        }
+        if (len < sizeof list)
+            len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", name);
+    }
+    return asp_error_set(err, ASP_EINVAL, "no level '%s' (the file holds %s)", text, list);
 }

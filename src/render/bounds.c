@@ -1,8 +1,7 @@
 /*
- * Framing a point set for rendering: the disc radius used when a cloud has
- * none, and the bounding sphere of the drawn discs that the orbit camera fits
- * (asp_camera_fit). Journal section 1: a disc primitive is position, radius,
- * colour and normal; without a radius we estimate one from the sampling density.
+ * Framing a point set for rendering in the cloud's local frame: thin wrappers
+ * over the one framing of core (asp_cloud_frame, asp_cloud_default_radius),
+ * and the camera fitted to a recorded frame (asp_camera_frame).
  */
 #include <math.h>
 
@@ -11,51 +10,31 @@
 
 float asp_render_default_radius(const asp_cloud *cloud)
 {
-    float lo[3], hi[3];
-    if (cloud->count == 0 || asp_cloud_bounds(cloud, lo, hi, NULL) != 0)
-        return 0.0f;
-    // double: products of large float extents would lose digits
-    double x = (double)hi[0] - lo[0], y = (double)hi[1] - lo[1], z = (double)hi[2] - lo[2];
-    double n = (double)cloud->count;
-    double area = x * y + y * z + z * x;
-    if (area > 0 && isfinite(area))
-        return (float)(2.0 * sqrt(area / (3.14159265358979323846 * n)));
-    double longest = fmax(x, fmax(y, z));
-    return isfinite(longest) ? (float)(longest / n) : 0.0f;
+    return asp_cloud_default_radius(cloud);
 }
 
 int asp_render_bounding_sphere(const asp_cloud *cloud, float center[3], float *radius, asp_error *err)
 {
-    if (cloud->count == 0)
-        return asp_error_set(err, ASP_EDEGENERATE, "cannot frame an empty point set");
-    int rc = asp_cloud_validate(cloud, err);
+    asp_frame f;
+    int rc = asp_cloud_frame(cloud, &f, err);
     if (rc)
         return rc;
-    float lo[3], hi[3];
-    rc = asp_cloud_bounds(cloud, lo, hi, err);
-    if (rc)
-        return rc;
-    double c[3];
     for (int k = 0; k < 3; k++)
-        c[k] = 0.5 * ((double)lo[k] + hi[k]);
-    double max_d2 = 0, max_r = 0;
-    for (size_t i = 0; i < cloud->count; i++) {
-        const float *p = cloud->positions + 3 * i;
-        double dx = p[0] - c[0], dy = p[1] - c[1], dz = p[2] - c[2];
-        double d2 = dx * dx + dy * dy + dz * dz;
-        max_d2 = d2 > max_d2 ? d2 : max_d2;
-        if (cloud->radii && cloud->radii[i] > max_r)
-            max_r = cloud->radii[i];
-    }
-    if (!cloud->radii)
-        max_r = asp_render_default_radius(cloud);
-    double r = sqrt(max_d2) + max_r;
-    if (!(r > 0) || !isfinite(r))
-        return asp_error_set(err, ASP_EDEGENERATE,
-                             "cannot frame %zu points: they are all at the same position and have no radius",
-                             cloud->count);
-    for (int k = 0; k < 3; k++)
-        center[k] = (float)c[k];
-    *radius = (float)r;
+        center[k] = (float)(f.center[k] - cloud->origin[k]);
+    *radius = (float)f.radius;
     return 0;
+}
+
+void asp_camera_frame(asp_camera *cam, const asp_frame *frame, const double origin[3], float aspect,
+                      float distance_radii)
+{
+    float c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = (float)(frame->center[k] - (origin ? origin[k] : 0.0));
+    float r = (float)frame->radius;
+    asp_camera_fit(cam, c, r, aspect);
+    if (distance_radii > 0) {
+        cam->distance = distance_radii * r;
+        asp_camera_clip_to_sphere(cam, c, r);
+    }
 }

@@ -188,12 +188,8 @@ struct dps_state {
 static void dps_status(asp__viewer_scene *s)
 {
     const struct dps_state *d = s->data;
-    asp_dps_summary rows[64];
-    const char *name = "?";
-    if (d->dps->level_count <= 64) { // files hold at most the AMG's levels
-        asp_dps_summarize(d->dps, rows);
-        name = rows[d->level].name;
-    }
+    char name[16];
+    asp_dps_level_name(d->dps, d->level, name);
     snprintf(s->status, sizeof s->status, "level %u (%s)", d->dps->levels[d->level].level, name);
 }
 
@@ -209,24 +205,11 @@ static void dps_release(asp__viewer_scene *s)
 /* --level: "L", "L-2" (names of asp_dps_summarize) or an AMG level index, as amgsplat render takes it. */
 static int dps_pick_level(const asp_dps *dps, const char *path, const char *want, size_t *out, asp_error *err)
 {
-    asp_dps_summary rows[64];
-    if (dps->level_count > 64)
-        return asp_error_set(err, ASP_EFORMAT, "cannot view '%s': %zu levels, expected at most 64", path,
-                             dps->level_count);
-    asp_dps_summarize(dps, rows);
-    char list[160] = "";
-    size_t len = 0;
-    for (size_t i = 0; i < dps->level_count; i++) {
-        char index[16];
-        snprintf(index, sizeof index, "%u", rows[i].level);
-        if (strcmp(want, rows[i].name) == 0 || strcmp(want, index) == 0) {
-            *out = i;
-            return 0;
-        }
-        if (len < sizeof list)
-            len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", rows[i].name);
-    }
-    return asp_error_set(err, ASP_EINVAL, "cannot view '%s': it has no level '%s' (it holds %s)", path, want, list);
+    if (!asp_dps_level_parse(dps, want, out, err))
+        return 0;
+    char msg[sizeof err->msg];
+    snprintf(msg, sizeof msg, "%s", err->msg);
+    return asp_error_set(err, ASP_EINVAL, "cannot view '%s': it has %s", path, msg);
 }
 
 static int dps_load(asp__viewer_scene *s, const char *path, const asp_viewer_desc *desc, asp_error *err)

@@ -114,7 +114,10 @@ static void test_round_trip_and_damage(void)
               0);
         CHECK(fabs(b->prims[0].centre[0] - 1000.5) < 1); /* world coordinates */
         asp_dps_summary row;
-        asp_dps_summarize(back, &row);
+        CHECK(asp_dps_summarize(back, &row, 1) == 1);
+        size_t index = 9;
+        CHECK(asp_dps_level_parse(back, "L-2", &index, NULL) == 0 && index == 0);
+        CHECK(asp_dps_level_parse(back, "L-3", &index, NULL) == ASP_EINVAL && index == 0);
         CHECK(strcmp(row.name, "L-2") == 0 && row.primitives == 4 && row.neighbour_pairs == 6 && row.normal_map);
         asp_dps_destroy(back);
     }

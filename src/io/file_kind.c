@@ -1,0 +1,214 @@
+/*
+ * The one file recogniser (STYLE.md 9b): what a path holds, told by its first
+ * bytes where the format has a magic number and by its extension
+ * (case-insensitive) otherwise. Every command asks here, so "O.AMG" is an .amg
+ * file for info, decompose and render alike, and a PLY with faces is a mesh.
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "amgsplat/io.h"
+#include "util/banned.h"
+
+enum { HEAD_BYTES = 4096 }; /* a PLY header's element lines fit in far less */
+
+struct ext_row {
+    const char *ext; /* lower case, with the dot */
+    asp_file_kind kind;
+    const char *format;
+};
+
+/*
+ * Formats without a reliable magic (OBJ, ASCII STL, XYZ) and the fallback for
+ * all others. Mesh extensions are those of assimp's importers that users meet
+ * (assimp reads more; asp_mesh_load takes any it reads).
+ */
+static const struct ext_row ext_table[] = {
+    {".ply", ASP_FILE_POINTS, "ply"},   {".xyz", ASP_FILE_POINTS, "xyz"},   {".pts", ASP_FILE_POINTS, "xyz"},
+    {".txt", ASP_FILE_POINTS, "xyz"},   {".obj", ASP_FILE_MESH, "obj"},     {".off", ASP_FILE_MESH, "off"},
+    {".stl", ASP_FILE_MESH, "stl"},     {".gltf", ASP_FILE_MESH, "gltf"},   {".glb", ASP_FILE_MESH, "glb"},
+    {".3ds", ASP_FILE_MESH, "3ds"},     {".fbx", ASP_FILE_MESH, "fbx"},     {".dae", ASP_FILE_MESH, "dae"},
+    {".amg", ASP_FILE_AMG, "amg"},      {".dps", ASP_FILE_DPS, "dps"},      {".hier", ASP_FILE_HIER, "hier"},
+    {".png", ASP_FILE_IMAGE, "png"},    {".jpg", ASP_FILE_IMAGE, "jpeg"},   {".jpeg", ASP_FILE_IMAGE, "jpeg"},
+    {".bmp", ASP_FILE_IMAGE, "bmp"},    {".tga", ASP_FILE_IMAGE, "tga"},
+};
+enum { N_EXT = sizeof ext_table / sizeof ext_table[0] };
+
+static const char expected[] = ".ply, .xyz, .pts, .txt, .obj, .off, .stl, .gltf, .glb, .3ds, .fbx, .dae, .amg, .dps, "
+                               ".hier, .png, .jpg, .bmp, .tga";
+
+const char *asp_file_kind_name(asp_file_kind kind)
+{
+    static const char *const names[] = {"unknown", "points", "mesh", "amg", "dps", "hier", "image"};
+    return (unsigned)kind < sizeof names / sizeof names[0] ? names[kind] : "unknown";
+}
+
+/* The extension of the last path component, "" when none. */
+static const char *extension_of(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(slash ? slash + 1 : path, '.');
+    return dot ? dot : "";
+}
+
+static int same_ci(const char *a, const char *b)
+{
+    for (; *a && *b; a++, b++) {
+        char x = (*a >= 'A' && *a <= 'Z') ? (char)(*a - 'A' + 'a') : *a;
+        if (x != *b)
+            return 0;
+    }
+    return *a == *b;
+}
+
+static const struct ext_row *by_extension(const char *path)
+{
+    const char *ext = extension_of(path);
+    for (size_t i = 0; i < N_EXT; i++)
+        if (same_ci(ext, ext_table[i].ext))
+            return &ext_table[i];
+    return NULL;
+}
+
+static void fill(asp_file_type *out, asp_file_kind kind, const char *format, int by_magic)
+{
+    out->kind = kind;
+    snprintf(out->format, sizeof out->format, "%s", format);
+    out->by_magic = by_magic;
+}
+
+/*
+ * A PLY header (within the bytes given) declaring a face element with a
+ * non-zero count makes a mesh. A header longer than the bytes read is taken
+ * as points: its vertex element comes first in every exporter we know.
+ */
+static int ply_has_faces(const char *h, size_t n)
+{
+    size_t i = 0;
+    while (i < n) {
+        size_t e = i;
+        while (e < n && h[e] != '\n')
+            e++;
+        size_t len = e - i;
+        if (len >= 10 && memcmp(h + i, "end_header", 10) == 0)
+            return 0;
+        if (len > 13 && memcmp(h + i, "element face ", 13) == 0) {
+            for (size_t k = i + 13; k < e; k++)
+                if (h[k] >= '1' && h[k] <= '9')
+                    return 1;
+            return 0;
+        }
+        i = e + 1;
+    }
+    return 0;
+}
+
+/* 0 and *out filled when the first bytes name the format; 1 when they do not. */
+static int by_magic(const unsigned char *h, size_t n, asp_file_type *out)
+{
+    if (n >= 4 && memcmp(h, "ply", 3) == 0 && (h[3] == '\n' || h[3] == '\r')) {
+        fill(out, ply_has_faces((const char *)h, n) ? ASP_FILE_MESH : ASP_FILE_POINTS, "ply", 1);
+        return 0;
+    }
+    static const struct {
+        const char *magic;
+        size_t len;
+        asp_file_kind kind;
+        const char *format;
+    } magics[] = {
+        {"ASPAMG\r\n", 8, ASP_FILE_AMG, "amg"},
+        {"ASPDPS\r\n", 8, ASP_FILE_DPS, "dps"},
+        {"ASPHIER", 8, ASP_FILE_HIER, "hier"}, /* with its NUL */
+        {"\x89PNG\r\n\x1a\n", 8, ASP_FILE_IMAGE, "png"},
+        {"\xff\xd8\xff", 3, ASP_FILE_IMAGE, "jpeg"},
+        {"glTF", 4, ASP_FILE_MESH, "glb"},
+        {"Kaydara FBX Binary", 18, ASP_FILE_MESH, "fbx"},
+    };
+    for (size_t i = 0; i < sizeof magics / sizeof magics[0]; i++)
+        if (n >= magics[i].len && memcmp(h, magics[i].magic, magics[i].len) == 0) {
+            fill(out, magics[i].kind, magics[i].format, 1);
+            return 0;
+        }
+    // OFF, COFF, NOFF, STOFF ...: the keyword ends in "OFF" and stands alone on the first line
+    for (size_t k = 0; k + 3 <= n && k < 8; k++)
+        if (memcmp(h + k, "OFF", 3) == 0 && (k + 3 == n || h[k + 3] == '\n' || h[k + 3] == '\r' || h[k + 3] == ' ')) {
+            fill(out, ASP_FILE_MESH, "off", 1);
+            return 0;
+        }
+    // 3DS: the main chunk 0x4D4D, then its length (little endian), then the version chunk 0x0002
+    if (n >= 8 && h[0] == 0x4d && h[1] == 0x4d && h[6] == 0x02 && h[7] == 0x00) {
+        fill(out, ASP_FILE_MESH, "3ds", 1);
+        return 0;
+    }
+    return 1;
+}
+
+int asp_file_recognise_memory(const void *head, size_t size, const char *name, asp_file_type *out, asp_error *err)
+{
+    const char *nm = name ? name : "<memory>";
+    if (head && !by_magic(head, size, out))
+        return 0;
+    const struct ext_row *row = by_extension(nm);
+    if (!row || row->kind == ASP_FILE_AMG || row->kind == ASP_FILE_DPS || row->kind == ASP_FILE_HIER) {
+        // amgsplat's own files always carry their magic: a name alone does not make one
+        if (row && size > 0)
+            return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': not %s file (bad magic)", nm,
+                                 row->kind == ASP_FILE_AMG ? "an .amg" : row->kind == ASP_FILE_DPS ? "a .dps" : "a .hier");
+        if (!row)
+            return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': unknown file type '%s' (expected %s)", nm,
+                                 extension_of(nm), expected);
+    }
+    fill(out, row->kind, row->format, 0);
+    return 0;
+}
+
+int asp_file_recognise(const char *path, asp_file_type *out, asp_error *err)
+{
+    // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it
+    int fd = open(path, O_RDONLY | O_NONBLOCK);
+    if (fd < 0)
+        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) != 0) {
+        int e = errno;
+        close(fd);
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, strerror(e));
+    }
+    if (!S_ISREG(st.st_mode)) {
+        int dir = S_ISDIR(st.st_mode);
+        close(fd);
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path,
+                             dir ? "is a directory, expected a file" : "not a regular file");
+    }
+    unsigned char head[HEAD_BYTES];
+    size_t n = 0;
+    while (n < sizeof head) {
+        ssize_t got = read(fd, head + n, sizeof head - n);
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got < 0) {
+            int e = errno;
+            close(fd);
+            return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, strerror(e));
+        }
+        if (got == 0)
+            break;
+        n += (size_t)got;
+    }
+    close(fd);
+    return asp_file_recognise_memory(head, n, path, out, err);
+}
+
+int asp_file_type_of_name(const char *path, asp_file_type *out, asp_error *err)
+{
+    const struct ext_row *row = by_extension(path);
+    if (!row)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot write '%s': unknown file type '%s' (expected %s)", path,
+                             extension_of(path), expected);
+    fill(out, row->kind, row->format, 0);
+    return 0;
+}
