@@ -16,8 +16,11 @@
 #include "amgsplat/core.h"
 #include "harness.h"
 
-/* Both formats: a 64-byte header, then the payload, then a 4-byte CRC-32 of everything before it. */
-enum { FORGE_HEADER_BYTES = 64, FORGE_TRAILER_BYTES = 4 };
+/*
+ * Both formats: a header (96 bytes since the frame was recorded, 64 before),
+ * then the payload, then a 4-byte CRC-32 of everything before it.
+ */
+enum { FORGE_HEADER_BYTES = 96, FORGE_TRAILER_BYTES = 4 };
 
 /* The size of a file in bytes, 0 when it cannot be read. */
 static inline size_t forge_file_size(const char *file)
@@ -75,7 +78,17 @@ static inline uint64_t forge_get_le(const unsigned char *p, int bytes)
     return v;
 }
 
-/* Makes b (n >= 68 bytes) self-consistent: the 8-byte payload size at header byte payload_at and the CRC trailer. */
+/*
+ * Makes b (n >= header + 4 bytes) self-consistent: the 8-byte payload size at
+ * header byte payload_at and the CRC trailer.
+ */
+static inline void forge_fix_header(unsigned char *b, size_t n, size_t payload_at, size_t header)
+{
+    forge_put_le(b + payload_at, n - header - FORGE_TRAILER_BYTES, 8);
+    forge_put_le(b + n - FORGE_TRAILER_BYTES, forge_crc32(b, n - FORGE_TRAILER_BYTES), FORGE_TRAILER_BYTES);
+}
+
+/* forge_fix_header for the current versions' header. */
 static inline void forge_fix(unsigned char *b, size_t n, size_t payload_at)
 {
     forge_put_le(b + payload_at, n - FORGE_HEADER_BYTES - FORGE_TRAILER_BYTES, 8);

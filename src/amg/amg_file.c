@@ -17,7 +17,12 @@
 #include "util/banned.h"
 
 #define AMG_MAGIC "ASPAMG\r\n"
-enum { AMG_VERSION = 2, AMG_HEADER = 64, AMG_OPTIONS = 128 };
+/*
+ * Version 3 appends the source point set's frame (asp_frame, 32 bytes) to the
+ * header, so every representation of a model is framed by one sphere (issue
+ * 12); version 2 files still load, their frame computed from the points.
+ */
+enum { AMG_VERSION = 3, AMG_HEADER = 96, AMG_HEADER_V2 = 64, AMG_OPTIONS = 128 };
 /* point attributes a version-2 file may carry after the classifier */
 static const unsigned amg_attrs = ASP_ATTR_NORMALS | ASP_ATTR_COLORS | ASP_ATTR_RADII | ASP_ATTR_UVS | ASP_ATTR_LABELS;
 
@@ -73,6 +78,9 @@ int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err)
     asp__put_u64(&w, payload_size(amg));
     for (int a = 0; a < 3; a++)
         asp__put_f64(&w, amg->cloud->origin[a]);
+    for (int a = 0; a < 3; a++)
+        asp__put_f64(&w, amg->frame.center[a]);
+    asp__put_f64(&w, amg->frame.radius);
     asp__crc_put(&w, amg->cloud->positions, 3 * n * sizeof(float));
     asp__crc_put(&w, amg->tangent, 3 * n * sizeof(float));
     asp__crc_put(&w, amg->classifier, n * sizeof(float));
@@ -235,10 +243,10 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
     uint64_t n, nlevels, payload, u64;
     double origin[3];
     int rc;
-    if (r->size < AMG_HEADER + 4)
+    if (r->size < AMG_HEADER_V2 + 4)
         return asp_error_set(r->err, ASP_EFORMAT,
                              "cannot read '%s': %zu bytes is too short for an .amg file (expected at least %d)", r->path,
-                             r->size, AMG_HEADER + 4);
+                             r->size, AMG_HEADER_V2 + 4);
     /* the size was checked: the header fields cannot fail */
     asp__byte_take(r, magic, 8, "the header");
     if (memcmp(magic, AMG_MAGIC, 8) != 0)
@@ -249,25 +257,43 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
         return asp_error_set(r->err, ASP_EFORMAT,
                              "cannot read '%s': .amg version 1 lacks the point attributes; decompose the input again "
                              "(version %d)", r->path, AMG_VERSION);
-    if (version != AMG_VERSION)
-        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': .amg version %u, expected %d", r->path,
+    if (version != AMG_VERSION && version != 2)
+        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': .amg version %u, expected 2 or %d", r->path,
                              (unsigned)version, AMG_VERSION);
-    if (header != AMG_HEADER)
+    const size_t hsize = version == 2 ? AMG_HEADER_V2 : AMG_HEADER;
+    if (header != hsize)
         return asp__byte_bad(r, "unexpected header size");
+    if (r->size < hsize + 4)
+        return asp_error_set(r->err, ASP_EFORMAT,
+                             "cannot read '%s': %zu bytes is too short for an .amg file (expected at least %zu)", r->path,
+                             r->size, hsize + 4);
     asp__byte_take(r, &n, 8, "the header");
     asp__byte_take(r, &nlevels, 8, "the header");
     asp__byte_take(r, &payload, 8, "the header");
     asp__byte_take(r, origin, 24, "the header");
-    if (payload != r->size - AMG_HEADER - 4)
+    const size_t frame_at = r->at;
+    const int recorded = version >= 3;
+    if (recorded) {
+        asp__byte_take(r, a->frame.center, 24, "the header");
+        asp__byte_take(r, &a->frame.radius, 8, "the header");
+    }
+    if (payload != r->size - hsize - 4)
         return asp_error_set(r->err, ASP_EFORMAT,
                              "cannot read '%s': truncated or padded: the header promises %llu payload bytes, the "
                              "file has %zu",
-                             r->path, (unsigned long long)payload, r->size - AMG_HEADER - 4);
+                             r->path, (unsigned long long)payload, r->size - hsize - 4);
     uint32_t stored;
     memcpy(&stored, r->buf + r->size - 4, 4);
     if (asp__crc32(0, r->buf, r->size - 4) != stored)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': checksum mismatch (file corrupted)", r->path);
     r->size -= 4; /* the trailer is not payload */
+    if (recorded && !(isfinite(a->frame.center[0]) && isfinite(a->frame.center[1]) &&
+                               isfinite(a->frame.center[2]) && isfinite(a->frame.radius) && a->frame.radius >= 0)) {
+        r->at = frame_at;
+        snprintf(msg, sizeof msg, "frame: centre (%g, %g, %g), radius %g, expected finite values and a radius >= 0",
+                 a->frame.center[0], a->frame.center[1], a->frame.center[2], a->frame.radius);
+        return asp__byte_bad(r, msg);
+    }
     /* sizes come from a checksummed file, but a crafted one must still not make us allocate wildly */
     if (n < 1 || n > payload / 28 || n > (uint64_t)INT32_MAX) {
         r->at = 16;
@@ -283,7 +309,7 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
     }
     /* the attribute bit set sits after the fixed per-point arrays; read it first to size the cloud */
     uint32_t attrs = 0;
-    r->at = AMG_HEADER + 28 * (size_t)n;
+    r->at = hsize + 28 * (size_t)n;
     if ((rc = asp__byte_take(r, &attrs, 4, "the attribute set")) != 0)
         return rc;
     r->at -= 4;
@@ -297,7 +323,7 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
                  (unsigned long long)payload);
         return asp__byte_bad(r, msg);
     }
-    r->at = AMG_HEADER;
+    r->at = hsize;
     if ((rc = asp_cloud_create((size_t)n, ASP_ATTR_NORMALS | attrs, ctx, &a->cloud, r->err)) != 0)
         return rc;
     memcpy(a->cloud->origin, origin, sizeof origin);
@@ -364,6 +390,9 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
     a->info.k_min = a->desc.k_min;
     a->info.k_max = a->desc.k_max;
     a->info.fan_k = a->desc.fan_k;
+    // a version-2 file predates the recorded frame: computed as decompose does (radius 0 if nothing to frame)
+    if (!recorded && asp_cloud_frame(a->cloud, &a->frame, NULL) != 0)
+        memset(&a->frame, 0, sizeof a->frame);
     return 0;
 }
 
@@ -382,8 +411,6 @@ int asp_amg_load_memory(const void *data, size_t size, const char *name, const a
         return rc;
     asp__byte_reader r = {data ? data : empty, data ? size : 0, 0, nm, err};
     rc = parse(&r, ctx, a);
-    if (!rc && asp_cloud_frame(a->cloud, &a->frame, NULL) != 0) // NEEDSWORK: read the recorded frame
-        memset(&a->frame, 0, sizeof a->frame);
     if (rc) {
         asp_amg_destroy(a);
         return rc;

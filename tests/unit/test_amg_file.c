@@ -55,6 +55,11 @@ static void test_round_trip_and_damage(void)
         CHECK(asp_amg_cloud(back)->count == n);
         const asp_cloud *b = asp_amg_cloud(back);
         CHECK(memcmp(b->origin, c->origin, sizeof c->origin) == 0);
+        /* the recorded frame comes back bit for bit, and it is the source points' frame */
+        asp_frame want;
+        CHECK_OK(asp_cloud_frame(c, &want, err), err);
+        CHECK(asp_amg_frame(amg)->radius > 0 && memcmp(asp_amg_frame(amg), &want, sizeof want) == 0);
+        CHECK(memcmp(asp_amg_frame(back), asp_amg_frame(amg), sizeof want) == 0);
         CHECK(memcmp(b->positions, c->positions, 12 * n) == 0);
         /* the input had normals: they are kept, not replaced by the unoriented tangent normals */
         CHECK(asp_amg_has_input_normals(amg) && asp_amg_has_input_normals(back));
@@ -94,18 +99,18 @@ static void test_round_trip_and_damage(void)
     char bad[600];
     snprintf(bad, sizeof bad, "%s.bad", path);
     /* truncated at many places, including inside the header */
-    const size_t cuts[] = {0, 5, 40, 64, 67, 100, size / 3, size / 2, size - 5, size - 1};
+    const size_t cuts[] = {0, 5, 40, 64, 67, 90, 100, size / 3, size / 2, size - 5, size - 1};
     for (size_t i = 0; i < sizeof cuts / sizeof cuts[0]; i++) {
         spit(bad, bytes, cuts[i]);
         back = NULL;
         int rc = asp_amg_load(bad, NULL, &back, err);
         CHECK_MSG(rc == ASP_EFORMAT && back == NULL, "cut at %zu: rc %d", cuts[i], rc);
         CHECK(strstr(err->msg, bad) != NULL);
-        CHECK_MSG(cuts[i] < 64 + 4 || strstr(err->msg, "truncated") != NULL, "cut at %zu: %s", cuts[i], err->msg);
+        CHECK_MSG(cuts[i] < 96 + 4 || strstr(err->msg, "truncated") != NULL, "cut at %zu: %s", cuts[i], err->msg);
     }
     /* one flipped byte anywhere: the checksum catches it */
-    const size_t flips[] = {70, size / 2, size - 10};
-    for (size_t i = 0; i < 3; i++) {
+    const size_t flips[] = {70, 100, size / 2, size - 10};
+    for (size_t i = 0; i < 4; i++) {
         bytes[flips[i]] ^= 0x40;
         spit(bad, bytes, size);
         bytes[flips[i]] ^= 0x40;
@@ -128,7 +133,7 @@ static void test_round_trip_and_damage(void)
     CHECK(asp_amg_load(bad, NULL, &back, err) == ASP_EFORMAT);
     CHECK_MSG(strstr(err->msg, "version 1") != NULL && strstr(err->msg, "decompose") != NULL, "%s", err->msg);
     /* a huge count in the header is refused before anything is allocated */
-    bytes[8] = 2;
+    bytes[8] = 3;
     memset(bytes + 16, 0xFF, 8);
     spit(bad, bytes, size);
     CHECK(asp_amg_load(bad, NULL, &back, err) == ASP_EFORMAT);
@@ -213,11 +218,11 @@ static void test_memory_cuts_and_forged_counts(void)
 
     /* forged counts behind a valid checksum */
     const uint64_t n = forge_get_le(bytes + 16, 8), nlevels = forge_get_le(bytes + 24, 8);
-    const uint32_t attrs = (uint32_t)forge_get_le(bytes + 64 + 28 * n, 4);
+    const uint32_t attrs = (uint32_t)forge_get_le(bytes + 96 + 28 * n, 4);
     const uint64_t per_point = (attrs & ASP_ATTR_NORMALS ? 12u : 0u) + (attrs & ASP_ATTR_COLORS ? 4u : 0u) +
                                (attrs & ASP_ATTR_RADII ? 4u : 0u) + (attrs & ASP_ATTR_UVS ? 8u : 0u) +
                                (attrs & ASP_ATTR_LABELS ? 4u : 0u);
-    const size_t nnz_at = (size_t)(64 + 28 * n + 8 + per_point * n + 128 + 8 * nlevels);
+    const size_t nnz_at = (size_t)(96 + 28 * n + 8 + per_point * n + 128 + 8 * nlevels);
     CHECK(nlevels >= 2 && nnz_at + 8 < size);
     const struct {
         size_t at;
@@ -230,8 +235,66 @@ static void test_memory_cuts_and_forged_counts(void)
                   {nnz_at + 8 + 8, (uint64_t)size, "row pointer"}}; /* row 0 would run past the entries */
     for (size_t i = 0; i < sizeof forged / sizeof forged[0]; i++)
         forge_expect_refused(&amg_format, bytes, size, forged[i].at, forged[i].value, 8, forged[i].field);
+    /* a recorded frame that is not finite or has a negative radius names the field and its byte (64) */
+    const double nan = strtod("nan", NULL), minus_one = -1;
+    uint64_t nan_bits, minus_bits;
+    memcpy(&nan_bits, &nan, 8);
+    memcpy(&minus_bits, &minus_one, 8);
+    forge_expect_refused(&amg_format, bytes, size, 88, minus_bits, 8, "byte 64: frame");
+    forge_expect_refused(&amg_format, bytes, size, 72, nan_bits, 8, "byte 64: frame");
     free(bytes);
     remove(p3);
+    asp_amg_destroy(amg);
+    asp_cloud_destroy(c);
+}
+
+/*
+ * A version-2 file (64-byte header, no frame), forged from a version-3 one by
+ * cutting the frame out: it still loads, its frame computed from the points
+ * as decompose computes it, so it equals the recorded one bit for bit.
+ */
+static void test_version_2_without_frame(void)
+{
+    asp_error errbuf, *err = &errbuf;
+    asp_cloud *c = NULL;
+    asp_amg *amg = NULL, *back = NULL;
+    char p4[600];
+    snprintf(p4, sizeof p4, "/tmp/asp_test_amg_v2_%ld.amg", (long)getpid());
+    CHECK_OK(asp_synth(ASP_SYNTH_SPHERE, &(asp_synth_desc){.points = 400}, NULL, &c, err), err);
+    if (c)
+        CHECK_OK(asp_amg_decompose(c, NULL, NULL, &amg, err), err);
+    if (!amg) {
+        asp_cloud_destroy(c);
+        return;
+    }
+    CHECK_OK(asp_amg_save(amg, p4, err), err);
+    size_t size = 0;
+    unsigned char *v3 = forge_slurp(p4, &size);
+    CHECK(v3 && size > 100 && forge_get_le(v3 + 8, 4) == 3 && forge_get_le(v3 + 12, 4) == 96);
+    if (v3 && size > 100) {
+        unsigned char *v2 = malloc(size - 32);
+        memcpy(v2, v3, 64);
+        memcpy(v2 + 64, v3 + 96, size - 96);
+        forge_put_le(v2 + 8, 2, 4);
+        forge_put_le(v2 + 12, 64, 4);
+        forge_fix_header(v2, size - 32, 32, 64);
+        CHECK_OK(asp_amg_load_memory(v2, size - 32, "v2.amg", NULL, &back, err), err);
+        if (back) {
+            CHECK(asp_amg_frame(back)->radius > 0);
+            CHECK(memcmp(asp_amg_frame(back), asp_amg_frame(amg), sizeof(asp_frame)) == 0);
+            CHECK(same_amg(amg, back));
+            asp_amg_destroy(back);
+        }
+        /* a version-2 header size on a version-3 file is refused */
+        forge_put_le(v3 + 12, 64, 4);
+        forge_fix(v3, size, 32);
+        back = NULL;
+        CHECK(asp_amg_load_memory(v3, size, "v3.amg", NULL, &back, err) == ASP_EFORMAT && back == NULL);
+        CHECK_MSG(strstr(err->msg, "header size") != NULL, "%s", err->msg);
+        free(v2);
+    }
+    free(v3);
+    remove(p4);
     asp_amg_destroy(amg);
     asp_cloud_destroy(c);
 }
@@ -267,7 +330,7 @@ static void test_bare_positions(void)
             CHECK(memcmp(b->positions, c->positions, 12 * n) == 0);
             CHECK(memcmp(b->normals, asp_amg_tangent_normals(amg), 12 * n) == 0);
             /* no attribute arrays: header, 7 floats per point, the attribute set, options, levels, P, CRC */
-            size_t expect = 64 + 28 * n + 8 + 128 + 8 * asp_amg_level_count(amg) + 4;
+            size_t expect = 96 + 28 * n + 8 + 128 + 8 * asp_amg_level_count(amg) + 4;
             for (size_t l = 1; l < asp_amg_level_count(amg); l++) {
                 const asp_amg_csr *p = asp_amg_prolongation(amg, l);
                 expect += 8 + 8 * (p->rows + 1) + 12 * p->row_ptr[p->rows];
@@ -284,4 +347,4 @@ static void test_bare_positions(void)
 }
 
 TEST_MAIN(TEST_CASE(test_round_trip_and_damage), TEST_CASE(test_memory_cuts_and_forged_counts),
-          TEST_CASE(test_bare_positions))
+          TEST_CASE(test_version_2_without_frame), TEST_CASE(test_bare_positions))
