@@ -16,7 +16,12 @@
 #include "util/banned.h"
 
 #define DPS_MAGIC "ASPDPS\r\n"
-enum { DPS_VERSION = 1, DPS_HEADER = 64, DPS_PARAMS = 128, DPS_LEVEL = 96, DPS_PRIM = 124, DPS_SIDE = 16384 };
+/*
+ * Version 2 appends the source point set's frame (asp_frame, 32 bytes) to the
+ * header, so a .dps is framed exactly as its points (issue 12); version 1
+ * files still load with radius 0 ("not known").
+ */
+enum { DPS_VERSION = 2, DPS_HEADER = 96, DPS_HEADER_V1 = 64, DPS_PARAMS = 128, DPS_LEVEL = 96, DPS_PRIM = 124, DPS_SIDE = 16384 };
 
 /* ---- writing: explicit little-endian bytes, so the format does not depend on the host ---- */
 
@@ -71,6 +76,9 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
     asp__put_u32(&w, normals ? 1u : 0u);
     asp__put_u32(&w, dps->skipped_levels);
     asp__put_u32(&w, 0);
+    for (int k = 0; k < 3; k++)
+        asp__put_f64(&w, dps->frame.center[k]);
+    asp__put_f64(&w, dps->frame.radius);
     /* parameters: 128 bytes */
     const asp_prim_desc *d = &dps->desc;
     asp__put_f64(&w, d->tau);
@@ -325,15 +333,19 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_dps *dps)
         return bad_file(r, total >= 6 && memcmp(r->buf, DPS_MAGIC, 6) == 0
                           ? "unsupported variant of the magic 'ASPDPS'"
                           : "not a .dps file (expected the magic 'ASPDPS')");
-    if (total < DPS_HEADER + 4) {
-        snprintf(msg, sizeof msg, "truncated header (%zu bytes, expected at least %d)", total, DPS_HEADER + 4);
+    if (total < DPS_HEADER_V1 + 4) {
+        snprintf(msg, sizeof msg, "truncated header (%zu bytes, expected at least %d)", total, DPS_HEADER_V1 + 4);
         return bad_file(r, msg);
     }
     r->at += 8;
     uint32_t version = asp__get_u32(r), hsize = asp__get_u32(r);
-    if (version != DPS_VERSION || hsize != DPS_HEADER) {
-        snprintf(msg, sizeof msg, "unsupported version %u (header %u bytes), expected version %d", version, hsize,
-                 DPS_VERSION);
+    if (!(version == DPS_VERSION && hsize == DPS_HEADER) && !(version == 1 && hsize == DPS_HEADER_V1)) {
+        snprintf(msg, sizeof msg, "unsupported version %u (header %u bytes), expected version 1 (64 bytes) or %d "
+                 "(%d bytes)", version, hsize, DPS_VERSION, DPS_HEADER);
+        return bad_file(r, msg);
+    }
+    if (total < (size_t)hsize + 4) {
+        snprintf(msg, sizeof msg, "truncated header (%zu bytes, expected at least %u)", total, hsize + 4);
         return bad_file(r, msg);
     }
     uint64_t nl = asp__get_u64(r), payload = asp__get_u64(r);
@@ -343,7 +355,13 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_dps *dps)
     (void)asp__get_u32(r);
     dps->skipped_levels = asp__get_u32(r);
     (void)asp__get_u32(r);
-    const size_t have = total - DPS_HEADER - 4;
+    const size_t frame_at = r->at;
+    if (version >= 2) {
+        for (int k = 0; k < 3; k++)
+            dps->frame.center[k] = asp__get_f64(r);
+        dps->frame.radius = asp__get_f64(r);
+    } /* else radius 0 ("not known"): a version-1 file's primitives do not bound the source points */
+    const size_t have = total - hsize - 4;
     if (payload != have) {
         snprintf(msg, sizeof msg, "%s: header says %llu payload bytes, the file has %zu",
                  payload > have ? "truncated" : "trailing bytes", (unsigned long long)payload, have);
@@ -359,6 +377,14 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_dps *dps)
         return bad_file(r, msg);
     }
     r->size = total - 4; /* the trailer is not payload */
+    const asp_frame *fr = &dps->frame;
+    if (!(isfinite(fr->center[0]) && isfinite(fr->center[1]) && isfinite(fr->center[2]) && isfinite(fr->radius) &&
+          fr->radius >= 0)) {
+        r->at = frame_at;
+        snprintf(msg, sizeof msg, "frame: centre (%g, %g, %g), radius %g, expected finite values and a radius >= 0",
+                 fr->center[0], fr->center[1], fr->center[2], fr->radius);
+        return asp__byte_bad(r, msg);
+    }
     if (nl == 0 || nl > 64 || dps->amg_levels == 0 || !(dps->mean_radius > 0) || !isfinite(dps->mean_radius)) {
         r->at = 16;
         snprintf(msg, sizeof msg, "level count %llu of a %u-level decomposition, mean radius %g: expected 1..64 "

@@ -93,6 +93,8 @@ static void test_round_trip_and_damage(void)
     asp_dps dps = {.level_count = 1, .levels = &lv, .amg_levels = 7, .skipped_levels = 1, .source_points = c->count,
                    .mean_radius = 0.02, .desc = {.tau = 0.05, .texel_size = 1, .normal_map = 1}};
     snprintf(dps.source, sizeof dps.source, "patch.ply");
+    CHECK_OK(asp_cloud_frame(c, &dps.frame, NULL), NULL);
+    CHECK(dps.frame.radius > 0 && dps.frame.center[0] > 1000);
     lv.level = 4;
     char path[256], bad[300];
     snprintf(path, sizeof path, "%s/asp_test_prim_file_%d.dps", ASP_TEST_TMP_DIR, (int)getpid());
@@ -104,6 +106,7 @@ static void test_round_trip_and_damage(void)
         CHECK(back->level_count == 1 && back->amg_levels == 7 && back->skipped_levels == 1);
         CHECK(strcmp(back->source, "patch.ply") == 0 && back->source_points == c->count);
         CHECK(back->desc.normal_map == 1 && back->desc.texel_size == 1);
+        CHECK(memcmp(&back->frame, &dps.frame, sizeof dps.frame) == 0); /* bit for bit */
         const asp_dps_level *b = &back->levels[0];
         CHECK(b->level == 4 && b->prim_count == lv.prim_count && b->texels == lv.texels);
         CHECK(memcmp(b->prims, lv.prims, lv.prim_count * sizeof *lv.prims) == 0);
@@ -172,7 +175,7 @@ static int same_dps(const asp_dps *x, const asp_dps *y)
     int ok = x->level_count == y->level_count && x->amg_levels == y->amg_levels &&
              x->skipped_levels == y->skipped_levels && x->source_points == y->source_points &&
              x->mean_radius == y->mean_radius && !memcmp(&x->desc, &y->desc, sizeof x->desc) &&
-             !strcmp(x->source, y->source);
+             !strcmp(x->source, y->source) && !memcmp(&x->frame, &y->frame, sizeof x->frame);
     for (size_t i = 0; ok && i < x->level_count; i++) {
         const asp_dps_level *a = &x->levels[i], *b = &y->levels[i];
         size_t px = 4 * (size_t)a->atlas.width * a->atlas.height;
@@ -199,6 +202,7 @@ static void test_memory_cuts_and_forged_counts(void)
     asp_dps dps = {.level_count = 1, .levels = &lv, .amg_levels = 7, .source_points = c->count, .mean_radius = 0.02,
                    .desc = {.tau = 0.05, .texel_size = 1, .normal_map = 1}};
     snprintf(dps.source, sizeof dps.source, "patch.ply");
+    CHECK_OK(asp_cloud_frame(c, &dps.frame, NULL), NULL);
     lv.level = 4;
     char path[256];
     snprintf(path, sizeof path, "%s/asp_test_prim_mem_%d.dps", ASP_TEST_TMP_DIR, (int)getpid());
@@ -218,7 +222,7 @@ static void test_memory_cuts_and_forged_counts(void)
     CHECK(asp_dps_load_memory(NULL, 0, NULL, NULL, &from_mem, &err) == ASP_EFORMAT && strstr(err.msg, "<memory>"));
 
     /* forged counts: header level count, then level 0's primitive and neighbour counts and atlas size */
-    const size_t level_at = 64 + 128 + 4 + strlen("patch.ply");
+    const size_t level_at = 96 + 128 + 4 + strlen("patch.ply");
     const struct {
         size_t at;
         uint64_t value;
@@ -233,6 +237,39 @@ static void test_memory_cuts_and_forged_counts(void)
                   {level_at, 9, 4, "AMG level"}};
     for (size_t i = 0; i < sizeof forged / sizeof forged[0]; i++)
         forge_expect_refused(&dps_format, bytes, size, forged[i].at, forged[i].value, forged[i].bytes, forged[i].field);
+    /* a recorded frame that is not finite or has a negative radius names the field and its byte (64) */
+    const double inf = strtod("inf", NULL), minus_one = -1;
+    uint64_t inf_bits, minus_bits;
+    memcpy(&inf_bits, &inf, 8);
+    memcpy(&minus_bits, &minus_one, 8);
+    forge_expect_refused(&dps_format, bytes, size, 88, minus_bits, 8, "byte 64: frame");
+    forge_expect_refused(&dps_format, bytes, size, 64, inf_bits, 8, "byte 64: frame");
+
+    /* a version-1 file (64-byte header, no frame), forged by cutting the frame out, loads with radius 0 */
+    unsigned char *v1 = malloc(size - 32);
+    if (v1) {
+        memcpy(v1, bytes, 64);
+        memcpy(v1 + 64, bytes + 96, size - 96);
+        forge_put_le(v1 + 8, 1, 4);
+        forge_put_le(v1 + 12, 64, 4);
+        forge_fix_header(v1, size - 32, 24, 64);
+        asp_dps *old = NULL;
+        CHECK_OK(asp_dps_load_memory(v1, size - 32, "v1.dps", NULL, &old, &err), &err);
+        if (old) {
+            const asp_frame zero = {{0, 0, 0}, 0};
+            CHECK(memcmp(&old->frame, &zero, sizeof zero) == 0);
+            old->frame = dps.frame; /* everything else is the same */
+            CHECK(same_dps(&dps, old));
+            asp_dps_destroy(old);
+        }
+        /* version 1 with the version-2 header size (and the reverse) is refused */
+        forge_put_le(v1 + 12, 96, 4);
+        forge_fix_header(v1, size - 32, 24, 96);
+        old = NULL;
+        CHECK(asp_dps_load_memory(v1, size - 32, "v1.dps", NULL, &old, &err) == ASP_EFORMAT && !old);
+        CHECK_MSG(strstr(err.msg, "version 1 (header 96 bytes)") != NULL, "%s", err.msg);
+        free(v1);
+    }
     free(bytes);
     remove(path);
     asp_dps_level_release(&lv, NULL);
