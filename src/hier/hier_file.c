@@ -1,8 +1,10 @@
 /*
  * On-disk hierarchy, so a large model loads without rebuilding (issue 6; layout
  * in docs/hier.md): a little-endian header and payload, each with an FNV-1a 64
- * checksum. Loading checks sizes against the file before allocating and
- * validates the tree, so a corrupted file is an error, never a crash.
+ * checksum. Loading reads the whole file through the shared byte reader
+ * (util/byte_io.h, like .amg and .dps), checks sizes against it before
+ * allocating and validates the tree, so a corrupted file is an error naming the
+ * byte offset, never a crash.
  */
 #include <errno.h>
 #include <math.h>
@@ -11,10 +13,18 @@
 
 #include "hier/internal.h"
 #include "util/atomic_file.h"
+#include "util/byte_io.h"
 #include "util/banned.h"
 
 #define MAGIC "ASPHIER"
-enum { VERSION = 1, HEADER_SIZE = 128, NODE_REC = 48, SPLAT_REC = 64, COV_REC = 8 * ASP_HIER_COV };
+/*
+ * Version 2 records the source point set's frame (asp_frame) at header byte
+ * 96, so a hierarchy is framed exactly as its points (issue 12); its header
+ * checksum moves to byte 152. Version 1 (128-byte header) still loads, framed
+ * by the root bounding sphere.
+ */
+enum { VERSION = 2, HEADER_SIZE = 160, HEADER_V1 = 128, FRAME_AT = 96, NODE_REC = 48, SPLAT_REC = 64,
+       COV_REC = 8 * ASP_HIER_COV };
 enum { CHUNK = 1 << 16 };
 
 #define FNV_OFFSET 0xcbf29ce484222325ULL
@@ -49,35 +59,11 @@ static void put64(uint8_t *p, uint64_t v)
         p[i] = (uint8_t)(v >> (8 * i));
 }
 
-static uint32_t get32(const uint8_t *p)
-{
-    uint32_t v = 0;
-    for (int i = 0; i < 4; i++)
-        v |= (uint32_t)p[i] << (8 * i);
-    return v;
-}
-
-static uint64_t get64(const uint8_t *p)
-{
-    uint64_t v = 0;
-    for (int i = 0; i < 8; i++)
-        v |= (uint64_t)p[i] << (8 * i);
-    return v;
-}
-
 static void putf64(uint8_t *p, double d)
 {
     uint64_t v;
     memcpy(&v, &d, 8);
     put64(p, v);
-}
-
-static double getf64(const uint8_t *p)
-{
-    uint64_t v = get64(p);
-    double d;
-    memcpy(&d, &v, 8);
-    return d;
 }
 
 /*
@@ -141,8 +127,11 @@ static void encode_header(const asp_hier *h, uint64_t payload, uint64_t payload_
     put32(hd + 76, SPLAT_REC);
     put64(hd + 80, payload);
     put64(hd + 88, payload_hash);
-    /* bytes 96-119 are reserved (zero); the header checksum covers everything before it */
-    put64(hd + 120, fnv1a(FNV_OFFSET, hd, 120));
+    for (int i = 0; i < 3; i++)
+        putf64(hd + FRAME_AT + 8 * i, h->frame.center[i]);
+    putf64(hd + FRAME_AT + 24, h->frame.radius);
+    /* bytes 128-151 are reserved (zero); the header checksum covers everything before it */
+    put64(hd + HEADER_SIZE - 8, fnv1a(FNV_OFFSET, hd, HEADER_SIZE - 8));
 }
 
 static uint64_t payload_size(uint64_t nodes, uint64_t points)
@@ -187,45 +176,6 @@ int asp_hier_save(const asp_hier *hier, const char *path, asp_error *err)
 
 /* ---- loading ---- */
 
-typedef struct reader {
-    FILE *fp;
-    const uint8_t *mem;
-    size_t size; /* total bytes; known for memory and seekable files */
-    size_t pos;
-    const char *name;
-    uint64_t hash;
-} reader;
-
-static size_t read_bytes(reader *r, void *dst, size_t n)
-{
-    size_t got;
-    if (r->mem) {
-        got = r->size - r->pos < n ? r->size - r->pos : n;
-        memcpy(dst, r->mem + r->pos, got);
-    } else {
-        got = fread(dst, 1, n, r->fp);
-    }
-    r->pos += got;
-    return got;
-}
-
-static int get_array(reader *r, void *dst, size_t bytes, size_t word, size_t rec, size_t skip_word, const char *what,
-                     asp_error *err)
-{
-    uint8_t *d = dst;
-    int le = host_is_le();
-    for (size_t off = 0; off < bytes; off += CHUNK) {
-        size_t n = bytes - off < CHUNK ? bytes - off : CHUNK;
-        if (read_bytes(r, d + off, n) != n)
-            return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': truncated at byte %zu in the %s", r->name,
-                                 r->pos, what);
-        r->hash = fnv1a(r->hash, d + off, n);
-        if (!le)
-            swap_words(d + off, n, word, rec, skip_word);
-    }
-    return 0;
-}
-
 static int finite_n(const float *p, size_t n)
 {
     for (size_t i = 0; i < n; i++)
@@ -240,150 +190,219 @@ static int splat_ok(const asp_hier_splat *s)
            isfinite(s->a) && s->b >= 0 && s->a >= s->b;
 }
 
-/* the tree is a tree, ranges in bounds, so traversal can trust it */
-static int validate(const asp_hier *h, const char *name, asp_error *err)
+/* Fails naming the byte where record i (of rec bytes, starting at base) begins. */
+static int bad_record(asp__byte_reader *r, size_t base, size_t i, size_t rec, const char *msg)
+{
+    r->at = base + i * rec;
+    return asp__byte_bad(r, msg);
+}
+
+/* the tree is a tree, ranges in bounds, so traversal can trust it; nodes start at byte hsize */
+static int validate(const asp_hier *h, asp__byte_reader *r, size_t hsize)
 {
     const asp_hier_node *nd = h->nodes;
-    size_t nn = h->node_count, np = h->point_count;
-    if (nd[0].parent != UINT32_MAX || nd[0].depth != 0 || nd[0].first_point != 0 || nd[0].point_count != np)
-        return asp_error_set(err, ASP_EFORMAT, "invalid hierarchy '%s': node 0 is not a root over all %zu points",
-                             name, np);
+    const size_t nn = h->node_count, np = h->point_count, splats = hsize + nn * NODE_REC;
+    char msg[200];
+    if (nd[0].parent != UINT32_MAX || nd[0].depth != 0 || nd[0].first_point != 0 || nd[0].point_count != np) {
+        snprintf(msg, sizeof msg, "invalid hierarchy: node 0 is not a root over all %zu points, expected parent "
+                 "none, depth 0, points 0+%zu", np, np);
+        return bad_record(r, hsize, 0, NODE_REC, msg);
+    }
     uint64_t claimed = 0;
     uint32_t depth = 0;
     for (size_t i = 0; i < nn; i++) {
         const asp_hier_node *n = &nd[i];
         const asp_hier_splat *s = &h->splats[i];
-        if (!finite_n(n->sphere, 5) || !(n->sphere[3] >= 0) || !(n->cone_angle >= 0) ||
-            !splat_ok(s) || s->index != i)
-            return asp_error_set(err, ASP_EFORMAT, "invalid hierarchy '%s': node %zu has a bad value", name, i);
-        if (n->depth > ASP_HIER_MAX_DEPTH || (size_t)n->first_point + n->point_count > np || n->point_count == 0)
-            return asp_error_set(err, ASP_EFORMAT, "invalid hierarchy '%s': node %zu: depth %u or points %u+%u out of range",
-                                 name, i, n->depth, n->first_point, n->point_count);
+        if (!finite_n(n->sphere, 5) || !(n->sphere[3] >= 0) || !(n->cone_angle >= 0)) {
+            snprintf(msg, sizeof msg, "invalid hierarchy: node %zu has a bad value, expected a finite sphere and cone",
+                     i);
+            return bad_record(r, hsize, i, NODE_REC, msg);
+        }
+        if (!splat_ok(s) || s->index != i) {
+            snprintf(msg, sizeof msg, "invalid hierarchy: node %zu has a bad splat, expected finite axes a >= b >= 0 "
+                     "and index %zu", i, i);
+            return bad_record(r, splats, i, SPLAT_REC, msg);
+        }
+        if (n->depth > ASP_HIER_MAX_DEPTH || (size_t)n->first_point + n->point_count > np || n->point_count == 0) {
+            snprintf(msg, sizeof msg, "invalid hierarchy: node %zu: depth %u or points %u+%u out of range, expected "
+                     "depth <= %d and points within 0..%zu", i, n->depth, n->first_point, n->point_count,
+                     ASP_HIER_MAX_DEPTH, np);
+            return bad_record(r, hsize, i, NODE_REC, msg);
+        }
         depth = n->depth > depth ? n->depth : depth;
         if (n->child_count == 0) {
-            if (n->point_count > h->leaf_size)
-                return asp_error_set(err, ASP_EFORMAT, "invalid hierarchy '%s': leaf %zu holds %u points, leaf size is %zu",
-                                     name, i, n->point_count, h->leaf_size);
+            if (n->point_count > h->leaf_size) {
+                snprintf(msg, sizeof msg, "invalid hierarchy: leaf %zu holds %u points, expected at most the leaf "
+                         "size %zu", i, n->point_count, h->leaf_size);
+                return bad_record(r, hsize, i, NODE_REC, msg);
+            }
             continue;
         }
         if (n->child_count == 1 || n->child_count > 8 || n->first_child <= i ||
-            (size_t)n->first_child + n->child_count > nn)
-            return asp_error_set(err, ASP_EFORMAT, "invalid hierarchy '%s': node %zu: children %u+%u out of range",
-                                 name, i, n->first_child, n->child_count);
+            (size_t)n->first_child + n->child_count > nn) {
+            snprintf(msg, sizeof msg, "invalid hierarchy: node %zu: children %u+%u out of range, expected 2..8 "
+                     "children after it, below %zu", i, n->first_child, n->child_count, nn);
+            return bad_record(r, hsize, i, NODE_REC, msg);
+        }
         uint32_t next = n->first_point;
         for (uint32_t c = 0; c < n->child_count; c++) {
             const asp_hier_node *k = &nd[n->first_child + c];
-            if (k->parent != i || k->depth != n->depth + 1 || k->first_point != next)
-                return asp_error_set(err, ASP_EFORMAT, "invalid hierarchy '%s': node %u: inconsistent with parent %zu",
-                                     name, n->first_child + c, i);
+            if (k->parent != i || k->depth != n->depth + 1 || k->first_point != next) {
+                snprintf(msg, sizeof msg, "invalid hierarchy: node %u: inconsistent with parent %zu, expected its "
+                         "parent, depth %u, first point %u", n->first_child + c, i, n->depth + 1, next);
+                return bad_record(r, hsize, n->first_child + c, NODE_REC, msg);
+            }
             next += k->point_count;
         }
-        if (next != n->first_point + n->point_count)
-            return asp_error_set(err, ASP_EFORMAT, "invalid hierarchy '%s': node %zu: children hold %u points, not %u",
-                                 name, i, next - n->first_point, n->point_count);
+        if (next != n->first_point + n->point_count) {
+            snprintf(msg, sizeof msg, "invalid hierarchy: node %zu: children hold %u points, expected %u", i,
+                     next - n->first_point, n->point_count);
+            return bad_record(r, hsize, i, NODE_REC, msg);
+        }
         claimed += n->child_count;
     }
     if (claimed != nn - 1)
-        return asp_error_set(err, ASP_EFORMAT, "invalid hierarchy '%s': %llu of %zu nodes are children", name,
-                             (unsigned long long)claimed, nn - 1);
-    if (depth != h->depth)
-        return asp_error_set(err, ASP_EFORMAT, "invalid hierarchy '%s': depth %u, header says %u", name, depth, h->depth);
+        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': invalid hierarchy: %llu of %zu nodes are "
+                             "children, expected all but the root", r->path, (unsigned long long)claimed, nn - 1);
+    if (depth != h->depth) {
+        snprintf(msg, sizeof msg, "invalid hierarchy: depth %u in the nodes, the header says %u", depth, h->depth);
+        r->at = 20;
+        return asp__byte_bad(r, msg);
+    }
     for (size_t j = 0; j < np; j++) {
         const asp_hier_splat *s = &h->splats[nn + j];
-        if (!splat_ok(s) || s->index >= np)
-            return asp_error_set(err, ASP_EFORMAT, "invalid hierarchy '%s': point %zu has a bad value", name, j);
+        if (!splat_ok(s) || s->index >= np) {
+            snprintf(msg, sizeof msg, "invalid hierarchy: point %zu has a bad splat, expected finite axes a >= b >= 0 "
+                     "and an index below %zu", j, np);
+            return bad_record(r, splats, nn + j, SPLAT_REC, msg);
+        }
     }
     return 0;
 }
 
-static int load(reader *r, const asp_context *ctx, asp_hier **out, asp_error *err)
+/* Copies one array of records out of the file (checked to fit), swapping words on big-endian hosts. */
+static void get_array(asp__byte_reader *r, void *dst, size_t bytes, size_t word, size_t rec, size_t skip_word)
 {
-    uint8_t hd[HEADER_SIZE];
-    size_t got = read_bytes(r, hd, HEADER_SIZE);
-    if (got != HEADER_SIZE)
-        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': truncated header: %zu of %d bytes", r->name, got,
-                             HEADER_SIZE);
-    if (memcmp(hd, MAGIC, 8) != 0)
-        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': not a hierarchy file (bad magic at byte 0)",
-                             r->name);
-    if (get64(hd + 120) != fnv1a(FNV_OFFSET, hd, 120))
-        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': header checksum mismatch (bytes 0-119)", r->name);
-    uint32_t version = get32(hd + 8);
-    if (version != VERSION)
-        return asp_error_set(err, version > VERSION ? ASP_EUNSUPPORTED : ASP_EFORMAT,
-                             "cannot read '%s': format version %u, this build reads version %d", r->name, version,
-                             VERSION);
-    uint64_t nodes = get64(hd + 24), points = get64(hd + 32), leaf = get64(hd + 40), payload = get64(hd + 80);
-    uint32_t flags = get32(hd + 16);
-    if (get32(hd + 12) != HEADER_SIZE || get32(hd + 72) != NODE_REC || get32(hd + 76) != SPLAT_REC)
-        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': unexpected header or record sizes", r->name);
+    memcpy(dst, r->buf + r->at, bytes);
+    r->at += bytes;
+    if (!host_is_le())
+        swap_words(dst, bytes, word, rec, skip_word);
+}
+
+static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
+{
+    char msg[200];
+    /* a prefix of the magic is a truncated hierarchy file; anything else is not one */
+    const size_t mlen = r->size < 8 ? r->size : 8;
+    if (memcmp(r->buf, MAGIC, mlen) != 0)
+        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': not a hierarchy file (bad magic at byte 0)",
+                             r->path);
+    if (r->size < 16)
+        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': truncated header: %zu of at least %d bytes",
+                             r->path, r->size, HEADER_V1);
+    r->at = 8;
+    const uint32_t version = asp__get_u32(r);
+    if (version != 1 && version != VERSION)
+        return asp_error_set(r->err, version > VERSION ? ASP_EUNSUPPORTED : ASP_EFORMAT,
+                             "cannot read '%s': format version %u, this build reads versions 1 and %d", r->path,
+                             version, VERSION);
+    const size_t hsize = version == 1 ? HEADER_V1 : HEADER_SIZE;
+    if (r->size < hsize)
+        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': truncated header: %zu of %zu bytes", r->path,
+                             r->size, hsize);
+    r->at = hsize - 8;
+    if (asp__get_u64(r) != fnv1a(FNV_OFFSET, r->buf, hsize - 8))
+        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': header checksum mismatch (bytes 0-%zu)",
+                             r->path, hsize - 9);
+    r->at = 12;
+    const uint32_t header = asp__get_u32(r), flags = asp__get_u32(r), depth = asp__get_u32(r);
+    const uint64_t nodes = asp__get_u64(r), points = asp__get_u64(r), leaf = asp__get_u64(r);
+    double origin[3];
+    for (int i = 0; i < 3; i++)
+        origin[i] = asp__get_f64(r);
+    const uint32_t node_rec = asp__get_u32(r), splat_rec = asp__get_u32(r);
+    const uint64_t payload = asp__get_u64(r), payload_hash = asp__get_u64(r);
+    if (header != hsize || node_rec != NODE_REC || splat_rec != SPLAT_REC) {
+        r->at = 12;
+        snprintf(msg, sizeof msg, "header: header size %u, records %u and %u bytes, expected %zu, %d and %d", header,
+                 node_rec, splat_rec, hsize, NODE_REC, SPLAT_REC);
+        return asp__byte_bad(r, msg);
+    }
     if (points == 0 || points > (UINT32_MAX - 1) / 3 || nodes == 0 || nodes > 2 * points - 1 || leaf == 0 ||
-        leaf > ASP_HIER_MAX_LEAF || (flags & ~7u))
-        return asp_error_set(err, ASP_EFORMAT,
-                             "cannot read '%s': header: %llu nodes, %llu points, leaf size %llu, flags %#x out of range",
-                             r->name, (unsigned long long)nodes, (unsigned long long)points,
-                             (unsigned long long)leaf, flags);
-    if (payload != payload_size(nodes, points))
-        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': header: payload %llu bytes, expected %llu",
-                             r->name, (unsigned long long)payload, (unsigned long long)payload_size(nodes, points));
-    if (r->size != (size_t)-1 && r->size != HEADER_SIZE + payload)
-        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': file has %zu bytes, header says %llu%s", r->name,
-                             r->size, (unsigned long long)(HEADER_SIZE + payload),
-                             r->size < HEADER_SIZE + payload ? " (truncated)" : "");
+        leaf > ASP_HIER_MAX_LEAF || (flags & ~7u)) {
+        r->at = 16;
+        snprintf(msg, sizeof msg, "header: %llu nodes, %llu points, leaf size %llu, flags %#x out of range, expected "
+                 "1..%u points, fewer than twice as many nodes, leaf size 1..%d, flags below 8",
+                 (unsigned long long)nodes, (unsigned long long)points, (unsigned long long)leaf, flags,
+                 (UINT32_MAX - 1) / 3, ASP_HIER_MAX_LEAF);
+        return asp__byte_bad(r, msg);
+    }
+    if (payload != payload_size(nodes, points)) {
+        r->at = 80;
+        snprintf(msg, sizeof msg, "header: payload %llu bytes, expected %llu", (unsigned long long)payload,
+                 (unsigned long long)payload_size(nodes, points));
+        return asp__byte_bad(r, msg);
+    }
+    if (r->size - hsize != payload)
+        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': file has %zu bytes, header says %llu%s", r->path,
+                             r->size, (unsigned long long)(hsize + payload),
+                             r->size - hsize < payload ? " (truncated)" : " (trailing bytes)");
+    asp_frame frame = {{0, 0, 0}, 0};
+    if (version >= 2) {
+        r->at = FRAME_AT;
+        for (int i = 0; i < 3; i++)
+            frame.center[i] = asp__get_f64(r);
+        frame.radius = asp__get_f64(r);
+        if (!(isfinite(frame.center[0]) && isfinite(frame.center[1]) && isfinite(frame.center[2]) &&
+              isfinite(frame.radius) && frame.radius >= 0)) {
+            r->at = FRAME_AT;
+            snprintf(msg, sizeof msg, "frame: centre (%g, %g, %g), radius %g, expected finite values and a radius >= 0",
+                     frame.center[0], frame.center[1], frame.center[2], frame.radius);
+            return asp__byte_bad(r, msg);
+        }
+    }
+    /* the whole payload is hashed before anything large is allocated */
+    if (fnv1a(FNV_OFFSET, r->buf + hsize, (size_t)payload) != payload_hash)
+        return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': payload checksum mismatch (bytes %zu-%llu)",
+                             r->path, hsize, (unsigned long long)(hsize + payload - 1));
     asp_hier *h = NULL;
-    int rc = asp__hier_alloc(ctx, (size_t)nodes, (size_t)points, &h, err);
+    int rc = asp__hier_alloc(ctx, (size_t)nodes, (size_t)points, &h, r->err);
     if (rc)
         return rc;
     h->flags = flags;
-    h->depth = get32(hd + 20);
+    h->depth = depth;
     h->leaf_size = (size_t)leaf;
-    for (int i = 0; i < 3; i++)
-        h->origin[i] = getf64(hd + 48 + 8 * i);
-    r->hash = FNV_OFFSET;
-    size_t ns = h->node_count + h->point_count;
-    if ((rc = get_array(r, h->nodes, h->node_count * NODE_REC, 4, NODE_REC, (size_t)-1, "nodes", err)) ||
-        (rc = get_array(r, h->splats, ns * SPLAT_REC, 4, SPLAT_REC, 3, "splats", err)) ||
-        (rc = get_array(r, h->cov, h->node_count * COV_REC, 8, COV_REC, (size_t)-1, "covariances", err)))
-        goto fail;
-    uint8_t extra;
-    if (r->size == (size_t)-1 && read_bytes(r, &extra, 1) == 1) {
-        rc = asp_error_set(err, ASP_EFORMAT, "cannot read '%s': trailing bytes after byte %zu", r->name, r->pos - 1);
-        goto fail;
+    memcpy(h->origin, origin, sizeof origin);
+    r->at = hsize;
+    get_array(r, h->nodes, h->node_count * NODE_REC, 4, NODE_REC, (size_t)-1);
+    get_array(r, h->splats, (h->node_count + h->point_count) * SPLAT_REC, 4, SPLAT_REC, 3);
+    get_array(r, h->cov, h->node_count * COV_REC, 8, COV_REC, (size_t)-1);
+    if ((rc = validate(h, r, hsize)) != 0) {
+        asp_hier_destroy(h);
+        return rc;
     }
-    if (r->hash != get64(hd + 88)) {
-        rc = asp_error_set(err, ASP_EFORMAT, "cannot read '%s': payload checksum mismatch (bytes %d-%llu)", r->name,
-                           HEADER_SIZE, (unsigned long long)(HEADER_SIZE + payload - 1));
-        goto fail;
+    if (version >= 2) {
+        h->frame = frame;
+    } else { // version 1 predates the recorded frame: the root bounding sphere is close to it
+        for (int i = 0; i < 3; i++)
+            h->frame.center[i] = h->origin[i] + h->nodes[0].sphere[i];
+        h->frame.radius = h->nodes[0].sphere[3];
     }
-    if ((rc = validate(h, r->name, err)) != 0)
-        goto fail;
-    for (int i = 0; i < 3; i++) // NEEDSWORK: read the recorded frame; the root sphere is close
-        h->frame.center[i] = h->origin[i] + h->nodes[0].sphere[i];
-    h->frame.radius = h->nodes[0].sphere[3];
     *out = h;
     return 0;
-fail:
-    asp_hier_destroy(h);
-    return rc;
 }
 
 int asp_hier_load(const char *path, const asp_context *ctx, asp_hier **out, asp_error *err)
 {
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
-    reader r = {.fp = fp, .size = (size_t)-1, .name = path};
-    if (fseek(fp, 0, SEEK_END) == 0) {
-        long end = ftell(fp);
-        if (end >= 0)
-            r.size = (size_t)end;
-        if (fseek(fp, 0, SEEK_SET) != 0)
-            r.size = (size_t)-1;
-    }
-    int rc = load(&r, ctx, out, err);
-    if (rc == ASP_EFORMAT && ferror(fp))
-        rc = asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, strerror(errno));
-    fclose(fp);
+    if (!path || !out)
+        return asp_error_set(err, ASP_EINVAL, "asp_hier_load needs a path and an output");
+    uint8_t *buf = NULL;
+    size_t size = 0;
+    int rc = asp__byte_slurp(path, ctx, &buf, &size, err);
+    if (rc)
+        return rc;
+    rc = asp_hier_load_memory(buf, size, path, ctx, out, err);
+    asp_free(ctx, buf);
     return rc;
 }
 
@@ -391,6 +410,8 @@ int asp_hier_load_memory(const void *data, size_t size, const char *name, const 
                          asp_error *err)
 {
     static const uint8_t empty[1];
-    reader r = {.mem = data ? data : empty, .size = data ? size : 0, .name = name ? name : "<memory>"};
-    return load(&r, ctx, out, err);
+    if (!out)
+        return asp_error_set(err, ASP_EINVAL, "asp_hier_load_memory needs an output");
+    asp__byte_reader r = {data ? data : empty, data ? size : 0, 0, name ? name : "<memory>", err};
+    return load(&r, ctx, out);
 }

@@ -72,11 +72,16 @@ static void put32le(uint8_t *p, uint32_t v)
         p[i] = (uint8_t)(v >> (8 * i));
 }
 
-/* recompute both checksums, as a forger would */
+/* recompute both checksums, as a forger would, for a header of hsize bytes (160; 128 in version 1) */
+static void reseal_header(uint8_t *b, size_t size, size_t hsize)
+{
+    put64le(b + 88, fnv(b + hsize, size - hsize));
+    put64le(b + hsize - 8, fnv(b, hsize - 8));
+}
+
 static void reseal(uint8_t *b, size_t size)
 {
-    put64le(b + 88, fnv(b + 128, size - 128));
-    put64le(b + 120, fnv(b, 120));
+    reseal_header(b, size, 160);
 }
 
 static int same(const asp_hier *a, const asp_hier *b)
@@ -87,7 +92,7 @@ static int same(const asp_hier *a, const asp_hier *b)
     asp_hier_origin(b, ob);
     return nn == asp_hier_node_count(b) && np == asp_hier_point_count(b) && asp_hier_depth(a) == asp_hier_depth(b) &&
            asp_hier_flags(a) == asp_hier_flags(b) && asp_hier_leaf_size(a) == asp_hier_leaf_size(b) &&
-           memcmp(oa, ob, sizeof oa) == 0 &&
+           memcmp(oa, ob, sizeof oa) == 0 && memcmp(asp_hier_frame(a), asp_hier_frame(b), sizeof(asp_frame)) == 0 &&
            memcmp(asp_hier_nodes(a), asp_hier_nodes(b), nn * sizeof(asp_hier_node)) == 0 &&
            memcmp(asp_hier_splats(a), asp_hier_splats(b), (nn + np) * sizeof(asp_hier_splat)) == 0 &&
            memcmp(asp_hier_covariances(a), asp_hier_covariances(b), nn * 10 * sizeof(double)) == 0;
@@ -108,8 +113,13 @@ static void test_round_trip(void)
     asp_hier *back = NULL;
     CHECK_OK(asp_hier_load(path, NULL, &back, err), err);
     CHECK(back && same(built, back));
+    /* the recorded frame is the source points' frame, bit for bit */
+    asp_frame want;
+    CHECK_OK(asp_cloud_frame(cl, &want, err), err);
+    CHECK(want.radius > 0 && memcmp(asp_hier_frame(built), &want, sizeof want) == 0);
+    CHECK(back && memcmp(asp_hier_frame(back), &want, sizeof want) == 0);
     image = read_all(path, &image_size);
-    CHECK(image && image_size == 128 + asp_hier_node_count(built) * (48 + 64 + 80) + 3000 * 64);
+    CHECK(image && image_size == 160 + asp_hier_node_count(built) * (48 + 64 + 80) + 3000 * 64);
     CHECK(image && memcmp(image, "ASPHIER", 8) == 0);
     /* the same bytes through memory */
     asp_hier *mem = NULL;
@@ -170,7 +180,7 @@ static void test_corrupted(void)
     asp_error err;
     size_t bad = 0;
     /* any flipped byte: header or payload checksum catches it */
-    for (size_t at = 0; at < image_size; at += at < 128 ? 1 : image_size / 211 + 1) {
+    for (size_t at = 0; at < image_size; at += at < 160 ? 1 : image_size / 211 + 1) {
         memcpy(b, image, image_size);
         b[at] ^= 0x20;
         memset(&err, 0, sizeof err);
@@ -187,14 +197,68 @@ static void test_corrupted(void)
     CHECK(load_bytes(b, image_size, &err) == ASP_EFORMAT && strstr(err.msg, "magic"));
     /* a newer version, properly sealed */
     memcpy(b, image, image_size);
-    b[8] = 2;
+    b[8] = 3;
     reseal(b, image_size);
-    CHECK(load_bytes(b, image_size, &err) == ASP_EUNSUPPORTED && strstr(err.msg, "version 2"));
+    CHECK(load_bytes(b, image_size, &err) == ASP_EUNSUPPORTED && strstr(err.msg, "version 3"));
     /* huge counts with a valid header checksum: refused before allocating */
     memcpy(b, image, image_size);
     put64le(b + 32, 1ULL << 40);
     reseal(b, image_size);
-    CHECK(load_bytes(b, image_size, &err) == ASP_EFORMAT);
+    CHECK(load_bytes(b, image_size, &err) == ASP_EFORMAT && strstr(err.msg, "byte 16: header"));
+    /* a recorded frame that is not finite, or has a negative radius: refused naming its byte (96) */
+    const double bad_values[2] = {-1.0, strtod("nan", NULL)};
+    for (int k = 0; k < 2; k++) {
+        memcpy(b, image, image_size);
+        uint64_t bits;
+        memcpy(&bits, &bad_values[k], 8);
+        put64le(b + (k ? 104 : 120), bits);
+        reseal(b, image_size);
+        CHECK(load_bytes(b, image_size, &err) == ASP_EFORMAT);
+        CHECK_MSG(strstr(err.msg, "x.asph") && strstr(err.msg, "byte 96: frame") && strstr(err.msg, "expected"), "%s",
+                  err.msg);
+    }
+    free(b);
+}
+
+/*
+ * A version-1 file (128-byte header, no frame), forged from a version-2 one:
+ * it loads, framed by the root bounding sphere as before the frame was
+ * recorded; everything else is the same.
+ */
+static void test_version_1(void)
+{
+    if (!image || !built)
+        return;
+    const size_t size = image_size - 32;
+    uint8_t *b = malloc(size);
+    memcpy(b, image, 96);
+    memset(b + 96, 0, 32);
+    memcpy(b + 128, image + 160, image_size - 160);
+    put32le(b + 8, 1);
+    put32le(b + 12, 128);
+    reseal_header(b, size, 128);
+    asp_hier *h = NULL;
+    asp_error errbuf = {0}, *err = &errbuf;
+    CHECK_OK(asp_hier_load_memory(b, size, "v1.asph", NULL, &h, err), err);
+    if (h) {
+        double o[3];
+        asp_hier_origin(h, o);
+        const asp_hier_node *root = asp_hier_nodes(h);
+        const asp_frame *f = asp_hier_frame(h);
+        CHECK(f->radius == root->sphere[3] && f->center[0] == o[0] + root->sphere[0] &&
+              f->center[2] == o[2] + root->sphere[2]);
+        /* the root sphere bounds the points (loosely), so it encloses the recorded frame's points too */
+        const asp_frame *want = asp_hier_frame(built);
+        CHECK(f->radius >= 0.9 * want->radius && f->radius < 2 * want->radius);
+        CHECK(memcmp(asp_hier_nodes(h), asp_hier_nodes(built), asp_hier_node_count(built) * sizeof(asp_hier_node)) == 0);
+        asp_hier_destroy(h);
+    }
+    /* a version-1 header size on a version-2 file is refused (its header checksum sits elsewhere) */
+    memcpy(b, image, size);
+    put32le(b + 12, 128);
+    reseal(b, size);
+    h = NULL;
+    CHECK(asp_hier_load_memory(b, size, "v2.asph", NULL, &h, err) == ASP_EFORMAT && h == NULL);
     free(b);
 }
 
@@ -207,24 +271,28 @@ static void test_inconsistent_tree(void)
     size_t nn = asp_hier_node_count(built);
     /* node 0's first_child (bytes 24-27 of the record) pointing past the end */
     memcpy(b, image, image_size);
-    put32le(b + 128 + 24, (uint32_t)nn + 5);
+    put32le(b + 160 + 24, (uint32_t)nn + 5);
     reseal(b, image_size);
     CHECK(load_bytes(b, image_size, &err) == ASP_EFORMAT && strstr(err.msg, "node 0"));
+    CHECK_MSG(strstr(err.msg, "byte 160: ") != NULL, "%s", err.msg); /* node 0's record */
     /* a child that claims another parent */
     uint32_t c = asp_hier_nodes(built)[0].first_child;
     memcpy(b, image, image_size);
-    b[128 + 48 * (size_t)c + 20] ^= 1;
+    b[160 + 48 * (size_t)c + 20] ^= 1;
     reseal(b, image_size);
     CHECK(load_bytes(b, image_size, &err) == ASP_EFORMAT && strstr(err.msg, "invalid hierarchy"));
     /* a NaN ellipse axis in a point splat */
     memcpy(b, image, image_size);
-    size_t at = 128 + 48 * nn + 64 * (nn + 3) + 44;
+    size_t at = 160 + 48 * nn + 64 * (nn + 3) + 44;
     b[at] = 0xff;
     b[at + 1] = 0xff;
     b[at + 2] = 0xc0;
     b[at + 3] = 0x7f;
     reseal(b, image_size);
     CHECK(load_bytes(b, image_size, &err) == ASP_EFORMAT && strstr(err.msg, "point 3"));
+    char where[40];
+    snprintf(where, sizeof where, "byte %zu: ", at - 44);
+    CHECK_MSG(strstr(err.msg, where) != NULL, "%s lacks %s", err.msg, where);
     free(b);
 }
 
@@ -237,6 +305,13 @@ static void test_io_errors(void)
     CHECK(asp_hier_load(path, NULL, &h, &err) == ASP_EIO && h == NULL);
     CHECK(strstr(err.msg, "missing.asph") != NULL);
     CHECK(load_bytes(NULL, 0, &err) == ASP_EFORMAT);
+    /* a directory or a FIFO is refused at once (a FIFO would block a reader that opened it) */
+    CHECK(asp_hier_load(tmpdir, NULL, &h, &err) == ASP_EIO && h == NULL && strstr(err.msg, "directory"));
+    path_of(path, sizeof path, "fifo.asph");
+    if (mkfifo(path, 0600) == 0) {
+        CHECK(asp_hier_load(path, NULL, &h, &err) == ASP_EIO && h == NULL && strstr(err.msg, "not a regular file"));
+        remove(path);
+    }
     if (built) {
         path_of(path, sizeof path, "no/such/dir/x.asph");
         CHECK(asp_hier_save(built, path, &err) == ASP_EIO);
@@ -255,7 +330,8 @@ int main(void)
     snprintf(tmpdir, sizeof tmpdir, "%s/asp_hier_file_%ld", base ? base : "/tmp", (long)getpid());
     mkdir(tmpdir, 0700);
     static const asp_test_case cases[] = {TEST_CASE(test_round_trip), TEST_CASE(test_truncated),
-                                          TEST_CASE(test_corrupted), TEST_CASE(test_inconsistent_tree),
+                                          TEST_CASE(test_corrupted), TEST_CASE(test_version_1),
+                                          TEST_CASE(test_inconsistent_tree),
                                           TEST_CASE(test_io_errors)};
     int rc = asp_test_run(__FILE__, cases, sizeof cases / sizeof cases[0]);
     cleanup();
