@@ -82,6 +82,11 @@ static void one(const uint8_t *data, size_t size)
     if (rc == 0) {
         if (!a)
             abort();
+        /* the recorded (or, version 2, computed) frame is finite with radius >= 0 */
+        const asp_frame *f = asp_amg_frame(a);
+        if (!(isfinite(f->center[0]) && isfinite(f->center[1]) && isfinite(f->center[2]) && isfinite(f->radius) &&
+              f->radius >= 0))
+            abort();
         check(a);
         asp_amg_destroy(a);
         return;

@@ -72,10 +72,14 @@ static void one(const uint8_t *data, size_t size)
         if (!d || d->level_count < 1 || d->level_count > 64 || !d->levels || !(d->mean_radius > 0) ||
             memchr(d->source, 0, sizeof d->source) == NULL)
             abort();
+        /* the recorded frame was validated: finite, radius >= 0 */
+        if (!(isfinite(d->frame.center[0]) && isfinite(d->frame.center[1]) && isfinite(d->frame.center[2]) &&
+              isfinite(d->frame.radius) && d->frame.radius >= 0))
+            abort();
         for (size_t i = 0; i < d->level_count; i++)
             check_level(d, i, size);
         asp_dps_summary rows[64];
-        asp_dps_summarize(d, rows);
+        asp_dps_summarize(d, rows, 64);
         for (size_t i = 0; i < d->level_count; i++)
             if (rows[i].name[0] == '\0' || rows[i].primitives != d->levels[i].prim_count)
                 abort();

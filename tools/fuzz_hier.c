@@ -3,8 +3,10 @@
  * arbitrary bytes must give a clean error or a consistent hierarchy, never a
  * crash, leak or huge allocation (STYLE.md section 11).
  *   ./fuzz_hier -max_total_time=300 -rss_limit_mb=2048 corpus
- * Seed the corpus with a small saved hierarchy (asp_hier_save).
+ * Seed the corpus with a small saved hierarchy (asp_hier_save; version 2, and a
+ * version-1 file for the old-header path).
  */
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,6 +20,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     int rc = asp_hier_load_memory(data, size, "fuzz.hier", NULL, &h, &err);
     if (rc == 0) {
         if (!h)
+            abort();
+        /* the recorded (or, version 1, root-sphere) frame is finite with radius >= 0 */
+        const asp_frame *f = asp_hier_frame(h);
+        if (!(isfinite(f->center[0]) && isfinite(f->center[1]) && isfinite(f->center[2]) && isfinite(f->radius) &&
+              f->radius >= 0))
             abort();
         /* every node's child and point ranges must lie inside the arrays */
         size_t n = asp_hier_node_count(h), points = asp_hier_point_count(h);

@@ -91,15 +91,51 @@ int asp_knn_all(const asp_kdtree *tree, size_t k, asp_index *idx, float *dist2,
  */
 void asp_eigen_sym3(const double m[6], double evals[3], double evecs[9]);
 
+/* ---- covariance (src/geom/covariance.c) ---- */
+
+/** Optional parameters of asp_covariance_sym3; the zero value means none. */
+typedef struct asp_covariance_desc {
+    /*
+     * also_count more point indices summed after idx's: e.g. the point itself
+     * after its kNN row, which does not list it.
+     */
+    const asp_index *also;
+    size_t also_count;
+    /*
+     * Per-point weights >= 0, indexed like positions (weights[p] for point p,
+     * so per-point attributes serve directly); NULL: every point weighs 1.
+     */
+    const float *weights;
+    /*
+     * Sum the outer products about this point instead of the (weighted) mean:
+     * the second moment about a given centre (a splat's bounding ellipse).
+     * centroid still reports the mean.
+     */
+    const double *center;
+} asp_covariance_desc;
+
 /**
- * Centroid and covariance (divided by n) of n points, accumulated in double
- * with the centroid subtracted first. The points are positions[idx[j]] for
- * j < n, or the first n points when idx is NULL; stride_bytes separates
- * consecutive points (12 for packed xyz). cov is {xx, xy, xz, yy, yz, zz},
- * ready for asp_eigen_sym3. n == 0 gives zeros. Thread-safe; no allocation.
+ * The one covariance sum of the library (PCA normals, the AMG classifier's
+ * first moment M1, point ellipses): centroid = weighted mean and cov = the 6
+ * unique entries {xx, xy, xz, yy, yz, zz} of sum_j w_j (p_j - m)(p_j - m)^T /
+ * sum_j w_j, ready for asp_eigen_sym3, with m the centroid (or desc->center).
+ * Accumulated in double in two passes, the mean first, so points far from the
+ * origin relative to their spread keep their digits (E[x^2] - E[x]^2 would
+ * cancel them). The points are positions[idx[j]] for j < n (the first n
+ * points when idx is NULL), then positions[desc->also[j]]; consecutive points
+ * are stride_bytes apart (12 for packed xyz). desc may be NULL. No points or a
+ * total weight of 0 give zeros. Never fails; thread-safe; no allocation.
  */
 void asp_covariance_sym3(const float *positions, size_t stride_bytes, const asp_index *idx, size_t n,
-                         double centroid[3], double cov[6]);
+                         const asp_covariance_desc *desc, double centroid[3], double cov[6]);
+
+/**
+ * asp_covariance_sym3 of double positions (stride_bytes apart, 24 for packed
+ * xyz), for points already held as double offsets (asp_amg_classify_points).
+ * The same sum, the same order, the same contract.
+ */
+void asp_covariance_sym3d(const double *positions, size_t stride_bytes, const asp_index *idx, size_t n,
+                          const asp_covariance_desc *desc, double centroid[3], double cov[6]);
 
 /* ---- normals (src/geom/normals.c) ---- */
 

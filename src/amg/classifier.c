@@ -21,24 +21,9 @@ int asp_amg_classify_points(const double *pts, size_t m, double epsilon, asp_amg
         alpha = 0.01;
     if (beta <= 0)
         beta = 100;
-    double m0[3] = {0, 0, 0};
-    for (size_t j = 0; j < m; j++)
-        for (int a = 0; a < 3; a++)
-            m0[a] += pts[3 * j + a];
-    if (m > 0)
-        for (int a = 0; a < 3; a++)
-            m0[a] /= (double)m;
-    /* double sums: point offsets are small relative to each other, float would lose the normal of dense scans */
-    double cov[6] = {0, 0, 0, 0, 0, 0};
-    for (size_t j = 0; j < m; j++) {
-        double dx = pts[3 * j] - m0[0], dy = pts[3 * j + 1] - m0[1], dz = pts[3 * j + 2] - m0[2];
-        cov[0] += dx * dx;
-        cov[1] += dx * dy;
-        cov[2] += dx * dz;
-        cov[3] += dy * dy;
-        cov[4] += dy * dz;
-        cov[5] += dz * dz;
-    }
+    /* M0 (the mean) and M1 (the covariance about it), summed in double by asp_covariance_sym3d */
+    double m0[3], cov[6];
+    asp_covariance_sym3d(pts, 3 * sizeof *pts, NULL, m, NULL, m0, cov);
     double ev[3], evec[9];
     asp_eigen_sym3(cov, ev, evec);
     if (m < 3 || !(ev[0] > 0) || !(epsilon > 0)) {

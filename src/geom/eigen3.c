@@ -1,6 +1,6 @@
 /*
- * Symmetric 3x3 eigen-decomposition by cyclic Jacobi rotations, and the
- * neighbourhood covariance it is applied to: the PCA behind local surface
+ * Symmetric 3x3 eigen-decomposition by cyclic Jacobi rotations, applied to the
+ * neighbourhood covariance (covariance.c): the PCA behind local surface
  * classification (journal 3.1, thesis 3.3.1) and normal estimation. Jacobi is
  * chosen over the closed-form cubic because it stays accurate for repeated and
  * near-repeated eigenvalues, which flat neighbourhoods produce all the time.
@@ -108,43 +108,4 @@ void asp_eigen_sym3(const double m[6], double evals[3], double evecs[9])
     for (int k = 0; k < 3; k++)
         for (int r = 0; r < 3; r++)
             evecs[3 * r + k] = cols[k][r];
-}
-
-void asp_covariance_sym3(const float *positions, size_t stride_bytes, const asp_index *idx, size_t n,
-                         double centroid[3], double cov[6])
-{
-    double c[3] = {0, 0, 0};
-    double s[6] = {0, 0, 0, 0, 0, 0};
-    const size_t stride = stride_bytes / sizeof(float);
-    if (n == 0) {
-        memcpy(centroid, c, sizeof c);
-        memcpy(cov, s, sizeof s);
-        return;
-    }
-    /*
-     * Two passes in double: subtracting the centroid before squaring avoids
-     * the catastrophic cancellation of E[x^2] - E[x]^2 for points far from
-     * the origin relative to their spread.
-     */
-    for (size_t j = 0; j < n; j++) {
-        const float *p = positions + (size_t)(idx ? idx[j] : j) * stride;
-        c[0] += p[0];
-        c[1] += p[1];
-        c[2] += p[2];
-    }
-    for (int a = 0; a < 3; a++)
-        c[a] /= (double)n;
-    for (size_t j = 0; j < n; j++) {
-        const float *p = positions + (size_t)(idx ? idx[j] : j) * stride;
-        double x = p[0] - c[0], y = p[1] - c[1], z = p[2] - c[2];
-        s[0] += x * x;
-        s[1] += x * y;
-        s[2] += x * z;
-        s[3] += y * y;
-        s[4] += y * z;
-        s[5] += z * z;
-    }
-    for (int i = 0; i < 6; i++)
-        cov[i] = s[i] / (double)n;
-    memcpy(centroid, c, sizeof c);
 }

@@ -12,29 +12,13 @@
 
 /* ---- PCA ---- */
 
-/* Normal of point i and its k neighbours; double accumulation as in asp_covariance_sym3. */
+/* Normal of point i and its k neighbours: PCA of their covariance (asp_covariance_sym3). */
 static void pca_normal(const float *pos, size_t stride, size_t i, const asp_index *row, size_t k, float out[3])
 {
-    double c[3] = {pos[i * stride], pos[i * stride + 1], pos[i * stride + 2]};
-    for (size_t j = 0; j < k; j++) {
-        const float *p = pos + (size_t)row[j] * stride;
-        c[0] += p[0];
-        c[1] += p[1];
-        c[2] += p[2];
-    }
-    for (int a = 0; a < 3; a++)
-        c[a] /= (double)(k + 1);
-    double m[6] = {0, 0, 0, 0, 0, 0};
-    for (size_t j = 0; j <= k; j++) {
-        const float *p = pos + (j == k ? i : (size_t)row[j]) * stride;
-        double x = p[0] - c[0], y = p[1] - c[1], z = p[2] - c[2];
-        m[0] += x * x;
-        m[1] += x * y;
-        m[2] += x * z;
-        m[3] += y * y;
-        m[4] += y * z;
-        m[5] += z * z;
-    }
+    const asp_index self = (asp_index)i;
+    double c[3], m[6];
+    asp_covariance_sym3(pos, stride * sizeof *pos, row, k, &(asp_covariance_desc){.also = &self, .also_count = 1}, c,
+                        m);
     double ev[3], V[9];
     asp_eigen_sym3(m, ev, V);
     /* column 2 belongs to the smallest eigenvalue; a zero matrix gives the identity, i.e. +z */

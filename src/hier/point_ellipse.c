@@ -23,26 +23,10 @@ typedef struct point_job {
 /* smallest-eigenvalue eigenvector of the neighbourhood of row i (the point and its neighbours) */
 static void pca_normal(const point_job *job, size_t i, float n[3])
 {
-    const float *pos = job->pos;
-    const asp_index *row = job->knn + i * job->k;
-    double mu[3] = {pos[3 * (size_t)i], pos[3 * (size_t)i + 1], pos[3 * (size_t)i + 2]};
-    for (size_t j = 0; j < job->k; j++)
-        for (int d = 0; d < 3; d++)
-            mu[d] += pos[3 * (size_t)row[j] + d];
-    double inv = 1.0 / (double)(job->k + 1);
-    for (int d = 0; d < 3; d++)
-        mu[d] *= inv;
-    double c[6] = {0};
-    for (size_t j = 0; j <= job->k; j++) {
-        size_t q = j == job->k ? i : row[j];
-        double x = pos[3 * q] - mu[0], y = pos[3 * q + 1] - mu[1], z = pos[3 * q + 2] - mu[2];
-        c[0] += x * x;
-        c[1] += x * y;
-        c[2] += x * z;
-        c[3] += y * y;
-        c[4] += y * z;
-        c[5] += z * z;
-    }
+    const asp_index self = (asp_index)i;
+    double mu[3], c[6];
+    asp_covariance_sym3(job->pos, 3 * sizeof(float), job->knn + i * job->k, job->k,
+                        &(asp_covariance_desc){.also = &self, .also_count = 1}, mu, c);
     double evals[3], evecs[9];
     asp_eigen_sym3(c, evals, evecs);
     for (int d = 0; d < 3; d++)
@@ -54,18 +38,10 @@ static void knn_ellipse(const point_job *job, size_t i, asp_hier_splat *s)
 {
     const float *pos = job->pos;
     const asp_index *row = job->knn + i * job->k;
-    double c[6] = {0};
-    for (size_t j = 0; j < job->k; j++) {
-        double x = (double)pos[3 * (size_t)row[j]] - s->center[0];
-        double y = (double)pos[3 * (size_t)row[j] + 1] - s->center[1];
-        double z = (double)pos[3 * (size_t)row[j] + 2] - s->center[2];
-        c[0] += x * x;
-        c[1] += x * y;
-        c[2] += x * z;
-        c[3] += y * y;
-        c[4] += y * z;
-        c[5] += z * z;
-    }
+    /* second moment of the neighbours about the point itself, not their mean: the ellipse is centred there */
+    const double at[3] = {s->center[0], s->center[1], s->center[2]};
+    double mu[3], c[6];
+    asp_covariance_sym3(pos, 3 * sizeof *pos, row, job->k, &(asp_covariance_desc){.center = at}, mu, c);
     asp__ellipse_axes(s, c, 0.0);
     double f = 0;
     for (size_t j = 0; j < job->k; j++) {

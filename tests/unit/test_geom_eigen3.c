@@ -1,8 +1,8 @@
 /*
  * Symmetric 3x3 eigen solver: diagonal matrices, random rotations of given
  * spectra (distinct, repeated, rank-1, zero), huge and tiny scales; checks
- * A v = l v, orthonormality and right-handedness to 1e-10 relative, and the
- * double-precision neighbourhood covariance.
+ * A v = l v, orthonormality and right-handedness to 1e-10 relative. The
+ * covariance it is applied to is tested in test_geom_covariance.c.
  */
 #include <stdint.h>
 
@@ -154,42 +154,5 @@ static void test_non_finite(void)
     CHECK(V[0] == 1 && V[4] == 1 && V[8] == 1);
 }
 
-/* Covariance of points far from the origin: a naive E[x^2]-E[x]^2 in float would lose it. */
-static void test_covariance(void)
-{
-    float p[4 * 4];
-    const float base = 1000.0f;
-    const float off[4][3] = {{0, 0, 0}, {0.5f, 0, 0}, {0, 0.25f, 0}, {0.5f, 0.25f, 0}};
-    for (int i = 0; i < 4; i++) {
-        p[4 * i] = base + off[i][0];
-        p[4 * i + 1] = -base + off[i][1];
-        p[4 * i + 2] = 2 * base;
-        p[4 * i + 3] = 123.0f; /* padding, skipped by the stride */
-    }
-    double c[3], cov[6];
-    asp_covariance_sym3(p, 16, NULL, 4, c, cov);
-    CHECK_NEAR(c[0], base + 0.25, 1e-9);
-    CHECK_NEAR(c[1], -base + 0.125, 1e-9);
-    CHECK_NEAR(c[2], 2 * base, 1e-9);
-    CHECK_NEAR(cov[0], 0.0625, 1e-12);
-    CHECK_NEAR(cov[3], 0.015625, 1e-12);
-    CHECK_NEAR(cov[1], 0.0, 1e-12);
-    CHECK_NEAR(cov[5], 0.0, 1e-12);
-    asp_index sel[2] = {3, 1};
-    asp_covariance_sym3(p, 16, sel, 2, c, cov);
-    CHECK_NEAR(c[0], base + 0.5, 1e-9);
-    CHECK_NEAR(c[1], -base + 0.125, 1e-9);
-    CHECK_NEAR(cov[3], 0.015625, 1e-12);
-    CHECK_NEAR(cov[0], 0.0, 1e-12);
-    double ev[3], V[9];
-    asp_covariance_sym3(p, 16, NULL, 4, c, cov);
-    asp_eigen_sym3(cov, ev, V);
-    /* smallest-variance direction of a z = const patch is +-z */
-    CHECK_NEAR(fabs(V[3 * 2 + 2]), 1.0, 1e-12);
-    asp_covariance_sym3(p, 16, NULL, 0, c, cov);
-    CHECK(c[0] == 0 && cov[0] == 0);
-}
-
 TEST_MAIN(TEST_CASE(test_diagonal), TEST_CASE(test_distinct), TEST_CASE(test_repeated),
-          TEST_CASE(test_rank1_and_zero), TEST_CASE(test_scales), TEST_CASE(test_non_finite),
-          TEST_CASE(test_covariance))
+          TEST_CASE(test_rank1_and_zero), TEST_CASE(test_scales), TEST_CASE(test_non_finite))
