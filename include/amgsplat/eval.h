@@ -40,6 +40,52 @@ int asp_image_silhouette_iou(const asp_image *a, const asp_image *b, const uint8
 /** Number of foreground pixels (same rule as asp_image_silhouette_iou). */
 size_t asp_image_foreground_count(const asp_image *img, const uint8_t background[3]);
 
+/** Where an image's silhouette came from (asp_image_silhouettes). */
+typedef enum asp_silhouette_source {
+    ASP_SILHOUETTE_ALPHA = 0,      /* the image has non-opaque alpha: foreground is alpha != 0 */
+    ASP_SILHOUETTE_BACKGROUND = 1, /* opaque image, background colour given by the caller */
+    ASP_SILHOUETTE_CORNERS = 2     /* opaque image, background colour detected from its four corners */
+} asp_silhouette_source;
+
+/** "alpha", "background" or "corners". */
+const char *asp_silhouette_source_name(asp_silhouette_source source);
+
+/** Options of asp_image_silhouettes; the zero value means defaults. */
+typedef struct asp_silhouette_desc {
+    /*
+     * RGB background for opaque images; NULL: detected from each opaque
+     * image's corners. Images with non-opaque alpha use their alpha either way.
+     */
+    const uint8_t *background;
+    /*
+     * A pixel is background when every channel is within this many levels of
+     * the background colour. 0: the default, 8 (antialiased edges and 8-bit
+     * sRGB rounding of a flat background stay background); negative: exact.
+     */
+    int tolerance;
+} asp_silhouette_desc;
+
+/** How one image's silhouette was taken. */
+typedef struct asp_silhouette_info {
+    asp_silhouette_source source;
+    uint8_t background[3]; /* the background colour used (not for ASP_SILHOUETTE_ALPHA) */
+    int corners_agreeing;  /* ASP_SILHOUETTE_CORNERS: how many of the 4 corners match it (1..4) */
+    size_t foreground;     /* foreground pixels */
+} asp_silhouette_info;
+
+/**
+ * Intersection over union of the silhouettes of two equally sized images, each
+ * taken from its alpha when it has any alpha below 255, else from the
+ * background colour: desc->background, or detected as the colour most of the
+ * four corner pixels share (ties go to the first of top-left, top-right,
+ * bottom-left, bottom-right). A white-background render thus gets its real
+ * silhouette, not the whole frame. Two empty silhouettes give 1. info (may be
+ * NULL) receives one entry per image. desc may be NULL. Returns 0 or ASP_EINVAL
+ * (sizes differ); *iou and info are unchanged on failure. Thread safe.
+ */
+int asp_image_silhouettes(const asp_image *a, const asp_image *b, const asp_silhouette_desc *desc, double *iou,
+                          asp_silhouette_info info[2], asp_error *err);
+
 /* ------------------------------------------------------------------------ */
 /* Line charts (src/eval/chart.c; no GL, thread safe)                       */
 /* ------------------------------------------------------------------------ */

@@ -116,6 +116,118 @@ static void test_iou(void)
     asp_image_release(&b);
 }
 
+/* Disc of radius 20 about (32, 32) and the square [30, 64)^2, pixel centres tested: the silhouettes below. */
+static int in_disc(int x, int y)
+{
+    double dx = x + 0.5 - 32, dy = y + 0.5 - 32;
+    return dx * dx + dy * dy <= 400;
+}
+
+static int in_square(int x, int y)
+{
+    return x >= 30 && y >= 30;
+}
+
+/* A shaded shape on a flat background; transparent: alpha 0 (and black) off the shape instead. */
+static void draw(asp_image *img, int (*inside)(int, int), const uint8_t bg[3], int transparent)
+{
+    asp_image_init(img, 64, 64, NULL);
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            uint8_t *p = img->pixels + 4 * (y * 64 + x);
+            if (inside(x, y)) {
+                p[0] = (uint8_t)(40 + 2 * x), p[1] = (uint8_t)(30 + y), p[2] = 90, p[3] = 255;
+            } else if (transparent) {
+                memset(p, 0, 4);
+            } else {
+                memcpy(p, bg, 3);
+                p[3] = 255;
+            }
+        }
+}
+
+/*
+ * Issue 12: with a white background imgdiff reported IoU 1.000 for two clearly
+ * different silhouettes (alpha is 255 everywhere). The silhouette of an opaque
+ * image now comes from its background colour, detected from the corners or
+ * given; alpha still rules when an image has any. Expected values by counting.
+ */
+static void test_silhouettes(void)
+{
+    size_t both = 0, any = 0, disc = 0, square = 0;
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            both += (size_t)(in_disc(x, y) && in_square(x, y));
+            any += (size_t)(in_disc(x, y) || in_square(x, y));
+            disc += (size_t)in_disc(x, y);
+            square += (size_t)in_square(x, y);
+        }
+    const double want = (double)both / (double)any;
+    CHECK(want > 0.1 && want < 0.5); /* clearly different shapes */
+    const uint8_t white[3] = {255, 255, 255}, black[3] = {0, 0, 0}, red[3] = {255, 0, 0};
+    asp_image a, b;
+    draw(&a, in_disc, white, 0);
+    draw(&b, in_square, white, 0);
+    /* an antialiased background pixel, off both shapes: within the default tolerance of white */
+    memset(a.pixels + 4 * (32 * 64 + 2), 250, 3);
+    double iou = 0, old = 0;
+    asp_silhouette_info info[2];
+    CHECK_OK(asp_image_silhouette_iou(&a, &b, NULL, &old, NULL), (asp_error *)NULL);
+    CHECK(old == 1); /* alpha alone sees two full frames: the bug */
+    CHECK_OK(asp_image_silhouettes(&a, &b, NULL, &iou, info, NULL), (asp_error *)NULL);
+    CHECK_NEAR(iou, want, 1e-12);
+    CHECK(info[0].source == ASP_SILHOUETTE_CORNERS && info[1].source == ASP_SILHOUETTE_CORNERS);
+    CHECK(memcmp(info[0].background, white, 3) == 0 && memcmp(info[1].background, white, 3) == 0);
+    /* the square covers the bottom-right corner: three of four corners still name the background */
+    CHECK(info[0].corners_agreeing == 4 && info[1].corners_agreeing == 3);
+    CHECK(info[0].foreground == disc && info[1].foreground == square);
+    CHECK(strcmp(asp_silhouette_source_name(info[0].source), "corners") == 0);
+    /* exact matching counts the antialiased pixel as silhouette: one more in a and in the union */
+    CHECK_OK(asp_image_silhouettes(&a, &b, &(asp_silhouette_desc){.tolerance = -1}, &iou, info, NULL),
+             (asp_error *)NULL);
+    CHECK_NEAR(iou, (double)both / (double)(any + 1), 1e-12);
+    CHECK(info[0].foreground == disc + 1);
+    /* a given background: the same result for the right colour; the wrong one makes everything silhouette */
+    CHECK_OK(asp_image_silhouettes(&a, &b, &(asp_silhouette_desc){.background = white}, &iou, info, NULL),
+             (asp_error *)NULL);
+    CHECK_NEAR(iou, want, 1e-12);
+    CHECK(info[0].source == ASP_SILHOUETTE_BACKGROUND && info[1].source == ASP_SILHOUETTE_BACKGROUND);
+    CHECK_OK(asp_image_silhouettes(&a, &b, &(asp_silhouette_desc){.background = red}, &iou, info, NULL),
+             (asp_error *)NULL);
+    CHECK_NEAR(iou, 1.0, 1e-12);
+    asp_image_release(&a);
+    asp_image_release(&b);
+    /* a black background is detected as such */
+    draw(&a, in_disc, black, 0);
+    draw(&b, in_square, black, 0);
+    CHECK_OK(asp_image_silhouettes(&a, &b, NULL, &iou, info, NULL), (asp_error *)NULL);
+    CHECK_NEAR(iou, want, 1e-12);
+    CHECK(memcmp(info[0].background, black, 3) == 0 && memcmp(info[1].background, black, 3) == 0);
+    asp_image_release(&b);
+    /* alpha rules when an image has it, even with a background given; the other image keeps its colour rule */
+    draw(&b, in_square, white, 1);
+    CHECK_OK(asp_image_silhouettes(&a, &b, &(asp_silhouette_desc){.background = black}, &iou, info, NULL),
+             (asp_error *)NULL);
+    CHECK_NEAR(iou, want, 1e-12);
+    CHECK(info[0].source == ASP_SILHOUETTE_BACKGROUND && info[1].source == ASP_SILHOUETTE_ALPHA);
+    CHECK(info[1].foreground == square);
+    asp_image_release(&a);
+    draw(&a, in_disc, white, 1);
+    CHECK_OK(asp_image_silhouettes(&a, &b, NULL, &iou, info, NULL), (asp_error *)NULL);
+    CHECK_NEAR(iou, want, 1e-12);
+    CHECK(info[0].source == ASP_SILHOUETTE_ALPHA && info[1].source == ASP_SILHOUETTE_ALPHA);
+    CHECK(strcmp(asp_silhouette_source_name(info[0].source), "alpha") == 0);
+    /* sizes differ: ASP_EINVAL, outputs unchanged */
+    asp_image c;
+    asp_image_init(&c, 32, 64, NULL);
+    iou = -5;
+    asp_error err = {0};
+    CHECK(asp_image_silhouettes(&a, &c, NULL, &iou, info, &err) == ASP_EINVAL && iou == -5);
+    asp_image_release(&c);
+    asp_image_release(&a);
+    asp_image_release(&b);
+}
+
 static void test_contact_sheet_and_png(void)
 {
     asp_image tiles[3], sheet, back;
@@ -153,4 +265,4 @@ static void test_contact_sheet_and_png(void)
 }
 
 TEST_MAIN(TEST_CASE(test_identical), TEST_CASE(test_psnr_known), TEST_CASE(test_ssim_properties), TEST_CASE(test_errors),
-          TEST_CASE(test_iou), TEST_CASE(test_contact_sheet_and_png))
+          TEST_CASE(test_iou), TEST_CASE(test_silhouettes), TEST_CASE(test_contact_sheet_and_png))
