@@ -10,9 +10,11 @@
 #include "util/banned.h"
 
 /*
- * The points come as float or double (f or d is NULL); one loop body for both
- * keeps the two entry points one sum. The type test is loop-invariant, so the
- * compiler hoists it out (bench/bench_knn: no slower than the hand loops).
+ * The points come as float or double (f or d is NULL). One loop body serves
+ * both entry points, specialised below by constant flags (float or double,
+ * weighted or not) so each hot loop is as tight as the hand-written ones it
+ * replaced (measured in docs/hier.md? no: in the issue-12 report; a generic
+ * loop with the tests inside was 1.8x slower).
  */
 typedef struct points {
     const float *f;
@@ -23,43 +25,83 @@ typedef struct points {
     const asp_covariance_desc *desc;
 } points;
 
-static inline size_t point_at(const points *p, size_t j)
-{
-    if (j < p->n)
-        return p->idx ? (size_t)p->idx[j] : j;
-    return (size_t)p->desc->also[j - p->n];
-}
+#if defined(__GNUC__)
+#define ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define ALWAYS_INLINE inline
+#endif
 
-static inline void fetch(const points *p, size_t q, double x[3])
+static ALWAYS_INLINE void fetch(const points *p, int dbl, size_t q, double x[3])
 {
-    if (p->f) {
-        const float *a = p->f + q * p->stride;
+    if (dbl) {
+        const double *a = p->d + q * p->stride;
         x[0] = a[0], x[1] = a[1], x[2] = a[2];
     } else {
-        const double *a = p->d + q * p->stride;
+        const float *a = p->f + q * p->stride;
         x[0] = a[0], x[1] = a[1], x[2] = a[2];
     }
 }
 
-static void sum(const points *p, double centroid[3], double cov[6])
+static ALWAYS_INLINE size_t listed(const points *p, size_t j)
 {
-    const size_t total = p->n + (p->desc ? p->desc->also_count : 0);
-    const float *w = p->desc ? p->desc->weights : NULL;
-    double c[3] = {0, 0, 0}, s[6] = {0, 0, 0, 0, 0, 0}, wsum = 0, x[3];
+    return p->idx ? (size_t)p->idx[j] : j;
+}
+
+static ALWAYS_INLINE void add_first(const points *p, int dbl, const float *w, size_t q, double c[3], double *wsum)
+{
+    double x[3];
+    fetch(p, dbl, q, x);
+    const double wj = w ? (double)w[q] : 1.0;
+    c[0] += wj * x[0];
+    c[1] += wj * x[1];
+    c[2] += wj * x[2];
+    *wsum += wj;
+}
+
+static ALWAYS_INLINE void add_second(const points *p, int dbl, const float *w, size_t q, const double m[3],
+                                     double s[6])
+{
+    double x[3];
+    fetch(p, dbl, q, x);
+    const double dx = x[0] - m[0], dy = x[1] - m[1], dz = x[2] - m[2];
+    const double wj = w ? (double)w[q] : 1.0; // times 1.0 is exact: unweighted sums are the plain ones
+    s[0] += wj * dx * dx;
+    s[1] += wj * dx * dy;
+    s[2] += wj * dx * dz;
+    s[3] += wj * dy * dy;
+    s[4] += wj * dy * dz;
+    s[5] += wj * dz * dz;
+}
+
+/* First pass: weighted sum of the positions of the listed points (idx's, then also's). */
+static ALWAYS_INLINE double sum_first(const points *p, int dbl, const float *w, double c[3])
+{
+    double wsum = 0;
+    for (size_t j = 0; j < p->n; j++)
+        add_first(p, dbl, w, listed(p, j), c, &wsum);
+    for (size_t j = 0; p->desc && j < p->desc->also_count; j++)
+        add_first(p, dbl, w, p->desc->also[j], c, &wsum);
+    return wsum;
+}
+
+/* Second pass: weighted outer products about m, in the same order. */
+static ALWAYS_INLINE void sum_second(const points *p, int dbl, const float *w, const double m[3], double s[6])
+{
+    for (size_t j = 0; j < p->n; j++)
+        add_second(p, dbl, w, listed(p, j), m, s);
+    for (size_t j = 0; p->desc && j < p->desc->also_count; j++)
+        add_second(p, dbl, w, p->desc->also[j], m, s);
+}
+
+static ALWAYS_INLINE void sum(const points *p, int dbl, const float *w, double centroid[3], double cov[6])
+{
+    double c[3] = {0, 0, 0}, s[6] = {0, 0, 0, 0, 0, 0};
     /*
      * Two passes in double: subtracting the mean before squaring avoids the
      * catastrophic cancellation of E[x^2] - E[x]^2 for points far from the
      * origin relative to their spread (dense scans in UTM-like coordinates).
      */
-    for (size_t j = 0; j < total; j++) {
-        const size_t q = point_at(p, j);
-        const double wj = w ? (double)w[q] : 1.0;
-        fetch(p, q, x);
-        c[0] += wj * x[0];
-        c[1] += wj * x[1];
-        c[2] += wj * x[2];
-        wsum += wj;
-    }
+    const double wsum = sum_first(p, dbl, w, c);
     if (!(wsum > 0)) {
         memset(centroid, 0, 3 * sizeof *centroid);
         memset(cov, 0, 6 * sizeof *cov);
@@ -67,19 +109,7 @@ static void sum(const points *p, double centroid[3], double cov[6])
     }
     for (int a = 0; a < 3; a++)
         c[a] /= wsum;
-    const double *m = p->desc && p->desc->center ? p->desc->center : c;
-    for (size_t j = 0; j < total; j++) {
-        const size_t q = point_at(p, j);
-        const double wj = w ? (double)w[q] : 1.0;
-        fetch(p, q, x);
-        const double dx = x[0] - m[0], dy = x[1] - m[1], dz = x[2] - m[2];
-        s[0] += wj * dx * dx;
-        s[1] += wj * dx * dy;
-        s[2] += wj * dx * dz;
-        s[3] += wj * dy * dy;
-        s[4] += wj * dy * dz;
-        s[5] += wj * dz * dz;
-    }
+    sum_second(p, dbl, w, p->desc && p->desc->center ? p->desc->center : c, s);
     for (int i = 0; i < 6; i++)
         cov[i] = s[i] / wsum;
     memcpy(centroid, c, sizeof c);
@@ -89,12 +119,18 @@ void asp_covariance_sym3(const float *positions, size_t stride_bytes, const asp_
                          const asp_covariance_desc *desc, double centroid[3], double cov[6])
 {
     const points p = {positions, NULL, stride_bytes / sizeof(float), idx, n, desc};
-    sum(&p, centroid, cov);
+    if (desc && desc->weights)
+        sum(&p, 0, desc->weights, centroid, cov);
+    else
+        sum(&p, 0, NULL, centroid, cov);
 }
 
 void asp_covariance_sym3d(const double *positions, size_t stride_bytes, const asp_index *idx, size_t n,
                           const asp_covariance_desc *desc, double centroid[3], double cov[6])
 {
     const points p = {NULL, positions, stride_bytes / sizeof(double), idx, n, desc};
-    sum(&p, centroid, cov);
+    if (desc && desc->weights)
+        sum(&p, 1, desc->weights, centroid, cov);
+    else
+        sum(&p, 1, NULL, centroid, cov);
 }
