@@ -274,16 +274,17 @@ int asp_amg_level_stats_all(const asp_amg *amg, double tau, const asp_context *c
 
 /**
  * Writes the decomposition to path (atomically) in the versioned binary .amg
- * format, version 2 (docs/cli/decompose.md): the whole point set (positions,
- * origin, normals, colours, radii, uvs, labels as present), tangent normals,
- * classifier and the prolongations, with a CRC-32. Returns 0, ASP_EIO,
+ * format, version 3 (docs/cli/decompose.md): the source frame (asp_amg_frame),
+ * the whole point set (positions, origin, normals, colours, radii, uvs, labels
+ * as present), tangent normals, classifier and the prolongations, with a CRC-32. Returns 0, ASP_EIO,
  * ASP_EUNSUPPORTED (big-endian host).
  */
 int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err);
 
 /**
- * Reads a .amg file (version 2; version 1 files, which lack the point
- * attributes, are refused with a message to decompose again): reads the whole
+ * Reads a .amg file (version 3; version 2, without the recorded frame, gets it
+ * computed from the points as decompose does; version 1 files, which lack the
+ * point attributes, are refused with a message to decompose again): reads the whole
  * file and parses it with asp_amg_load_memory. Returns 0, ASP_EINVAL (path or
  * out NULL), ASP_EIO (cannot open/read), ASP_EFORMAT (as
  * asp_amg_load_memory), ASP_EUNSUPPORTED (big-endian host), ASP_ENOMEM. The

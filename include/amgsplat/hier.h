@@ -138,7 +138,10 @@ const double *asp_hier_covariances(const asp_hier *hier);
 int asp_hier_save(const asp_hier *hier, const char *path, asp_error *err);
 
 /**
- * Loads a hierarchy written by asp_hier_save. A truncated, corrupted (checksum
+ * Loads a hierarchy written by asp_hier_save (version 2, with the recorded
+ * frame; a version-1 file is framed by its root bounding sphere) through the
+ * shared byte reader: a directory or FIFO is refused (ASP_EIO) before it is
+ * opened. A truncated, corrupted (checksum
  * mismatch) or structurally inconsistent file fails with ASP_EFORMAT naming the
  * file and the byte offset or element; a newer version with ASP_EUNSUPPORTED;
  * ASP_EIO if it cannot be read; ASP_ENOMEM. Sizes are checked against the

@@ -214,7 +214,8 @@ int asp_prim_neighbours(const asp_amg_csr *dom, double fraction, const asp_conte
 
 /**
  * Writes dps to path atomically in the versioned, little-endian .dps format
- * (docs/cli/build.md): parameters, source name and per level the primitives,
+ * (docs/cli/build.md, version 2): the source frame (dps->frame), parameters,
+ * source name and per level the primitives,
  * neighbour lists and atlases, with a CRC-32 trailer. Returns 0, ASP_EIO,
  * ASP_ENOMEM.
  */
@@ -222,7 +223,8 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err);
 
 /**
  * Reads a .dps file into a new asp_dps (*out): reads the whole file and parses
- * it with asp_dps_load_memory. Returns 0, ASP_EINVAL (path or out NULL),
+ * it with asp_dps_load_memory. A version-1 file (no recorded frame) loads
+ * with frame.radius 0 ("not known"). Returns 0, ASP_EINVAL (path or out NULL),
  * ASP_EIO (cannot open/read), ASP_ENOMEM, or ASP_EFORMAT as
  * asp_dps_load_memory. On failure *out is unchanged. Thread-safe.
  */
