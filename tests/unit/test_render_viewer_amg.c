@@ -10,7 +10,7 @@
 #include "amgsplat/amg.h"
 #include "amgsplat/sample.h"
 #include "harness.h"
-#include "render/viewer_internal.h"
+#include "viewer/internal.h"
 
 static size_t distinct_colours(const asp_cloud *c)
 {

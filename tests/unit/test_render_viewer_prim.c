@@ -12,7 +12,7 @@
 #include "amgsplat/prim.h"
 #include "amgsplat/sample.h"
 #include "harness.h"
-#include "render/viewer_internal.h"
+#include "viewer/internal.h"
 
 /* Saves the octahedron's decomposition to amg_path (unless NULL) and levels L-1, L to dps_path naming source. */
 static int write_files(const char *amg_path, const char *dps_path, const char *source, size_t *points)
