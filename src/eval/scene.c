@@ -181,8 +181,11 @@ static int load_dps(asp_scene *s, const asp_scene_desc *d, asp_error *err)
         return rc;
     if (s->dps->level_count == 0)
         return asp_error_set(err, ASP_EDEGENERATE, "cannot draw '%s': it holds no level", s->path);
-    if (d->level && asp_dps_level_parse(s->dps, d->level, &s->dps_level, err))
-        return rewrap(err, ASP_EINVAL, "cannot draw", s->path);
+    if (d->level && asp_dps_level_parse(s->dps, d->level, &s->dps_level, err)) {
+        char msg[sizeof err->msg];
+        snprintf(msg, sizeof msg, "%s", err ? err->msg : "");
+        return asp_error_set(err, ASP_EINVAL, "'%s' has %s", s->path, msg);
+    }
     s->frame = s->dps->frame;
     if (!(s->frame.radius > 0) && (rc = frame_dps_fallback(s, err)) != 0)
         return rc;
