@@ -78,7 +78,7 @@ static inline asp_gl_context *bench_gl_headless(const char *prog)
 {
     asp_gl_context *gl = NULL;
     asp_error err;
-    if (asp_gl_context_create_headless(NULL, &gl, &err)) {
+    if (asp_gl_context_create_headless(NULL, NULL, &gl, &err)) {
         fprintf(stderr, "%s: %s\n", prog, err.msg);
         return NULL;
     }

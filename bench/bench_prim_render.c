@@ -234,7 +234,7 @@ int main(int argc, char **argv)
             q = l;
     int rc = asp_prim_build(amg, NULL, levels, n, NULL, model, NULL, &dps, &err);
     if (!rc)
-        rc = asp_gl_context_create_headless(NULL, &gl, &err);
+        rc = asp_gl_context_create_headless(NULL, NULL, &gl, &err);
     if (rc) {
         fprintf(stderr, "bench_prim_render: %s\n", err.msg);
         asp_dps_destroy(dps);

@@ -19,7 +19,7 @@ static asp_gl_context *gl;
 static inline void setup(void)
 {
     asp_error err = {0, ""};
-    int rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.flags = ASP_GL_CONTEXT_DEBUG}, &gl, &err);
+    int rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.flags = ASP_GL_CONTEXT_DEBUG}, NULL, &gl, &err);
     CHECK_MSG(rc == 0, "no headless GL: %s", err.msg);
 }
 

@@ -18,5 +18,7 @@
 #include "amg.h"
 #include "prim.h"
 #include "render.h"
+#include "scene.h"
+#include "viewer.h"
 
 #endif

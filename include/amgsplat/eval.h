@@ -167,7 +167,6 @@ typedef struct asp_eval_desc {
                                   creases (asp_crease_clip_planes; skipped for a cloud without normals) and the
                                   primitives use it as asp_prim_render_options.crease_angle; 0 = 60; < 0 = no
                                   clipping anywhere (the seeds' renders) */
-    const asp_context *ctx;    /* threads, allocator, progress (stages "decompose", "primitives", "render") */
 } asp_eval_desc;
 
 /** Figures of one representation at one level and image size, over all views. */
@@ -209,8 +208,8 @@ typedef struct asp_eval_result {
  * Evaluates the representations of cloud against the reference: decomposes it
  * once (asp_amg_decompose), builds the domain primitives of every level with
  * at most max_primitives primitives (asp_prim_build), and renders from views
- * cameras (azimuth 360 i / views, elevation alternating, the bounding sphere
- * filling the view) at each size: the reference (the full point set as
+ * cameras (azimuth 360 i / views, elevation alternating, framed by the one
+ * camera framing of render and view: asp_camera_frame on asp_cloud_frame) at each size: the reference (the full point set as
  * blended, normalised splats at tolerance 0, seed 001 section 5), then every
  * representation at every level: the point hierarchy cut to the level's
  * primitive count (thesis Fig. 1.1: asp_renderer_set_budget, the splats of
@@ -222,9 +221,12 @@ typedef struct asp_eval_result {
  * Returns 0; ASP_EINVAL (bad option); the errors of asp_amg_decompose,
  * asp_prim_build, asp_gl_context_create_headless and the renderers;
  * ASP_EUNSUPPORTED (built without GL); ASP_ECANCELED; ASP_ENOMEM. *out is
- * unchanged on failure. Not thread safe against other hypre users.
+ * unchanged on failure. ctx (NULL = defaults) gives threads, allocator and
+ * progress (stages "decompose", "primitives", "render"). Not thread safe
+ * against other hypre users.
  */
-int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_result **out, asp_error *err);
+int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_context *ctx, asp_eval_result **out,
+                 asp_error *err);
 
 /** Frees a result; NULL is accepted. */
 void asp_eval_result_destroy(asp_eval_result *res);
@@ -273,7 +275,6 @@ typedef struct asp_eval_paper_desc {
     int skip_texture_methods;  /* 1: leave Table 5.4 out (it builds 12 variants of the level) */
     const asp_amg_desc *amg;
     const asp_prim_desc *prim;
-    const asp_context *ctx;
 } asp_eval_paper_desc;
 
 /** One level of journal Table 2 / thesis Table 5.2. */
@@ -314,8 +315,8 @@ typedef struct asp_eval_paper {
  * model filling a square view at azimuth 30, elevation 20. Errors as
  * asp_eval_run. *out is unchanged on failure.
  */
-int asp_eval_paper_run(const asp_cloud *cloud, const asp_eval_paper_desc *desc, asp_eval_paper **out,
-                       asp_error *err);
+int asp_eval_paper_run(const asp_cloud *cloud, const asp_eval_paper_desc *desc, const asp_context *ctx,
+                       asp_eval_paper **out, asp_error *err);
 
 /** Frees a result of asp_eval_paper_run; NULL is accepted. */
 void asp_eval_paper_destroy(asp_eval_paper *p);

@@ -45,7 +45,6 @@ typedef struct asp_gl_context_desc {
     unsigned flags;           /* asp_gl_context_flags */
     uint32_t width, height;   /* window only: client area in screen units; 0 = 1280 x 800 */
     const char *title;        /* window only: title; NULL = "amgsplat" */
-    const asp_context *ctx;   /* allocator for the context's CPU-side memory; NULL = C library */
 } asp_gl_context_desc;
 
 /**
@@ -55,14 +54,16 @@ typedef struct asp_gl_context_desc {
  * EGL devices that are not software (EGL_EXT_platform_device; the GPU on an
  * NVIDIA machine), Mesa's surfaceless platform (llvmpipe when there is no GPU),
  * software EGL devices, and eglGetDisplay(EGL_DEFAULT_DISPLAY); with
- * ASP_GL_CONTEXT_SOFTWARE, software displays come first. desc may be NULL.
+ * ASP_GL_CONTEXT_SOFTWARE, software displays come first. desc may be NULL;
+ * ctx (NULL = C library) is the allocator of the context's CPU-side memory.
  *
  * On success *out owns the context (free with asp_gl_context_destroy). On
  * failure returns ASP_EGL with "no OpenGL 4.5 context: ..." naming each display
  * tried and its EGL error (e.g. EGL_NOT_INITIALIZED), or ASP_ENOMEM; *out is
  * unchanged. Nothing process-wide is changed (no environment variables).
  */
-int asp_gl_context_create_headless(const asp_gl_context_desc *desc, asp_gl_context **out, asp_error *err);
+int asp_gl_context_create_headless(const asp_gl_context_desc *desc, const asp_context *ctx, asp_gl_context **out,
+                                  asp_error *err);
 
 /**
  * Creates a window of desc->width x desc->height with an OpenGL 4.5 core
@@ -72,7 +73,8 @@ int asp_gl_context_create_headless(const asp_gl_context_desc *desc, asp_gl_conte
  * ..." with GLFW's reason, e.g. no display) or ASP_ENOMEM; *out is unchanged on
  * failure.
  */
-int asp_gl_context_create_window(const asp_gl_context_desc *desc, asp_gl_context **out, asp_error *err);
+int asp_gl_context_create_window(const asp_gl_context_desc *desc, const asp_context *ctx, asp_gl_context **out,
+                                asp_error *err);
 
 /**
  * Destroys the context and every GL object it still owns (the offscreen
@@ -109,6 +111,22 @@ void asp_gl_context_poll_events(asp_gl_context *gl);
 int asp_gl_context_should_close(const asp_gl_context *gl);
 /** Window contexts: framebuffer size in pixels; 0 x 0 for headless contexts. */
 void asp_gl_context_framebuffer_size(const asp_gl_context *gl, uint32_t *width, uint32_t *height);
+
+/**
+ * Window contexts: the GLFWwindow * (as void *) for an application that
+ * handles the window's input itself (the viewer); NULL for headless contexts.
+ * Valid until asp_gl_context_destroy.
+ */
+void *asp_gl_context_window(const asp_gl_context *gl);
+
+/**
+ * Window contexts: reads what the last frame drew into the back buffer (call
+ * before asp_gl_context_swap_buffers) into *out (zeroed or released; RGBA8,
+ * rows top first, the stored sRGB bytes, alpha 255). Returns 0;
+ * ASP_EUNSUPPORTED (a headless context: use asp_render_to_image); ASP_EINVAL
+ * (a minimised window); ASP_EGL; ASP_ENOMEM. *out is unchanged on failure.
+ */
+int asp_gl_context_read_window(asp_gl_context *gl, asp_image *out, asp_error *err);
 
 /* ------------------------------------------------------------------------ */
 /* Orbit camera (no GL; thread safe)                                        */
@@ -318,104 +336,6 @@ float asp_render_default_radius(const asp_cloud *cloud);
 int asp_render_bounding_sphere(const asp_cloud *cloud, float center[3], float *radius, asp_error *err);
 
 /* ------------------------------------------------------------------------ */
-/* Interactive viewer (GLFW window; amgsplat view)                          */
-/* ------------------------------------------------------------------------ */
-
-/** Flags for asp_viewer_desc.flags; 0 is the default. */
-enum asp_viewer_flags {
-    ASP_VIEWER_UNLIT = 1 << 0,  /* start with lighting off (the l key toggles it) */
-    ASP_VIEWER_VERBOSE = 1 << 1 /* log frame time and primitive count about once a second */
-};
-
-/**
- * Receives one line of viewer output (no trailing newline): screenshot names,
- * key help, the current view, renderer switches that failed, and with
- * ASP_VIEWER_VERBOSE the frame statistics. Called on the viewer's thread.
- */
-typedef void (*asp_viewer_log_fn)(void *user, const char *line);
-
-/** Options of asp_viewer_run; the zero value means defaults. */
-typedef struct asp_viewer_desc {
-    uint32_t width, height;  /* window client area, 1..16384; 0 = 1280 x 800 */
-    const char *renderer;    /* first renderer: a name of asp_viewer_renderer_name; NULL = "disc" */
-    float tolerance;         /* screen tolerance tau in pixels for renderers that take one, >= 0 */
-    int set_view;            /* nonzero: start at azimuth/elevation/distance below, else 30, 20, fitted */
-    float azimuth;           /* degrees (asp_camera conventions) */
-    float elevation;         /* degrees, -90..90 */
-    float distance;          /* eye distance in bounding-sphere radii; 0 = the sphere fills the view */
-    asp_up_axis up;          /* world axis shown upright (asp_camera.up); the zero value is +y */
-    unsigned amg_color;      /* .amg input: first colour mode, an asp_amg_color_mode (amg.h; 0 = classifier),
-                                or 3 = the points' own colours (refused when they have none) */
-    const char *amg_level;   /* .amg input: first level, "L", "L-2" or an index; NULL = "L";
-                                .dps input: the level drawn, a name or index in the file; NULL = its finest */
-    unsigned prim_method;    /* .dps input: first blending method, an asp_prim_render_method (0 = normalized) */
-    float prim_alpha_ref;    /* .dps input: first alpha reference as asp_prim_render_options.alpha_ref
-                                (0 = 0.1, < 0 = exactly 0, at most 1) */
-    uint8_t background[4];   /* sRGB; alpha 0 = default opaque white */
-    size_t frames;           /* 0 = interactive until closed; N = scripted: draw N frames, then return */
-    const char *screenshot;  /* scripted: PNG written from the last frame's back buffer; may be NULL */
-    const char *keys;        /* keys pressed one per frame from the first frame on, e.g. "]]l" (see docs/cli/view.md) */
-    unsigned flags;          /* asp_viewer_flags */
-    asp_viewer_log_fn log;   /* NULL = lines are dropped */
-    void *log_user;
-    const asp_context *ctx;  /* allocator and threads for loading and colouring; NULL = defaults */
-} asp_viewer_desc;
-
-/** What a viewer run did, for scripts (amgsplat view --json). */
-typedef struct asp_viewer_stats {
-    size_t frames;            /* frames drawn */
-    double mean_frame_ms;     /* mean time of asp_render_frame with ASP_RENDER_WAIT (drawing finished) */
-    double last_frame_ms;
-    size_t count;             /* primitives the renderer drew in the last frame */
-    char renderer[32];        /* renderer of the last frame */
-    uint32_t width, height;   /* framebuffer size of the last frame, pixels */
-    size_t screenshots;       /* PNG files written (the s key and desc->screenshot) */
-    char gl_renderer[128];    /* GL_RENDERER of the window's context */
-    char title[320];          /* the window title at the end: file, renderer, count, frame time, tau, mode */
-} asp_viewer_stats;
-
-/**
- * Name of renderer kind i of the viewer ("disc", then "splat", "square", "prim" ...
- * in the order the 1..9 keys pick them), or NULL when i is past the end. Every
- * name listed is built in; a kind may still fail to draw a given input, in
- * which case the viewer skips it. Thread safe.
- */
-const char *asp_viewer_renderer_name(size_t i);
-
-/**
- * Checks desc without opening anything: sizes, renderer name, tolerance,
- * view, colour mode, .dps method and alpha reference, keys (each must be a viewer key), and that screenshot
- * ends in .png and is given only with frames > 0. Returns 0 or ASP_EINVAL
- * naming the bad value, e.g. "unknown renderer 'x' (expected disc, splat)".
- * Thread safe.
- */
-int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err);
-
-/**
- * Opens a window on path (.ply/.xyz/.pts/.txt points, an .amg decomposition
- * coloured by classifier or domains, or a .dps level of domain primitives
- * drawn by the "prim" renderer, its method, alpha reference, outlines and
- * domain colours on keys, its source points on p) and runs the viewer:
- * orbit with the left mouse button, zoom with the wheel or the right button,
- * pan with the middle button or shift + left; keys switch renderers, the
- * tolerance, lighting, colour mode and level (docs/cli/view.md lists them).
- * The window title shows the renderer, the primitive count and the frame time.
- * Interactive (desc->frames == 0) it returns when the window is closed or q /
- * Esc is pressed; scripted it draws desc->frames frames, pressing desc->keys
- * one per frame, writes desc->screenshot from the last frame and returns.
- *
- * The file is loaded before the window opens, so a bad file fails without a
- * display. Must run on the main thread; opens and closes GLFW itself (no other
- * window context may be alive). stats may be NULL; it is filled on success.
- * Returns 0; ASP_EINVAL (desc, as asp_viewer_desc_check; a level out of
- * range); the loader's ASP_EIO / ASP_EFORMAT / ASP_EUNSUPPORTED naming the
- * file; ASP_EDEGENERATE (nothing to frame); ASP_EGL (no display or no OpenGL
- * 4.5: "no OpenGL 4.5 window: ..."); ASP_EIO (screenshot not written);
- * ASP_ENOMEM. Everything is freed on return.
- */
-int asp_viewer_run(const char *path, const asp_viewer_desc *desc, asp_viewer_stats *stats, asp_error *err);
-
-/* ------------------------------------------------------------------------ */
 /* Splat and square renderers on the point hierarchy (hier.h)               */
 /* ------------------------------------------------------------------------ */
 
@@ -478,7 +398,6 @@ typedef struct asp_splat_renderer_desc {
     unsigned flags;          /* asp_splat_renderer_flags */
     uint8_t default_color[4]; /* sRGB colour when the cloud has no colours; all 0 = light grey 200,200,200 */
     asp_hier_desc hier;      /* hierarchy build options for asp_splat_renderer_create */
-    const asp_context *ctx;  /* threads and allocator of the hierarchy build; NULL = defaults */
     const float *clip_planes; /* 8 floats per INPUT point, by input point index (asp_crease_clip_planes in
                                  geom.h), NULL = none; only read during create */
 } asp_splat_renderer_desc;
@@ -487,7 +406,8 @@ typedef struct asp_splat_renderer_desc {
  * Builds the point hierarchy of cloud (asp_hier_build with desc->hier; the
  * renderer owns it) and returns a renderer drawing, per frame, the
  * view-dependent cut of the hierarchy for tau = desc->tolerance pixels (seed
- * 001 section 5.1 step 1) as elliptical splats blended with the kernel
+ * 001 section 5.1 step 1; ctx: threads and allocator of the build, NULL =
+ * defaults) as elliptical splats blended with the kernel
  * psi_E (see asp_splat_renderer_desc): pass 1 writes the depth of the splats
  * pushed back by epsilon along the eye rays, pass 2 adds (psi * colour, psi)
  * of every splat within epsilon of the front surface into a float target,
@@ -509,12 +429,11 @@ typedef struct asp_splat_renderer_desc {
  * ASP_ENOMEM. *out is unchanged on failure; free it with asp_renderer_destroy.
  */
 int asp_splat_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_splat_renderer_desc *desc,
-                              asp_renderer **out, asp_error *err);
+                              const asp_context *ctx, asp_renderer **out, asp_error *err);
 
 /**
  * Like asp_splat_renderer_create on an existing hierarchy, which the renderer
- * keeps a reference to: hier must outlive it (desc->hier and desc->ctx are
- * not used). Colours come from the splats when the hierarchy has them
+ * keeps a reference to: hier must outlive it (desc->hier is not used). Colours come from the splats when the hierarchy has them
  * (ASP_HIER_HAS_COLORS), else desc->default_color. desc->clip_planes, if
  * given, holds 8 * asp_hier_point_count(hier) floats indexed by the input
  * point index of the hierarchy's source cloud (asp_hier_splat.index).
@@ -531,7 +450,6 @@ typedef struct asp_square_renderer_desc {
     unsigned flags;          /* asp_splat_renderer_flags */
     uint8_t default_color[4]; /* as asp_splat_renderer_desc */
     asp_hier_desc hier;      /* hierarchy build options for asp_square_renderer_create */
-    const asp_context *ctx;  /* threads and allocator of the hierarchy build; NULL = defaults */
 } asp_square_renderer_desc;
 
 /**
@@ -544,7 +462,7 @@ typedef struct asp_square_renderer_desc {
  * work. Same frame, count and errors as asp_splat_renderer_create.
  */
 int asp_square_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_square_renderer_desc *desc,
-                               asp_renderer **out, asp_error *err);
+                               const asp_context *ctx, asp_renderer **out, asp_error *err);
 
 /** Like asp_square_renderer_create on an existing hierarchy, which must outlive the renderer. */
 int asp_square_renderer_create_hier(asp_gl_context *gl, const asp_hier *hier, const asp_square_renderer_desc *desc,
@@ -731,6 +649,73 @@ int asp_prim_level_bounding_sphere(const asp_dps_level *level, const double orig
  */
 const char *asp_prim_render_method_name(asp_prim_render_method m);
 int asp_prim_render_method_parse(const char *name, asp_prim_render_method *out, asp_error *err);
+
+/* ------------------------------------------------------------------------ */
+/* The renderer table (STYLE.md 9b: one table, owned by render)             */
+/* ------------------------------------------------------------------------ */
+
+/** What a renderer of the table can draw (asp_renderer_kind.inputs). */
+enum asp_render_input_bits {
+    ASP_RENDER_INPUT_POINTS = 1 << 0, /* asp_render_source.cloud or .hier: points, splats */
+    ASP_RENDER_INPUT_PRIMS = 1 << 1   /* asp_render_source.level: domain primitives */
+};
+
+/**
+ * What to draw, as a scene loader hands it over (asp_scene_render_source in
+ * scene.h). Everything is borrowed for the create call, except hier, which a
+ * hierarchy renderer keeps a reference to (it must outlive the renderer).
+ */
+typedef struct asp_render_source {
+    const asp_cloud *cloud;      /* points in the cloud's local frame; NULL when only hier or level is given */
+    const asp_hier *hier;        /* optional: a hierarchy of cloud (or alone, e.g. a .hier file): splat and
+                                    square draw it instead of building one; NULL = built from cloud */
+    const float *clip_planes;    /* 8 floats per point of cloud (asp_crease_clip_planes), NULL = none */
+    const asp_dps_level *level;  /* domain primitives (the prim renderer) */
+    double origin[3];            /* the frame the primitives are drawn in (asp_prim_renderer_desc.origin);
+                                    for points it is cloud->origin (or asp_hier_origin), which the point
+                                    renderers use by themselves */
+} asp_render_source;
+
+/** Options of every renderer of the table; the zero value means defaults. */
+typedef struct asp_renderer_options {
+    asp_disc_renderer_desc disc;     /* clip_planes comes from the source */
+    asp_splat_renderer_desc splat;   /* clip_planes comes from the source */
+    asp_square_renderer_desc square;
+    asp_prim_render_options prim;
+} asp_renderer_options;
+
+/** One row of the renderer table. */
+typedef struct asp_renderer_kind {
+    const char *name;   /* "disc", "splat", "square", "prim" */
+    const char *noun;   /* what asp_renderer_count counts: "points", "splats", "primitives" */
+    unsigned inputs;    /* asp_render_input_bits it draws */
+    int has_lod;        /* draws a cut of the point hierarchy: tau and budgets apply (asp_renderer_set_lod) */
+    /*
+     * Makes the renderer from src with the options of its kind; ctx (threads
+     * and allocator of a hierarchy build; NULL = defaults) is passed on.
+     * Errors of the renderer's own create function, or ASP_EUNSUPPORTED when
+     * src lacks what the kind draws ("renderer 'prim' draws domain
+     * primitives (a .dps input)").
+     */
+    int (*create)(asp_gl_context *gl, const asp_render_source *src, const asp_renderer_options *options,
+                  const asp_context *ctx, asp_renderer **out, asp_error *err);
+} asp_renderer_kind;
+
+/**
+ * Row i of the renderer table, in the order "disc", "splat", "square",
+ * "prim" (the viewer's 1..9 keys follow it), or NULL past the end. Thread safe.
+ */
+const asp_renderer_kind *asp_renderer_kind_at(size_t i);
+
+/** Number of rows of the renderer table. */
+size_t asp_renderer_kind_count(void);
+
+/**
+ * The row named name that draws at least one of inputs (asp_render_input_bits;
+ * 0 = any). Returns 0 and *out, or ASP_EINVAL "unknown renderer 'x' (expected
+ * disc, splat, square)" listing the names that draw inputs. Thread safe.
+ */
+int asp_renderer_kind_find(const char *name, unsigned inputs, const asp_renderer_kind **out, asp_error *err);
 
 #ifdef __cplusplus
 }

@@ -261,9 +261,8 @@ int cmd_bench_paper(int argc, char **argv, struct cli_env *env)
     asp_eval_paper *p = NULL;
     if (!rc) {
         asp_eval_paper_desc desc = {.sizes = sizes, .size_count = nsizes, .frames = frames,
-                                    .max_primitives = max_prims, .budget = budget, .skip_texture_methods = no_t54,
-                                    .ctx = &env->ctx};
-        rc = asp_eval_paper_run(cloud, &desc, &p, &err);
+                                    .max_primitives = max_prims, .budget = budget, .skip_texture_methods = no_t54};
+        rc = asp_eval_paper_run(cloud, &desc, &env->ctx, &p, &err);
     }
     asp_cloud_destroy(cloud);
     asp_amg_shutdown();

@@ -228,11 +228,10 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
     }
     asp_eval_desc desc = {.views = views, .sizes = sizes, .size_count = nsizes, .max_primitives = max_prims,
                           .frames = frames, .elevation = (float)elevation, .crease_angle = (float)crease,
-                          .ctx = &env->ctx,
                           .methods = methods_text ? methods : NULL, .method_count = nmethods};
     double t0 = asp_time_now();
     asp_eval_result *res = NULL;
-    rc = asp_eval_run(cloud, &desc, &res, &err);
+    rc = asp_eval_run(cloud, &desc, &env->ctx, &res, &err);
     if (!rc)
         rc = save_outputs(res, argv[0], dir, sizes, nsizes, &err);
     double seconds = asp_time_now() - t0;

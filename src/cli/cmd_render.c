@@ -3,8 +3,8 @@
  * (coloured by classifier or domains, journal Fig. 1b, 5) headlessly (EGL) to
  * PNG with discs, blended splats (Pajarola et al. 2003) or squares, or the
  * domain primitives of a .dps level (journal section 4, thesis chapter 4),
- * one view or a contact sheet. Glue only: loading, colouring, framing and drawing are
- * library calls (io.h, amg.h, render.h); see docs/cli/render.md.
+ * one view or a contact sheet. Glue only: loading, colouring and framing are the
+ * one scene loader (scene.h), drawing the one renderer table (render.h); see docs/cli/render.md.
  */
 #include <ctype.h>
 #include <math.h>
@@ -83,18 +83,6 @@ struct render_opts {
     const asp_context *ctx;
 };
 
-/* What was loaded from IN. Later inputs (.dps domain primitives) add their members here. */
-struct scene {
-    asp_cloud *cloud; /* owned: the file's points, or a copy of the .amg points with their colours */
-    asp_amg *amg;
-    asp_dps *dps;
-    const asp_dps_level *dps_level; /* the level drawn, inside dps */
-    float *clip_planes; /* point inputs with --crease-angle: 8 per point (asp_crease_clip_planes) */
-    float center[3];
-    float radius;
-    size_t count;
-};
-
 static int ends_with_ci(const char *path, const char *ext)
 {
     size_t n = strlen(path), m = strlen(ext);
@@ -106,124 +94,33 @@ static int ends_with_ci(const char *path, const char *ext)
     return 1;
 }
 
-/* The .amg points coloured by classifier or domains (or as the input had them, without --color-by). */
-static int load_amg(const char *path, const struct render_opts *o, const struct cli_env *env, struct scene *s,
-                    asp_error *err)
-{
-    int rc = asp_amg_load(path, &env->ctx, &s->amg, err);
-    if (!rc)
-        rc = asp_cloud_clone(asp_amg_cloud(s->amg), &s->cloud, err);
-    if (rc || !o->color_by)
-        return rc;
-    size_t level = 0;
-    if (o->color_mode != ASP_AMG_COLOR_CLASSIFIER)
-        rc = asp_amg_level_parse(s->amg, o->level ? o->level : "L-3", &level, err);
-    if (!rc)
-        rc = asp_cloud_add_attrs(s->cloud, ASP_ATTR_COLORS, err);
-    if (!rc)
-        rc = asp_amg_colorize(s->amg, o->color_mode, level, &env->ctx, s->cloud->colors, err);
-    return rc;
-}
-
-/* A .dps file and the level --level names (default: the finest level in the file). */
-static int load_dps(const char *path, const struct render_opts *o, const struct cli_env *env, struct scene *s,
-                    asp_error *err)
-{
-    int rc = asp_dps_load(path, &env->ctx, &s->dps, err);
-    if (rc)
-        return rc;
-    size_t pick = 0;
-    if (o->level && asp_dps_level_parse(s->dps, o->level, &pick, err)) {
-        char msg[sizeof err->msg];
-        snprintf(msg, sizeof msg, "%s", err->msg);
-        return asp_error_set(err, ASP_EINVAL, "'%s' has %s", path, msg);
-    }
-    s->dps_level = &s->dps->levels[pick];
-    s->count = s->dps_level->prim_count;
-    return asp_prim_level_bounding_sphere(s->dps_level, NULL, s->center, &s->radius, err);
-}
-
-static int load_scene(const char *path, const struct render_opts *o, const struct cli_env *env, struct scene *s,
+/* The loaded file as the one scene loader gives it (scene.h), and the picked row of the renderer table. */
+static int load_scene(const char *path, const struct render_opts *o, const struct cli_env *env, asp_scene *s,
                       asp_error *err)
 {
-    if (o->dps_input)
-        return load_dps(path, o, env, s, err);
-    int rc = o->amg_input ? load_amg(path, o, env, s, err) : asp_cloud_load(path, &env->ctx, &s->cloud, err);
-    if (rc)
-        return rc;
-    s->count = s->cloud->count;
-    if (o->point_crease > 0) {
-        // sharp features: each disc or splat cut by its neighbours' planes across a crease
-        s->clip_planes = asp_alloc(&env->ctx, 8 * s->cloud->count * sizeof(float));
-        if (!s->clip_planes)
-            return asp_error_set(err, ASP_ENOMEM, "out of memory for the crease planes of %zu points", s->count);
-        rc = asp_crease_clip_planes(s->cloud, &(asp_crease_desc){.angle_deg = (float)o->point_crease, .ctx = &env->ctx},
-                                    s->clip_planes, NULL, err);
-        if (rc) {
-            char msg[sizeof err->msg];
-            snprintf(msg, sizeof msg, "%s", err->msg);
-            return asp_error_set(err, rc, "cannot clip '%s' at creases: %s", path, msg);
-        }
+    asp_scene_desc d = {.level = o->level, .crease_angle = (float)o->point_crease};
+    if (o->amg_input && o->color_by) {
+        d.amg_color = (asp_scene_amg_color)(o->color_mode + 1);
+        if (o->color_mode != ASP_AMG_COLOR_CLASSIFIER && !o->level)
+            d.level = "L-3";
     }
-    return asp_render_bounding_sphere(s->cloud, s->center, &s->radius, err);
+    return asp_scene_load(path, &d, &env->ctx, s, err);
 }
 
-static void scene_release(const struct cli_env *env, struct scene *s)
+static void renderer_options(const struct render_opts *o, asp_renderer_options *r)
 {
-    asp_free(&env->ctx, s->clip_planes);
-    asp_cloud_destroy(s->cloud);
-    asp_amg_destroy(s->amg);
-    asp_dps_destroy(s->dps);
-    memset(s, 0, sizeof *s);
+    memset(r, 0, sizeof *r);
+    r->disc.radius_scale = (float)o->radius_scale;
+    r->splat = (asp_splat_renderer_desc){.kernel_a = o->kernel_abn[0], .kernel_b = o->kernel_abn[1],
+                                         .kernel_n = o->kernel_abn[2],
+                                         .epsilon = o->epsilon > 0 ? (float)o->epsilon : -1.0f, // 0 = no offset
+                                         .tolerance = (float)o->tolerance, .radius_scale = (float)o->radius_scale,
+                                         .lighting = o->light_mode,
+                                         .mode = o->opaque ? ASP_SPLAT_OPAQUE : ASP_SPLAT_BLEND};
+    r->square = (asp_square_renderer_desc){.point_size = (float)o->point_size, .tolerance = (float)o->tolerance,
+                                           .radius_scale = (float)o->radius_scale};
+    r->prim = o->prim;
 }
-
-static int make_disc(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
-                     asp_error *err)
-{
-    asp_disc_renderer_desc desc = {.radius_scale = (float)o->radius_scale, .clip_planes = s->clip_planes};
-    return asp_disc_renderer_create(gl, s->cloud, &desc, r, err);
-}
-
-static int make_splat(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
-                      asp_error *err)
-{
-    asp_splat_renderer_desc desc = {.kernel_a = o->kernel_abn[0], .kernel_b = o->kernel_abn[1],
-                                    .kernel_n = o->kernel_abn[2],
-                                    .epsilon = o->epsilon > 0 ? (float)o->epsilon : -1.0f, // 0 = no offset
-                                    .tolerance = (float)o->tolerance, .radius_scale = (float)o->radius_scale,
-                                    .lighting = o->light_mode, .mode = o->opaque ? ASP_SPLAT_OPAQUE : ASP_SPLAT_BLEND,
-                                    .clip_planes = s->clip_planes, .ctx = o->ctx};
-    return asp_splat_renderer_create(gl, s->cloud, &desc, r, err);
-}
-
-static int make_square(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
-                       asp_error *err)
-{
-    asp_square_renderer_desc desc = {.point_size = (float)o->point_size, .tolerance = (float)o->tolerance,
-                                     .radius_scale = (float)o->radius_scale, .ctx = o->ctx};
-    return asp_square_renderer_create(gl, s->cloud, &desc, r, err);
-}
-
-static int make_prim(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
-                     asp_error *err)
-{
-    asp_prim_renderer_desc desc = {.options = o->prim};
-    return asp_prim_renderer_create(gl, s->dps_level, &desc, r, err);
-}
-
-/* --renderer values; "prim" is what a .dps input gets */
-static const struct {
-    const char *name;
-    int (*make)(asp_gl_context *gl, const struct scene *s, const struct render_opts *o, asp_renderer **r,
-                asp_error *err);
-} renderers[] = {
-    {"disc", make_disc},
-    {"splat", make_splat},
-    {"square", make_square},
-    {"prim", make_prim},
-};
-enum { N_RENDERERS = sizeof renderers / sizeof renderers[0], PRIM_RENDERER = N_RENDERERS - 1 };
-
 
 static int parse_colour(struct cli_env *env, const char *s, uint8_t out[4])
 {
@@ -404,8 +301,8 @@ struct view_stats {
     double seconds; /* all asp_render_to_image calls, read-back included */
 };
 
-/* Renders the views into tiles[0 .. views-1]. */
-static int render_views(asp_gl_context *gl, asp_renderer *r, const struct scene *s, const struct render_opts *o,
+/* Renders the views into tiles[0 .. views-1], every one framed by the scene's frame (asp_camera_frame). */
+static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s, const struct render_opts *o,
                         const struct cli_env *env, asp_image *tiles, struct view_stats *vs, asp_error *err)
 {
     vs->min_count = SIZE_MAX;
@@ -419,11 +316,7 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const struct scene 
         cam.up = o->up_axis;
         cam.azimuth = (float)(o->az + 360.0 * (double)i / (double)o->views);
         cam.elevation = (float)(i % 2 ? -o->el : o->el);
-        asp_camera_fit(&cam, s->center, s->radius, (float)o->width / (float)o->height);
-        if (o->dist > 0) {
-            cam.distance = (float)(o->dist * s->radius);
-            asp_camera_clip_to_sphere(&cam, s->center, s->radius);
-        }
+        asp_camera_frame(&cam, &s->frame, s->origin, (float)o->width / (float)o->height, (float)o->dist);
         double t0 = asp_time_now();
         int rc = asp_render_to_image(gl, r, &cam, &desc, &tiles[i], err);
         if (rc)
@@ -439,19 +332,19 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const struct scene 
     return 0;
 }
 
-static void print_json(const struct render_opts *o, const struct scene *s, asp_gl_context *gl, const char *renderer,
+static void print_json(const struct render_opts *o, size_t count, const asp_scene *s, asp_gl_context *gl, const char *renderer,
                        const asp_image *img, const struct view_stats *vs, double seconds)
 {
     printf("{\"output\": ");
     cli_json_string(stdout, o->output);
     printf(", \"width\": %u, \"height\": %u, \"tile_width\": %u, \"tile_height\": %u, \"views\": %zu, "
            "\"points\": %zu, \"renderer\": ",
-           img->width, img->height, o->width, o->height, o->views, s->count);
+           img->width, img->height, o->width, o->height, o->views, count);
     cli_json_string(stdout, renderer);
     if (o->dps_input) {
         printf(", \"method\": ");
         cli_json_string(stdout, asp_prim_render_method_name(o->prim.method));
-        printf(", \"level\": %u", s->dps_level->level);
+        printf(", \"level\": %u", asp_scene_dps_level(s)->level);
     }
     printf(", \"gl_renderer\": ");
     cli_json_string(stdout, asp_gl_context_renderer(gl));
@@ -508,25 +401,29 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         return prc > 0 ? 0 : 2;
     if (npos != 1)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat render -h'", npos);
-    o.amg_input = ends_with_ci(argv[0], ".amg");
-    o.dps_input = ends_with_ci(argv[0], ".dps");
+    // the file's kind decides which options apply; a file that cannot be read fails in the loader
+    asp_file_type type = {ASP_FILE_UNKNOWN, "", 0};
+    if (asp_file_recognise(argv[0], &type, NULL) != 0)
+        asp_file_type_of_name(argv[0], &type, NULL);
+    o.amg_input = type.kind == ASP_FILE_AMG;
+    o.dps_input = type.kind == ASP_FILE_DPS;
     if (parse_options(env, &o))
         return 2;
     if (o.dps_input && o.renderer)
         return cli_usage_error(env, "--renderer is for point inputs; a .dps input is drawn with --method");
-    size_t kind = o.dps_input ? PRIM_RENDERER : N_RENDERERS;
-    for (size_t i = 0; !o.dps_input && i < PRIM_RENDERER; i++)
-        if (strcmp(renderers[i].name, o.renderer ? o.renderer : "disc") == 0)
-            kind = i;
-    if (kind == N_RENDERERS)
-        return cli_usage_error(env, "unknown renderer '%s' (expected disc, splat or square)", o.renderer);
-    if (o.budget && strcmp(renderers[kind].name, "splat") != 0 && strcmp(renderers[kind].name, "square") != 0)
+    asp_error err = {0, ""};
+    const asp_renderer_kind *kind = NULL;
+    // a .hier is a hierarchy without its points: the splats draw it
+    const char *dflt = type.kind == ASP_FILE_HIER ? "splat" : "disc";
+    if (asp_renderer_kind_find(o.dps_input ? "prim" : o.renderer ? o.renderer : dflt,
+                               o.dps_input ? ASP_RENDER_INPUT_PRIMS : ASP_RENDER_INPUT_POINTS, &kind, &err))
+        return cli_usage_error(env, "%s", err.msg);
+    if (o.budget && !kind->has_lod)
         return cli_usage_error(env, "--budget needs --renderer splat or square (the %s renderer draws every %s)",
-                               renderers[kind].name, o.dps_input ? "primitive" : "point");
+                               kind->name, o.dps_input ? "primitive" : "point");
 
     double t0 = asp_time_now();
-    asp_error err = {0, ""};
-    struct scene s;
+    asp_scene s;
     memset(&s, 0, sizeof s);
     asp_gl_context *gl = NULL;
     asp_renderer *r = NULL;
@@ -534,11 +431,16 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     asp_image sheet = {0, 0, NULL};
     memset(tiles, 0, sizeof tiles);
     struct view_stats vs = {0, 0, 0, 0};
+    asp_renderer_options ropts;
+    renderer_options(&o, &ropts);
+    asp_render_source src;
     int rc = load_scene(argv[0], &o, env, &s, &err);
     if (!rc)
-        rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.ctx = &env->ctx}, &gl, &err);
-    if (!rc)
-        rc = renderers[kind].make(gl, &s, &o, &r, &err);
+        rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err);
+    if (!rc) {
+        asp_scene_render_source(&s, &src);
+        rc = kind->create(gl, &src, &ropts, &env->ctx, &r, &err);
+    }
     if (!rc && o.budget)
         rc = asp_renderer_set_budget(r, o.budget, &err);
     if (!rc)
@@ -549,19 +451,20 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     if (!rc)
         rc = asp_image_save_png(result, o.output, &err);
     double seconds = asp_time_now() - t0;
+    size_t count = s.dps ? asp_scene_dps_level(&s)->prim_count : s.cloud ? s.cloud->count : 0;
     int status = 0;
     if (rc) {
         status = cli_fail(env, &err);
     } else {
         cli_progress_end(env);
         if (env->json)
-            print_json(&o, &s, gl, renderers[kind].name, result, &vs, seconds);
+            print_json(&o, count, &s, gl, kind->name, result, &vs, seconds);
         else
             cli_info(env,
                      "rendered %zu view%s of %zu %s (%s, %zu primitives in the last view, %.1f ms per view, %s) "
                      "to '%s' (%ux%u) in %.2f s\n",
-                     o.views, o.views > 1 ? "s" : "", s.count, o.dps_input ? "domain primitives" : "points",
-                     o.dps_input ? asp_prim_render_method_name(o.prim.method) : renderers[kind].name, vs.last_count,
+                     o.views, o.views > 1 ? "s" : "", count, o.dps_input ? "domain primitives" : "points",
+                     o.dps_input ? asp_prim_render_method_name(o.prim.method) : kind->name, vs.last_count,
                      1e3 * vs.seconds / (double)o.views, asp_gl_context_renderer(gl), o.output, result->width,
                      result->height, seconds);
     }
@@ -570,6 +473,6 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         asp_image_release(&tiles[i]);
     asp_renderer_destroy(r);
     asp_gl_context_destroy(gl);
-    scene_release(env, &s);
+    asp_scene_release(&s);
     return status;
 }

@@ -92,8 +92,10 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
         }
         d->background[3] = 255;
     }
-    size_t n = strlen(path);
-    int dps = n >= 4 && strcmp(path + n - 4, ".dps") == 0;
+    asp_file_type type = {ASP_FILE_UNKNOWN, "", 0};
+    if (asp_file_recognise(path, &type, NULL) != 0)
+        asp_file_type_of_name(path, &type, NULL);
+    int dps = type.kind == ASP_FILE_DPS;
     if ((o->method || o->alpha_ref != -1) && !dps)
         return cli_usage_error(env, "--method and --alpha-ref need a .dps input (amgsplat build makes one)");
     if (o->method) {
@@ -177,12 +179,12 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         return prc > 0 ? 0 : 2;
     if (npos != 1)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat view -h'", npos);
-    asp_viewer_desc desc = {.log = log_line, .log_user = env, .ctx = &env->ctx};
+    asp_viewer_desc desc = {.log = log_line, .log_user = env};
     if (parse_into(env, argv[0], &o, &desc))
         return 2;
     asp_error err = {0, ""};
     asp_viewer_stats stats;
-    if (asp_viewer_run(argv[0], &desc, &stats, &err))
+    if (asp_viewer_run(argv[0], &desc, &env->ctx, &stats, &err))
         return cli_fail(env, &err);
     if (env->json)
         print_json(argv[0], &desc, &stats);

@@ -73,7 +73,7 @@ struct eval_state {
     asp_hier *hier;
     asp_renderer *splat; /* the reference at tolerance 0; the point cut with a splat budget */
     asp_dps *dps;
-    float center[3], radius;
+    asp_frame frame;     /* the one camera framing (asp_camera_frame), in the cloud's local frame */
     float elevation;
     float crease_angle;  /* resolved: degrees, or -1 for none */
     size_t views, frames;
@@ -84,9 +84,15 @@ struct eval_state {
 static int create_prim(struct eval_state *s, const struct rep *rep, const asp_dps_level *lv, asp_renderer **out,
                        asp_error *err)
 {
-    asp_prim_renderer_desc pd = {.options = {.method = rep->method, .crease_angle = s->crease_angle}};
-    memcpy(pd.origin, s->cloud->origin, sizeof pd.origin);
-    return asp_prim_renderer_create(s->gl, lv, &pd, out, err);
+    // the one renderer table, in the cloud's frame so the camera is the points' camera
+    const asp_renderer_kind *prim = NULL;
+    int rc = asp_renderer_kind_find("prim", 0, &prim, err);
+    if (rc)
+        return rc;
+    asp_render_source src = {.level = lv};
+    memcpy(src.origin, s->cloud->origin, sizeof src.origin);
+    asp_renderer_options o = {.prim = {.method = rep->method, .crease_angle = s->crease_angle}};
+    return prim->create(s->gl, &src, &o, s->ctx, out, err);
 }
 
 static void view_camera(const struct eval_state *s, size_t v, asp_camera *cam)
@@ -94,7 +100,7 @@ static void view_camera(const struct eval_state *s, size_t v, asp_camera *cam)
     asp_camera_init(cam);
     cam->azimuth = (float)(360.0 * (double)v / (double)s->views);
     cam->elevation = v % 2 ? -s->elevation : s->elevation;
-    asp_camera_fit(cam, s->center, s->radius, 1.0f);
+    asp_camera_frame(cam, &s->frame, s->cloud->origin, 1.0f, 0.0f);
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -276,9 +282,9 @@ static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result
     if (!rc)
         rc = asp_hier_build(s->cloud, NULL, s->ctx, &s->hier, err);
     if (!rc)
-        rc = asp_render_bounding_sphere(s->cloud, s->center, &s->radius, err);
+        rc = asp_cloud_frame(s->cloud, &s->frame, err);
     if (!rc)
-        rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.ctx = s->ctx}, &s->gl, err);
+        rc = asp_gl_context_create_headless(NULL, s->ctx, &s->gl, err);
     // the reference's splats cut at creases, so its sharp edges are the surface's, not the sampling's
     float *planes = NULL;
     if (!rc && s->crease_angle > 0 && s->cloud->normals) {
@@ -290,8 +296,8 @@ static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result
                                         planes, &res->clipped_points, err);
     }
     if (!rc)
-        rc = asp_splat_renderer_create_hier(s->gl, s->hier, &(asp_splat_renderer_desc){.clip_planes = planes},
-                                            &s->splat, err);
+        rc = asp_renderer_kind_at(1)->create(s->gl, &(asp_render_source){.hier = s->hier, .clip_planes = planes},
+                                             NULL, s->ctx, &s->splat, err); // row 1: "splat"
     asp_free(s->ctx, planes);
     if (!rc)
         snprintf(res->gl_renderer, sizeof res->gl_renderer, "%s", asp_gl_context_renderer(s->gl));
@@ -361,7 +367,8 @@ static int make_sheet(struct eval_state *s, struct sheet *sh, asp_eval_result *r
     return asp_image_contact_sheet(sh->tiles, sh->rows * sh->cols, (uint32_t)sh->cols, &res->sheet, err);
 }
 
-int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_result **out, asp_error *err)
+int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_context *ctx, asp_eval_result **out,
+                 asp_error *err)
 {
     static const uint32_t default_sizes[3] = {128, 256, 512};
     asp_eval_desc d = desc ? *desc : (asp_eval_desc){0};
@@ -373,14 +380,14 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_res
     if (!cloud || cloud->count < 3)
         return asp_error_set(err, ASP_EDEGENERATE, "cannot evaluate a model of %zu points (at least 3)",
                              cloud ? cloud->count : (size_t)0);
-    struct eval_state s = {.ctx = d.ctx, .cloud = cloud, .elevation = d.elevation ? d.elevation : 20.0f,
+    struct eval_state s = {.ctx = ctx, .cloud = cloud, .elevation = d.elevation ? d.elevation : 20.0f,
                            .views = d.views ? d.views : 16, .frames = d.frames ? d.frames : 5,
                            .crease_angle = d.crease_angle == 0 ? 60.0f : d.crease_angle < 0 ? -1.0f : d.crease_angle};
-    asp_eval_result *res = asp_calloc(d.ctx, 1, sizeof *res);
+    asp_eval_result *res = asp_calloc(ctx, 1, sizeof *res);
     if (!res)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the evaluation result");
-    if (d.ctx)
-        res->ctx = *d.ctx;
+    if (ctx)
+        res->ctx = *ctx;
     res->views = s.views;
     res->points = cloud->count;
     res->crease_angle = s.crease_angle;
@@ -400,12 +407,12 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_res
     if (!rc) {
         res->level_count = s.dps->level_count;
         res->row_count = nsizes * (1 + s.nreps * s.dps->level_count);
-        res->rows = asp_calloc(d.ctx, res->row_count, sizeof *res->rows);
-        res->ssim = asp_calloc(d.ctx, res->row_count * s.views, sizeof *res->ssim);
-        res->psnr = asp_calloc(d.ctx, res->row_count * s.views, sizeof *res->psnr);
+        res->rows = asp_calloc(ctx, res->row_count, sizeof *res->rows);
+        res->ssim = asp_calloc(ctx, res->row_count * s.views, sizeof *res->ssim);
+        res->psnr = asp_calloc(ctx, res->row_count * s.views, sizeof *res->psnr);
         sh.cols = 1 + s.dps->level_count;
         sh.rows = s.nreps;
-        sh.tiles = asp_calloc(d.ctx, sh.cols * sh.rows, sizeof *sh.tiles);
+        sh.tiles = asp_calloc(ctx, sh.cols * sh.rows, sizeof *sh.tiles);
         if (!res->rows || !res->ssim || !res->psnr || !sh.tiles)
             rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu result rows", res->row_count);
     }
@@ -428,7 +435,7 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_res
     if (sh.tiles) {
         for (size_t i = 0; i < sh.rows * sh.cols; i++)
             asp_image_release(&sh.tiles[i]);
-        asp_free(d.ctx, sh.tiles);
+        asp_free(ctx, sh.tiles);
     }
     state_release(&s);
     if (rc) {

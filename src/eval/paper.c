@@ -37,14 +37,14 @@ static int cmp_double(const void *a, const void *b)
  * Frames per second of r: median of frames finished frames, the model filling
  * a square view of side size (journal Table 2 measures at 128, 256 and 512).
  */
-static int fps(asp_gl_context *gl, asp_renderer *r, const float center[3], float radius, uint32_t size,
+static int fps(asp_gl_context *gl, asp_renderer *r, const asp_frame *frame, const double origin[3], uint32_t size,
                size_t frames, double *out, asp_error *err)
 {
     asp_camera cam;
     asp_camera_init(&cam);
     cam.azimuth = 30;
     cam.elevation = 20;
-    asp_camera_fit(&cam, center, radius, 1.0f);
+    asp_camera_frame(&cam, frame, origin, 1.0f, 0.0f); // the one framing of render, view and eval
     asp_render_desc rd = {.width = size, .height = size, .flags = ASP_RENDER_WAIT};
     double t[MAX_FRAMES];
     int rc = asp_render_frame(gl, r, &cam, &rd, err); // warm-up: uploads, shader compilation
@@ -66,17 +66,17 @@ static int frame_rates(const asp_cloud *cloud, const asp_dps *dps, asp_eval_pape
 {
     asp_gl_context *gl = NULL;
     asp_renderer *r = NULL;
-    float center[3], radius;
-    int rc = asp_render_bounding_sphere(cloud, center, &radius, err);
+    asp_frame frame;
+    int rc = asp_cloud_frame(cloud, &frame, err);
     if (!rc)
-        rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.ctx = ctx}, &gl, err);
+        rc = asp_gl_context_create_headless(NULL, ctx, &gl, err);
     if (!rc) {
         snprintf(p->gl_renderer, sizeof p->gl_renderer, "%s", asp_gl_context_renderer(gl));
         // thesis 5.2.3: the points drawn as splats, the full set (QSplat at its finest)
-        rc = asp_splat_renderer_create(gl, cloud, &(asp_splat_renderer_desc){.ctx = ctx}, &r, err);
+        rc = asp_splat_renderer_create(gl, cloud, NULL, ctx, &r, err);
     }
     for (size_t i = 0; !rc && i < p->size_count; i++)
-        rc = fps(gl, r, center, radius, p->sizes[i], frames, &p->fps_points[i], err);
+        rc = fps(gl, r, &frame, cloud->origin, p->sizes[i], frames, &p->fps_points[i], err);
     asp_renderer_destroy(r);
     r = NULL;
     // thesis 5.2.3 measures "the overlapping domains method"
@@ -87,7 +87,7 @@ static int frame_rates(const asp_cloud *cloud, const asp_dps *dps, asp_eval_pape
         memcpy(pd.origin, cloud->origin, sizeof pd.origin);
         rc = asp_prim_renderer_create(gl, lv, &pd, &r, err);
         for (size_t i = 0; !rc && i < p->size_count; i++)
-            rc = fps(gl, r, center, radius, p->sizes[i], frames, &p->levels[l].fps[i], err);
+            rc = fps(gl, r, &frame, cloud->origin, p->sizes[i], frames, &p->levels[l].fps[i], err);
         asp_renderer_destroy(r);
         r = NULL;
     }
@@ -142,14 +142,14 @@ static int check_desc(const asp_eval_paper_desc *d, asp_error *err)
     return 0;
 }
 
-int asp_eval_paper_run(const asp_cloud *cloud, const asp_eval_paper_desc *desc, asp_eval_paper **out,
+int asp_eval_paper_run(const asp_cloud *cloud, const asp_eval_paper_desc *desc, const asp_context *ctx,
+                       asp_eval_paper **out,
                        asp_error *err)
 {
     asp_eval_paper_desc d = desc ? *desc : (asp_eval_paper_desc){0};
     int rc = check_desc(&d, err);
     if (rc)
         return rc;
-    const asp_context *ctx = d.ctx;
     asp_eval_paper *p = asp_calloc(ctx, 1, sizeof *p);
     if (!p)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the tables");

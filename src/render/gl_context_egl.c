@@ -185,16 +185,17 @@ static int try_surfaceless(asp_gl_context *gl, const char *client_ext, unsigned 
     return try_display(gl, dpy, "egl-surfaceless", flags, t);
 }
 
-int asp_gl_context_create_headless(const asp_gl_context_desc *desc, asp_gl_context **out, asp_error *err)
+int asp_gl_context_create_headless(const asp_gl_context_desc *desc, const asp_context *ctx, asp_gl_context **out,
+                                  asp_error *err)
 {
     static const asp_gl_context_desc zero_desc;
     if (!desc)
         desc = &zero_desc;
-    asp_gl_context *gl = asp_calloc(desc->ctx, 1, sizeof *gl);
+    asp_gl_context *gl = asp_calloc(ctx, 1, sizeof *gl);
     if (!gl)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for a GL context");
-    if (desc->ctx)
-        gl->actx = *desc->ctx;
+    if (ctx)
+        gl->actx = *ctx;
     gl->backend = ASP__GL_EGL;
 
     /* Client extensions need EGL 1.5 or EGL_EXT_client_extensions; NULL means neither. */
@@ -216,7 +217,7 @@ int asp_gl_context_create_headless(const asp_gl_context_desc *desc, asp_gl_conte
              try_devices(gl, client, 1, flags, &t) ||
              try_display(gl, eglGetDisplay(EGL_DEFAULT_DISPLAY), "egl-default", flags, &t);
     if (!ok) {
-        asp_free(desc->ctx, gl);
+        asp_free(ctx, gl);
         return asp_error_set(err, ASP_EGL, "no OpenGL 4.5 context: %s", t.text);
     }
     *out = gl;

@@ -4,6 +4,7 @@
  * interactive viewer. GLFW state is process-wide: one window at a time.
  */
 #include <stdio.h>
+#include <string.h>
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -18,7 +19,8 @@ static const char *glfw_reason(void)
     return msg ? msg : "unknown GLFW error";
 }
 
-int asp_gl_context_create_window(const asp_gl_context_desc *desc, asp_gl_context **out, asp_error *err)
+int asp_gl_context_create_window(const asp_gl_context_desc *desc, const asp_context *ctx, asp_gl_context **out,
+                                  asp_error *err)
 {
     static const asp_gl_context_desc zero_desc;
     if (!desc)
@@ -26,15 +28,15 @@ int asp_gl_context_create_window(const asp_gl_context_desc *desc, asp_gl_context
     int w = desc->width ? (int)desc->width : 1280, h = desc->height ? (int)desc->height : 800;
     if (desc->width > 16384 || desc->height > 16384)
         return asp_error_set(err, ASP_EINVAL, "window size %ux%u is outside 1..16384", desc->width, desc->height);
-    asp_gl_context *gl = asp_calloc(desc->ctx, 1, sizeof *gl);
+    asp_gl_context *gl = asp_calloc(ctx, 1, sizeof *gl);
     if (!gl)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for a GL context");
-    if (desc->ctx)
-        gl->actx = *desc->ctx;
+    if (ctx)
+        gl->actx = *ctx;
     gl->backend = ASP__GL_GLFW;
     if (!glfwInit()) {
         asp_error_set(err, ASP_EGL, "no OpenGL 4.5 window: %s", glfw_reason());
-        asp_free(desc->ctx, gl);
+        asp_free(ctx, gl);
         return ASP_EGL;
     }
     glfwDefaultWindowHints();
@@ -48,7 +50,7 @@ int asp_gl_context_create_window(const asp_gl_context_desc *desc, asp_gl_context
     if (!win) {
         asp_error_set(err, ASP_EGL, "no OpenGL 4.5 window: %s", glfw_reason());
         glfwTerminate();
-        asp_free(desc->ctx, gl);
+        asp_free(ctx, gl);
         return ASP_EGL;
     }
     glfwMakeContextCurrent(win);
@@ -58,9 +60,10 @@ int asp_gl_context_create_window(const asp_gl_context_desc *desc, asp_gl_context
     if (rc) {
         glfwDestroyWindow(win);
         glfwTerminate();
-        asp_free(desc->ctx, gl);
+        asp_free(ctx, gl);
         return rc;
     }
+    asp__gl_pin_driver();
     *out = gl;
     return 0;
 }
@@ -103,4 +106,58 @@ void asp_gl_context_framebuffer_size(const asp_gl_context *gl, uint32_t *width, 
         glfwGetFramebufferSize((GLFWwindow *)gl->window, &w, &h);
     *width = w > 0 ? (uint32_t)w : 0;
     *height = h > 0 ? (uint32_t)h : 0;
+}
+
+void *asp_gl_context_window(const asp_gl_context *gl)
+{
+    return gl->backend == ASP__GL_GLFW ? gl->window : NULL;
+}
+
+int asp_gl_context_read_window(asp_gl_context *gl, asp_image *out, asp_error *err)
+{
+    if (gl->backend != ASP__GL_GLFW)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read a window back: the context is headless");
+    uint32_t w = 0, h = 0;
+    asp_gl_context_framebuffer_size(gl, &w, &h);
+    if (w == 0 || h == 0)
+        return asp_error_set(err, ASP_EINVAL, "cannot read a window back: it has no pixels (minimised)");
+    int rc = asp__gl_ensure_current(gl, err);
+    if (rc)
+        return rc;
+    asp_image img;
+    rc = asp_image_init(&img, w, h, err);
+    if (rc)
+        return rc;
+    size_t stride = 4 * (size_t)w;
+    uint8_t *row = asp_alloc(&gl->actx, stride);
+    if (!row) {
+        asp_image_release(&img);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for a %ux%u window read-back", w, h);
+    }
+    asp__gl_clear_errors(gl);
+    // the bytes as stored: already sRGB-encoded when the window is sRGB-capable
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    glReadBuffer(GL_BACK);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadnPixels(0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_UNSIGNED_BYTE, (GLsizei)(stride * h), img.pixels);
+    rc = asp__gl_check(gl, "read the window back", err);
+    if (!rc) {
+        for (uint32_t y = 0; y < h / 2; y++) { // GL rows run bottom-up, asp_image top-down
+            uint8_t *a = img.pixels + y * stride, *b = img.pixels + (h - 1 - y) * stride;
+            memcpy(row, a, stride);
+            memcpy(a, b, stride);
+            memcpy(b, row, stride);
+        }
+        // a window is opaque whatever alpha its visual stores (or lacks)
+        for (size_t i = 0; i < (size_t)w * h; i++)
+            img.pixels[4 * i + 3] = 255;
+    }
+    asp_free(&gl->actx, row);
+    if (rc) {
+        asp_image_release(&img);
+        return rc;
+    }
+    *out = img;
+    return 0;
 }

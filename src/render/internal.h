@@ -100,4 +100,11 @@ float asp__srgb_to_linear(uint8_t v);
 /* Linear light in 0..1 to sRGB 8-bit, rounded to nearest. */
 uint8_t asp__linear_to_srgb(float v);
 
+/*
+ * Sanitizer builds: keeps the current context's GL driver loaded until exit
+ * (gl_driver_pin.c explains why); called after a window context is made. A
+ * no-op otherwise.
+ */
+void asp__gl_pin_driver(void);
+
 #endif

@@ -88,7 +88,7 @@ typedef struct asp__lod_desc {
 } asp__lod_desc;
 
 /* The shared options of d, an asp_splat_renderer_desc or asp_square_renderer_desc (the fields have the same names). */
-#define ASP__LOD_DESC(d) (&(const asp__lod_desc){&(d)->hier, (d)->ctx, (d)->tolerance, (d)->flags, (d)->default_color})
+#define ASP__LOD_DESC(d, c) (&(const asp__lod_desc){&(d)->hier, (c), (d)->tolerance, (d)->flags, (d)->default_color})
 
 /*
  * Allocates a zeroed renderer of size bytes (a struct that starts with

@@ -530,7 +530,7 @@ static int upload_clips(splat_renderer *s, const float *planes, asp_error *err)
     return asp__gl_check(gl, "upload the splat clip planes", err);
 }
 
-static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hier, const asp_splat_renderer_desc *desc,
+static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hier, const asp_context *ctx, const asp_splat_renderer_desc *desc,
                   asp_renderer **out, asp_error *err)
 {
     static const asp_splat_renderer_desc zero_desc;
@@ -545,7 +545,7 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     if (rc)
         return rc;
     asp__lod_renderer *lr;
-    rc = asp__lod_renderer_create(gl, sizeof(splat_renderer), &asp__splat_vtable, cloud, hier, ASP__LOD_DESC(desc),
+    rc = asp__lod_renderer_create(gl, sizeof(splat_renderer), &asp__splat_vtable, cloud, hier, ASP__LOD_DESC(desc, ctx),
                                   &lr, err);
     if (rc)
         return rc;
@@ -581,13 +581,13 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
 }
 
 int asp_splat_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_splat_renderer_desc *desc,
-                              asp_renderer **out, asp_error *err)
+                              const asp_context *ctx,                               asp_renderer **out, asp_error *err)
 {
-    return create(gl, cloud, NULL, desc, out, err);
+    return create(gl, cloud, NULL, ctx, desc, out, err);
 }
 
 int asp_splat_renderer_create_hier(asp_gl_context *gl, const asp_hier *hier, const asp_splat_renderer_desc *desc,
                                    asp_renderer **out, asp_error *err)
 {
-    return create(gl, NULL, hier, desc, out, err);
+    return create(gl, NULL, hier, NULL, desc, out, err);
 }

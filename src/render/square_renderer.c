@@ -102,7 +102,7 @@ static int check_desc(const asp_square_renderer_desc *d, asp_error *err)
     return rc;
 }
 
-static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hier,
+static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hier, const asp_context *ctx,
                   const asp_square_renderer_desc *desc, asp_renderer **out, asp_error *err)
 {
     static const asp_square_renderer_desc zero_desc;
@@ -120,7 +120,7 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
         return asp_error_set(err, ASP_EINVAL, "square size %g pixels exceeds this GL context's limit of %g",
                              (double)desc->point_size, (double)range[1]);
     asp__lod_renderer *lr;
-    rc = asp__lod_renderer_create(gl, sizeof(square_renderer), &asp__square_vtable, cloud, hier, ASP__LOD_DESC(desc),
+    rc = asp__lod_renderer_create(gl, sizeof(square_renderer), &asp__square_vtable, cloud, hier, ASP__LOD_DESC(desc, ctx),
                                   &lr, err);
     if (rc)
         return rc;
@@ -149,13 +149,13 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
 }
 
 int asp_square_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const asp_square_renderer_desc *desc,
-                               asp_renderer **out, asp_error *err)
+                              const asp_context *ctx,                                asp_renderer **out, asp_error *err)
 {
-    return create(gl, cloud, NULL, desc, out, err);
+    return create(gl, cloud, NULL, ctx, desc, out, err);
 }
 
 int asp_square_renderer_create_hier(asp_gl_context *gl, const asp_hier *hier, const asp_square_renderer_desc *desc,
                                     asp_renderer **out, asp_error *err)
 {
-    return create(gl, NULL, hier, desc, out, err);
+    return create(gl, NULL, hier, NULL, desc, out, err);
 }

@@ -38,7 +38,7 @@ static asp_renderer *make_renderer(int kind, const asp_cloud *c, const float *pl
         CHECK_OK(asp_disc_renderer_create(gl, c, &(asp_disc_renderer_desc){.clip_planes = planes}, &r, &err),
                  ep(&err));
     else
-        CHECK_OK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.clip_planes = planes}, &r, &err),
+        CHECK_OK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.clip_planes = planes}, NULL, &r, &err),
                  ep(&err));
     return r;
 }
@@ -424,7 +424,7 @@ static void test_bad_planes(void)
     CHECK(asp_disc_renderer_create(gl, c, &(asp_disc_renderer_desc){.clip_planes = planes}, &r, &err) ==
           ASP_EFORMAT);
     CHECK_MSG(strstr(err.msg, "point 123") != NULL, "message '%s'", err.msg);
-    CHECK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.clip_planes = planes}, &r, &err) ==
+    CHECK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.clip_planes = planes}, NULL, &r, &err) ==
           ASP_EFORMAT);
     CHECK_MSG(strstr(err.msg, "point 123") != NULL, "message '%s'", err.msg);
     CHECK(r == NULL);

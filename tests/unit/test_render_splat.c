@@ -127,7 +127,7 @@ static void test_checker_no_holes(void)
     for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
         asp_renderer *r = NULL;
         asp_error err;
-        CHECK_OK(asp_splat_renderer_create(gl, checker, &kinds[k].desc, &r, &err), ep(&err));
+        CHECK_OK(asp_splat_renderer_create(gl, checker, &kinds[k].desc, NULL, &r, &err), ep(&err));
         if (!r)
             continue;
         static const double zooms[] = {1, 2, 3, 5, 8};
@@ -193,7 +193,7 @@ static void test_checker_oblique_lod(void)
     static const float taus[] = {0, 1, 2};
     for (size_t t = 0; t < 3; t++) {
         asp_renderer *r = NULL;
-        CHECK_OK(asp_splat_renderer_create(gl, checker, &(asp_splat_renderer_desc){.tolerance = taus[t]}, &r, &err),
+        CHECK_OK(asp_splat_renderer_create(gl, checker, &(asp_splat_renderer_desc){.tolerance = taus[t]}, NULL, &r, &err),
                  ep(&err));
         if (!r)
             continue;
@@ -234,9 +234,9 @@ static void test_coverage_matches_discs(void)
     asp_error err;
     asp_renderer *disc = NULL, *splat = NULL, *splat1 = NULL, *square = NULL;
     CHECK_OK(asp_disc_renderer_create(gl, c, NULL, &disc, &err), ep(&err));
-    CHECK_OK(asp_splat_renderer_create(gl, c, NULL, &splat, &err), ep(&err));
-    CHECK_OK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.tolerance = 1}, &splat1, &err), ep(&err));
-    CHECK_OK(asp_square_renderer_create(gl, c, NULL, &square, &err), ep(&err));
+    CHECK_OK(asp_splat_renderer_create(gl, c, NULL, NULL, &splat, &err), ep(&err));
+    CHECK_OK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.tolerance = 1}, NULL, &splat1, &err), ep(&err));
+    CHECK_OK(asp_square_renderer_create(gl, c, NULL, NULL, &square, &err), ep(&err));
     static const float views[][2] = {{0, 0}, {30, 20}, {135, -50}, {250, 80}};
     for (size_t v = 0; v < 4 && disc && splat && splat1 && square; v++) {
         asp_camera cam;
@@ -302,8 +302,8 @@ static void test_count_and_tau(void)
         return;
     asp_error err;
     asp_renderer *r = NULL, *q = NULL;
-    CHECK_OK(asp_splat_renderer_create(gl, checker, NULL, &r, &err), ep(&err));
-    CHECK_OK(asp_square_renderer_create(gl, checker, NULL, &q, &err), ep(&err));
+    CHECK_OK(asp_splat_renderer_create(gl, checker, NULL, NULL, &r, &err), ep(&err));
+    CHECK_OK(asp_square_renderer_create(gl, checker, NULL, NULL, &q, &err), ep(&err));
     if (!r || !q) {
         asp_renderer_destroy(r);
         asp_renderer_destroy(q);
@@ -396,7 +396,7 @@ static void test_epsilon_z_buffer(void)
     static const float eps[] = {0, 20};
     for (int e = 0; e < 2; e++) {
         asp_renderer *r = NULL;
-        CHECK_OK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.epsilon = eps[e]}, &r, &err),
+        CHECK_OK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.epsilon = eps[e]}, NULL, &r, &err),
                  ep(&err));
         asp_image img = {0, 0, NULL};
         if (r)
@@ -448,7 +448,7 @@ static void test_lighting_modes(void)
             asp_renderer *r = NULL;
             asp_error err;
             CHECK_OK(asp_splat_renderer_create(gl, c,
-                                               &(asp_splat_renderer_desc){.lighting = modes[m], .tolerance = (float)tau},
+                                               &(asp_splat_renderer_desc){.lighting = modes[m], .tolerance = (float)tau}, NULL,
                                                &r, &err),
                      ep(&err));
             asp_image img = {0, 0, NULL};
@@ -515,7 +515,7 @@ static void test_square_fixed_size(void)
     static const float sizes[] = {1, 5, 8};
     for (int s = 0; s < 3; s++) {
         asp_renderer *r = NULL;
-        CHECK_OK(asp_square_renderer_create(gl, c, &(asp_square_renderer_desc){.point_size = sizes[s]}, &r, &err),
+        CHECK_OK(asp_square_renderer_create(gl, c, &(asp_square_renderer_desc){.point_size = sizes[s]}, NULL, &r, &err),
                  ep(&err));
         asp_camera cam;
         top_camera(&cam, 0, 0, 2.0f);
@@ -533,7 +533,7 @@ static void test_square_fixed_size(void)
         asp_image_release(&img);
         asp_renderer_destroy(r);
     }
-    CHECK(asp_square_renderer_create(gl, c, &(asp_square_renderer_desc){.point_size = 1e9f}, &(asp_renderer *){NULL},
+    CHECK(asp_square_renderer_create(gl, c, &(asp_square_renderer_desc){.point_size = 1e9f}, NULL, &(asp_renderer *){NULL},
                                      &err) == ASP_EINVAL);
     asp_cloud_destroy(c);
 }
@@ -551,7 +551,7 @@ static void test_deterministic_and_hier(void)
     CHECK_OK(asp_hier_build(c, NULL, NULL, &h, &err), ep(&err));
     asp_renderer *r1 = NULL, *r2 = NULL;
     asp_splat_renderer_desc d = {.tolerance = 2};
-    CHECK_OK(asp_splat_renderer_create(gl, c, &d, &r1, &err), ep(&err));
+    CHECK_OK(asp_splat_renderer_create(gl, c, &d, NULL, &r1, &err), ep(&err));
     if (h)
         CHECK_OK(asp_splat_renderer_create_hier(gl, h, &d, &r2, &err), ep(&err));
     asp_camera cam;
@@ -588,31 +588,31 @@ static void test_bad_input(void)
     asp_cloud *c = NULL;
     CHECK_OK(asp_cloud_create(0, 0, NULL, &c, &err), ep(&err));
     if (c) {
-        CHECK(asp_splat_renderer_create(gl, c, NULL, &r, &err) == ASP_EDEGENERATE && r == NULL);
-        CHECK(asp_square_renderer_create(gl, c, NULL, &r, &err) == ASP_EDEGENERATE && r == NULL);
+        CHECK(asp_splat_renderer_create(gl, c, NULL, NULL, &r, &err) == ASP_EDEGENERATE && r == NULL);
+        CHECK(asp_square_renderer_create(gl, c, NULL, NULL, &r, &err) == ASP_EDEGENERATE && r == NULL);
         asp_cloud_destroy(c);
         c = NULL;
     }
     // all points equal, no radii: nothing has a size
     CHECK_OK(asp_cloud_create(50, 0, NULL, &c, &err), ep(&err));
     if (c) {
-        CHECK(asp_splat_renderer_create(gl, c, NULL, &r, &err) == ASP_EDEGENERATE && r == NULL);
+        CHECK(asp_splat_renderer_create(gl, c, NULL, NULL, &r, &err) == ASP_EDEGENERATE && r == NULL);
         CHECK_MSG(strstr(err.msg, "same position") != NULL, "message '%s'", err.msg);
         c->positions[3 * 7 + 1] = NAN;
-        CHECK(asp_splat_renderer_create(gl, c, NULL, &r, &err) == ASP_EINVAL && r == NULL);
+        CHECK(asp_splat_renderer_create(gl, c, NULL, NULL, &r, &err) == ASP_EINVAL && r == NULL);
         asp_cloud_destroy(c);
         c = NULL;
     }
     c = make_sphere(300);
     if (!c)
         return;
-    CHECK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.kernel_a = -1}, &r, &err) == ASP_EINVAL);
+    CHECK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.kernel_a = -1}, NULL, &r, &err) == ASP_EINVAL);
     CHECK_MSG(strstr(err.msg, "kernel_a") != NULL, "message '%s'", err.msg);
-    CHECK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.kernel_n = NAN}, &r, &err) == ASP_EINVAL);
-    CHECK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.tolerance = INFINITY}, &r, &err) ==
+    CHECK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.kernel_n = NAN}, NULL, &r, &err) == ASP_EINVAL);
+    CHECK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.tolerance = INFINITY}, NULL, &r, &err) ==
           ASP_EINVAL);
-    CHECK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.lighting = 7}, &r, &err) == ASP_EINVAL);
-    CHECK(asp_square_renderer_create(gl, c, &(asp_square_renderer_desc){.point_size = -2}, &r, &err) == ASP_EINVAL);
+    CHECK(asp_splat_renderer_create(gl, c, &(asp_splat_renderer_desc){.lighting = 7}, NULL, &r, &err) == ASP_EINVAL);
+    CHECK(asp_square_renderer_create(gl, c, &(asp_square_renderer_desc){.point_size = -2}, NULL, &r, &err) == ASP_EINVAL);
     CHECK(r == NULL);
     // set_lod: only hierarchy renderers; tau must be a number >= 0
     asp_renderer *disc = NULL;
@@ -627,7 +627,7 @@ static void test_bad_input(void)
         CHECK(st.count == 300 && st.nodes == 0);
         asp_renderer_destroy(disc);
     }
-    CHECK_OK(asp_splat_renderer_create(gl, c, NULL, &r, &err), ep(&err));
+    CHECK_OK(asp_splat_renderer_create(gl, c, NULL, NULL, &r, &err), ep(&err));
     if (r) {
         CHECK(asp_renderer_set_lod(r, NAN, 0, &err) == ASP_EINVAL);
         CHECK(asp_renderer_set_lod(r, -1, 0, &err) == ASP_EINVAL);
@@ -651,7 +651,7 @@ static void test_bad_input(void)
 static void setup(void)
 {
     asp_error err = {0, ""};
-    int rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.flags = ASP_GL_CONTEXT_DEBUG}, &gl, ep(&err));
+    int rc = asp_gl_context_create_headless(&(asp_gl_context_desc){.flags = ASP_GL_CONTEXT_DEBUG}, NULL, &gl, ep(&err));
     CHECK_MSG(rc == 0, "no headless GL: %s", err.msg);
     CHECK_OK(asp_synth(ASP_SYNTH_CHECKER_PLANE, NULL, NULL, &checker, &err), ep(&err));
 }

@@ -2,13 +2,13 @@
  * The viewer without a window: mouse interaction on the orbit camera (orbit
  * follows the drag, pan keeps the grabbed point under the cursor, dolly is
  * clamped), the tau ladder, the key table and option checking
- * (render/viewer_control.c, viewer.c). The .amg input: test_render_viewer_amg.c.
+ * (src/viewer/control.c, viewer.c). The .amg input: test_render_viewer_amg.c.
  */
 #include <math.h>
 
 #include "amgsplat/render.h"
 #include "harness.h"
-#include "render/viewer_internal.h"
+#include "viewer/internal.h"
 
 static void camera_at(asp_camera *cam, float az, float el)
 {

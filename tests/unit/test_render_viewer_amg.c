@@ -10,8 +10,16 @@
 #include "amgsplat/amg.h"
 #include "amgsplat/sample.h"
 #include "harness.h"
-#include "render/viewer_internal.h"
+#include "viewer/internal.h"
 
+
+/* The viewer's title text for s (asp__viewer_scene_status). */
+static const char *status_of(const asp_scene *s)
+{
+    static char buf[96];
+    asp__viewer_scene_status(s, buf, sizeof buf);
+    return buf;
+}
 static size_t distinct_colours(const asp_cloud *c)
 {
     size_t n = 0;
@@ -62,60 +70,61 @@ static void test_amg_scene_actions(void)
         asp_cloud_destroy(bare);
         return;
     }
-    CHECK(asp__viewer_input_for(path)->bit == ASP__VIEWER_INPUT_AMG);
-    CHECK(asp__viewer_input_for("x.PLY")->bit == ASP__VIEWER_INPUT_POINTS);
+    asp_file_type ft;
+    CHECK(asp_file_recognise(path, &ft, &err) == 0 && ft.kind == ASP_FILE_AMG);
+    CHECK(asp_file_type_of_name("x.PLY", &ft, &err) == 0 && ft.kind == ASP_FILE_POINTS);
 
-    asp__viewer_scene s;
+    asp_scene s;
     memset(&s, 0, sizeof s);
     asp_error bad = {0, ""};
-    CHECK(asp__viewer_scene_load(&s, path, &(asp_viewer_desc){.amg_level = "L-99"}, &bad) == ASP_EINVAL);
+    CHECK(asp__viewer_scene_load(&s, path, &(asp_viewer_desc){.amg_level = "L-99"}, NULL, &bad) == ASP_EINVAL);
     CHECK_MSG(strstr(bad.msg, path) && strstr(bad.msg, "L-99"), "%s", bad.msg);
-    CHECK(s.cloud == NULL && s.kind == NULL);
+    CHECK(s.cloud == NULL && s.type.kind == ASP_FILE_UNKNOWN);
 
-    CHECK_OK(asp__viewer_scene_load(&s, path, &(asp_viewer_desc){0}, &err), &err);
+    CHECK_OK(asp__viewer_scene_load(&s, path, &(asp_viewer_desc){0}, NULL, &err), &err);
     if (!s.cloud) {
         asp_cloud_destroy(c);
         asp_cloud_destroy(bare);
         return;
     }
-    CHECK(s.radius > 1.0f && s.radius < 1.2f); // the octahedron |x|+|y|+|z| = 1 plus disc radii
-    CHECK(strcmp(s.status, "classifier") == 0);
+    CHECK(s.frame.radius > 1.0 && s.frame.radius < 1.2); // the octahedron |x|+|y|+|z| = 1 plus disc radii
+    CHECK(strcmp(status_of(&s), "classifier") == 0);
     CHECK(s.cloud->colors != NULL && memcmp(s.cloud->colors, c->colors, 4 * c->count) != 0);
     char note[160] = "";
     // ] from classifier colours shows the domains of the first level (L, the coarsest)
-    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 1);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 1);
     char want[64];
     snprintf(want, sizeof want, "domains, level %zu (L-0)", levels - 1);
-    CHECK_MSG(strncmp(s.status, want, strlen(want)) == 0, "%s", s.status);
+    CHECK_MSG(strncmp(status_of(&s), want, strlen(want)) == 0, "%s", status_of(&s));
     size_t coarse_colours = distinct_colours(s.cloud);
     // already coarsest: nothing changes and the note says why
-    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 0);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 0);
     CHECK(strstr(note, "coarsest") != NULL);
     for (size_t l = levels - 1; l > 0; l--)
-        CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_FINER, note, sizeof note, &err) == 1);
-    CHECK(strncmp(s.status, "domains, level 0 (L-", 20) == 0);
-    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_FINER, note, sizeof note, &err) == 0);
+        CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_LEVEL_FINER, note, sizeof note, &err) == 1);
+    CHECK(strncmp(status_of(&s), "domains, level 0 (L-", 20) == 0);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_LEVEL_FINER, note, sizeof note, &err) == 0);
     CHECK(strstr(note, "finest") != NULL);
     // finer levels have more domains, so more distinct mixed colours
     CHECK_MSG(distinct_colours(s.cloud) > coarse_colours, "%zu vs %zu", distinct_colours(s.cloud), coarse_colours);
-    CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
-    CHECK(strncmp(s.status, "strict domains", 14) == 0);
-    CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
-    CHECK(strcmp(s.status, "input colours") == 0);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
+    CHECK(strncmp(status_of(&s), "strict domains", 14) == 0);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
+    CHECK(strcmp(status_of(&s), "input colours") == 0);
     CHECK(memcmp(s.cloud->colors, c->colors, 4 * c->count) == 0);
-    CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
-    CHECK(strcmp(s.status, "classifier") == 0);
-    asp__viewer_scene_release(&s);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
+    CHECK(strcmp(status_of(&s), "classifier") == 0);
+    asp_scene_release(&s);
 
     // without colours the cycle skips "input colours", and asking for them is an error
-    CHECK_OK(asp__viewer_scene_load(&s, bare_path, &(asp_viewer_desc){.amg_color = 2}, &err), &err);
+    CHECK_OK(asp__viewer_scene_load(&s, bare_path, &(asp_viewer_desc){.amg_color = 2}, NULL, &err), &err);
     if (s.cloud) {
-        CHECK(strncmp(s.status, "strict domains", 14) == 0);
-        CHECK(s.kind->action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
-        CHECK(strcmp(s.status, "classifier") == 0);
+        CHECK(strncmp(status_of(&s), "strict domains", 14) == 0);
+        CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_COLOR_MODE, note, sizeof note, &err) == 1);
+        CHECK(strcmp(status_of(&s), "classifier") == 0);
     }
-    asp__viewer_scene_release(&s);
-    CHECK(asp__viewer_scene_load(&s, bare_path, &(asp_viewer_desc){.amg_color = 3}, &bad) == ASP_EINVAL);
+    asp_scene_release(&s);
+    CHECK(asp__viewer_scene_load(&s, bare_path, &(asp_viewer_desc){.amg_color = 3}, NULL, &bad) == ASP_EINVAL);
     CHECK_MSG(strstr(bad.msg, "no colours") != NULL, "%s", bad.msg);
     unlink(path);
     unlink(bare_path);

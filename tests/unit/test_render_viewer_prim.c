@@ -12,8 +12,16 @@
 #include "amgsplat/prim.h"
 #include "amgsplat/sample.h"
 #include "harness.h"
-#include "render/viewer_internal.h"
+#include "viewer/internal.h"
 
+
+/* The viewer's title text for s (asp__viewer_scene_status). */
+static const char *status_of(const asp_scene *s)
+{
+    static char buf[96];
+    asp__viewer_scene_status(s, buf, sizeof buf);
+    return buf;
+}
 /* Saves the octahedron's decomposition to amg_path (unless NULL) and levels L-1, L to dps_path naming source. */
 static int write_files(const char *amg_path, const char *dps_path, const char *source, size_t *points)
 {
@@ -56,72 +64,74 @@ static void test_dps_scene_actions(void)
     CHECK(ok);
     if (!ok)
         goto done;
-    CHECK(asp__viewer_input_for(dps_path)->bit == ASP__VIEWER_INPUT_DPS);
-    CHECK(asp__viewer_input_for("X.DPS")->bit == ASP__VIEWER_INPUT_DPS);
+    asp_file_type ft;
+    CHECK(asp_file_recognise(dps_path, &ft, &err) == 0 && ft.kind == ASP_FILE_DPS);
+    CHECK(asp_file_type_of_name("X.DPS", &ft, &err) == 0 && ft.kind == ASP_FILE_DPS);
 
-    asp__viewer_scene s;
+    asp_scene s;
     memset(&s, 0, sizeof s);
     asp_error bad = {0, ""};
-    CHECK(asp__viewer_scene_load(&s, dps_path, &(asp_viewer_desc){.amg_level = "L-5"}, &bad) == ASP_EINVAL);
+    CHECK(asp__viewer_scene_load(&s, dps_path, &(asp_viewer_desc){.amg_level = "L-5"}, NULL, &bad) == ASP_EINVAL);
     CHECK_MSG(strstr(bad.msg, dps_path) && strstr(bad.msg, "no level 'L-5'") && strstr(bad.msg, "L-1, L"), "%s",
               bad.msg);
-    CHECK(s.kind == NULL && s.data == NULL);
+    CHECK(s.type.kind == ASP_FILE_UNKNOWN && s.dps == NULL);
 
     // the default is the finest level in the file; no points until p
-    CHECK_OK(asp__viewer_scene_load(&s, dps_path, &(asp_viewer_desc){0}, &err), &err);
-    if (!s.kind)
+    CHECK_OK(asp__viewer_scene_load(&s, dps_path, &(asp_viewer_desc){0}, NULL, &err), &err);
+    if (!s.dps)
         goto done;
-    CHECK(s.cloud == NULL && s.radius > 0);
-    const asp_dps_level *fine = asp__viewer_scene_dps_level(&s);
+    CHECK(s.cloud == NULL && s.frame.radius > 0);
+    const asp_dps_level *fine = asp_scene_dps_level(&s);
     CHECK(fine != NULL && fine->prim_count > 0);
-    CHECK_MSG(strstr(s.status, "(L-1)") != NULL, "%s", s.status);
+    CHECK_MSG(strstr(status_of(&s), "(L-1)") != NULL, "%s", status_of(&s));
     char note[256] = "";
-    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_FINER, note, sizeof note, &err) == 0);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_LEVEL_FINER, note, sizeof note, &err) == 0);
     CHECK_MSG(strstr(note, "already at the finest level") != NULL, "%s", note);
-    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 1);
-    const asp_dps_level *coarse = asp__viewer_scene_dps_level(&s);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 1);
+    const asp_dps_level *coarse = asp_scene_dps_level(&s);
     CHECK(coarse != fine && coarse->level == fine->level + 1);
-    CHECK_MSG(strstr(s.status, "(L)") != NULL, "%s", s.status);
+    CHECK_MSG(strstr(status_of(&s), "(L)") != NULL, "%s", status_of(&s));
     note[0] = 0;
-    CHECK(s.kind->action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 0);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_LEVEL_COARSER, note, sizeof note, &err) == 0);
     CHECK_MSG(strstr(note, "already at the coarsest level") != NULL, "%s", note);
-    CHECK(asp__viewer_scene_dps_level(&s) == coarse);
+    CHECK(asp_scene_dps_level(&s) == coarse);
 
     // p: the source .amg's points, in the world frame of the primitives, loaded once
-    CHECK(s.kind->action(&s, ASP__VIEWER_POINTS, note, sizeof note, &err) == 1);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_POINTS, note, sizeof note, &err) == 1);
     CHECK(s.cloud != NULL && s.cloud->count == points);
     if (s.cloud) {
-        CHECK(s.cloud->origin[0] == 0 && s.cloud->origin[1] == 0 && s.cloud->origin[2] == 0);
+        // moved into the primitives' frame, so one camera shows both
+        CHECK(memcmp(s.cloud->origin, s.origin, sizeof s.origin) == 0);
         // every point lies within the primitives' bounding sphere (plus a point radius of slack)
         float worst = 0;
         for (size_t i = 0; i < s.cloud->count; i++) {
             float d2 = 0;
             for (int k = 0; k < 3; k++) {
-                float e = s.cloud->positions[3 * i + k] - s.center[k];
+                float e = (float)(s.cloud->positions[3 * i + k] - (s.frame.center[k] - s.origin[k]));
                 d2 += e * e;
             }
             worst = d2 > worst ? d2 : worst;
         }
-        CHECK_MSG(worst <= 1.1f * 1.1f * s.radius * s.radius, "a point at %g from the centre, radius %g",
-                  (double)sqrtf(worst), (double)s.radius);
+        CHECK_MSG(worst <= 1.1 * 1.1 * s.frame.radius * s.frame.radius, "a point at %g from the centre, radius %g",
+                  (double)sqrtf(worst), s.frame.radius);
     }
     const asp_cloud *first = s.cloud;
-    CHECK(s.kind->action(&s, ASP__VIEWER_POINTS, note, sizeof note, &err) == 1 && s.cloud == first);
-    asp__viewer_scene_release(&s);
-    CHECK(s.kind == NULL && s.cloud == NULL);
+    CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_POINTS, note, sizeof note, &err) == 1 && s.cloud == first);
+    asp_scene_release(&s);
+    CHECK(s.type.kind == ASP_FILE_UNKNOWN && s.cloud == NULL);
 
-    // a source that is not there: p explains, once with the loader's message, then briefly
-    CHECK_OK(asp__viewer_scene_load(&s, lone_path, &(asp_viewer_desc){.amg_level = "L"}, &err), &err);
-    if (s.kind) {
-        CHECK_MSG(strstr(s.status, "(L)") != NULL, "%s", s.status);
+    // a source that is not there: p explains with the loader's message, every time
+    CHECK_OK(asp__viewer_scene_load(&s, lone_path, &(asp_viewer_desc){.amg_level = "L"}, NULL, &err), &err);
+    if (s.dps) {
+        CHECK_MSG(strstr(status_of(&s), "(L)") != NULL, "%s", status_of(&s));
         note[0] = 0;
-        CHECK(s.kind->action(&s, ASP__VIEWER_POINTS, note, sizeof note, &err) == 0 && s.cloud == NULL);
+        CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_POINTS, note, sizeof note, &err) == 0 && s.cloud == NULL);
         CHECK_MSG(strstr(note, "cannot show the source points") && strstr(note, "/nonexistent/dir/o.amg"), "%s",
                   note);
         note[0] = 0;
-        CHECK(s.kind->action(&s, ASP__VIEWER_POINTS, note, sizeof note, &err) == 0 && s.cloud == NULL);
-        CHECK_MSG(strstr(note, "no source points to show") != NULL, "%s", note);
-        asp__viewer_scene_release(&s);
+        CHECK(asp__viewer_scene_action(&s, ASP__VIEWER_POINTS, note, sizeof note, &err) == 0 && s.cloud == NULL);
+        CHECK_MSG(strstr(note, "cannot show the source points") != NULL, "%s", note);
+        asp_scene_release(&s);
     }
 done:
     unlink(amg_path);

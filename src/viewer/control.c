@@ -7,7 +7,7 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "render/viewer_internal.h"
+#include "viewer/internal.h"
 #include "util/banned.h"
 
 const asp__viewer_key asp__viewer_keys[] = {

@@ -12,52 +12,36 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "render/internal.h"
-#include "render/viewer_internal.h"
+#include "viewer/internal.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
 #include "util/banned.h"
 
-/* ---- renderer kinds: one row each; the 1..9 keys pick them in this order ---- */
+/* ---- renderer kinds: the rows of the one renderer table; the 1..9 keys pick them in this order ---- */
 
 typedef struct viewer viewer;
 
-typedef struct renderer_kind {
-    const char *name;
-    unsigned inputs; /* asp__viewer_input_bits it draws */
-    int has_lod;     /* draws a cut of the point hierarchy: tau matters (asp_renderer_set_lod) */
-    int (*create)(viewer *v, asp_renderer **out, asp_error *err);
-    const char *noun; /* what asp_renderer_count counts, for the title */
-} renderer_kind;
-
-static int make_disc(viewer *v, asp_renderer **out, asp_error *err);
-static int make_splat(viewer *v, asp_renderer **out, asp_error *err);
-static int make_square(viewer *v, asp_renderer **out, asp_error *err);
-static int make_prim(viewer *v, asp_renderer **out, asp_error *err);
-
-enum { INPUT_CLOUDS = ASP__VIEWER_INPUT_POINTS | ASP__VIEWER_INPUT_AMG };
-
-static const renderer_kind renderer_kinds[] = {
-    {"disc", INPUT_CLOUDS, 0, make_disc, "points"},
-    {"splat", INPUT_CLOUDS, 1, make_splat, "splats"},
-    {"square", INPUT_CLOUDS, 1, make_square, "splats"},
-    {"prim", ASP__VIEWER_INPUT_DPS, 0, make_prim, "primitives"},
-};
-enum { N_RENDERER_KINDS = sizeof renderer_kinds / sizeof renderer_kinds[0], KIND_DISC = 0, KIND_PRIM = 3 };
+static const asp_renderer_kind *K(size_t i)
+{
+    return asp_renderer_kind_at(i);
+}
 
 const char *asp_viewer_renderer_name(size_t i)
 {
-    return i < N_RENDERER_KINDS ? renderer_kinds[i].name : NULL;
+    const asp_renderer_kind *k = asp_renderer_kind_at(i);
+    return k ? k->name : NULL;
 }
 
+/* Index of the row named name, or asp_renderer_kind_count() when there is none. */
 static size_t find_renderer(const char *name)
 {
-    for (size_t i = 0; i < N_RENDERER_KINDS; i++)
-        if (strcmp(renderer_kinds[i].name, name) == 0)
+    size_t n = asp_renderer_kind_count();
+    for (size_t i = 0; i < n; i++)
+        if (strcmp(K(i)->name, name) == 0)
             return i;
-    return N_RENDERER_KINDS;
+    return n;
 }
 
 /* ---- options ---- */
@@ -78,13 +62,9 @@ int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err)
     if (desc->width > MAX_SIDE || desc->height > MAX_SIDE)
         return asp_error_set(err, ASP_EINVAL, "window size %ux%u is outside 1..%d", desc->width, desc->height,
                              MAX_SIDE);
-    if (desc->renderer && find_renderer(desc->renderer) == N_RENDERER_KINDS) {
-        char names[128] = "";
-        size_t len = 0;
-        for (size_t i = 0; i < N_RENDERER_KINDS && len < sizeof names; i++)
-            len += (size_t)snprintf(names + len, sizeof names - len, "%s%s", i ? ", " : "", renderer_kinds[i].name);
-        return asp_error_set(err, ASP_EINVAL, "unknown renderer '%s' (expected %s)", desc->renderer, names);
-    }
+    const asp_renderer_kind *found;
+    if (desc->renderer && asp_renderer_kind_find(desc->renderer, 0, &found, err))
+        return ASP_EINVAL;
     if (!(desc->tolerance >= 0) || !isfinite(desc->tolerance))
         return asp_error_set(err, ASP_EINVAL, "tolerance %g is not a number of pixels >= 0", desc->tolerance);
     if (desc->set_view && (!isfinite(desc->azimuth) || !(desc->elevation >= -90 && desc->elevation <= 90) ||
@@ -129,11 +109,15 @@ typedef struct action {
 struct viewer {
     const asp_viewer_desc *desc;
     const char *path;
-    asp__viewer_scene scene;
+    asp_scene scene;
+    char status[96];       /* the scene's title text (asp__viewer_scene_status) */
+    float center[3];       /* the scene's frame in its renderers' local frame (scene.origin) */
+    float radius;
+    asp_context ctx;
     asp_gl_context *gl;
     GLFWwindow *window;
     asp_renderer *r;
-    size_t kind;           /* index into renderer_kinds of r */
+    size_t kind;           /* row of the renderer table (asp_renderer_kind_at) of r */
     asp_hier *hier;        /* point hierarchy of scene.cloud, built when a renderer first needs it */
     float tolerance;
     int unlit;
@@ -159,6 +143,7 @@ struct viewer {
     double title_time;
     int title_stale;       /* the last frame's figures are not in the title yet */
     asp_viewer_stats stats;
+    size_t kind_prim;      /* row of the "prim" renderer */
 };
 
 static void vlog(const viewer *v, const char *fmt, ...)
@@ -195,11 +180,8 @@ static void reset_view(viewer *v)
     v->cam.up = d->up;
     v->cam.azimuth = d->set_view ? d->azimuth : 30.0f;
     v->cam.elevation = d->set_view ? d->elevation : 20.0f;
-    // the same framing as amgsplat render, so a scripted view matches its --view
-    asp_camera_fit(&v->cam, v->scene.center, v->scene.radius, aspect);
-    if (d->set_view && d->distance > 0)
-        v->cam.distance = d->distance * v->scene.radius;
-    asp_camera_clip_to_sphere(&v->cam, v->scene.center, v->scene.radius);
+    // the one framing of amgsplat render, so a scripted view matches its --view
+    asp_camera_frame(&v->cam, &v->scene.frame, v->scene.origin, aspect, d->set_view ? d->distance : 0.0f);
     v->dirty = 1;
 }
 
@@ -270,7 +252,7 @@ static void on_cursor(GLFWwindow *w, double x, double y)
     } else if (left) {
         asp__viewer_orbit(&v->cam, dx, dy);
     } else if (right) {
-        asp__viewer_dolly(&v->cam, exp(0.01 * dy), v->scene.radius); // drag up to come closer
+        asp__viewer_dolly(&v->cam, exp(0.01 * dy), v->radius); // drag up to come closer
     } else {
         return;
     }
@@ -281,7 +263,7 @@ static void on_scroll(GLFWwindow *w, double xoff, double yoff)
 {
     (void)xoff;
     viewer *v = from_window(w);
-    asp__viewer_dolly(&v->cam, pow(0.85, yoff), v->scene.radius);
+    asp__viewer_dolly(&v->cam, pow(0.85, yoff), v->radius);
     v->dirty = 1;
 }
 
@@ -299,18 +281,13 @@ static void on_resize(GLFWwindow *w, int width, int height)
 
 /* ---- renderers ---- */
 
-static int make_disc(viewer *v, asp_renderer **out, asp_error *err)
-{
-    return asp_disc_renderer_create(v->gl, v->scene.cloud, &(asp_disc_renderer_desc){.radius_scale = 1}, out, err);
-}
-
 /* The splat and square renderers share one hierarchy, so switching between them is instant. */
 static int ensure_hier(viewer *v, asp_error *err)
 {
-    if (v->hier)
+    if (v->hier || v->scene.hier || !v->scene.cloud)
         return 0;
     double t0 = asp_time_now();
-    int rc = asp_hier_build(v->scene.cloud, NULL, &v->scene.ctx, &v->hier, err);
+    int rc = asp_hier_build(v->scene.cloud, NULL, &v->ctx, &v->hier, err);
     if (rc)
         return rc;
     vlog(v, "built the point hierarchy: %zu nodes over %zu points in %.2f s", asp_hier_node_count(v->hier),
@@ -318,43 +295,35 @@ static int ensure_hier(viewer *v, asp_error *err)
     return 0;
 }
 
-static int make_splat(viewer *v, asp_renderer **out, asp_error *err)
+static int make_renderer(viewer *v, size_t k, asp_renderer **out, asp_error *err)
 {
-    int rc = ensure_hier(v, err);
-    if (rc)
-        return rc;
-    return asp_splat_renderer_create_hier(v->gl, v->hier, &(asp_splat_renderer_desc){.tolerance = v->tolerance},
-                                          out, err);
-}
-
-static int make_square(viewer *v, asp_renderer **out, asp_error *err)
-{
-    int rc = ensure_hier(v, err);
-    if (rc)
-        return rc;
-    return asp_square_renderer_create_hier(v->gl, v->hier, &(asp_square_renderer_desc){.tolerance = v->tolerance},
-                                           out, err);
-}
-
-static int make_prim(viewer *v, asp_renderer **out, asp_error *err)
-{
-    const asp_dps_level *level = asp__viewer_scene_dps_level(&v->scene);
-    if (!level)
-        return asp_error_set(err, ASP_EUNSUPPORTED, "renderer 'prim' draws .dps input only");
-    return asp_prim_renderer_create(v->gl, level, &(asp_prim_renderer_desc){.options = v->prim}, out, err);
+    if (K(k)->has_lod) {
+        int rc = ensure_hier(v, err);
+        if (rc)
+            return rc;
+    }
+    asp_render_source src;
+    asp_scene_render_source(&v->scene, &src);
+    if (v->hier)
+        src.hier = v->hier;
+    asp_renderer_options o;
+    memset(&o, 0, sizeof o);
+    o.disc.radius_scale = 1;
+    o.splat.tolerance = v->tolerance;
+    o.square.tolerance = v->tolerance;
+    o.prim = v->prim;
+    return K(k)->create(v->gl, &src, &o, &v->ctx, out, err);
 }
 
 /* A .dps whose source points were loaded (p) can be drawn by the point renderers too. */
 static int kind_accepts(const viewer *v, size_t k)
 {
-    if (renderer_kinds[k].inputs & v->scene.kind->bit)
-        return 1;
-    return v->scene.cloud && (renderer_kinds[k].inputs & ASP__VIEWER_INPUT_POINTS);
+    return (K(k)->inputs & asp_scene_inputs(&v->scene)) != 0;
 }
 
 static size_t first_accepted(const viewer *v)
 {
-    for (size_t k = 0; k < N_RENDERER_KINDS; k++)
+    for (size_t k = 0; k < asp_renderer_kind_count(); k++)
         if (kind_accepts(v, k))
             return k;
     return 0;
@@ -364,10 +333,10 @@ static size_t first_accepted(const viewer *v)
 static int switch_renderer(viewer *v, size_t k, asp_error *err)
 {
     if (!kind_accepts(v, k))
-        return asp_error_set(err, ASP_EUNSUPPORTED, "renderer '%s' cannot draw %s input", renderer_kinds[k].name,
-                             v->scene.kind->name);
+        return asp_error_set(err, ASP_EUNSUPPORTED, "renderer '%s' cannot draw %s input", K(k)->name,
+                             asp_file_kind_name(v->scene.type.kind));
     asp_renderer *r = NULL;
-    int rc = renderer_kinds[k].create(v, &r, err);
+    int rc = make_renderer(v, k, &r, err);
     if (rc)
         return rc;
     asp_renderer_destroy(v->r);
@@ -401,21 +370,21 @@ static void try_renderer(viewer *v, size_t k)
 {
     asp_error e = {0, ""};
     if (switch_renderer(v, k, &e))
-        vlog(v, "renderer '%s' unavailable: %s", renderer_kinds[k].name, e.msg);
+        vlog(v, "renderer '%s' unavailable: %s", K(k)->name, e.msg);
 }
 
 static void next_renderer(viewer *v)
 {
-    for (size_t step = 1; step < N_RENDERER_KINDS; step++) {
-        size_t k = (v->kind + step) % N_RENDERER_KINDS;
+    for (size_t step = 1; step < asp_renderer_kind_count(); step++) {
+        size_t k = (v->kind + step) % asp_renderer_kind_count();
         if (!kind_accepts(v, k))
             continue;
         asp_error e = {0, ""};
         if (switch_renderer(v, k, &e) == 0)
             return;
-        vlog(v, "renderer '%s' unavailable: %s", renderer_kinds[k].name, e.msg);
+        vlog(v, "renderer '%s' unavailable: %s", K(k)->name, e.msg);
     }
-    vlog(v, "no other renderer for this input; still '%s'", renderer_kinds[v->kind].name);
+    vlog(v, "no other renderer for this input; still '%s'", K(v->kind)->name);
 }
 
 /* ---- actions ---- */
@@ -440,17 +409,17 @@ static void print_view(const viewer *v)
 {
     const asp_camera *c = &v->cam;
     vlog(v, "view: --view %.1f,%.1f,%.3f (target %.4g,%.4g,%.4g, scene centre %.4g,%.4g,%.4g)", c->azimuth,
-         c->elevation, c->distance / v->scene.radius, c->target[0], c->target[1], c->target[2],
-         v->scene.center[0], v->scene.center[1], v->scene.center[2]);
+         c->elevation, c->distance / v->radius, c->target[0], c->target[1], c->target[2],
+         v->center[0], v->center[1], v->center[2]);
 }
 
 static void change_tolerance(viewer *v, int dir)
 {
     float old = v->tolerance;
     v->tolerance = asp__viewer_tolerance_step(old, dir);
-    if (!renderer_kinds[v->kind].has_lod) {
+    if (!K(v->kind)->has_lod) {
         vlog(v, "tau %g px (renderer '%s' draws every point; tau applies to the hierarchy renderers)", v->tolerance,
-             renderer_kinds[v->kind].name);
+             K(v->kind)->name);
         return;
     }
     asp_error e = {0, ""};
@@ -462,14 +431,14 @@ static void change_tolerance(viewer *v, int dir)
 
 static int is_dps(const viewer *v)
 {
-    return v->scene.kind->bit == ASP__VIEWER_INPUT_DPS;
+    return v->scene.dps != NULL;
 }
 
 /* Applies v->prim to the prim renderer when it is the one drawing; restores old on failure. */
 static void set_prim_options(viewer *v, const asp_prim_render_options *old)
 {
     asp_error e = {0, ""};
-    if (v->kind == KIND_PRIM && asp_prim_renderer_set_options(v->r, &v->prim, &e)) {
+    if (v->kind == v->kind_prim && asp_prim_renderer_set_options(v->r, &v->prim, &e)) {
         vlog(v, "cannot change the .dps options: %s", e.msg);
         v->prim = *old;
     }
@@ -522,7 +491,7 @@ static void prim_action(viewer *v, enum asp__viewer_action a)
         break;
     default: return;
     }
-    if (v->kind != KIND_PRIM)
+    if (v->kind != v->kind_prim)
         vlog(v, "(the primitives are hidden: p shows them with these options)");
     set_prim_options(v, &old);
 }
@@ -534,22 +503,22 @@ static void toggle_points(viewer *v)
         vlog(v, "p applies to .dps input only");
         return;
     }
-    size_t to = KIND_PRIM;
-    if (v->kind == KIND_PRIM) {
+    size_t to = v->kind_prim;
+    if (v->kind == v->kind_prim) {
         char note[LOG_CAP] = "";
         asp_error e = {0, ""};
-        int rc = v->scene.kind->action(&v->scene, ASP__VIEWER_POINTS, note, sizeof note, &e);
+        int rc = asp__viewer_scene_action(&v->scene, ASP__VIEWER_POINTS, note, sizeof note, &e);
         if (rc <= 0) {
             vlog(v, "%s", rc < 0 ? e.msg : note);
             return;
         }
-        to = KIND_DISC;
+        to = find_renderer("disc");
     }
     asp_error e = {0, ""};
     if (switch_renderer(v, to, &e))
-        vlog(v, "renderer '%s' unavailable: %s", renderer_kinds[to].name, e.msg);
+        vlog(v, "renderer '%s' unavailable: %s", K(to)->name, e.msg);
     else
-        vlog(v, "showing the %s", to == KIND_PRIM ? "primitives" : "source points");
+        vlog(v, "showing the %s", to == v->kind_prim ? "primitives" : "source points");
 }
 
 static void scene_action(viewer *v, enum asp__viewer_action a)
@@ -558,13 +527,13 @@ static void scene_action(viewer *v, enum asp__viewer_action a)
         prim_action(v, a);
         return;
     }
-    if (!v->scene.kind->action) {
+    if (!v->scene.amg && !v->scene.dps) {
         vlog(v, "colour modes and levels apply to .amg and .dps input only");
         return;
     }
     char note[160] = "";
     asp_error e = {0, ""};
-    int rc = v->scene.kind->action(&v->scene, a, note, sizeof note, &e);
+    int rc = asp__viewer_scene_action(&v->scene, a, note, sizeof note, &e);
     if (rc < 0) {
         vlog(v, "%s", e.msg);
         return;
@@ -574,17 +543,18 @@ static void scene_action(viewer *v, enum asp__viewer_action a)
             vlog(v, "%s", note);
         return;
     }
+    asp__viewer_scene_status(&v->scene, v->status, sizeof v->status);
     if (is_dps(v)) {
         // a new level: only the prim renderer draws it (the source points stay)
-        if (v->kind == KIND_PRIM && switch_renderer(v, KIND_PRIM, &e))
+        if (v->kind == v->kind_prim && switch_renderer(v, v->kind_prim, &e))
             vlog(v, "cannot draw the new level: %s", e.msg);
-        vlog(v, "%s, %zu primitives", v->scene.status, asp__viewer_scene_dps_level(&v->scene)->prim_count);
+        vlog(v, "%s, %zu primitives", v->status, asp_scene_dps_level(&v->scene)->prim_count);
         return;
     }
     // the points' colours changed: upload them again
     if (rebuild_renderer(v, &e))
         vlog(v, "cannot redraw with the new colours: %s", e.msg);
-    vlog(v, "%s", v->scene.status);
+    vlog(v, "%s", v->status);
 }
 
 static void apply(viewer *v, const action *a)
@@ -597,10 +567,10 @@ static void apply(viewer *v, const action *a)
     case ASP__VIEWER_LIGHT: v->unlit = !v->unlit; break;
     case ASP__VIEWER_NEXT_RENDERER: next_renderer(v); break;
     case ASP__VIEWER_PICK_RENDERER:
-        if ((size_t)a->arg < N_RENDERER_KINDS)
+        if ((size_t)a->arg < asp_renderer_kind_count())
             try_renderer(v, (size_t)a->arg);
         else
-            vlog(v, "no renderer %d (this build has %d)", a->arg + 1, (int)N_RENDERER_KINDS);
+            vlog(v, "no renderer %d (this build has %d)", a->arg + 1, (int)asp_renderer_kind_count());
         break;
     case ASP__VIEWER_TAU_UP: change_tolerance(v, +1); break;
     case ASP__VIEWER_TAU_DOWN: change_tolerance(v, -1); break;
@@ -620,53 +590,26 @@ static void apply(viewer *v, const action *a)
     case ASP__VIEWER_ORBIT_RIGHT: asp__viewer_orbit(&v->cam, step_px, 0); break;
     case ASP__VIEWER_ORBIT_UP: asp__viewer_orbit(&v->cam, 0, -step_px); break;
     case ASP__VIEWER_ORBIT_DOWN: asp__viewer_orbit(&v->cam, 0, step_px); break;
-    case ASP__VIEWER_ZOOM_IN: asp__viewer_dolly(&v->cam, 0.85, v->scene.radius); break;
-    case ASP__VIEWER_ZOOM_OUT: asp__viewer_dolly(&v->cam, 1 / 0.85, v->scene.radius); break;
+    case ASP__VIEWER_ZOOM_IN: asp__viewer_dolly(&v->cam, 0.85, v->radius); break;
+    case ASP__VIEWER_ZOOM_OUT: asp__viewer_dolly(&v->cam, 1 / 0.85, v->radius); break;
     }
     v->dirty = 1;
 }
 
 /* ---- screenshots ---- */
 
-/* Reads the window's back buffer (what the frame just drew, before the swap) into a PNG. */
-static int save_back_buffer(viewer *v, const char *path, uint32_t w, uint32_t h, asp_error *err)
+/* The window's back buffer (what the frame just drew, before the swap) into a PNG. */
+static int save_back_buffer(viewer *v, const char *path, asp_error *err)
 {
-    asp_image img;
-    int rc = asp_image_init(&img, w, h, err);
-    if (rc)
-        return rc;
-    size_t stride = 4 * (size_t)w;
-    uint8_t *row = asp_alloc(&v->scene.ctx, stride);
-    if (!row) {
-        asp_image_release(&img);
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for a %ux%u screenshot", w, h);
-    }
-    asp__gl_clear_errors(v->gl);
-    // the bytes as stored: already sRGB-encoded when the window is sRGB-capable
-    glDisable(GL_FRAMEBUFFER_SRGB);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
-    glReadBuffer(GL_BACK);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadnPixels(0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_UNSIGNED_BYTE, (GLsizei)(stride * h), img.pixels);
-    rc = asp__gl_check(v->gl, "read the window back", err);
-    if (!rc) {
-        for (uint32_t y = 0; y < h / 2; y++) { // GL rows run bottom-up, asp_image top-down
-            uint8_t *a = img.pixels + y * stride, *b = img.pixels + (h - 1 - y) * stride;
-            memcpy(row, a, stride);
-            memcpy(a, b, stride);
-            memcpy(b, row, stride);
-        }
-        // a window is opaque whatever alpha its visual stores (or lacks)
-        for (size_t i = 0; i < (size_t)w * h; i++)
-            img.pixels[4 * i + 3] = 255;
+    asp_image img = {0, 0, NULL};
+    int rc = asp_gl_context_read_window(v->gl, &img, err);
+    if (!rc)
         rc = asp_image_save_png(&img, path, err);
-    }
-    asp_free(&v->scene.ctx, row);
-    asp_image_release(&img);
     if (!rc) {
         v->stats.screenshots++;
-        vlog(v, "wrote '%s' (%ux%u)", path, w, h);
+        vlog(v, "wrote '%s' (%ux%u)", path, img.width, img.height);
     }
+    asp_image_release(&img);
     return rc;
 }
 
@@ -701,19 +644,19 @@ static void update_title(viewer *v, double now, int force)
     const char *base = strrchr(v->path, '/');
     base = base ? base + 1 : v->path;
     char tau[96] = "";
-    if (renderer_kinds[v->kind].has_lod)
+    if (K(v->kind)->has_lod)
         snprintf(tau, sizeof tau, " | tau %g px", v->tolerance);
-    else if (v->kind == KIND_PRIM)
+    else if (v->kind == v->kind_prim)
         snprintf(tau, sizeof tau, " | %s, alpha-ref %.2f%s%s%s", asp_prim_render_method_name(v->prim.method),
                  alpha_ref_of(&v->prim), v->prim.crease_angle < 0 ? ", no creases" : "",
                  v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? ", outline" : "",
                  v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? ", domain colours" : "");
     char *title = v->stats.title;
     snprintf(title, sizeof v->stats.title, "amgsplat view: %s | %s | %zu %s | %.1f ms (%.0f fps)%s | %s%s%s", base,
-             renderer_kinds[v->kind].name, v->r ? asp_renderer_count(v->r) : 0,
-             renderer_kinds[v->kind].noun, v->last_ms,
+             K(v->kind)->name, v->r ? asp_renderer_count(v->r) : 0,
+             K(v->kind)->noun, v->last_ms,
              v->last_ms > 0 ? 1000.0 / v->last_ms : 0.0, tau, v->unlit ? "unlit" : "lit",
-             v->scene.status[0] ? " | " : "", v->scene.status);
+             v->status[0] ? " | " : "", v->status);
     glfwSetWindowTitle(v->window, title);
 }
 
@@ -728,11 +671,11 @@ static void account_frame(viewer *v, double ms, double now)
         asp_renderer_stats rs;
         asp_renderer_stats_get(v->r, &rs);
         char lod[96] = "";
-        if (renderer_kinds[v->kind].has_lod)
+        if (K(v->kind)->has_lod)
             snprintf(lod, sizeof lod, ", tau %g px, cut %.2f ms", v->tolerance, 1000.0 * rs.select_seconds);
         vlog(v, "%zu frames in %.1f s: %.2f ms per frame drawn, %zu %s (%s%s)", v->window_frames,
              now - v->window_start, v->window_ms / (double)v->window_frames, rs.count,
-             renderer_kinds[v->kind].noun, renderer_kinds[v->kind].name, lod);
+             K(v->kind)->noun, K(v->kind)->name, lod);
         v->window_start = now;
         v->window_frames = 0;
         v->window_ms = 0;
@@ -746,7 +689,7 @@ static int draw(viewer *v, int last, asp_error *err)
     if (w == 0 || h == 0) // minimised
         return 0;
     v->cam.aspect = (float)w / (float)h;
-    asp_camera_clip_to_sphere(&v->cam, v->scene.center, v->scene.radius);
+    asp_camera_clip_to_sphere(&v->cam, v->center, v->radius);
     const uint8_t *bg = v->desc->background;
     asp_render_desc rd = {.flags = ASP_RENDER_WAIT | (v->unlit ? ASP_RENDER_UNLIT : 0u)};
     if (bg[3])
@@ -765,11 +708,11 @@ static int draw(viewer *v, int last, asp_error *err)
         asp_error e = {0, ""};
         if (next_screenshot_name(v, name, sizeof name))
             vlog(v, "no free screenshot name in the current directory");
-        else if (save_back_buffer(v, name, w, h, &e))
+        else if (save_back_buffer(v, name, &e))
             vlog(v, "%s", e.msg);
     }
     if (last && v->desc->screenshot) {
-        rc = save_back_buffer(v, v->desc->screenshot, w, h, err);
+        rc = save_back_buffer(v, v->desc->screenshot, err);
         if (rc)
             return rc;
     }
@@ -820,12 +763,11 @@ static int open_window(viewer *v, asp_error *err)
     const char *base = strrchr(v->path, '/');
     char title[256];
     snprintf(title, sizeof title, "amgsplat view: %s", base ? base + 1 : v->path);
-    int rc = asp_gl_context_create_window(
-        &(asp_gl_context_desc){.width = d->width, .height = d->height, .title = title, .ctx = d->ctx}, &v->gl, err);
+    int rc = asp_gl_context_create_window(&(asp_gl_context_desc){.width = d->width, .height = d->height, .title = title},
+                                          &v->ctx, &v->gl, err);
     if (rc)
         return rc;
-    v->window = v->gl->window;
-    asp__viewer_pin_gl_driver();
+    v->window = asp_gl_context_window(v->gl);
     glfwSetWindowUserPointer(v->window, v);
     glfwSetCharCallback(v->window, on_char);
     glfwSetKeyCallback(v->window, on_key);
@@ -840,7 +782,8 @@ static int open_window(viewer *v, asp_error *err)
     return 0;
 }
 
-int asp_viewer_run(const char *path, const asp_viewer_desc *desc, asp_viewer_stats *stats, asp_error *err)
+int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_context *ctx, asp_viewer_stats *stats,
+                   asp_error *err)
 {
     static const asp_viewer_desc zero_desc;
     if (!desc)
@@ -856,10 +799,20 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, asp_viewer_sta
     v.unlit = (desc->flags & ASP_VIEWER_UNLIT) != 0;
     v.prim.method = (asp_prim_render_method)desc->prim_method;
     v.prim.alpha_ref = desc->prim_alpha_ref;
-    rc = asp__viewer_scene_load(&v.scene, path, desc, err);
+    if (ctx)
+        v.ctx = *ctx;
+    rc = asp__viewer_scene_load(&v.scene, path, desc, ctx, err);
     if (rc)
         return rc;
-    v.kind = desc->renderer ? find_renderer(desc->renderer) : first_accepted(&v);
+    asp__viewer_scene_status(&v.scene, v.status, sizeof v.status);
+    for (int k = 0; k < 3; k++)
+        v.center[k] = (float)(v.scene.frame.center[k] - v.scene.origin[k]);
+    v.radius = (float)v.scene.frame.radius;
+    v.kind_prim = find_renderer("prim");
+    // a .hier holds splats without their points: the splat renderer draws it
+    v.kind = desc->renderer ? find_renderer(desc->renderer)
+             : v.scene.hier ? find_renderer("splat")
+                            : first_accepted(&v);
     rc = open_window(&v, err);
     if (!rc) {
         uint32_t w = 0, h = 0;
@@ -878,12 +831,12 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, asp_viewer_sta
         v.stats.mean_frame_ms = v.frames ? v.total_ms / (double)v.frames : 0;
         v.stats.last_frame_ms = v.last_ms;
         v.stats.count = asp_renderer_count(v.r);
-        snprintf(v.stats.renderer, sizeof v.stats.renderer, "%s", renderer_kinds[v.kind].name);
+        snprintf(v.stats.renderer, sizeof v.stats.renderer, "%s", K(v.kind)->name);
         *stats = v.stats;
     }
     asp_renderer_destroy(v.r);
     asp_hier_destroy(v.hier);
     asp_gl_context_destroy(v.gl);
-    asp__viewer_scene_release(&v.scene);
+    asp_scene_release(&v.scene);
     return rc;
 }

@@ -1,0 +1,115 @@
+/*
+ * amgsplat scene: the one loader behind render, view and eval (STYLE.md 9b).
+ * It tells a file's kind with asp_file_recognise (io.h), loads points, an
+ * .amg decomposition (coloured by classifier or domains, journal Fig. 1b, 5),
+ * a .dps level of domain primitives (journal section 4) or a .hier point
+ * hierarchy, and hands back what to draw together with the one frame every
+ * representation of a model is fitted to (asp_frame, cloud.h: the source point
+ * set's sphere), so `--view AZ,EL` means one picture whatever the file.
+ */
+#ifndef AMGSPLAT_SCENE_H
+#define AMGSPLAT_SCENE_H
+
+#include "amg.h"
+#include "cloud.h"
+#include "hier.h"
+#include "io.h"
+#include "prim.h"
+#include "render.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** How the points of an .amg are coloured (asp_scene_desc.amg_color). */
+typedef enum asp_scene_amg_color {
+    ASP_SCENE_AMG_INPUT = 0,      /* the points' own colours (light grey without any) */
+    ASP_SCENE_AMG_CLASSIFIER = 1, /* asp_amg_colorize ASP_AMG_COLOR_CLASSIFIER (journal Fig. 1b) */
+    ASP_SCENE_AMG_DOMAINS = 2,    /* ASP_AMG_COLOR_DOMAINS of one level (journal Fig. 5c-d) */
+    ASP_SCENE_AMG_STRICT = 3      /* ASP_AMG_COLOR_STRICT of one level (thesis 2.5) */
+} asp_scene_amg_color;
+
+/** Options of asp_scene_load; the zero value means defaults. */
+typedef struct asp_scene_desc {
+    asp_scene_amg_color amg_color; /* .amg only */
+    const char *level;   /* .amg: level of the domain colours ("L", "L-3" or an index; NULL = "L");
+                            .dps: level drawn (asp_dps_level_parse; NULL = the finest in the file) */
+    float crease_angle;  /* point and .amg inputs: degrees in (0, 90): clip planes at sharper creases
+                            (asp_crease_clip_planes; needs normals); 0 = none */
+} asp_scene_desc;
+
+/** What asp_scene_load loaded; release with asp_scene_release. */
+typedef struct asp_scene {
+    asp_file_type type;      /* what the file is (asp_file_recognise) */
+    char path[512];          /* the file as given */
+    asp_cloud *cloud;        /* points to draw, in the cloud's local frame: the file's points or a coloured
+                                copy of the .amg's; NULL for .dps (until asp_scene_load_source) and .hier */
+    asp_amg *amg;            /* .amg: the decomposition */
+    asp_scene_amg_color amg_color;
+    size_t amg_level;        /* .amg: level of the domain colours */
+    asp_dps *dps;            /* .dps: every level of the file */
+    size_t dps_level;        /* .dps: index into dps->levels of the level drawn */
+    asp_hier *hier;          /* .hier */
+    float *clip_planes;      /* 8 floats per point of cloud with desc->crease_angle, else NULL */
+    asp_frame frame;         /* world-space sphere to fit the camera to (asp_camera_frame): the frame of the
+                                source point set, recorded in .amg/.dps/.hier; a representation's own
+                                bounds only when the file records none (radius 0) and no source is found */
+    double origin[3];        /* the local frame every renderer of the scene draws in: cloud->origin, the
+                                hierarchy's origin, or for .dps the frame centre */
+    asp_context ctx;
+} asp_scene;
+
+/**
+ * Loads path (recognised by magic bytes, then extension: asp_file_recognise)
+ * into *out (zeroed or released before; filled only on success). Points go
+ * through asp_cloud_load, .amg through asp_amg_load (coloured by
+ * desc->amg_color), .dps through asp_dps_load (desc->level picked), .hier
+ * through asp_hier_load. A .dps that records no frame is framed by its
+ * source points (asp_dps.source, tried as stored and next to the .dps) when
+ * they load, else by the level's support rectangles. desc may be NULL; ctx
+ * (NULL = defaults) gives threads and allocator and is kept in out->ctx.
+ * Returns 0; the loaders' errors (ASP_EIO, ASP_EFORMAT naming the file);
+ * ASP_EUNSUPPORTED for a mesh or image ("cannot draw 'x.obj': a mesh; sample
+ * it to points first (amgsplat sample)"); ASP_EINVAL (a level the file does
+ * not have, input colours asked of points without colours is not an error);
+ * ASP_EDEGENERATE (nothing to frame); ASP_ENOMEM. Reentrant.
+ */
+int asp_scene_load(const char *path, const asp_scene_desc *desc, const asp_context *ctx, asp_scene *out,
+                   asp_error *err);
+
+/**
+ * .amg scenes: colours s->cloud by color at level (an index of the
+ * decomposition; ignored by INPUT and CLASSIFIER). The cloud is unchanged on
+ * failure. Returns 0, ASP_EINVAL (not an .amg scene, a level out of range,
+ * input colours of points that have none) or ASP_ENOMEM.
+ */
+int asp_scene_recolor(asp_scene *s, asp_scene_amg_color color, size_t level, asp_error *err);
+
+/**
+ * .dps scenes: loads the source points the file names (asp_dps.source, an
+ * .amg or point file, tried as stored and next to the .dps) into s->cloud,
+ * moved into the primitives' frame (s->origin) so one camera shows both. A
+ * no-op when s->cloud is already there. Returns 0, ASP_EINVAL (not a .dps
+ * scene), ASP_EUNSUPPORTED (no usable source name) or the loaders' errors.
+ */
+int asp_scene_load_source(asp_scene *s, asp_error *err);
+
+/** The .dps level drawn (s->dps_level), or NULL for other kinds. */
+const asp_dps_level *asp_scene_dps_level(const asp_scene *s);
+
+/**
+ * What the renderer table (asp_renderer_kind in render.h) draws of s: its
+ * cloud, clip planes, hierarchy, .dps level and origin, borrowed from s.
+ */
+void asp_scene_render_source(const asp_scene *s, asp_render_source *out);
+
+/** The asp_render_input_bits s can feed: points when it has a cloud or hierarchy, primitives for .dps. */
+unsigned asp_scene_inputs(const asp_scene *s);
+
+/** Frees everything s owns and zeroes it; a zeroed scene is accepted. */
+void asp_scene_release(asp_scene *s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,109 @@
+/*
+ * Private to the viewer module (src/viewer/): the key table, the camera
+ * interaction math (no GL, unit-tested alone) and the keys on the scene.
+ */
+#ifndef ASP_VIEWER_INTERNAL_H
+#define ASP_VIEWER_INTERNAL_H
+
+#include "amgsplat/scene.h"
+#include "amgsplat/viewer.h"
+
+/* What a key (or a character of asp_viewer_desc.keys) asks for. */
+enum asp__viewer_action {
+    ASP__VIEWER_NONE = 0,
+    ASP__VIEWER_QUIT,
+    ASP__VIEWER_RESET,
+    ASP__VIEWER_LIGHT,
+    ASP__VIEWER_NEXT_RENDERER,
+    ASP__VIEWER_PICK_RENDERER, /* arg = index into the renderer table, 0-based */
+    ASP__VIEWER_TAU_UP,
+    ASP__VIEWER_TAU_DOWN,
+    ASP__VIEWER_COLOR_MODE,
+    ASP__VIEWER_LEVEL_FINER,
+    ASP__VIEWER_LEVEL_COARSER,
+    ASP__VIEWER_SCREENSHOT,
+    ASP__VIEWER_HELP,
+    ASP__VIEWER_PRINT_VIEW,
+    ASP__VIEWER_ORBIT_LEFT,
+    ASP__VIEWER_ORBIT_RIGHT,
+    ASP__VIEWER_ORBIT_UP,
+    ASP__VIEWER_ORBIT_DOWN,
+    ASP__VIEWER_ZOOM_IN,
+    ASP__VIEWER_ZOOM_OUT,
+    /* .dps input (journal section 4): renderer options and the source points */
+    ASP__VIEWER_NEXT_METHOD,
+    ASP__VIEWER_ALPHA_DOWN,
+    ASP__VIEWER_ALPHA_UP,
+    ASP__VIEWER_OUTLINE,
+    ASP__VIEWER_CREASES,
+    ASP__VIEWER_POINTS
+};
+
+/* One printable key of the viewer; the table ends with key 0. */
+typedef struct asp__viewer_key {
+    char key;
+    enum asp__viewer_action action;
+    int arg;
+    const char *help;
+} asp__viewer_key;
+
+extern const asp__viewer_key asp__viewer_keys[];
+
+/* The table entry for character c, or NULL. */
+const asp__viewer_key *asp__viewer_key_find(unsigned c);
+
+/* ---- camera interaction (viewer_control.c; pure math, thread safe) ---- */
+
+/* Degrees of orbit per pixel of mouse motion. */
+#define ASP__VIEWER_ORBIT_DEG_PER_PX 0.25
+
+/*
+ * Orbits: dragging right by dx pixels turns the object right (the eye moves
+ * left, azimuth decreases), dragging down raises the eye; elevation is clamped
+ * to -90..90 and azimuth kept in [-180, 180).
+ */
+void asp__viewer_orbit(asp_camera *cam, double dx, double dy);
+
+/*
+ * Multiplies the eye distance by factor, clamped to [1e-3, 1e3] times the
+ * scene radius so the view never collapses onto the target or loses it.
+ */
+void asp__viewer_dolly(asp_camera *cam, double factor, float radius);
+
+/*
+ * Pans by (dx, dy) pixels of a framebuffer height pixels tall: the target
+ * moves in the image plane so that a point at the target's depth follows the
+ * cursor exactly (dy > 0 is downwards, as in window coordinates).
+ */
+void asp__viewer_pan(asp_camera *cam, double dx, double dy, uint32_t height);
+
+/*
+ * The next screen tolerance on a fixed ladder 0, 0.25, 0.5, 1, 1.5, 2, 3, 4,
+ * 6, 8, 12, 16, 24, 32, 48, 64 pixels: dir > 0 gives the smallest rung above
+ * tau (tau itself at the top), dir < 0 the largest rung below (0 at the
+ * bottom), so every value is reachable and 0 (every leaf) is one key away.
+ */
+float asp__viewer_tolerance_step(float tau, int dir);
+
+/* ---- what is shown (scene_actions.c, over the one scene loader of scene.h) ---- */
+
+/* Checks the scene parts of desc that need no file (colour mode). */
+int asp__viewer_scene_check_desc(const asp_viewer_desc *desc, asp_error *err);
+
+/* Loads path with asp_scene_load in the viewer's first colour mode and level. On failure s stays zeroed. */
+int asp__viewer_scene_load(asp_scene *s, const char *path, const asp_viewer_desc *desc, const asp_context *ctx,
+                           asp_error *err);
+
+/*
+ * A key on the scene (colour mode, level, source points). Returns 1 when what
+ * is drawn changed (renderers must be made again; for ASP__VIEWER_POINTS:
+ * s->cloud holds the source points), 0 when nothing changed (note says why,
+ * or is empty when the key does not apply), or a negative ASP_E* with s
+ * unchanged.
+ */
+int asp__viewer_scene_action(asp_scene *s, enum asp__viewer_action a, char *note, size_t note_cap, asp_error *err);
+
+/* Title text for the scene, e.g. "domains, level 3 (L-2), 40 domains" or "level 2 (L-1)"; "" for points. */
+void asp__viewer_scene_status(const asp_scene *s, char *status, size_t cap);
+
+#endif

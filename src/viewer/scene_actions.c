@@ -1,0 +1,147 @@
+/*
+ * The viewer's keys on what it shows, over the one scene loader (scene.h):
+ * .amg points coloured by the classifier (journal 2.1, Fig. 1b) or by the
+ * domains of one level (journal 2.3 Fig. 5c-d; strict domains, thesis 2.5),
+ * .dps domain primitives (journal section 4) one level at a time, with their
+ * source points loaded on demand.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "viewer/internal.h"
+#include "util/banned.h"
+
+/* The viewer's colour modes in the order the c key cycles them (asp_viewer_desc.amg_color). */
+enum { MODE_CLASSIFIER = 0, MODE_DOMAINS = 1, MODE_STRICT = 2, MODE_INPUT = 3, MODES = 4 };
+static const char *const mode_names[MODES] = {"classifier", "domains", "strict domains", "input colours"};
+
+/* viewer mode -> scene colour: the scene counts the points' own colours first */
+static asp_scene_amg_color scene_color(unsigned mode)
+{
+    return mode == MODE_INPUT ? ASP_SCENE_AMG_INPUT : (asp_scene_amg_color)(mode + 1);
+}
+
+static unsigned viewer_mode(asp_scene_amg_color c)
+{
+    return c == ASP_SCENE_AMG_INPUT ? MODE_INPUT : (unsigned)c - 1;
+}
+
+void asp__viewer_scene_status(const asp_scene *s, char *status, size_t cap)
+{
+    status[0] = '\0';
+    if (s->amg) {
+        unsigned mode = viewer_mode(s->amg_color);
+        size_t coarsest = asp_amg_level_count(s->amg) - 1;
+        if (mode == MODE_DOMAINS || mode == MODE_STRICT)
+            snprintf(status, cap, "%s, level %zu (L-%zu), %zu domains", mode_names[mode], s->amg_level,
+                     coarsest - s->amg_level, asp_amg_level_size(s->amg, s->amg_level));
+        else
+            snprintf(status, cap, "%s", mode_names[mode]);
+    } else if (s->dps) {
+        char name[16];
+        asp_dps_level_name(s->dps, s->dps_level, name);
+        snprintf(status, cap, "level %u (%s)", s->dps->levels[s->dps_level].level, name);
+    }
+}
+
+int asp__viewer_scene_check_desc(const asp_viewer_desc *desc, asp_error *err)
+{
+    if (desc->amg_color >= MODES)
+        return asp_error_set(err, ASP_EINVAL, "unknown .amg colour mode %u (expected 0..%d)", desc->amg_color,
+                             MODES - 1);
+    return 0;
+}
+
+int asp__viewer_scene_load(asp_scene *s, const char *path, const asp_viewer_desc *desc, const asp_context *ctx,
+                           asp_error *err)
+{
+    asp_scene_desc d = {.amg_color = scene_color(desc->amg_color), .level = desc->amg_level};
+    asp_scene t;
+    memset(&t, 0, sizeof t);
+    int rc = asp_scene_load(path, &d, ctx, &t, err);
+    if (rc)
+        return rc;
+    if (t.amg && desc->amg_color == MODE_INPUT && !asp_amg_cloud(t.amg)->colors) {
+        asp_scene_release(&t);
+        return asp_error_set(err, ASP_EINVAL, "cannot view '%s' in input colours: its points have no colours", path);
+    }
+    *s = t;
+    return 0;
+}
+
+static int amg_action(asp_scene *s, enum asp__viewer_action act, char *note, size_t cap, asp_error *err)
+{
+    unsigned mode = viewer_mode(s->amg_color);
+    size_t level = s->amg_level, levels = asp_amg_level_count(s->amg);
+    int has_input = asp_amg_cloud(s->amg)->colors != NULL;
+    switch (act) {
+    case ASP__VIEWER_COLOR_MODE:
+        mode = (mode + 1) % (has_input ? MODES : MODE_INPUT);
+        break;
+    case ASP__VIEWER_LEVEL_FINER:
+    case ASP__VIEWER_LEVEL_COARSER:
+        // a level means nothing to the classifier colours: stepping it shows domains
+        if (mode != MODE_DOMAINS && mode != MODE_STRICT) {
+            mode = MODE_DOMAINS;
+        } else if (act == ASP__VIEWER_LEVEL_FINER) {
+            if (level == 0) {
+                snprintf(note, cap, "already at the finest level (0, the points)");
+                return 0;
+            }
+            level--;
+        } else {
+            if (level + 1 >= levels) {
+                snprintf(note, cap, "already at the coarsest level (%zu, L)", level);
+                return 0;
+            }
+            level++;
+        }
+        break;
+    default:
+        return 0;
+    }
+    int rc = asp_scene_recolor(s, scene_color(mode), level, err);
+    return rc ? rc : 1;
+}
+
+static int dps_action(asp_scene *s, enum asp__viewer_action act, char *note, size_t cap, asp_error *err)
+{
+    switch (act) {
+    case ASP__VIEWER_LEVEL_FINER:
+        if (s->dps_level == 0) {
+            snprintf(note, cap, "already at the finest level in the file (%u)", s->dps->levels[0].level);
+            return 0;
+        }
+        s->dps_level--;
+        return 1;
+    case ASP__VIEWER_LEVEL_COARSER:
+        if (s->dps_level + 1 >= s->dps->level_count) {
+            snprintf(note, cap, "already at the coarsest level in the file (%u)", s->dps->levels[s->dps_level].level);
+            return 0;
+        }
+        s->dps_level++;
+        return 1;
+    case ASP__VIEWER_POINTS: {
+        if (s->cloud)
+            return 1;
+        asp_error e = {0, ""};
+        if (asp_scene_load_source(s, &e)) {
+            snprintf(note, cap, "cannot show the source points: %s", e.msg);
+            return 0;
+        }
+        return 1;
+    }
+    default:
+        (void)err;
+        return 0;
+    }
+}
+
+int asp__viewer_scene_action(asp_scene *s, enum asp__viewer_action act, char *note, size_t cap, asp_error *err)
+{
+    if (s->amg)
+        return amg_action(s, act, note, cap, err);
+    if (s->dps)
+        return dps_action(s, act, note, cap, err);
+    return 0;
+}
