@@ -46,7 +46,7 @@ typedef struct asp_mesh {
                                uvs holds the first */
     asp_up_axis up;         /* the axis of the file's coordinates taken as up; positions and normals
                                are turned so that it is +y (asp_mesh_load_desc.up) */
-    char up_rule[96];       /* why that axis, for info: "file coordinates (OBJ has no up axis; y by convention)" */
+    char up_rule[96];       /* why that axis, for info: "obj stores no up axis: the file's coordinates, y by convention" */
     asp_context ctx;        /* copy of the context that allocated the arrays */
 } asp_mesh;
 

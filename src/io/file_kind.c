@@ -167,8 +167,13 @@ int asp_file_recognise_memory(const void *head, size_t size, const char *name, a
         if (row && size > 0)
             return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': not %s file (bad magic)", nm,
                                  row->kind == ASP_FILE_AMG ? "an .amg" : row->kind == ASP_FILE_DPS ? "a .dps" : "a .hier");
+        if (!row && !*extension_of(nm))
+            return asp_error_set(err, ASP_EUNSUPPORTED,
+                                 "cannot read '%s': unknown file type (no known magic bytes and no extension; "
+                                 "expected %s)",
+                                 nm, expected);
         if (!row)
-            return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': unknown file type '%s' (expected %s)", nm,
+            return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': unknown file type '%.16s' (expected %s)", nm,
                                  extension_of(nm), expected);
     }
     fill(out, row->kind, row->format, 0);
@@ -216,8 +221,8 @@ int asp_file_type_of_name(const char *path, asp_file_type *out, asp_error *err)
 {
     const struct ext_row *row = by_extension(path);
     if (!row)
-        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot write '%s': unknown file type '%s' (expected %s)", path,
-                             extension_of(path), expected);
+        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot write '%s': unknown file type '%.16s' (expected %s)", path,
+                             *extension_of(path) ? extension_of(path) : "(none)", expected);
     fill(out, row->kind, row->format, 0);
     return 0;
 }

@@ -529,13 +529,13 @@ static mat4 start_transform(const char *format, asp_up_axis up, char *rule, size
         snprintf(rule, cap, "as asked: the file's %s turned to y%s", axis_name(up),
                  is_3ds ? " (assimp's 3DS z-up turn undone first)" : "");
     else if (is_3ds)
-        snprintf(rule, cap, "file coordinates (3DS stores no up axis; assimp's z-up turn undone)");
+        snprintf(rule, cap, "3DS stores no up axis: the file's coordinates, assimp's z-up turn undone");
     else if (strcmp(format, "gltf") == 0 || strcmp(format, "glb") == 0)
         snprintf(rule, cap, "glTF is y-up by its specification");
     else if (strcmp(format, "dae") == 0)
         snprintf(rule, cap, "the file's <up_axis>, turned to y by assimp");
     else
-        snprintf(rule, cap, "file coordinates (%s stores no up axis; y by convention)", format[0] ? format : "the format");
+        snprintf(rule, cap, "%s stores no up axis: the file's coordinates, y by convention", format[0] ? format : "the format");
     return t;
 }
 
