@@ -7,6 +7,7 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli/cli.h"
@@ -281,15 +282,20 @@ static const char *up_name(asp_up_axis up)
     return (unsigned)up < 6 ? names[up] : "y";
 }
 
+
+/* Materials no triangle uses (assimp's OBJ reader always adds "DefaultMaterial") are left out: used_by[i]. */
 static void print_mesh_text(const char *path, const asp_file_type *type, const asp_mesh *m, const double lo[3],
-                            const double hi[3], size_t found, size_t missing)
+                            const double hi[3], const unsigned char *used_by, size_t used, size_t found,
+                            size_t missing)
 {
     printf("file        %s\nkind        mesh (%s)\n", path, type->format);
     printf("vertices    %zu\nfaces       %zu (triangles)\n", m->vertex_count, m->triangle_count);
     printf("uv sets     %u\ncolours     %s\n", m->uv_set_count, m->colors ? "per vertex" : "materials only");
-    printf("materials   %zu\n", m->material_count);
+    printf("materials   %zu\n", used);
     for (size_t i = 0; i < m->material_count; i++) {
         const asp_material *mt = &m->materials[i];
+        if (!used_by[i])
+            continue;
         printf("  %-20s", mt->name);
         if (mt->has_color)
             printf(" colour %.3g %.3g %.3g %.3g", mt->diffuse[0], mt->diffuse[1], mt->diffuse[2], mt->diffuse[3]);
@@ -303,7 +309,7 @@ static void print_mesh_text(const char *path, const asp_file_type *type, const a
     }
     printf("textures    %zu found, %zu missing\n", found, missing);
     for (size_t i = 0; i < m->material_count; i++)
-        if (m->materials[i].texture_missing)
+        if (m->materials[i].texture_missing && used_by[i])
             printf("missing     %s (material '%s')\n", m->materials[i].texture_path, m->materials[i].name);
     printf("bbox min    %.9g %.9g %.9g\n", lo[0], lo[1], lo[2]);
     printf("bbox max    %.9g %.9g %.9g\n", hi[0], hi[1], hi[2]);
@@ -312,16 +318,18 @@ static void print_mesh_text(const char *path, const asp_file_type *type, const a
 }
 
 static void print_mesh_json(const char *path, const asp_file_type *type, const asp_mesh *m, const double lo[3],
-                            const double hi[3], size_t found, size_t missing)
+                            const double hi[3], const unsigned char *used_by, size_t found, size_t missing)
 {
     printf("{\"file\": ");
     cli_json_string(stdout, path);
     printf(", \"kind\": \"mesh\", \"format\": \"%s\", \"vertices\": %zu, \"faces\": %zu, \"uv_sets\": %u, "
            "\"vertex_colors\": %s, \"materials\": [",
            type->format, m->vertex_count, m->triangle_count, m->uv_set_count, m->colors ? "true" : "false");
-    for (size_t i = 0; i < m->material_count; i++) {
+    for (size_t i = 0, k = 0; i < m->material_count; i++) {
         const asp_material *mt = &m->materials[i];
-        printf("%s{\"name\": ", i ? ", " : "");
+        if (!used_by[i])
+            continue;
+        printf("%s{\"name\": ", k++ ? ", " : "");
         cli_json_string(stdout, mt->name);
         if (mt->has_color)
             printf(", \"color\": [%.6g, %.6g, %.6g, %.6g]", mt->diffuse[0], mt->diffuse[1], mt->diffuse[2],
@@ -337,7 +345,7 @@ static void print_mesh_json(const char *path, const asp_file_type *type, const a
     }
     printf("], \"textures_found\": %zu, \"textures_missing\": [", found);
     for (size_t i = 0, k = 0; i < m->material_count; i++)
-        if (m->materials[i].texture_missing) {
+        if (m->materials[i].texture_missing && used_by[i]) {
             printf("%s", k++ ? ", " : "");
             cli_json_string(stdout, m->materials[i].texture_path);
         }
@@ -390,16 +398,28 @@ static int info_mesh(const char *path, const asp_file_type *type, struct cli_env
     }
     double lo[3], hi[3];
     mesh_bounds(m, lo, hi);
-    size_t found = 0, missing = 0;
+    unsigned char *used_by = calloc(m->material_count, 1);
+    if (!used_by) {
+        asp_mesh_destroy(m);
+        asp_error_set(&err, ASP_ENOMEM, "out of memory for %zu materials", m->material_count);
+        return cli_fail(env, &err);
+    }
+    for (size_t t = 0; t < m->triangle_count; t++)
+        used_by[m->material_ids[t]] = 1; /* ids are in range: asp_mesh_validate checked them */
+    size_t used = 0, found = 0, missing = 0;
     for (size_t i = 0; i < m->material_count; i++) {
+        if (!used_by[i])
+            continue;
+        used++;
         found += m->materials[i].texture.pixels != NULL;
         missing += m->materials[i].texture_missing != 0;
     }
     cli_progress_end(env);
     if (env->json)
-        print_mesh_json(path, type, m, lo, hi, found, missing);
+        print_mesh_json(path, type, m, lo, hi, used_by, found, missing);
     else
-        print_mesh_text(path, type, m, lo, hi, found, missing);
+        print_mesh_text(path, type, m, lo, hi, used_by, used, found, missing);
+    free(used_by);
     asp_mesh_destroy(m);
     return 0;
 }
