@@ -130,6 +130,20 @@ int asp_cloud_validate(const asp_cloud *cloud, asp_error *err);
 int asp_cloud_clone(const asp_cloud *src, asp_cloud **out, asp_error *err);
 
 /**
+ * Which world axis points up: for the orbit camera (asp_camera.up) and for the
+ * mesh loader (asp_mesh.up, the axis of the file taken as up). The zero value
+ * is +y (OpenGL, OBJ, glTF, PLY from most meshes).
+ */
+typedef enum asp_up_axis {
+    ASP_UP_Y = 0, /* azimuth 0 looks from +z */
+    ASP_UP_Z = 1, /* scanners, CAD, 3DS: azimuth 0 looks from -y (the "front" view of z-up tools) */
+    ASP_UP_X = 2, /* azimuth 0 looks from +z */
+    ASP_UP_NEG_Y = 3, /* the negative axes: the positive one's frame turned 180 degrees about its view axis */
+    ASP_UP_NEG_Z = 4,
+    ASP_UP_NEG_X = 5
+} asp_up_axis;
+
+/**
  * The sphere every representation of one point set is framed by: render, view
  * and eval point the camera at it whatever the file (.ply, .amg, .dps, .hier),
  * so one --view means one picture. .amg, .dps and .hier files record the frame

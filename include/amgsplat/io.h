@@ -125,26 +125,30 @@ int asp_xyz_read_memory(const void *data, size_t size, const char *name, const a
 int asp_xyz_write(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err);
 
 /**
- * Loads a point file by extension (case-insensitive): .ply through
- * asp_ply_read, .xyz/.pts/.txt through asp_xyz_read. Then rejects non-finite
+ * Loads a point file, its format told by asp_file_recognise (magic bytes, then
+ * the extension, case-insensitive: BUNNY.PLY loads): PLY through asp_ply_read
+ * (a PLY with faces too: its vertices), .xyz/.pts/.txt through asp_xyz_read. Then rejects non-finite
  * values (asp_cloud_validate) and an empty cloud, with ASP_EFORMAT
  * "cannot read 'F': ...". A cloud whose points are all equal loads fine.
  * Unknown extension: ASP_EUNSUPPORTED "cannot read 'f.abc': unknown point
- * format '.abc' (expected .ply, .xyz, .pts, .txt)". On failure *out is
- * unchanged. Reentrant; ctx may be NULL.
+ * format '.abc' (expected .ply, .xyz, .pts, .txt)". A file that is
+ * something else (a mesh, an image, an .amg ...: by its magic or extension)
+ * gives ASP_EUNSUPPORTED "cannot read 'f.obj': a mesh file (obj), not a point
+ * file; sample it ...". A directory or FIFO: ASP_EIO at once. On failure
+ * *out is unchanged. Reentrant; ctx may be NULL.
  */
 int asp_cloud_load(const char *path, const asp_context *ctx, asp_cloud **out, asp_error *err);
 
 /**
- * Saves by extension: .ply through asp_ply_write (desc->encoding applies),
+ * Saves by extension (case-insensitive, asp_file_type_of_name): .ply through asp_ply_write (desc->encoding applies),
  * .xyz/.pts/.txt through asp_xyz_write. Unknown extension: ASP_EUNSUPPORTED
  * "cannot write 'f.abc': unknown point format ...". Atomic. Reentrant.
  */
 int asp_cloud_save(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err);
 
 /**
- * Point format of a path by its extension: "ply", "xyz" (for .xyz, .pts,
- * .txt) or NULL when unknown. Pure; never fails.
+ * Point format of a path by its extension (case-insensitive): "ply", "xyz"
+ * (for .xyz, .pts, .txt) or NULL when unknown. Pure; never fails.
  */
 const char *asp_cloud_format_of(const char *path);
 
@@ -166,8 +170,9 @@ typedef enum asp_file_kind {
 /** What asp_file_recognise found. */
 typedef struct asp_file_type {
     asp_file_kind kind;
-    char format[16]; /* lower-case short name: "ply", "xyz", "obj", "off", "stl", "gltf", "glb", "3ds",
-                        "amg", "dps", "hier", "png", "jpeg" ...; "" when unknown */
+    char format[16]; /* lower-case short name: "ply", "xyz", "pts", "txt", "obj", "off", "stl", "gltf",
+                        "glb", "3ds", "fbx", "dae", "amg", "dps", "hier", "png", "jpeg", "bmp", "tga",
+                        "gif"; "" when unknown */
     int by_magic;    /* 1: told by the first bytes of the file, 0: by its extension */
 } asp_file_type;
 
@@ -198,6 +203,20 @@ int asp_file_recognise_memory(const void *head, size_t size, const char *name, a
  * naming the extension. Pure.
  */
 int asp_file_type_of_name(const char *path, asp_file_type *out, asp_error *err);
+
+/** An image file's header: what asp_image_probe reads without decoding pixels. */
+typedef struct asp_image_header {
+    uint32_t width, height;
+    unsigned channels; /* in the file: 1 grey, 2 grey+alpha, 3 RGB, 4 RGBA */
+} asp_image_header;
+
+/**
+ * Reads the size and channel count of an image (PNG, JPEG, BMP, TGA, GIF ...)
+ * from its header. Returns 0; ASP_EIO (cannot open); ASP_EFORMAT (not an
+ * image stb_image reads, with its reason). *out is unchanged on failure.
+ * Reentrant except for stb_image's failure reason string.
+ */
+int asp_image_probe(const char *path, asp_image_header *out, asp_error *err);
 
 /** "unknown", "points", "mesh", "amg", "dps", "hier", "image". Never NULL. */
 const char *asp_file_kind_name(asp_file_kind kind);

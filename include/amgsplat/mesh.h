@@ -20,7 +20,10 @@ typedef struct asp_material {
     float diffuse[4];       /* RGBA in 0..1 */
     int has_color;          /* 1 when the colour came from the file, 0 for assimp's default material */
     asp_image texture;      /* pixels == NULL when the material has no texture */
-    char texture_path[512]; /* where the texture came from ("*0" = embedded), "" when none */
+    char texture_path[512]; /* where the texture came from ("*0" = embedded), "" when none; when
+                               texture_missing, the file that was looked for */
+    int texture_missing;    /* 1: the material names a texture file that cannot be found (only with
+                               asp_mesh_load_desc.allow_missing_textures; texture.pixels is NULL) */
 } asp_material;
 
 /**
@@ -39,6 +42,11 @@ typedef struct asp_mesh {
     uint32_t *material_ids; /* triangle_count indices into materials */
     size_t material_count;  /* >= 1 */
     asp_material *materials;
+    unsigned uv_set_count;  /* texture coordinate sets in the file (the largest over its meshes);
+                               uvs holds the first */
+    asp_up_axis up;         /* the axis of the file's coordinates taken as up; positions and normals
+                               are turned so that it is +y (asp_mesh_load_desc.up) */
+    char up_rule[96];       /* why that axis, for info: "obj stores no up axis: the file's coordinates, y by convention" */
     asp_context ctx;        /* copy of the context that allocated the arrays */
 } asp_mesh;
 
@@ -69,6 +77,24 @@ typedef struct asp_mesh_load_desc {
      */
     const char *texture_override;
     int ignore_file_normals; /* 1: recompute area-weighted normals even if the file has some */
+    /*
+     * 1: a texture file that cannot be found is recorded (texture_missing,
+     * texture_path) instead of failing the load, for 'amgsplat info'. 0 (the
+     * default): ASP_EIO naming the file, since sampling would lose its colours.
+     */
+    int allow_missing_textures;
+    /*
+     * The axis of the file's coordinates that points up; the loaded mesh is
+     * turned so that it becomes +y (the renderer's default). The zero value,
+     * ASP_UP_Y, keeps the file's coordinates as they are. Rule for every
+     * format: the file's own coordinates, y up (OBJ, PLY, OFF, STL store no
+     * axis; glTF is y-up by its specification). assimp's 3DS importer turns
+     * the scene -90 degrees about x to make 3ds Max's z-up data y-up; the
+     * loader undoes that turn, because 3DS files store no up axis and those
+     * met in practice (glmark2's cat and horse) are y-up: a z-up 3DS file
+     * needs up = ASP_UP_Z like any other z-up file.
+     */
+    asp_up_axis up;
 } asp_mesh_load_desc;
 
 /**

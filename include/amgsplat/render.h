@@ -141,15 +141,7 @@ int asp_gl_context_read_window(asp_gl_context *gl, asp_image *out, asp_error *er
  * points away from the azimuth direction, so no singularity). Perspective
  * projection with vertical field of view fov_y. Caller-owned plain struct.
  */
-/** Which world axis points up for the orbit camera; the zero value is +y (OpenGL, PLY from most meshes). */
-typedef enum asp_up_axis {
-    ASP_UP_Y = 0, /* azimuth 0 looks from +z */
-    ASP_UP_Z = 1, /* scanners, CAD, 3DS: azimuth 0 looks from -y (the "front" view of z-up tools) */
-    ASP_UP_X = 2, /* azimuth 0 looks from +z */
-    ASP_UP_NEG_Y = 3, /* the negative axes: the positive one's frame turned 180 degrees about its view axis */
-    ASP_UP_NEG_Z = 4,
-    ASP_UP_NEG_X = 5
-} asp_up_axis;
+/* asp_up_axis (which world axis points up) is declared in cloud.h: mesh loading records it too. */
 
 typedef struct asp_camera {
     float target[3];

@@ -110,21 +110,17 @@ static void print_json(const char *input, const char *output, const asp_dps *dps
     printf("]}\n");
 }
 
-static int ends_with(const char *s, const char *suffix)
-{
-    size_t n = strlen(s), m = strlen(suffix);
-    return n >= m && strcmp(s + n - m, suffix) == 0;
-}
-
 /* Atlas PNGs: X.png for one level, X-L-3.png for each of several. */
 static int save_atlases(const char *path, const asp_dps *dps, const asp_dps_summary *rows, asp_error *err)
 {
+    asp_file_type t;
+    int png = asp_file_type_of_name(path, &t, NULL) == 0 && strcmp(t.format, "png") == 0;
     for (size_t i = 0; i < dps->level_count; i++) {
         char name[4096];
         size_t n = strlen(path);
         if (dps->level_count == 1)
             snprintf(name, sizeof name, "%s", path);
-        else if (ends_with(path, ".png"))
+        else if (png)
             snprintf(name, sizeof name, "%.*s-%s.png", (int)(n - 4), path, rows[i].name);
         else
             snprintf(name, sizeof name, "%s-%s.png", path, rows[i].name);
@@ -190,9 +186,12 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     double t0 = asp_time_now(), t_dec = 0;
     asp_amg *amg = NULL;
     asp_cloud *cloud = NULL;
-    if (ends_with(argv[0], ".amg")) {
+    asp_file_type type;
+    rc = asp_file_recognise(argv[0], &type, &err);
+    if (!rc && type.kind == ASP_FILE_AMG) {
         rc = asp_amg_load(argv[0], &env->ctx, &amg, &err);
-    } else {
+    } else if (!rc) {
+        /* asp_cloud_load names what anything else is (a mesh: "sample it to points first") */
         rc = asp_cloud_load(argv[0], &env->ctx, &cloud, &err);
         if (!rc)
             rc = asp_amg_decompose(cloud, NULL, &env->ctx, &amg, &err);

@@ -74,7 +74,8 @@ int cmd_convert(int argc, char **argv, struct cli_env *env)
     const char *in = argv[0], *out = argv[1];
     if (ascii && big_endian)
         return cli_usage_error(env, "--ascii and --big-endian exclude each other");
-    const char *out_fmt = asp_cloud_format_of(out);
+    asp_file_type out_type;
+    const char *out_fmt = asp_file_type_of_name(out, &out_type, NULL) == 0 ? out_type.format : NULL;
     if ((ascii || big_endian) && out_fmt && strcmp(out_fmt, "ply") != 0)
         return cli_usage_error(env, "--%s applies to .ply output only, not '%s'", ascii ? "ascii" : "big-endian", out);
 

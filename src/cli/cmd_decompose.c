@@ -55,12 +55,6 @@ static int lookup(const struct name_code *t, const char *name, int *out)
     return -1;
 }
 
-static int ends_with(const char *s, const char *suffix)
-{
-    size_t n = strlen(s), m = strlen(suffix);
-    return n >= m && strcmp(s + n - m, suffix) == 0;
-}
-
 static void print_info_json(const asp_amg *amg)
 {
     const asp_amg_info *in = asp_amg_get_info(amg);
@@ -168,7 +162,9 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     if (npos != 1)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat decompose -h'", npos);
     const char *input = argv[0];
-    int from_amg = ends_with(input, ".amg");
+    /* the recogniser (magic, then extension in any case: O.AMG); a failure here resurfaces in the loader */
+    asp_file_type type;
+    int from_amg = asp_file_recognise(input, &type, NULL) == 0 && type.kind == ASP_FILE_AMG;
     int color_mode = 0;
     asp_amg_desc desc = {.k_min = k, .k_max = k_max, .epsilon = epsilon, .fan_k = fan_k, .alpha = alpha,
                          .beta = beta, .strong_threshold = strong, .trunc_factor = trunc, .max_levels = max_levels,

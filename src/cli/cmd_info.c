@@ -1,26 +1,36 @@
 /*
- * amgsplat info: what a point file holds — counts, attributes, bounds, radii —
- * and the levels of a .dps (primitives) or .amg (decomposition) file.
+ * amgsplat info: what any file amgsplat reads holds, its kind told by the one
+ * recogniser (asp_file_recognise): a point file's counts, attributes, bounds and
+ * radii; a mesh's vertices, faces, UV sets, materials, textures (found and
+ * missing), bounds and the up axis assumed; the levels of a .dps or .amg; a
+ * .hier's nodes; an image's size.
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli/cli.h"
 #include "cli/commands.h"
 #include "amgsplat/amg.h"
+#include "amgsplat/mesh.h"
 #include "util/banned.h"
 
 static const char usage[] =
     "usage: amgsplat info FILE [--json]\n"
     "\n"
-    "Prints the number of points and faces, the attributes present (normals, colours,\n"
-    "radii, texture coordinates, labels and any extra properties with their types), the\n"
-    "bounding box in world coordinates and the radius statistics of a point file\n"
-    "(.ply, .xyz, .pts, .txt). For a primitive file (.dps, from 'amgsplat build') it prints\n"
-    "per level: primitives, texels, error, normalised error, cb and dpc times, atlas size. For a\n"
-    "decomposition (.amg, from 'amgsplat decompose') it prints the points, their attributes and\n"
-    "the unknowns of every AMG level (domains per level: 'amgsplat decompose --stats').";
+    "Tells what FILE is (by its first bytes, else its extension in any case) and describes it.\n"
+    "Point file (.ply, .xyz, .pts, .txt): points and faces, the attributes present (normals,\n"
+    "colours, radii, texture coordinates, labels and extra properties with their types), the\n"
+    "bounding box in world coordinates and the radius statistics. Mesh (OBJ, PLY with faces,\n"
+    "OFF, STL, glTF, 3DS ...): vertices, triangles, UV sets, vertex colours, materials with\n"
+    "their colour and texture (a texture file that cannot be found is named as MISSING; info\n"
+    "still succeeds), the bounds as 'sample' will see them and the up axis assumed. Primitive\n"
+    "file (.dps, from 'amgsplat build'): per level primitives, texels, error, normalised error,\n"
+    "cb and dpc times, atlas size. Decomposition (.amg, from 'amgsplat decompose'): the points,\n"
+    "their attributes and the unknowns of every AMG level. Hierarchy (.hier): nodes, points,\n"
+    "depth, leaf size. .amg, .dps and .hier also show the recorded frame of their source\n"
+    "points. Image: size and channels.";
 
 struct radius_stats {
     double mean, min, max;
@@ -98,6 +108,25 @@ static void print_json(const char *path, const asp_cloud *c, const double lo[3],
     printf("]}\n");
 }
 
+/* The framing sphere recorded with a representation (asp_frame); radius 0 means the file predates it. */
+static void print_frame_text(const asp_frame *f)
+{
+    if (f && f->radius > 0)
+        printf("frame       centre %.9g %.9g %.9g radius %.9g\n", f->center[0], f->center[1], f->center[2],
+               f->radius);
+    else
+        printf("frame       not recorded\n");
+}
+
+static void print_frame_json(const asp_frame *f)
+{
+    if (f && f->radius > 0)
+        printf(", \"frame\": {\"center\": [%.17g, %.17g, %.17g], \"radius\": %.17g}", f->center[0], f->center[1],
+               f->center[2], f->radius);
+    else
+        printf(", \"frame\": null");
+}
+
 /* A .dps file (amgsplat build): the thesis Table 5.2 columns per stored level. */
 static int info_dps(const char *path, struct cli_env *env)
 {
@@ -114,9 +143,11 @@ static int info_dps(const char *path, struct cli_env *env)
         cli_json_string(stdout, path);
         printf(", \"source\": ");
         cli_json_string(stdout, dps->source);
-        printf(", \"points\": %llu, \"mean_radius\": %.9g, \"method\": \"%s\", \"texel_size\": %g, \"levels\": [",
+        printf(", \"points\": %llu, \"mean_radius\": %.9g, \"method\": \"%s\", \"texel_size\": %g",
                (unsigned long long)dps->source_points, dps->mean_radius, asp_prim_method_name(dps->desc.method),
                dps->desc.texel_size);
+        print_frame_json(&dps->frame);
+        printf(", \"levels\": [");
         for (size_t i = 0; i < nl; i++)
             printf("%s{\"level\": %u, \"name\": \"%s\", \"primitives\": %zu, \"texels\": %llu, \"error\": %.9g, "
                    "\"normalised_error\": %.6g, \"cb_seconds\": %.4f, \"dpc_seconds\": %.4f, \"skipped\": %u, "
@@ -131,6 +162,7 @@ static int info_dps(const char *path, struct cli_env *env)
         printf("file        %s\nsource      %s (%llu points, mean radius %.6g)\n", path, dps->source,
                (unsigned long long)dps->source_points, dps->mean_radius);
         printf("textures    %s, texel size %g\n", asp_prim_method_name(dps->desc.method), dps->desc.texel_size);
+        print_frame_text(&dps->frame);
         printf("level  name   primitives    texels        error  normalised   cb (s)  dpc (s)  atlas\n");
         for (size_t i = 0; i < nl; i++)
             printf("%5u  %-5s %11zu %9llu  %11.6g  %10.3f  %7.3f  %7.3f  %ux%u\n", rows[i].level, rows[i].name,
@@ -156,9 +188,11 @@ static int info_amg(const char *path, struct cli_env *env)
         printf("{\"file\": ");
         cli_json_string(stdout, path);
         printf(", \"points\": %zu, \"normals\": \"%s\", \"colors\": %s, \"radii\": %s, \"uvs\": %s, "
-               "\"labels\": %s, \"levels\": [",
+               "\"labels\": %s",
                c->count, asp_amg_has_input_normals(amg) ? "input" : "tangent", c->colors ? "true" : "false",
                c->radii ? "true" : "false", c->uvs ? "true" : "false", c->labels ? "true" : "false");
+        print_frame_json(asp_amg_frame(amg));
+        printf(", \"levels\": [");
         for (size_t l = 0; l < nl; l++) {
             char name[32];
             snprintf(name, sizeof name, l == nl - 1 ? "L" : "L-%zu", nl - 1 - l);
@@ -170,6 +204,7 @@ static int info_amg(const char *path, struct cli_env *env)
         printf("file        %s\npoints      %zu\nnormals     %s\nattributes ", path, c->count, normals);
         printf("%s%s%s%s\n", c->colors ? " colours" : "", c->radii ? " radii" : "", c->uvs ? " uvs" : "",
                c->labels ? " labels" : "");
+        print_frame_text(asp_amg_frame(amg));
         printf("level  name   unknowns  reduction\n");
         for (size_t l = 0; l < nl; l++) {
             char name[32];
@@ -183,22 +218,151 @@ static int info_amg(const char *path, struct cli_env *env)
     return 0;
 }
 
-int cmd_info(int argc, char **argv, struct cli_env *env)
+/* A .hier file (asp_hier_save): the point hierarchy's shape (thesis chapter 4). */
+static int info_hier(const char *path, struct cli_env *env)
 {
-    const struct cli_option opts[] = {{0}};
-    int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
-    if (rc)
-        return rc > 0 ? 0 : 2;
-    if (npos != 1)
-        return cli_usage_error(env, "expected one file, got %d; see 'amgsplat info -h'", npos);
-    size_t len = strlen(argv[0]);
-    if (len >= 4 && strcmp(argv[0] + len - 4, ".dps") == 0)
-        return info_dps(argv[0], env);
-    if (len >= 4 && strcmp(argv[0] + len - 4, ".amg") == 0)
-        return info_amg(argv[0], env);
+    asp_hier *h = NULL;
+    asp_error err = {0};
+    if (asp_hier_load(path, &env->ctx, &h, &err))
+        return cli_fail(env, &err);
+    cli_progress_end(env);
+    if (env->json) {
+        printf("{\"file\": ");
+        cli_json_string(stdout, path);
+        printf(", \"kind\": \"hier\", \"nodes\": %zu, \"points\": %zu, \"depth\": %u, \"leaf_size\": %zu",
+               asp_hier_node_count(h), asp_hier_point_count(h), asp_hier_depth(h), asp_hier_leaf_size(h));
+        print_frame_json(asp_hier_frame(h));
+        printf("}\n");
+    } else {
+        printf("file        %s\nkind        point hierarchy (.hier)\nnodes       %zu\npoints      %zu\n"
+               "depth       %u\nleaf size   %zu\n",
+               path, asp_hier_node_count(h), asp_hier_point_count(h), asp_hier_depth(h), asp_hier_leaf_size(h));
+        print_frame_text(asp_hier_frame(h));
+    }
+    asp_hier_destroy(h);
+    return 0;
+}
+
+static int info_image(const char *path, const asp_file_type *type, struct cli_env *env)
+{
+    asp_image_header hd;
+    asp_error err = {0};
+    if (asp_image_probe(path, &hd, &err))
+        return cli_fail(env, &err);
+    static const char *const layout[] = {"", "grey", "grey+alpha", "RGB", "RGBA"};
+    cli_progress_end(env);
+    if (env->json) {
+        printf("{\"file\": ");
+        cli_json_string(stdout, path);
+        printf(", \"kind\": \"image\", \"format\": \"%s\", \"width\": %u, \"height\": %u, \"channels\": %u}\n",
+               type->format, hd.width, hd.height, hd.channels);
+    } else {
+        printf("file        %s\nkind        image (%s)\nsize        %ux%u\nchannels    %u (%s)\n", path, type->format,
+               hd.width, hd.height, hd.channels, layout[hd.channels]);
+    }
+    return 0;
+}
+
+/* Mesh bounds in the y-up frame the loader turned it to: what 'sample' will produce. */
+static void mesh_bounds(const asp_mesh *m, double lo[3], double hi[3])
+{
+    for (int k = 0; k < 3; k++)
+        lo[k] = INFINITY, hi[k] = -INFINITY;
+    for (size_t v = 0; v < m->vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            double x = m->origin[k] + m->positions[3 * v + k];
+            lo[k] = x < lo[k] ? x : lo[k];
+            hi[k] = x > hi[k] ? x : hi[k];
+        }
+}
+
+static const char *up_name(asp_up_axis up)
+{
+    static const char *const names[] = {"y", "z", "x", "-y", "-z", "-x"};
+    return (unsigned)up < 6 ? names[up] : "y";
+}
+
+
+/* Materials no triangle uses (assimp's OBJ reader always adds "DefaultMaterial") are left out: used_by[i]. */
+static void print_mesh_text(const char *path, const asp_file_type *type, const asp_mesh *m, const double lo[3],
+                            const double hi[3], const unsigned char *used_by, size_t used, size_t found,
+                            size_t missing)
+{
+    printf("file        %s\nkind        mesh (%s)\n", path, type->format);
+    printf("vertices    %zu\nfaces       %zu (triangles)\n", m->vertex_count, m->triangle_count);
+    printf("uv sets     %u\ncolours     %s\n", m->uv_set_count, m->colors ? "per vertex" : "materials only");
+    printf("materials   %zu\n", used);
+    for (size_t i = 0; i < m->material_count; i++) {
+        const asp_material *mt = &m->materials[i];
+        if (!used_by[i])
+            continue;
+        printf("  %-20s", mt->name);
+        if (mt->has_color)
+            printf(" colour %.3g %.3g %.3g %.3g", mt->diffuse[0], mt->diffuse[1], mt->diffuse[2], mt->diffuse[3]);
+        else
+            printf(" colour (default)");
+        if (mt->texture_missing)
+            printf("  texture MISSING '%s'", mt->texture_path);
+        else if (mt->texture.pixels)
+            printf("  texture '%s' %ux%u", mt->texture_path, mt->texture.width, mt->texture.height);
+        printf("\n");
+    }
+    printf("textures    %zu found, %zu missing\n", found, missing);
+    for (size_t i = 0; i < m->material_count; i++)
+        if (m->materials[i].texture_missing && used_by[i])
+            printf("missing     %s (material '%s')\n", m->materials[i].texture_path, m->materials[i].name);
+    printf("bbox min    %.9g %.9g %.9g\n", lo[0], lo[1], lo[2]);
+    printf("bbox max    %.9g %.9g %.9g\n", hi[0], hi[1], hi[2]);
+    printf("area        %.9g\n", asp_mesh_area(m));
+    printf("up          %s (%s)\n", up_name(m->up), m->up_rule);
+}
+
+static void print_mesh_json(const char *path, const asp_file_type *type, const asp_mesh *m, const double lo[3],
+                            const double hi[3], const unsigned char *used_by, size_t found, size_t missing)
+{
+    printf("{\"file\": ");
+    cli_json_string(stdout, path);
+    printf(", \"kind\": \"mesh\", \"format\": \"%s\", \"vertices\": %zu, \"faces\": %zu, \"uv_sets\": %u, "
+           "\"vertex_colors\": %s, \"materials\": [",
+           type->format, m->vertex_count, m->triangle_count, m->uv_set_count, m->colors ? "true" : "false");
+    for (size_t i = 0, k = 0; i < m->material_count; i++) {
+        const asp_material *mt = &m->materials[i];
+        if (!used_by[i])
+            continue;
+        printf("%s{\"name\": ", k++ ? ", " : "");
+        cli_json_string(stdout, mt->name);
+        if (mt->has_color)
+            printf(", \"color\": [%.6g, %.6g, %.6g, %.6g]", mt->diffuse[0], mt->diffuse[1], mt->diffuse[2],
+                   mt->diffuse[3]);
+        else
+            printf(", \"color\": null");
+        printf(", \"texture\": ");
+        if (mt->texture_path[0])
+            cli_json_string(stdout, mt->texture_path);
+        else
+            printf("null");
+        printf(", \"texture_missing\": %s}", mt->texture_missing ? "true" : "false");
+    }
+    printf("], \"textures_found\": %zu, \"textures_missing\": [", found);
+    for (size_t i = 0, k = 0; i < m->material_count; i++)
+        if (m->materials[i].texture_missing && used_by[i]) {
+            printf("%s", k++ ? ", " : "");
+            cli_json_string(stdout, m->materials[i].texture_path);
+        }
+    printf("], \"textures_missing_count\": %zu, \"bbox_min\": [%.17g, %.17g, %.17g], "
+           "\"bbox_max\": [%.17g, %.17g, %.17g], \"area\": %.9g",
+           missing, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], asp_mesh_area(m));
+    printf(", \"up\": \"%s\", \"up_rule\": ", up_name(m->up));
+    cli_json_string(stdout, m->up_rule);
+    printf("}\n");
+}
+
+/* A point file (or a PLY's vertices): counts, attributes, bounds, radii. */
+static int info_points(const char *path, struct cli_env *env)
+{
     asp_cloud *c = NULL;
     asp_error err = {0};
-    if (asp_cloud_load(argv[0], &env->ctx, &c, &err))
+    if (asp_cloud_load(path, &env->ctx, &c, &err))
         return cli_fail(env, &err);
     float flo[3], fhi[3];
     double lo[3], hi[3];
@@ -213,9 +377,80 @@ int cmd_info(int argc, char **argv, struct cli_env *env)
     struct radius_stats r = radius_stats(c);
     cli_progress_end(env);
     if (env->json)
-        print_json(argv[0], c, lo, hi, r);
+        print_json(path, c, lo, hi, r);
     else
-        print_text(argv[0], c, lo, hi, r);
+        print_text(path, c, lo, hi, r);
     asp_cloud_destroy(c);
     return 0;
+}
+
+/* A mesh, loaded as 'sample' would but tolerating missing textures, so they can be named. */
+static int info_mesh(const char *path, const asp_file_type *type, struct cli_env *env)
+{
+    asp_mesh *m = NULL;
+    asp_error err = {0};
+    if (asp_mesh_load(path, &(asp_mesh_load_desc){.allow_missing_textures = 1}, &env->ctx, &m, &err)) {
+        if (strcmp(type->format, "ply") != 0)
+            return cli_fail(env, &err);
+        /* our PLY reader takes more than assimp's (double coordinates, odd types): show the vertices at least */
+        cli_info(env, "amgsplat info: note: %s; describing its vertices as points", err.msg);
+        return info_points(path, env);
+    }
+    double lo[3], hi[3];
+    mesh_bounds(m, lo, hi);
+    unsigned char *used_by = calloc(m->material_count, 1);
+    if (!used_by) {
+        asp_mesh_destroy(m);
+        asp_error_set(&err, ASP_ENOMEM, "out of memory for %zu materials", m->material_count);
+        return cli_fail(env, &err);
+    }
+    for (size_t t = 0; t < m->triangle_count; t++)
+        used_by[m->material_ids[t]] = 1; /* ids are in range: asp_mesh_validate checked them */
+    size_t used = 0, found = 0, missing = 0;
+    for (size_t i = 0; i < m->material_count; i++) {
+        if (!used_by[i])
+            continue;
+        used++;
+        found += m->materials[i].texture.pixels != NULL;
+        missing += m->materials[i].texture_missing != 0;
+    }
+    cli_progress_end(env);
+    if (env->json)
+        print_mesh_json(path, type, m, lo, hi, used_by, found, missing);
+    else
+        print_mesh_text(path, type, m, lo, hi, used_by, used, found, missing);
+    free(used_by);
+    asp_mesh_destroy(m);
+    return 0;
+}
+
+int cmd_info(int argc, char **argv, struct cli_env *env)
+{
+    const struct cli_option opts[] = {{0}};
+    int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
+    if (rc)
+        return rc > 0 ? 0 : 2;
+    if (npos != 1)
+        return cli_usage_error(env, "expected one file, got %d; see 'amgsplat info -h'", npos);
+    const char *path = argv[0];
+    asp_file_type type;
+    asp_error err = {0};
+    if (asp_file_recognise(path, &type, &err))
+        return cli_fail(env, &err);
+    switch (type.kind) {
+    case ASP_FILE_DPS:
+        return info_dps(path, env);
+    case ASP_FILE_AMG:
+        return info_amg(path, env);
+    case ASP_FILE_HIER:
+        return info_hier(path, env);
+    case ASP_FILE_IMAGE:
+        return info_image(path, &type, env);
+    case ASP_FILE_MESH:
+        return info_mesh(path, &type, env);
+    case ASP_FILE_POINTS:
+    case ASP_FILE_UNKNOWN:
+        break;
+    }
+    return info_points(path, env);
 }

@@ -10,17 +10,21 @@
 
 static const char usage[] =
     "usage: amgsplat sample MESH -o OUT.ply [--method area|vertices|voxel] [--points N] [--grid n]\n"
-    "                       [--texture FILE] [--seed S] [--radius-scale X] [--uvs] [--labels] [--json]\n"
+    "                       [--texture FILE] [--seed S] [--radius-scale X] [--up AXIS] [--uvs] [--labels]\n"
+    "                       [--json]\n"
     "\n"
     "Samples a mesh (OBJ+MTL, PLY, OFF, STL, glTF/GLB, 3DS, ... via assimp) to points with\n"
     "normals, radii that close all holes, and colours from the texture, vertex colours or\n"
     "material. Methods: area (default) spreads N points evenly over the surface; vertices\n"
     "makes one point per vertex; voxel makes one point per occupied cell of an n^3 grid.\n"
-    "--texture applies an image to materials without a texture (e.g. Spot's OBJ).";
+    "--texture applies an image to materials without a texture (e.g. Spot's OBJ).\n"
+    "The points come out y-up, as render shows them by default. The file's own\n"
+    "coordinates are taken as y-up for every format (3DS too: assimp's z-up turn is\n"
+    "undone); --up z (or x, -y ...) names the file's up axis for files that differ.";
 
 int cmd_sample(int argc, char **argv, struct cli_env *env)
 {
-    const char *output = NULL, *method_name = "area", *texture = NULL;
+    const char *output = NULL, *method_name = "area", *texture = NULL, *up = NULL;
     size_t points = 100000, grid = 256, seed = 0;
     double radius_scale = 1.0;
     int uvs = 0, labels = 0;
@@ -32,6 +36,7 @@ int cmd_sample(int argc, char **argv, struct cli_env *env)
         {"texture", 't', CLI_STRING, &texture, "FILE", "texture for materials that have none"},
         {"seed", 's', CLI_SIZE, &seed, "S", "area: sequence seed (default 0)"},
         {"radius-scale", 0, CLI_DOUBLE, &radius_scale, "X", "multiply every radius (default 1)"},
+        {"up", 0, CLI_STRING, &up, "AXIS", "the file's up axis: y (default), z, x, -y, -z or -x"},
         {"uvs", 0, CLI_FLAG, &uvs, NULL, "also write texture coordinates"},
         {"labels", 0, CLI_FLAG, &labels, NULL, "also write the source triangle of each point"},
         {0},
@@ -54,9 +59,14 @@ int cmd_sample(int argc, char **argv, struct cli_env *env)
     if (!(radius_scale > 0.0) || radius_scale > 1e6)
         return cli_usage_error(env, "--radius-scale must be positive, got %g", radius_scale);
 
+    asp_up_axis up_axis = ASP_UP_Y;
+    if (up && cli_parse_up(up, &up_axis) != 0)
+        return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", up);
+
     double t0 = asp_time_now();
     asp_mesh *mesh = NULL;
-    if (asp_mesh_load(argv[0], &(asp_mesh_load_desc){.texture_override = texture}, &env->ctx, &mesh, &err))
+    if (asp_mesh_load(argv[0], &(asp_mesh_load_desc){.texture_override = texture, .up = up_axis}, &env->ctx, &mesh,
+                      &err))
         return cli_fail(env, &err);
     double t_load = asp_time_now() - t0;
     asp_sample_desc desc = {.method = method, .points = points, .grid = (uint32_t)grid, .seed = seed,

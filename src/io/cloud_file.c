@@ -1,14 +1,35 @@
 /*
- * Point files by extension: .ply through the PLY reader/writer, .xyz/.pts/
- * .txt through the text reader/writer. Loading also rejects non-finite values
- * and empty clouds, so every later stage (journal Sect. 2 onwards) starts from a
- * usable point set; degenerate but valid sets (all points equal) load fine.
+ * Point files, told apart by the one recogniser (file_kind.c: magic bytes,
+ * then the extension, case-insensitive): PLY through the PLY reader/writer,
+ * .xyz/.pts/.txt through the text reader/writer. Loading also rejects
+ * non-finite values and empty clouds, so every later stage (journal Sect. 2
+ * onwards) starts from a usable point set; degenerate but valid sets (all
+ * points equal) load fine.
  */
-#include <ctype.h>
 #include <string.h>
 
 #include "amgsplat/io.h"
 #include "util/banned.h"
+
+static const char point_exts[] = ".ply, .xyz, .pts, .txt";
+
+/* "ply" or "xyz" for a recognised point format, NULL otherwise. */
+static const char *reader_of(const asp_file_type *t)
+{
+    if (strcmp(t->format, "ply") == 0)
+        return "ply"; /* a PLY with faces is a mesh, but its vertices are points all the same */
+    if (t->kind == ASP_FILE_POINTS)
+        return "xyz";
+    return NULL;
+}
+
+const char *asp_cloud_format_of(const char *path)
+{
+    asp_file_type t;
+    if (asp_file_type_of_name(path, &t, NULL))
+        return NULL;
+    return reader_of(&t);
+}
 
 static const char *extension(const char *path)
 {
@@ -17,47 +38,41 @@ static const char *extension(const char *path)
     return dot ? dot : "";
 }
 
-static int ext_is(const char *ext, const char *lit)
-{
-    size_t n = strlen(lit);
-    if (strlen(ext) != n)
-        return 0;
-    for (size_t i = 0; i < n; i++)
-        if (tolower((unsigned char)ext[i]) != lit[i])
-            return 0;
-    return 1;
-}
-
-const char *asp_cloud_format_of(const char *path)
-{
-    const char *ext = extension(path);
-    if (ext_is(ext, ".ply"))
-        return "ply";
-    if (ext_is(ext, ".xyz") || ext_is(ext, ".pts") || ext_is(ext, ".txt"))
-        return "xyz";
-    return NULL;
-}
-
 static int unknown(const char *verb, const char *path, asp_error *err)
 {
     const char *ext = extension(path);
     if (!*ext)
         return asp_error_set(err, ASP_EUNSUPPORTED,
-                             "cannot %s '%s': no file extension to tell the point format (expected .ply, .xyz, "
-                             ".pts, .txt)",
-                             verb, path);
-    return asp_error_set(err, ASP_EUNSUPPORTED,
-                         "cannot %s '%s': unknown point format '%.16s' (expected .ply, .xyz, .pts, .txt)", verb, path,
-                         ext);
+                             "cannot %s '%s': no file extension to tell the point format (expected %s)", verb, path,
+                             point_exts);
+    return asp_error_set(err, ASP_EUNSUPPORTED, "cannot %s '%s': unknown point format '%.16s' (expected %s)", verb,
+                         path, ext, point_exts);
+}
+
+/* What to tell a user who hands a mesh, an image or an amgsplat file to a command that wants points. */
+static int not_points(const char *path, const asp_file_type *t, asp_error *err)
+{
+    const char *hint = t->kind == ASP_FILE_MESH  ? "; sample it to points first: amgsplat sample MESH -o OUT.ply"
+                       : t->kind == ASP_FILE_AMG ? "; 'amgsplat decompose' made it from a point file"
+                                                 : "";
+    return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': %s %s file (%s), not a point file%s", path,
+                         t->kind == ASP_FILE_IMAGE ? "an" : "a", asp_file_kind_name(t->kind), t->format, hint);
 }
 
 int asp_cloud_load(const char *path, const asp_context *ctx, asp_cloud **out, asp_error *err)
 {
-    const char *fmt = asp_cloud_format_of(path);
-    if (!fmt)
+    asp_file_type t;
+    asp_error e = {0};
+    int rc = asp_file_recognise(path, &t, &e);
+    if (rc == ASP_EUNSUPPORTED)
         return unknown("read", path, err);
+    if (rc)
+        return asp_error_set(err, rc, "%s", e.msg);
+    const char *fmt = reader_of(&t);
+    if (!fmt)
+        return not_points(path, &t, err);
     asp_cloud *c = NULL;
-    int rc = fmt[0] == 'p' ? asp_ply_read(path, ctx, &c, err) : asp_xyz_read(path, ctx, &c, err);
+    rc = fmt[0] == 'p' ? asp_ply_read(path, ctx, &c, err) : asp_xyz_read(path, ctx, &c, err);
     if (rc)
         return rc;
     asp_error e2;
@@ -75,8 +90,9 @@ int asp_cloud_load(const char *path, const asp_context *ctx, asp_cloud **out, as
 
 int asp_cloud_save(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err)
 {
-    const char *fmt = asp_cloud_format_of(path);
-    if (!fmt)
+    asp_file_type t;
+    if (asp_file_type_of_name(path, &t, NULL) || t.kind != ASP_FILE_POINTS)
         return unknown("write", path, err);
-    return fmt[0] == 'p' ? asp_ply_write(cloud, path, desc, err) : asp_xyz_write(cloud, path, desc, err);
+    return strcmp(t.format, "ply") == 0 ? asp_ply_write(cloud, path, desc, err)
+                                        : asp_xyz_write(cloud, path, desc, err);
 }

@@ -28,18 +28,18 @@ struct ext_row {
  * (assimp reads more; asp_mesh_load takes any it reads).
  */
 static const struct ext_row ext_table[] = {
-    {".ply", ASP_FILE_POINTS, "ply"},   {".xyz", ASP_FILE_POINTS, "xyz"},   {".pts", ASP_FILE_POINTS, "xyz"},
-    {".txt", ASP_FILE_POINTS, "xyz"},   {".obj", ASP_FILE_MESH, "obj"},     {".off", ASP_FILE_MESH, "off"},
+    {".ply", ASP_FILE_POINTS, "ply"},   {".xyz", ASP_FILE_POINTS, "xyz"},   {".pts", ASP_FILE_POINTS, "pts"},
+    {".txt", ASP_FILE_POINTS, "txt"},   {".obj", ASP_FILE_MESH, "obj"},     {".off", ASP_FILE_MESH, "off"},
     {".stl", ASP_FILE_MESH, "stl"},     {".gltf", ASP_FILE_MESH, "gltf"},   {".glb", ASP_FILE_MESH, "glb"},
     {".3ds", ASP_FILE_MESH, "3ds"},     {".fbx", ASP_FILE_MESH, "fbx"},     {".dae", ASP_FILE_MESH, "dae"},
     {".amg", ASP_FILE_AMG, "amg"},      {".dps", ASP_FILE_DPS, "dps"},      {".hier", ASP_FILE_HIER, "hier"},
     {".png", ASP_FILE_IMAGE, "png"},    {".jpg", ASP_FILE_IMAGE, "jpeg"},   {".jpeg", ASP_FILE_IMAGE, "jpeg"},
-    {".bmp", ASP_FILE_IMAGE, "bmp"},    {".tga", ASP_FILE_IMAGE, "tga"},
+    {".bmp", ASP_FILE_IMAGE, "bmp"},    {".tga", ASP_FILE_IMAGE, "tga"},    {".gif", ASP_FILE_IMAGE, "gif"},
 };
 enum { N_EXT = sizeof ext_table / sizeof ext_table[0] };
 
 static const char expected[] = ".ply, .xyz, .pts, .txt, .obj, .off, .stl, .gltf, .glb, .3ds, .fbx, .dae, .amg, .dps, "
-                               ".hier, .png, .jpg, .bmp, .tga";
+                               ".hier, .png, .jpg, .bmp, .tga, .gif";
 
 const char *asp_file_kind_name(asp_file_kind kind)
 {
@@ -125,6 +125,8 @@ static int by_magic(const unsigned char *h, size_t n, asp_file_type *out)
         {"ASPHIER", 8, ASP_FILE_HIER, "hier"}, /* with its NUL */
         {"\x89PNG\r\n\x1a\n", 8, ASP_FILE_IMAGE, "png"},
         {"\xff\xd8\xff", 3, ASP_FILE_IMAGE, "jpeg"},
+        {"GIF87a", 6, ASP_FILE_IMAGE, "gif"},
+        {"GIF89a", 6, ASP_FILE_IMAGE, "gif"},
         {"glTF", 4, ASP_FILE_MESH, "glb"},
         {"Kaydara FBX Binary", 18, ASP_FILE_MESH, "fbx"},
     };
@@ -133,12 +135,19 @@ static int by_magic(const unsigned char *h, size_t n, asp_file_type *out)
             fill(out, magics[i].kind, magics[i].format, 1);
             return 0;
         }
-    // OFF, COFF, NOFF, STOFF ...: the keyword ends in "OFF" and stands alone on the first line
-    for (size_t k = 0; k + 3 <= n && k < 8; k++)
-        if (memcmp(h + k, "OFF", 3) == 0 && (k + 3 == n || h[k + 3] == '\n' || h[k + 3] == '\r' || h[k + 3] == ' ')) {
-            fill(out, ASP_FILE_MESH, "off", 1);
-            return 0;
-        }
+    /*
+     * OFF and its variants ([ST][C][N][4][n]OFF: STOFF, COFF, NOFF, 4OFF ...):
+     * the keyword opens the file and ends at a blank or line end, so a text
+     * point file whose comment mentions "OFF" is not taken for a mesh.
+     */
+    size_t k = 0;
+    while (k < n && k < 6 && h[k] && strchr("STCN4n", h[k]))
+        k++;
+    if (k + 3 <= n && memcmp(h + k, "OFF", 3) == 0 &&
+        (k + 3 == n || h[k + 3] == '\n' || h[k + 3] == '\r' || h[k + 3] == ' ' || h[k + 3] == '\t')) {
+        fill(out, ASP_FILE_MESH, "off", 1);
+        return 0;
+    }
     // 3DS: the main chunk 0x4D4D, then its length (little endian), then the version chunk 0x0002
     if (n >= 8 && h[0] == 0x4d && h[1] == 0x4d && h[6] == 0x02 && h[7] == 0x00) {
         fill(out, ASP_FILE_MESH, "3ds", 1);
@@ -158,8 +167,13 @@ int asp_file_recognise_memory(const void *head, size_t size, const char *name, a
         if (row && size > 0)
             return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': not %s file (bad magic)", nm,
                                  row->kind == ASP_FILE_AMG ? "an .amg" : row->kind == ASP_FILE_DPS ? "a .dps" : "a .hier");
+        if (!row && !*extension_of(nm))
+            return asp_error_set(err, ASP_EUNSUPPORTED,
+                                 "cannot read '%s': unknown file type (no known magic bytes and no extension; "
+                                 "expected %s)",
+                                 nm, expected);
         if (!row)
-            return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': unknown file type '%s' (expected %s)", nm,
+            return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': unknown file type '%.16s' (expected %s)", nm,
                                  extension_of(nm), expected);
     }
     fill(out, row->kind, row->format, 0);
@@ -207,8 +221,8 @@ int asp_file_type_of_name(const char *path, asp_file_type *out, asp_error *err)
 {
     const struct ext_row *row = by_extension(path);
     if (!row)
-        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot write '%s': unknown file type '%s' (expected %s)", path,
-                             extension_of(path), expected);
+        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot write '%s': unknown file type '%.16s' (expected %s)", path,
+                             *extension_of(path) ? extension_of(path) : "(none)", expected);
     fill(out, row->kind, row->format, 0);
     return 0;
 }

@@ -16,6 +16,7 @@
 #include <assimp/scene.h>
 #include <stb/stb_image.h>
 
+#include "amgsplat/io.h"
 #include "amgsplat/mesh.h"
 #include "util/banned.h"
 
@@ -191,7 +192,7 @@ static int walk_node(struct walk *w, const struct aiNode *node, const mat4 *pare
 
 /* Which meshes the walk reaches, to decide which optional arrays the merged mesh needs. */
 static void scan_attrs(const struct aiScene *s, const struct aiNode *node, int depth, int *uvs, int *colors,
-                       int *all_normals)
+                       int *all_normals, unsigned *uv_sets)
 {
     if (depth > MAX_NODE_DEPTH)
         return;
@@ -204,9 +205,13 @@ static void scan_attrs(const struct aiScene *s, const struct aiNode *node, int d
         *uvs |= am->mTextureCoords[0] != NULL;
         *colors |= am->mColors[0] != NULL;
         *all_normals &= am->mNormals != NULL;
+        unsigned sets = 0;
+        for (unsigned k = 0; k < AI_MAX_NUMBER_OF_TEXTURECOORDS; k++)
+            sets += am->mTextureCoords[k] != NULL;
+        *uv_sets = sets > *uv_sets ? sets : *uv_sets;
     }
     for (unsigned c = 0; c < node->mNumChildren; c++)
-        scan_attrs(s, node->mChildren[c], depth + 1, uvs, colors, all_normals);
+        scan_attrs(s, node->mChildren[c], depth + 1, uvs, colors, all_normals, uv_sets);
 }
 
 static int image_from_rgba(asp_image *img, const uint8_t *rgba, uint32_t w, uint32_t h, asp_error *err)
@@ -358,6 +363,11 @@ static int load_materials(const struct aiScene *scene, const char *path, const a
                 copy_str(mat->texture_path, sizeof mat->texture_path, file);
                 continue;
             }
+            if (!desc->texture_override && desc->allow_missing_textures) {
+                mat->texture_missing = 1;
+                copy_str(mat->texture_path, sizeof mat->texture_path, file);
+                continue;
+            }
             if (!desc->texture_override)
                 return asp_error_set(err, ASP_EIO,
                                      "cannot open texture '%s' of material '%s' in '%s': No such file; "
@@ -386,20 +396,20 @@ static void fill_material_colors(asp_mesh *m)
     }
 }
 
-static int build(const struct aiScene *scene, const char *path, const asp_mesh_load_desc *desc,
+static int build(const struct aiScene *scene, const char *path, const asp_mesh_load_desc *desc, const mat4 *start,
                  const asp_context *ctx, asp_mesh **out, asp_error *err)
 {
     if (!scene->mRootNode)
         return asp_error_set(err, ASP_EDEGENERATE, "'%s' has no triangles", path);
     struct walk w = {.scene = scene, .path = path, .err = err};
-    mat4 id = {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
-    int rc = walk_node(&w, scene->mRootNode, &id, 0);
+    int rc = walk_node(&w, scene->mRootNode, start, 0);
     if (rc)
         return rc;
     if (w.nt == 0)
         return asp_error_set(err, ASP_EDEGENERATE, "'%s' has no triangles", path);
     int has_uvs = 0, has_colors = 0, all_normals = 1;
-    scan_attrs(scene, scene->mRootNode, 0, &has_uvs, &has_colors, &all_normals);
+    unsigned uv_sets = 0;
+    scan_attrs(scene, scene->mRootNode, 0, &has_uvs, &has_colors, &all_normals, &uv_sets);
     if (desc->texture_override && !has_uvs)
         return asp_error_set(err, ASP_EINVAL, "'%s' has no texture coordinates, so texture '%s' cannot be applied",
                              path, desc->texture_override);
@@ -417,6 +427,7 @@ static int build(const struct aiScene *scene, const char *path, const asp_mesh_l
         m->materials = mats;
         m->material_count = scene->mNumMaterials;
     }
+    m->uv_set_count = uv_sets;
     int use_file_normals = all_normals && !desc->ignore_file_normals;
     w.fill = 1;
     w.nv = w.nt = 0;
@@ -427,7 +438,7 @@ static int build(const struct aiScene *scene, const char *path, const asp_mesh_l
         asp_mesh_destroy(m);
         return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", path);
     }
-    rc = walk_node(&w, scene->mRootNode, &id, 0);
+    rc = walk_node(&w, scene->mRootNode, start, 0);
     if (rc == 0)
         rc = load_materials(scene, path, desc, m, err);
     if (rc) {
@@ -471,6 +482,75 @@ static int build(const struct aiScene *scene, const char *path, const asp_mesh_l
     return 0;
 }
 
+/*
+ * The proper rotation that turns the file axis `up` to +y (x stays x where it
+ * can, so a z-up model keeps its left and right): z-up (x,y,z) -> (x,z,-y).
+ */
+static mat4 up_rotation(asp_up_axis up)
+{
+    static const double r[6][3][3] = {
+        [ASP_UP_Y] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+        [ASP_UP_Z] = {{1, 0, 0}, {0, 0, 1}, {0, -1, 0}},
+        [ASP_UP_X] = {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
+        [ASP_UP_NEG_Y] = {{1, 0, 0}, {0, -1, 0}, {0, 0, -1}},
+        [ASP_UP_NEG_Z] = {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}},
+        [ASP_UP_NEG_X] = {{0, 1, 0}, {-1, 0, 0}, {0, 0, 1}},
+    };
+    unsigned u = (unsigned)up < 6 ? (unsigned)up : 0;
+    mat4 m = {{{0}}};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            m.m[i][j] = r[u][i][j];
+    m.m[3][3] = 1;
+    return m;
+}
+
+static const char *axis_name(asp_up_axis up)
+{
+    static const char *const names[] = {"y", "z", "x", "-y", "-z", "-x"};
+    return (unsigned)up < 6 ? names[up] : "y";
+}
+
+/*
+ * The turn from assimp's scene to y-up and the rule behind it (mesh.h,
+ * asp_mesh_load_desc.up). assimp's 3DS importer multiplies the root by
+ * (x,y,z) -> (x,z,-y), taking 3ds Max's z-up for granted; turning the scene
+ * as if its -z were up brings back the file's own coordinates.
+ */
+static mat4 start_transform(const char *format, asp_up_axis up, char *rule, size_t cap)
+{
+    mat4 t = up_rotation(up);
+    int is_3ds = strcmp(format, "3ds") == 0;
+    if (is_3ds) {
+        mat4 undo = up_rotation(ASP_UP_NEG_Z);
+        t = mat4_mul(&t, &undo);
+    }
+    if (up != ASP_UP_Y)
+        snprintf(rule, cap, "as asked: the file's %s turned to y%s", axis_name(up),
+                 is_3ds ? " (assimp's 3DS z-up turn undone first)" : "");
+    else if (is_3ds)
+        snprintf(rule, cap, "3DS stores no up axis: the file's coordinates, assimp's z-up turn undone");
+    else if (strcmp(format, "gltf") == 0 || strcmp(format, "glb") == 0)
+        snprintf(rule, cap, "glTF is y-up by its specification");
+    else if (strcmp(format, "dae") == 0)
+        snprintf(rule, cap, "the file's <up_axis>, turned to y by assimp");
+    else
+        snprintf(rule, cap, "%s stores no up axis: the file's coordinates, y by convention", format[0] ? format : "the format");
+    return t;
+}
+
+/* A point file handed to the mesh loader gets told what it is, not assimp's "no triangles". */
+static int refuse_non_mesh(const char *path, const asp_file_type *t, asp_error *err)
+{
+    if (t->kind == ASP_FILE_POINTS)
+        return asp_error_set(err, ASP_EUNSUPPORTED,
+                             "cannot read '%s': a point file (%s without faces), not a mesh; it needs no sampling: "
+                             "give it to decompose, render or estimate as it is",
+                             path, t->format);
+    return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': %s %s file (%s), not a mesh", path,
+                         t->kind == ASP_FILE_IMAGE ? "an" : "a", asp_file_kind_name(t->kind), t->format);
+}
+
 int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_context *ctx, asp_mesh **out,
                   asp_error *err)
 {
@@ -479,6 +559,14 @@ int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_co
     if (!fp)
         return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
     fclose(fp);
+    /* unknown extensions go on to assimp, which reads more formats than the recogniser names */
+    asp_file_type type = {.kind = ASP_FILE_MESH};
+    asp_error e = {0};
+    int rc = asp_file_recognise(path, &type, &e);
+    if (rc && rc != ASP_EUNSUPPORTED)
+        return asp_error_set(err, rc, "%s", e.msg);
+    if (rc == 0 && type.kind != ASP_FILE_MESH)
+        return refuse_non_mesh(path, &type, err);
     /*
      * JoinIdenticalVertices welds the per-corner vertices OBJ/STL importers
      * emit; SortByPType puts points and lines into meshes of their own so the
@@ -491,7 +579,13 @@ int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_co
         const char *why = aiGetErrorString();
         return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': %s", path, why && *why ? why : "unknown format");
     }
-    int rc = build(scene, path, &d, ctx, out, err);
+    char rule[96];
+    mat4 start = start_transform(type.format, d.up, rule, sizeof rule);
+    rc = build(scene, path, &d, &start, ctx, out, err);
     aiReleaseImport(scene);
+    if (rc == 0) {
+        (*out)->up = d.up;
+        snprintf((*out)->up_rule, sizeof (*out)->up_rule, "%s", rule);
+    }
     return rc;
 }

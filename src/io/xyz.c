@@ -244,11 +244,11 @@ int asp_xyz_read_memory(const void *data, size_t size, const char *name, const a
 
 /* ---------- writing ---------- */
 
-static int ends_with_pts(const char *path)
+/* Leica PTS opens with the point count; the one recogniser says which text flavour a name asks for. */
+static int wants_count_line(const char *path)
 {
-    size_t n = strlen(path);
-    return n >= 4 && path[n - 4] == '.' && tolower((unsigned char)path[n - 3]) == 'p' &&
-           tolower((unsigned char)path[n - 2]) == 't' && tolower((unsigned char)path[n - 1]) == 's';
+    asp_file_type t;
+    return asp_file_type_of_name(path, &t, NULL) == 0 && strcmp(t.format, "pts") == 0;
 }
 
 int asp_xyz_write(const asp_cloud *c, const char *path, const asp_save_desc *desc, asp_error *err)
@@ -260,7 +260,7 @@ int asp_xyz_write(const asp_cloud *c, const char *path, const asp_save_desc *des
     int rc = asp__atomic_open(&f, path, err);
     if (rc)
         return rc;
-    if (ends_with_pts(path))
+    if (wants_count_line(path))
         fprintf(f.fp, "%zu\n", c->count);
     char line[16 * 32];
     for (size_t i = 0; i < c->count; i++) {

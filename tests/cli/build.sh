@@ -71,8 +71,12 @@ cp "$T/oct.dps" "$T/flip.dps"
 printf '\x7f' | dd of="$T/flip.dps" bs=1 seek=2000 conv=notrunc status=none
 expect_exit 1 "$A" info "$T/flip.dps"
 grep -q "checksum" "$T/err" || fail "corrupted: $(cat "$T/err")"
+# the first bytes decide: a PLY named .dps is described as the points it holds
 cp "$T/oct.ply" "$T/notdps.dps"
-expect_exit 1 "$A" info "$T/notdps.dps"
+"$A" info "$T/notdps.dps" | grep "^points *16000$" >/dev/null || fail "a PLY named .dps"
+# bytes no format claims, under a .dps name, are no .dps
+head -c 300 /dev/zero | tr '\0' 'x' > "$T/junk.dps"
+expect_exit 1 "$A" info "$T/junk.dps"
 grep -q "not a .dps file" "$T/err" || fail "foreign: $(cat "$T/err")"
 
 # bad input: exit 1, no output file
@@ -96,4 +100,9 @@ expect_exit 2 "$A" build "$T/oct.amg" -o "$T/x.dps" --method nope
 grep -q "unknown texture method 'nope'" "$T/err" || fail "method: $(cat "$T/err")"
 expect_exit 2 "$A" build "$T/oct.amg" -o "$T/x.dps" --level L --primitives 4
 expect_exit 2 "$A" build "$T/oct.amg" -o "$T/x.dps" --texel-size -1
+# upper-case .AMG input and .DPS output (the recogniser, not an extension matcher)
+cp "$T/oct.amg" "$T/OCT.AMG"
+"$A" build "$T/OCT.AMG" -o "$T/OCT.DPS" --level L -q || fail "build OCT.AMG"
+"$A" info "$T/OCT.DPS" --json | python3 -c "import json,sys; d=json.load(sys.stdin); assert d['levels'][0]['primitives']==8, d" \
+  || fail "info OCT.DPS"
 echo "build: ok"

@@ -99,4 +99,17 @@ expect_exit 2 "$A" decompose "$T/oct.amg" --stats --tau 1.5
 expect_exit 1 "$A" decompose "$T/oct.amg" --export-colors domains --level L-99 --colors-out "$T/x.ply"
 grep -q "L-99" "$T/err" || fail "bad level: $(cat "$T/err")"
 expect_exit 1 "$A" decompose "$T/oct.ply" -o "$T/x.amg" --strong 1.5
+# upper-case names: the recogniser reads O.AMG as an .amg (by its magic), BUNNY.PLY as points
+cp "$T/oct.amg" "$T/O.AMG"
+"$A" decompose "$T/O.AMG" --stats --json > "$T/upper.json" || fail "decompose O.AMG"
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['points']==16000 and d['level_stats'][-1]['unknowns']==8, d['points']" "$T/upper.json" \
+  || fail "decompose O.AMG: $(cat "$T/upper.json")"
+"$A" info "$T/O.AMG" | grep "^points *16000$" >/dev/null || fail "info O.AMG"
+cp "$T/oct.ply" "$T/OCT.PLY"
+"$A" decompose "$T/OCT.PLY" -o "$T/OCT2.AMG" -q || fail "decompose OCT.PLY"
+"$A" info "$T/OCT2.AMG" --json | python3 -c "import json,sys; d=json.load(sys.stdin); assert d['points']==16000 and d['frame']['radius']>0, d" \
+  || fail "info OCT2.AMG frame"
+# a mesh given where points are wanted is told to be sampled
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$T/tri.obj"
+expect_fail 1 "amgsplat sample" "$A" decompose "$T/tri.obj" -o "$T/x.amg"
 echo "decompose: ok"

@@ -62,4 +62,17 @@ horse=/usr/share/glmark2/models/horse.3ds
 "$AMGSPLAT" sample "$horse" -n 5000 -o "$T/horse.ply" --json >"$T/horse.json"
 python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['points']==5000 and d['area']>0, d" "$T/horse.json" \
   || fail "3ds: $(cat "$T/horse.json")"
+# a point file given to sample is told what it is
+"$AMGSPLAT" sample "$T/quad.obj" -n 200 -o "$T/pts.ply" -q
+expect_fail 1 "a point file" "$AMGSPLAT" sample "$T/pts.ply" -o "$T/x.ply"
+expect_fail 2 "--up expects" "$AMGSPLAT" sample "$T/quad.obj" --up w -o "$T/x.ply"
+# the y-up 3DS horse stands upright (tallest along y: it rears)
+"$AMGSPLAT" sample "$horse" -n 5000 -o "$T/horse.ply" -q
+"$AMGSPLAT" info --json "$T/horse.ply" | python3 -c "
+import json,sys; d=json.load(sys.stdin); e=[b-a for a,b in zip(d['bbox_min'], d['bbox_max'])]
+assert e[1] == max(e), e" || fail "3ds horse not upright"
+# upper-case extensions for meshes and point output
+cp "$T/quad.obj" "$T/QUAD.OBJ"
+"$AMGSPLAT" sample "$T/QUAD.OBJ" -n 100 -o "$T/Q.PLY" -q || fail "sample QUAD.OBJ -> Q.PLY"
+head -c 3 "$T/Q.PLY" | grep ply >/dev/null || fail "Q.PLY is not a PLY"
 echo "sample: ok"

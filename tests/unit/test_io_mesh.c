@@ -299,6 +299,155 @@ static void test_real_models(void)
     asp_mesh_destroy(m);
 }
 
+/* Little-endian writers for the hand-made 3DS file below. */
+static size_t put16(unsigned char *b, size_t o, unsigned v)
+{
+    b[o] = (unsigned char)(v & 0xff), b[o + 1] = (unsigned char)(v >> 8);
+    return o + 2;
+}
+
+static size_t put32(unsigned char *b, size_t o, uint32_t v)
+{
+    for (int i = 0; i < 4; i++)
+        b[o + (size_t)i] = (unsigned char)(v >> (8 * i));
+    return o + 4;
+}
+
+static size_t putf(unsigned char *b, size_t o, float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    return put32(b, o, u);
+}
+
+/*
+ * A 3DS file (chunks 0x4D4D main / 0x0002 version / 0x3D3D editor / 0x4000
+ * object / 0x4100 trimesh / 0x4110 vertices / 0x4120 faces) holding a tall
+ * tetrahedron whose apex is at y = 10 in the file: data that is y-up, as in
+ * glmark2's cat.3ds and horse.3ds. Returns the byte count.
+ */
+static size_t make_tall_3ds(unsigned char *b)
+{
+    static const float v[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 10, 0}};
+    static const unsigned f[4][3] = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};
+    const size_t vert = 6 + 2 + 4 * 12, face = 6 + 2 + 4 * 8, mesh = 6 + vert + face, obj = 6 + 5 + mesh;
+    const size_t ver = 10, edit = 6 + obj, main_len = 6 + ver + edit;
+    size_t o = 0;
+    o = put16(b, o, 0x4D4D), o = put32(b, o, (uint32_t)main_len);
+    o = put16(b, o, 0x0002), o = put32(b, o, 10), o = put32(b, o, 3);
+    o = put16(b, o, 0x3D3D), o = put32(b, o, (uint32_t)edit);
+    o = put16(b, o, 0x4000), o = put32(b, o, (uint32_t)obj);
+    memcpy(b + o, "tall", 5), o += 5;
+    o = put16(b, o, 0x4100), o = put32(b, o, (uint32_t)mesh);
+    o = put16(b, o, 0x4110), o = put32(b, o, (uint32_t)vert), o = put16(b, o, 4);
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            o = putf(b, o, v[i][k]);
+    o = put16(b, o, 0x4120), o = put32(b, o, (uint32_t)face), o = put16(b, o, 4);
+    for (int i = 0; i < 4; i++)
+        o = put16(b, o, f[i][0]), o = put16(b, o, f[i][1]), o = put16(b, o, f[i][2]), o = put16(b, o, 0);
+    return o;
+}
+
+/* Extent of a cloud along each axis. */
+static void cloud_extent(const asp_cloud *c, double ext[3], double lo_out[3])
+{
+    double lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
+    for (size_t i = 0; i < c->count; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = c->positions[3 * i + k];
+            lo[k] = x < lo[k] ? x : lo[k];
+            hi[k] = x > hi[k] ? x : hi[k];
+        }
+    for (int k = 0; k < 3; k++)
+        ext[k] = hi[k] - lo[k], lo_out[k] = lo[k] + c->origin[k];
+}
+
+/*
+ * The issue: "a 3DS model whose data is y-up lies on its side by default".
+ * assimp's 3DS importer turns the scene (x,y,z) -> (x,z,-y); the loader undoes
+ * it, so the sampled points stand upright along +y, the renderer's default
+ * up, and the mesh records the assumption. Upper-case names load too.
+ */
+static void test_3ds_y_up(void)
+{
+    unsigned char buf[512];
+    size_t n = make_tall_3ds(buf);
+    FILE *fp = fopen(path_in("TALL.3DS"), "wb");
+    CHECK(fp != NULL);
+    if (!fp)
+        return;
+    fwrite(buf, 1, n, fp);
+    fclose(fp);
+    asp_mesh *m = NULL;
+    asp_error *err = &(asp_error){0};
+    CHECK_OK(asp_mesh_load(path_in("TALL.3DS"), NULL, NULL, &m, err), err);
+    if (!m)
+        return;
+    CHECK(m->up == ASP_UP_Y);
+    CHECK_MSG(strstr(m->up_rule, "3DS") != NULL, "%s", m->up_rule);
+    asp_cloud *c = NULL;
+    CHECK_OK(asp_sample_mesh(m, &(asp_sample_desc){.points = 3000}, NULL, &c, NULL, err), err);
+    asp_mesh_destroy(m);
+    if (!c)
+        return;
+    double ext[3], lo[3];
+    cloud_extent(c, ext, lo);
+    /* tallest along y, by the file's factor of 10, and standing on y = 0 (apex up, not down) */
+    CHECK_MSG(ext[1] > 8.0 && ext[0] < 1.5 && ext[2] < 1.5, "extent %g %g %g", ext[0], ext[1], ext[2]);
+    CHECK_NEAR(lo[1], 0.0, 0.05);
+    asp_cloud_destroy(c);
+
+    /* --up z: the same file read as z-up turns its y (the tall axis) to -z */
+    m = NULL;
+    CHECK_OK(asp_mesh_load(path_in("TALL.3DS"), &(asp_mesh_load_desc){.up = ASP_UP_Z}, NULL, &m, err), err);
+    if (!m)
+        return;
+    CHECK(m->up == ASP_UP_Z);
+    double zlo = 1e30, zhi = -1e30, ylo = 1e30, yhi = -1e30;
+    for (size_t v = 0; v < m->vertex_count; v++) {
+        double y = m->origin[1] + m->positions[3 * v + 1], z = m->origin[2] + m->positions[3 * v + 2];
+        ylo = y < ylo ? y : ylo, yhi = y > yhi ? y : yhi, zlo = z < zlo ? z : zlo, zhi = z > zhi ? z : zhi;
+    }
+    CHECK_NEAR(zlo, -10.0, 1e-5);
+    CHECK_NEAR(zhi, 0.0, 1e-5);
+    CHECK_NEAR(yhi - ylo, 1.0, 1e-5); /* the file's z (depth 1) is now up */
+    asp_mesh_destroy(m);
+}
+
+/* OBJ is y-up by convention and kept as it is; an upper-case .OBJ loads; a missing texture can be tolerated. */
+static void test_obj_upper_case_and_missing_texture(void)
+{
+    write_file("UP.OBJ", "mtllib up.mtl\nv 0 0 0\nv 1 0 0\nv 0 5 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl skin\n"
+                         "f 1/1 2/2 3/3\n");
+    write_file("up.mtl", "newmtl skin\nKd 0.5 0.25 1\nmap_Kd textures/absent.png\n");
+    asp_mesh *m = NULL;
+    asp_error *err = &(asp_error){0};
+    CHECK(asp_mesh_load(path_in("UP.OBJ"), NULL, NULL, &m, err) == ASP_EIO && m == NULL);
+    CHECK_MSG(strstr(err->msg, "absent.png") != NULL, "%s", err->msg);
+    CHECK_OK(asp_mesh_load(path_in("UP.OBJ"), &(asp_mesh_load_desc){.allow_missing_textures = 1}, NULL, &m, err),
+             err);
+    if (!m)
+        return;
+    CHECK(m->up == ASP_UP_Y && m->uv_set_count == 1);
+    CHECK(m->material_count >= 1);
+    const asp_material *mt = &m->materials[m->material_ids[0]];
+    CHECK(mt->texture_missing == 1 && mt->texture.pixels == NULL);
+    CHECK_MSG(strstr(mt->texture_path, "absent.png") != NULL, "%s", mt->texture_path);
+    CHECK_NEAR(mt->diffuse[2], 1.0, 1e-6);
+    double top = m->origin[1];
+    for (size_t v = 0; v < m->vertex_count; v++)
+        top = fmax(top, m->origin[1] + m->positions[3 * v + 1]);
+    CHECK_NEAR(top, 5.0, 1e-6);
+    asp_mesh_destroy(m);
+    /* a point file is not a mesh: the message says so instead of "no triangles" */
+    write_file("pts.PLY", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                          "property float z\nend_header\n0 0 0\n");
+    m = NULL;
+    CHECK(asp_mesh_load(path_in("pts.PLY"), NULL, NULL, &m, err) == ASP_EUNSUPPORTED && m == NULL);
+    CHECK_MSG(strstr(err->msg, "point file") && strstr(err->msg, "pts.PLY"), "%s", err->msg);
+}
+
 static void setup(void)
 {
     snprintf(dir, sizeof dir, "/tmp/asp_test_mesh_XXXXXX");
@@ -310,7 +459,7 @@ static void teardown(void)
 {
     const char *names[] = {"quad.png", "quad.mtl", "quad.obj", "lost.mtl", "lost.obj", "other.png", "cube.off",
                            "tri.stl", "quad.ply", "emb.png", "tri.gltf", "flat.obj", "points.obj", "nan.obj",
-                           "junk.stl", "t.png", "nouv.obj"};
+                           "junk.stl", "t.png", "nouv.obj", "TALL.3DS", "UP.OBJ", "up.mtl", "pts.PLY"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         remove(path_in(names[i]));
     rmdir(dir);
@@ -318,4 +467,5 @@ static void teardown(void)
 
 TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_obj_with_texture), TEST_CASE(test_missing_texture),
           TEST_CASE(test_simple_formats), TEST_CASE(test_gltf_transform_embedded), TEST_CASE(test_errors),
-          TEST_CASE(test_real_models), TEST_CASE(teardown))
+          TEST_CASE(test_3ds_y_up), TEST_CASE(test_obj_upper_case_and_missing_texture), TEST_CASE(test_real_models),
+          TEST_CASE(teardown))

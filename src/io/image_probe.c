@@ -1,0 +1,30 @@
+/*
+ * What an image file holds without decoding it: size and channel count from
+ * stb_image's header reader, for 'amgsplat info' (asp_image_load always gives
+ * RGBA, so the file's own channel count would be lost).
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <stb/stb_image.h>
+
+#include "amgsplat/io.h"
+#include "util/banned.h"
+
+int asp_image_probe(const char *path, asp_image_header *out, asp_error *err)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+    int w = 0, h = 0, comp = 0;
+    int ok = stbi_info_from_file(fp, &w, &h, &comp);
+    fclose(fp);
+    if (!ok || w <= 0 || h <= 0 || comp < 1 || comp > 4)
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': %s", path,
+                             ok ? "image header out of range" : stbi_failure_reason());
+    out->width = (uint32_t)w;
+    out->height = (uint32_t)h;
+    out->channels = (unsigned)comp;
+    return 0;
+}
