@@ -218,6 +218,13 @@ typedef struct asp_image_header {
  */
 int asp_image_probe(const char *path, asp_image_header *out, asp_error *err);
 
+/**
+ * 1 when path's extension names format (asp_file_type.format, e.g. "png"),
+ * compared case-insensitively as asp_file_type_of_name does; else 0. For
+ * checking output names. Pure.
+ */
+int asp_file_name_is(const char *path, const char *format);
+
 /** "unknown", "points", "mesh", "amg", "dps", "hier", "image". Never NULL. */
 const char *asp_file_kind_name(asp_file_kind kind);
 

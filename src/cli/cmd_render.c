@@ -83,16 +83,6 @@ struct render_opts {
     const asp_context *ctx;
 };
 
-static int ends_with_ci(const char *path, const char *ext)
-{
-    size_t n = strlen(path), m = strlen(ext);
-    if (n < m)
-        return 0;
-    for (size_t i = 0; i < m; i++)
-        if (tolower((unsigned char)path[n - m + i]) != ext[i])
-            return 0;
-    return 1;
-}
 
 /* The loaded file as the one scene loader gives it (scene.h), and the picked row of the renderer table. */
 static int load_scene(const char *path, const struct render_opts *o, const struct cli_env *env, asp_scene *s,
@@ -253,7 +243,7 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
         return cli_usage_error(env, "missing -o OUT.png");
     if (o->up && cli_parse_up(o->up, &o->up_axis) != 0)
         return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
-    if (!ends_with_ci(o->output, ".png"))
+    if (!asp_file_name_is(o->output, "png"))
         return cli_usage_error(env, "output '%s' must end in .png", o->output);
     if (o->size && (cli_parse_size2(o->size, &o->width, &o->height) != 0 || o->width == 0 || o->height == 0 ||
                     o->width > MAX_SIDE || o->height > MAX_SIDE))

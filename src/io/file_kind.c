@@ -226,3 +226,9 @@ int asp_file_type_of_name(const char *path, asp_file_type *out, asp_error *err)
     fill(out, row->kind, row->format, 0);
     return 0;
 }
+
+int asp_file_name_is(const char *path, const char *format)
+{
+    asp_file_type t;
+    return asp_file_type_of_name(path, &t, NULL) == 0 && strcmp(t.format, format) == 0;
+}

@@ -48,14 +48,6 @@ static size_t find_renderer(const char *name)
 
 enum { MAX_SIDE = 16384, QUEUE_CAP = 64, LOG_CAP = 512 };
 
-static int ends_with_png(const char *path)
-{
-    size_t n = strlen(path);
-    if (n < 4)
-        return 0;
-    const char *e = path + n - 4;
-    return e[0] == '.' && (e[1] | 32) == 'p' && (e[2] | 32) == 'n' && (e[3] | 32) == 'g';
-}
 
 int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err)
 {
@@ -94,7 +86,7 @@ int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err)
     }
     if (desc->screenshot && desc->frames == 0)
         return asp_error_set(err, ASP_EINVAL, "a screenshot file needs a number of frames (scripted mode)");
-    if (desc->screenshot && !ends_with_png(desc->screenshot))
+    if (desc->screenshot && !asp_file_name_is(desc->screenshot, "png"))
         return asp_error_set(err, ASP_EINVAL, "screenshot '%s' must end in .png", desc->screenshot);
     return 0;
 }
