@@ -75,7 +75,8 @@ static void one(const uint8_t *data, size_t size)
         for (size_t i = 0; i < d->level_count; i++)
             check_level(d, i, size);
         asp_dps_summary rows[64];
-        asp_dps_summarize(d, rows);
+        if (asp_dps_summarize(d, rows, sizeof rows / sizeof rows[0]) != d->level_count)
+            abort();
         for (size_t i = 0; i < d->level_count; i++)
             if (rows[i].name[0] == '\0' || rows[i].primitives != d->levels[i].prim_count)
                 abort();
