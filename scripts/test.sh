@@ -52,6 +52,7 @@ run_ctest() {
 build_a() {
   configure build -DCMAKE_BUILD_TYPE=RelWithDebInfo
   cmake --build build -j "$jobs"
+  scripts/check_declared.py build/libamgsplat.a
   run_ctest build
 }
 
@@ -68,14 +69,18 @@ build_c() {
   cmake --build build-fuzz -j "$jobs"
 }
 
-# The reduced builds compile the library and the tests that apply; every declared function a
-# test calls must then be defined, or the link fails.
+# The reduced builds compile the library and the tests that apply, and check that every function
+# the built modules' headers declare is defined (scripts/check_declared.py): a test only links
+# against what it calls.
 build_d() {
   configure build-nogl -DCMAKE_BUILD_TYPE=RelWithDebInfo -DASP_WITH_GL=OFF -DASP_BUILD_BENCH=OFF
   cmake --build build-nogl -j "$jobs"
+  # the modules this build leaves out whole (GL): their headers declare what it lacks
+  scripts/check_declared.py build-nogl/libamgsplat.a render.h viewer.h
   run_ctest build-nogl
   configure build-nohypre -DCMAKE_BUILD_TYPE=RelWithDebInfo -DASP_WITH_HYPRE=OFF -DASP_BUILD_BENCH=OFF
   cmake --build build-nohypre -j "$jobs"
+  scripts/check_declared.py build-nohypre/libamgsplat.a
   run_ctest build-nohypre
 }
 
