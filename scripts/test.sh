@@ -20,11 +20,12 @@ t_all=$SECONDS
 
 # stage NAME CMD...: runs CMD, records its wall time
 stage() {
-  local name=$1 t0=$SECONDS
+  local name=$1 t0=$SECONDS idx=${#summary[@]}
   shift
   echo "=== $name" >&2
+  summary+=("$name: failed")
   "$@"
-  summary+=("$(printf '%-34s %5ds' "$name" $((SECONDS - t0)))")
+  summary[idx]=$(printf '%-34s %5ds' "$name" $((SECONDS - t0)))
 }
 
 # configure DIR ARGS...: (re)configures DIR with -Werror
@@ -96,7 +97,7 @@ fuzz_smoke() {
   "$A" convert --ascii "$seeds/oct.ply" "$seeds/oct_ascii.ply"
   "$A" convert --big-endian "$seeds/oct.ply" "$seeds/oct_be.ply"
   "$A" decompose "$seeds/oct.ply" -o "$seeds/oct.amg" -q
-  "$A" build "$seeds/oct.amg" -o "$seeds/oct.dps" --primitives 8 -q
+  "$A" build "$seeds/oct.amg" -o "$seeds/oct.dps" --primitives 8 -q >/dev/null
   build/seed_hier "$seeds/oct.ply" "$seeds/oct.hier"
   local f name corpus
   for f in build-fuzz/fuzz_*; do
@@ -111,6 +112,8 @@ fuzz_smoke() {
       fuzz_hier) cp "$seeds"/*.hier "$corpus"/ ;;
       *) cp "$seeds"/* tests/data/bad/* "$corpus"/ ;; # a new target: every format as a start
     esac
+    local nseeds
+    nseeds=$(ls "$corpus" | wc -l)
     echo "--- $name: $fuzz_seconds s" >&2
     # leaks are checked: the readers start no MPI. -max_len keeps mutations near the seeds' sizes.
     local log=build-fuzz/$name.log st=0
@@ -124,7 +127,7 @@ fuzz_smoke() {
     fi
     local runs
     runs=$(grep -Eo 'stat::number_of_executed_units: *[0-9]+' "$log" | grep -Eo '[0-9]+$' || echo "?")
-    summary+=("  $name: $runs inputs in ${fuzz_seconds}s, $(ls "$corpus" | wc -l) seeds, no failure")
+    summary+=("  $name: $runs inputs in ${fuzz_seconds}s from $nseeds seeds, corpus now $(ls "$corpus" | wc -l), no failure")
   done
 }
 
