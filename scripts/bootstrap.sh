@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs every build, test and demo dependency from Debian packages (apt-get
 # only). Idempotent: installs nothing when everything is already present.
-# Usage: scripts/bootstrap.sh [--fuzz]   (--fuzz adds clang for the libFuzzer targets)
+# Usage: scripts/bootstrap.sh   (--fuzz is still accepted; clang is always installed now, since
+# scripts/test.sh compiles once with clang and runs the libFuzzer targets)
 set -euo pipefail
 
 packages=(
@@ -15,10 +16,9 @@ packages=(
   libflann-dev                     # k-NN baseline for bench/bench_knn.c
   xvfb xauth                       # viewer test under a virtual display
   glmark2-data                     # ships the Stanford bunny (demo model)
+  clang libclang-rt-14-dev         # the clang build and the libFuzzer targets (scripts/test.sh)
+  python3                          # tests/cli/png_check.py and the JSON checks of tests/cli
 )
-if [[ "${1:-}" == "--fuzz" ]]; then
-  packages+=(clang libclang-rt-14-dev)
-fi
 
 missing=()
 for p in "${packages[@]}"; do

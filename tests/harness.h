@@ -11,11 +11,20 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "amgsplat/core.h"
 
 static int asp_test_failures;
 static int asp_test_checks;
+static int asp_test_skips;
+
+/*
+ * Exit status of a test program that could not run all of its cases (models from ../shared/data
+ * missing). CMakeLists.txt gives every test SKIP_RETURN_CODE 77 (the automake convention), so
+ * ctest lists it as "Skipped", never as passed with the checks it could not make.
+ */
+enum { ASP_TEST_SKIP = 77 };
 
 #define CHECK(cond)                                                                  \
     do {                                                                             \
@@ -66,6 +75,25 @@ static inline const char *asp_test_error_text(const asp_error *e)
         }                                                                                     \
     } while (0)
 
+/*
+ * Path of the test model `name` in ASP_TEST_DATA (../shared/data, CMake's ASP_SHARED_DATA) in
+ * buf, or NULL when it cannot be read: then the caller returns from its test case, and the
+ * program ends with ASP_TEST_SKIP unless a check failed.
+ */
+static inline const char *asp_test_data(char *buf, size_t cap, const char *name)
+{
+#ifdef ASP_TEST_DATA
+    snprintf(buf, cap, "%s/%s", ASP_TEST_DATA, name);
+#else
+    snprintf(buf, cap, "%s", name);
+#endif
+    if (access(buf, R_OK) == 0)
+        return buf;
+    asp_test_skips++;
+    fprintf(stderr, "skip: test model '%s' not found\n", buf);
+    return NULL;
+}
+
 typedef void (*asp_test_fn)(void);
 typedef struct { const char *name; asp_test_fn fn; } asp_test_case;
 
@@ -75,11 +103,20 @@ static inline int asp_test_run(const char *file, const asp_test_case *cases, siz
 {
     for (size_t i = 0; i < n; i++) {
         int before = asp_test_failures;
+        int skips = asp_test_skips;
         cases[i].fn();
-        fprintf(stderr, "%s %s\n", asp_test_failures == before ? "ok  " : "FAIL", cases[i].name);
+        fprintf(stderr, "%s %s\n",
+                asp_test_failures != before ? "FAIL" : asp_test_skips != skips ? "skip" : "ok  ", cases[i].name);
     }
-    fprintf(stderr, "%s: %d checks, %d failed\n", file, asp_test_checks, asp_test_failures);
-    return asp_test_failures == 0 ? 0 : 1;
+    fprintf(stderr, "%s: %d checks, %d failed, %d skipped\n", file, asp_test_checks, asp_test_failures,
+            asp_test_skips);
+    if (asp_test_failures)
+        return 1;
+    if (asp_test_checks == 0 && asp_test_skips == 0) {
+        fprintf(stderr, "%s: no checks made: a test that cannot fail is a defect\n", file);
+        return 1;
+    }
+    return asp_test_skips ? ASP_TEST_SKIP : 0;
 }
 
 #define TEST_MAIN(...)                                                                 \

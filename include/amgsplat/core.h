@@ -49,6 +49,23 @@ int asp_error_set(asp_error *err, int code, const char *fmt, ...)
 #endif
     ;
 
+/**
+ * Programmer errors (STYLE.md section 4): a NULL where the contract forbids it, a count of 0 where
+ * one is required, a broken internal invariant. Unlike assert() it stays on whatever NDEBUG says,
+ * as meshopt's and git's BUG() do: a Release build that silently continues past a broken contract
+ * corrupts memory later, far from the cause. On failure it prints "file:line: assertion failed:
+ * cond" to stderr and calls abort(); that is the one place the library prints. Runtime errors
+ * (bad files, I/O, out of memory) never use it: they return an ASP_E* code.
+ * cond is evaluated exactly once.
+ */
+#define ASP_ASSERT(cond) ((cond) ? (void)0 : asp__assert_fail(__FILE__, __LINE__, #cond))
+
+/** ASP_ASSERT's failure path: prints file:line and the condition to stderr, then abort(). */
+#if defined(__GNUC__)
+__attribute__((noreturn, cold))
+#endif
+void asp__assert_fail(const char *file, int line, const char *cond);
+
 /** Returns a short constant name for an error code ("ASP_EFORMAT"). */
 const char *asp_error_name(int code);
 

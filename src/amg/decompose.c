@@ -112,6 +112,11 @@ static int check_cloud(const asp_cloud *cloud, asp_error *err)
     return 0;
 }
 
+#ifndef ASP_HAVE_HYPRE
+// Nothing to finalise: without hypre no decomposition ever starts MPI (hypre_bridge.c has the real one).
+void asp_amg_shutdown(void) {}
+#endif
+
 #ifdef ASP_HAVE_HYPRE
 /*
  * The decomposition keeps the whole input point set, so domain primitives can

@@ -33,6 +33,7 @@ static void *alloc_array(asp_cloud *c, size_t count, size_t elem)
 
 int asp_cloud_add_attrs(asp_cloud *c, unsigned attrs, asp_error *err)
 {
+    ASP_ASSERT(c);
     size_t n = c->count;
 #define ADD(bit, field, elems, type)                                                   \
     if ((attrs & (bit)) && !c->field) {                                                \
@@ -51,6 +52,7 @@ int asp_cloud_add_attrs(asp_cloud *c, unsigned attrs, asp_error *err)
 
 int asp_cloud_create(size_t count, unsigned attrs, const asp_context *ctx, asp_cloud **out, asp_error *err)
 {
+    ASP_ASSERT(out);
     if (count >= UINT32_MAX)
         return asp_error_set(err, ASP_EINVAL, "%zu points is more than a cloud holds (2^32-1)", count);
     if (count > SIZE_MAX / (3 * sizeof(float)))
@@ -121,6 +123,7 @@ asp_property *asp_cloud_find_property(const asp_cloud *c, const char *name)
 int asp_cloud_add_property(asp_cloud *c, const char *name, asp_scalar_type type, asp_property **out,
                            asp_error *err)
 {
+    ASP_ASSERT(c && name);
     size_t len = strlen(name);
     if (len == 0 || len >= sizeof c->properties[0].name)
         return asp_error_set(err, ASP_EINVAL, "property name '%.80s' must have 1 to 63 bytes", name);
@@ -177,6 +180,7 @@ int asp_cloud_add_obj_info(asp_cloud *c, const char *text, asp_error *err)
 
 int asp_cloud_set_faces(asp_cloud *c, const uint32_t *faces, size_t face_count, asp_error *err)
 {
+    ASP_ASSERT(c && (faces || face_count == 0));
     for (size_t i = 0; i < 3 * face_count; i++)
         if (faces[i] >= c->count)
             return asp_error_set(err, ASP_EFORMAT, "face %zu: vertex index %u is not below the vertex count %zu",
@@ -201,6 +205,7 @@ void asp_cloud_world_position(const asp_cloud *c, size_t i, double out[3])
 
 int asp_cloud_bounds(const asp_cloud *c, float lo[3], float hi[3], asp_error *err)
 {
+    ASP_ASSERT(c && lo && hi);
     if (c->count == 0)
         return asp_error_set(err, ASP_EDEGENERATE, "the point set is empty");
     for (int k = 0; k < 3; k++)
@@ -216,6 +221,7 @@ int asp_cloud_bounds(const asp_cloud *c, float lo[3], float hi[3], asp_error *er
 
 int asp_cloud_validate(const asp_cloud *c, asp_error *err)
 {
+    ASP_ASSERT(c);
     static const char axis[] = "xyz";
     for (size_t i = 0; i < c->count; i++) {
         for (int k = 0; k < 3; k++) {
@@ -237,6 +243,7 @@ int asp_cloud_validate(const asp_cloud *c, asp_error *err)
 
 int asp_cloud_clone(const asp_cloud *src, asp_cloud **out, asp_error *err)
 {
+    ASP_ASSERT(src && out);
     asp_cloud *c;
     int rc = asp_cloud_create(src->count, asp_cloud_attrs(src), &src->ctx, &c, err);
     if (rc)

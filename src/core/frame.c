@@ -12,6 +12,7 @@
 
 float asp_cloud_default_radius(const asp_cloud *cloud)
 {
+    ASP_ASSERT(cloud);
     float lo[3], hi[3];
     if (cloud->count == 0 || asp_cloud_bounds(cloud, lo, hi, NULL) != 0)
         return 0.0f;
@@ -27,6 +28,7 @@ float asp_cloud_default_radius(const asp_cloud *cloud)
 
 int asp_cloud_frame(const asp_cloud *cloud, asp_frame *out, asp_error *err)
 {
+    ASP_ASSERT(cloud && out);
     if (cloud->count == 0)
         return asp_error_set(err, ASP_EDEGENERATE, "cannot frame an empty point set");
     int rc = asp_cloud_validate(cloud, err);

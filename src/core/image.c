@@ -21,6 +21,7 @@ enum { ASP_IMAGE_MAX_SIDE = 16384 };
 
 int asp_image_init(asp_image *img, uint32_t width, uint32_t height, asp_error *err)
 {
+    ASP_ASSERT(img);
     memset(img, 0, sizeof *img);
     if (width == 0 || height == 0 || width > ASP_IMAGE_MAX_SIDE || height > ASP_IMAGE_MAX_SIDE)
         return asp_error_set(err, ASP_EINVAL, "image size %ux%u is outside 1..%d", width, height, ASP_IMAGE_MAX_SIDE);
@@ -42,6 +43,7 @@ void asp_image_release(asp_image *img)
 
 void asp_image_fill(asp_image *img, const uint8_t rgba[4])
 {
+    ASP_ASSERT(img && rgba);
     size_t n = (size_t)img->width * img->height;
     for (size_t i = 0; i < n; i++)
         memcpy(img->pixels + 4 * i, rgba, 4);
@@ -49,6 +51,7 @@ void asp_image_fill(asp_image *img, const uint8_t rgba[4])
 
 int asp_image_load(asp_image *img, const char *path, asp_error *err)
 {
+    ASP_ASSERT(img && path);
     FILE *fp = fopen(path, "rb");
     if (!fp)
         return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
@@ -88,6 +91,7 @@ static void write_to_file(void *context, void *data, int size)
 
 int asp_image_save_png(const asp_image *img, const char *path, asp_error *err)
 {
+    ASP_ASSERT(img && path);
     if (!img->pixels || img->width == 0 || img->height == 0)
         return asp_error_set(err, ASP_EINVAL, "cannot write '%s': the image is empty", path);
     asp__atomic_file f;
@@ -127,6 +131,7 @@ void asp_image_sample_bilinear(const asp_image *img, float u, float v, float out
 
 int asp_image_contact_sheet(const asp_image *tiles, size_t n, uint32_t cols, asp_image *dst, asp_error *err)
 {
+    ASP_ASSERT((tiles || n == 0) && dst);
     if (n == 0)
         return asp_error_set(err, ASP_EINVAL, "contact sheet needs at least one image");
     uint32_t w = tiles[0].width, h = tiles[0].height;

@@ -187,7 +187,8 @@ static void gather(const writer *w, const column *col, size_t i0, size_t n, doub
             out[t] = c->labels[i0 + t];
         break;
     default:
-        break;
+        // S_EXTRA columns are copied by the callers in their own type, never gathered as doubles
+        ASP_ASSERT(!"gather of a column without a cloud array");
     }
 }
 

@@ -4,7 +4,6 @@
  * read back and flip to rows-top-first. Pajarola et al. 2003 section 5.3 draw
  * opaque surfels with the depth buffer deciding visibility; so do we.
  */
-#include <assert.h>
 #include <math.h>
 #include <string.h>
 
@@ -128,7 +127,8 @@ static int read_back(asp_gl_context *gl, const asp__frame *f, asp_image *img, as
 static int prepare(asp_gl_context *gl, const asp_renderer *r, const asp_camera *cam, const asp_render_desc *desc,
                    uint32_t w, uint32_t h, asp__frame *frame, uint32_t *samples, asp_error *err)
 {
-    assert(r->gl == gl);
+    ASP_ASSERT(r->gl == gl);
+    *samples = 1; // defined on the error returns too, so no caller path reads it unset
     uint32_t limit = gl->max_size > 0 && (uint32_t)gl->max_size < MAX_SIDE ? (uint32_t)gl->max_size : MAX_SIDE;
     if (w == 0 || h == 0 || w > limit || h > limit)
         return asp_error_set(err, ASP_EINVAL, "image size %ux%u is outside 1..%u, the limit of this GL context", w,
@@ -153,7 +153,7 @@ static int prepare(asp_gl_context *gl, const asp_renderer *r, const asp_camera *
 int asp_render_frame(asp_gl_context *gl, asp_renderer *r, const asp_camera *cam, const asp_render_desc *desc,
                      asp_error *err)
 {
-    assert(gl && r && cam);
+    ASP_ASSERT(gl && r && cam);
     static const asp_render_desc zero_desc;
     if (!desc)
         desc = &zero_desc;
@@ -182,7 +182,7 @@ int asp_render_frame(asp_gl_context *gl, asp_renderer *r, const asp_camera *cam,
 int asp_render_to_image(asp_gl_context *gl, asp_renderer *r, const asp_camera *cam, const asp_render_desc *desc,
                         asp_image *out, asp_error *err)
 {
-    assert(gl && r && cam && out);
+    ASP_ASSERT(gl && r && cam && out);
     static const asp_render_desc zero_desc;
     if (!desc)
         desc = &zero_desc;

@@ -50,11 +50,9 @@ expect_fail 2 "missing -o" "$AMGSPLAT" sample "$T/quad.obj"
 expect_fail 2 "--points must be" "$AMGSPLAT" sample "$T/quad.obj" --points 1 -o "$T/x.ply"
 expect_fail 2 "--grid must be" "$AMGSPLAT" sample "$T/quad.obj" --method voxel --grid 0 -o "$T/x.ply"
 [[ ! -e "$T/x.ply" ]] || fail "failed runs left an output"
-if [[ -r "${ASP_TEST_DATA:-}/spot_triangulated.obj" ]]; then
+if have_data spot_triangulated.obj spot_texture.png; then
   "$AMGSPLAT" sample "$ASP_TEST_DATA/spot_triangulated.obj" --texture "$ASP_TEST_DATA/spot_texture.png" \
     -n 20000 -o "$T/spot.ply" --json | grep '"colors": true' >/dev/null || fail "spot"
-else
-  echo "skipping spot: ASP_TEST_DATA not found"
 fi
 # 3DS through assimp: glmark2-data (a declared dependency, scripts/bootstrap.sh) ships a horse
 horse=/usr/share/glmark2/models/horse.3ds

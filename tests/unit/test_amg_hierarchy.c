@@ -12,8 +12,10 @@
 
 static asp_cloud *sample_model(const char *name, size_t points)
 {
-    char path[1024];
-    snprintf(path, sizeof path, "%s/%s", ASP_TEST_DATA, name);
+    char buf[1024];
+    const char *path = asp_test_data(buf, sizeof buf, name);
+    if (!path)
+        return NULL;
     asp_error errbuf, *err = &errbuf;
     asp_mesh *mesh = NULL;
     asp_cloud *cloud = NULL;

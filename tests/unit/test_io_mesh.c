@@ -262,13 +262,12 @@ static void test_errors(void)
 
 static void test_real_models(void)
 {
-    char p[1024], t[1024];
-    snprintf(p, sizeof p, "%s/spot_triangulated.obj", ASP_TEST_DATA);
-    snprintf(t, sizeof t, "%s/spot_texture.png", ASP_TEST_DATA);
-    if (access(p, R_OK) != 0) {
-        fprintf(stderr, "skipping real models: %s not found\n", p);
+    char pbuf[1024], tbuf[1024], bbuf[1024];
+    const char *p = asp_test_data(pbuf, sizeof pbuf, "spot_triangulated.obj");
+    const char *t = asp_test_data(tbuf, sizeof tbuf, "spot_texture.png");
+    const char *bunny = asp_test_data(bbuf, sizeof bbuf, "stanford-bunny.obj");
+    if (!p || !t || !bunny)
         return;
-    }
     asp_error err_ = {0}, *err = &err_;
     asp_mesh *m = NULL;
     CHECK_OK(asp_mesh_load(p, &(asp_mesh_load_desc){.texture_override = t}, NULL, &m, err), err);
@@ -288,9 +287,8 @@ static void test_real_models(void)
         asp_cloud_destroy(c);
         asp_mesh_destroy(m);
     }
-    snprintf(p, sizeof p, "%s/stanford-bunny.obj", ASP_TEST_DATA);
     m = NULL;
-    CHECK_OK(asp_mesh_load(p, NULL, NULL, &m, err), err);
+    CHECK_OK(asp_mesh_load(bunny, NULL, NULL, &m, err), err);
     if (m) {
         CHECK(m->triangle_count == 69451);
         CHECK(m->vertex_count >= 34000 && m->vertex_count <= 35947);
