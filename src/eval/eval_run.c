@@ -39,10 +39,12 @@ size_t asp_eval_ssim_wins(const asp_eval_result *res, size_t a, size_t b)
 
 #ifndef ASP_HAVE_GL
 
-int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, asp_eval_result **out, asp_error *err)
+int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_context *ctx, asp_eval_result **out,
+                 asp_error *err)
 {
     (void)cloud;
     (void)desc;
+    (void)ctx;
     (void)out;
     return asp_error_set(err, ASP_EUNSUPPORTED, "cannot evaluate: this build has no OpenGL renderer (ASP_WITH_GL)");
 }
