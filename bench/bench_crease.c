@@ -26,7 +26,7 @@ static void run(asp_synth_shape shape, const char *name, size_t n, int runs)
     size_t clipped = 0;
     for (int r = 0; planes && r < runs; r++) {
         double t0 = asp_time_now();
-        if (asp_crease_clip_planes(c, NULL, planes, &clipped, &err) != 0) {
+        if (asp_crease_clip_planes(c, NULL, NULL, planes, &clipped, &err) != 0) {
             fprintf(stderr, "%s: %s\n", name, err.msg);
             break;
         }

@@ -257,7 +257,6 @@ typedef struct asp_crease_desc {
     float angle_deg;    /* normals further apart than this mark a crease; 0 = 60; else in (0, 90) */
     size_t k;           /* neighbours examined per point; 0 = 16; clamped to count - 1 */
     size_t min_support; /* neighbours needed on each side; 0 = 2 */
-    const asp_context *ctx; /* threads and allocator; NULL = defaults */
 } asp_crease_desc;
 
 /**
@@ -281,13 +280,13 @@ typedef struct asp_crease_desc {
  * Returns 0; ASP_EINVAL (NULL cloud or dst, cloud without normals: "crease
  * clipping needs normals", bad desc values); ASP_EDEGENERATE (fewer than 2
  * points); ASP_EFORMAT (a non-finite position or normal, naming the point);
- * ASP_ENOMEM; ASP_ECANCELED (progress callback of desc->ctx, stage "knn").
+ * ASP_ENOMEM; ASP_ECANCELED (progress callback of ctx, stage "knn").
  * All points equal gives no planes. On failure dst and *clipped are
- * unchanged. Parallel over points with asp_context_threads(desc->ctx)
- * threads; bit-identical for any thread count. Thread-safe.
+ * unchanged. Parallel over points with asp_context_threads(ctx) threads
+ * (ctx may be NULL); bit-identical for any thread count. Thread-safe.
  */
-int asp_crease_clip_planes(const asp_cloud *cloud, const asp_crease_desc *desc, float *dst, size_t *clipped,
-                           asp_error *err);
+int asp_crease_clip_planes(const asp_cloud *cloud, const asp_crease_desc *desc, const asp_context *ctx, float *dst,
+                           size_t *clipped, asp_error *err);
 
 #ifdef __cplusplus
 }

@@ -294,7 +294,7 @@ static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result
         if (!planes)
             rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the crease planes of %zu points", s->cloud->count);
         if (!rc)
-            rc = asp_crease_clip_planes(s->cloud, &(asp_crease_desc){.angle_deg = s->crease_angle, .ctx = s->ctx},
+            rc = asp_crease_clip_planes(s->cloud, &(asp_crease_desc){.angle_deg = s->crease_angle}, s->ctx,
                                         planes, &res->clipped_points, err);
     }
     if (!rc)

@@ -30,7 +30,7 @@ static int load_clip_planes(asp_scene *s, const asp_scene_desc *d, asp_error *er
     s->clip_planes = asp_alloc(&s->ctx, 8 * s->cloud->count * sizeof(float));
     if (!s->clip_planes)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the crease planes of %zu points", s->cloud->count);
-    int rc = asp_crease_clip_planes(s->cloud, &(asp_crease_desc){.angle_deg = d->crease_angle, .ctx = &s->ctx},
+    int rc = asp_crease_clip_planes(s->cloud, &(asp_crease_desc){.angle_deg = d->crease_angle}, &s->ctx,
                                     s->clip_planes, NULL, err);
     return rc ? rewrap(err, rc, "cannot clip", s->path) : 0;
 }

@@ -166,8 +166,8 @@ static int check_cloud(const asp_cloud *cloud, asp_error *err)
     return 0;
 }
 
-int asp_crease_clip_planes(const asp_cloud *cloud, const asp_crease_desc *desc, float *dst, size_t *clipped,
-                           asp_error *err)
+int asp_crease_clip_planes(const asp_cloud *cloud, const asp_crease_desc *desc, const asp_context *ctx, float *dst,
+                           size_t *clipped, asp_error *err)
 {
     static const asp_crease_desc zero_desc;
     if (!desc)
@@ -189,7 +189,6 @@ int asp_crease_clip_planes(const asp_cloud *cloud, const asp_crease_desc *desc, 
     int rc = check_cloud(cloud, err);
     if (rc)
         return rc;
-    const asp_context *ctx = desc->ctx;
     size_t n = cloud->count;
     if (n > (size_t)UINT32_MAX - 1)
         return asp_error_set(err, ASP_EINVAL, "cannot find creases among %zu points: at most 2^32 - 2", n);

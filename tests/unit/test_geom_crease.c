@@ -103,7 +103,7 @@ static void check_model(const model *m)
         return;
     size_t n = c->count, clipped = 0;
     float *planes = malloc(8 * n * sizeof(float));
-    CHECK_OK(asp_crease_clip_planes(c, NULL, planes, &clipped, &err), ep(&err));
+    CHECK_OK(asp_crease_clip_planes(c, NULL, NULL, planes, &clipped, &err), ep(&err));
     size_t bad_plane = 0, not_adjacent = 0, far_clipped = 0, near_total = 0, near_missed = 0, self_cut = 0;
     size_t with_plane = 0, two_planes = 0, overhang_total = 0, overhang_missed = 0;
     for (size_t i = 0; i < n; i++) {
@@ -177,7 +177,7 @@ static void test_sphere_and_threads(void)
         return;
     size_t clipped = 99;
     float *planes = malloc(8 * c->count * sizeof(float));
-    CHECK_OK(asp_crease_clip_planes(c, NULL, planes, &clipped, &err), ep(&err));
+    CHECK_OK(asp_crease_clip_planes(c, NULL, NULL, planes, &clipped, &err), ep(&err));
     CHECK(clipped == 0);
     size_t nonzero = 0;
     for (size_t i = 0; i < 8 * c->count; i++)
@@ -191,13 +191,13 @@ static void test_sphere_and_threads(void)
         return;
     float *a = malloc(8 * c->count * sizeof(float)), *b = malloc(8 * c->count * sizeof(float));
     size_t ca = 0, cb = 0;
-    CHECK_OK(asp_crease_clip_planes(c, &(asp_crease_desc){.ctx = &(asp_context){.threads = 1}}, a, &ca, &err),
+    CHECK_OK(asp_crease_clip_planes(c, NULL, &(asp_context){.threads = 1}, a, &ca, &err),
              ep(&err));
-    CHECK_OK(asp_crease_clip_planes(c, &(asp_crease_desc){.ctx = &(asp_context){.threads = 3}}, b, &cb, &err),
+    CHECK_OK(asp_crease_clip_planes(c, NULL, &(asp_context){.threads = 3}, b, &cb, &err),
              ep(&err));
     CHECK(ca == cb && ca > 0 && memcmp(a, b, 8 * c->count * sizeof(float)) == 0);
     // a wider angle keeps the octahedron's 70.5-degree creases inside S: no planes
-    CHECK_OK(asp_crease_clip_planes(c, &(asp_crease_desc){.angle_deg = 75}, a, &ca, &err), ep(&err));
+    CHECK_OK(asp_crease_clip_planes(c, &(asp_crease_desc){.angle_deg = 75}, NULL, a, &ca, &err), ep(&err));
     CHECK(ca == 0);
     free(a);
     free(b);
@@ -216,7 +216,7 @@ static void test_two_sided_sheet(void)
         c->normals[3 * i + 2] = -1.0f;
     float *planes = malloc(8 * c->count * sizeof(float));
     size_t clipped = 99;
-    CHECK_OK(asp_crease_clip_planes(c, NULL, planes, &clipped, &err), ep(&err));
+    CHECK_OK(asp_crease_clip_planes(c, NULL, NULL, planes, &clipped, &err), ep(&err));
     CHECK(clipped == 0);
     free(planes);
     asp_cloud_destroy(c);
@@ -236,7 +236,7 @@ static void test_errors(void)
         return;
     for (size_t i = 0; i < 16; i++)
         c->positions[3 * i] = (float)i;
-    CHECK(asp_crease_clip_planes(c, NULL, planes, &clipped, &err) == ASP_EINVAL);
+    CHECK(asp_crease_clip_planes(c, NULL, NULL, planes, &clipped, &err) == ASP_EINVAL);
     CHECK(strstr(err.msg, "needs normals") != NULL);
     asp_cloud_destroy(c);
 
@@ -245,7 +245,7 @@ static void test_errors(void)
     if (!c)
         return;
     c->normals[2] = 1.0f;
-    CHECK(asp_crease_clip_planes(c, NULL, planes, &clipped, &err) == ASP_EDEGENERATE);
+    CHECK(asp_crease_clip_planes(c, NULL, NULL, planes, &clipped, &err) == ASP_EDEGENERATE);
     asp_cloud_destroy(c);
 
     // NaN position, then NaN normal, named by point
@@ -258,19 +258,19 @@ static void test_errors(void)
         c->normals[3 * i + 2] = 1.0f;
     }
     c->positions[3 * 5 + 1] = NAN;
-    CHECK(asp_crease_clip_planes(c, NULL, planes, &clipped, &err) == ASP_EFORMAT);
+    CHECK(asp_crease_clip_planes(c, NULL, NULL, planes, &clipped, &err) == ASP_EFORMAT);
     CHECK_MSG(strstr(err.msg, "point 5") != NULL, "message '%s'", err.msg);
     c->positions[3 * 5 + 1] = 1.0f;
     c->normals[3 * 9] = INFINITY;
-    CHECK(asp_crease_clip_planes(c, NULL, planes, &clipped, &err) == ASP_EFORMAT);
+    CHECK(asp_crease_clip_planes(c, NULL, NULL, planes, &clipped, &err) == ASP_EFORMAT);
     CHECK_MSG(strstr(err.msg, "point 9") != NULL, "message '%s'", err.msg);
     c->normals[3 * 9] = 0.0f;
     // bad options
-    CHECK(asp_crease_clip_planes(c, &(asp_crease_desc){.angle_deg = 90}, planes, &clipped, &err) == ASP_EINVAL);
-    CHECK(asp_crease_clip_planes(c, &(asp_crease_desc){.angle_deg = -5}, planes, &clipped, &err) == ASP_EINVAL);
-    CHECK(asp_crease_clip_planes(c, &(asp_crease_desc){.angle_deg = NAN}, planes, &clipped, &err) == ASP_EINVAL);
-    CHECK(asp_crease_clip_planes(c, NULL, NULL, &clipped, &err) == ASP_EINVAL);
-    CHECK(asp_crease_clip_planes(NULL, NULL, planes, &clipped, &err) == ASP_EINVAL);
+    CHECK(asp_crease_clip_planes(c, &(asp_crease_desc){.angle_deg = 90}, NULL, planes, &clipped, &err) == ASP_EINVAL);
+    CHECK(asp_crease_clip_planes(c, &(asp_crease_desc){.angle_deg = -5}, NULL, planes, &clipped, &err) == ASP_EINVAL);
+    CHECK(asp_crease_clip_planes(c, &(asp_crease_desc){.angle_deg = NAN}, NULL, planes, &clipped, &err) == ASP_EINVAL);
+    CHECK(asp_crease_clip_planes(c, NULL, NULL, NULL, &clipped, &err) == ASP_EINVAL);
+    CHECK(asp_crease_clip_planes(NULL, NULL, NULL, planes, &clipped, &err) == ASP_EINVAL);
     // outputs unchanged on every failure above
     int untouched = clipped == 77;
     for (size_t i = 0; i < 8 * 16; i++)
@@ -284,7 +284,7 @@ static void test_errors(void)
         c->normals[3 * i + 1] = (float)(i % 3 == 1);
         c->normals[3 * i + 2] = (float)(i % 3 == 2);
     }
-    CHECK_OK(asp_crease_clip_planes(c, NULL, planes, &clipped, &err), ep(&err));
+    CHECK_OK(asp_crease_clip_planes(c, NULL, NULL, planes, &clipped, &err), ep(&err));
     CHECK(clipped == 0);
     // zero normals are ignored rather than counted as another surface
     for (size_t i = 0; i < 16; i++) {
@@ -294,7 +294,7 @@ static void test_errors(void)
         c->normals[3 * i] = c->normals[3 * i + 1] = 0.0f;
         c->normals[3 * i + 2] = i % 2 ? 1.0f : 0.0f;
     }
-    CHECK_OK(asp_crease_clip_planes(c, NULL, planes, &clipped, &err), ep(&err));
+    CHECK_OK(asp_crease_clip_planes(c, NULL, NULL, planes, &clipped, &err), ep(&err));
     CHECK(clipped == 0);
     asp_cloud_destroy(c);
 }

@@ -323,7 +323,7 @@ static void test_octahedron(void)
             goto done;
         planes[s] = malloc(8 * oct[s]->count * sizeof(float));
         size_t clipped = 0;
-        CHECK_OK(asp_crease_clip_planes(oct[s], NULL, planes[s], &clipped, &err), ep(&err));
+        CHECK_OK(asp_crease_clip_planes(oct[s], NULL, NULL, planes[s], &clipped, &err), ep(&err));
         CHECK(clipped > 1000);
     }
     float center[3], radius;
@@ -356,7 +356,7 @@ static void test_hier_and_opaque(void)
     float *planes = c ? malloc(8 * c->count * sizeof(float)) : NULL;
     if (!h || !planes)
         goto done;
-    CHECK_OK(asp_crease_clip_planes(c, NULL, planes, NULL, &err), ep(&err));
+    CHECK_OK(asp_crease_clip_planes(c, NULL, NULL, planes, NULL, &err), ep(&err));
     float center[3], radius;
     CHECK_OK(asp_render_bounding_sphere(c, center, &radius, &err), ep(&err));
     static float dist[SIZE * SIZE];

@@ -132,7 +132,7 @@ static asp_renderer *disc_renderer(const asp_cloud *cloud, int clip)
         if (!planes)
             return NULL;
         size_t clipped = 0;
-        CHECK_OK(asp_crease_clip_planes(cloud, NULL, planes, &clipped, &err), ep(&err));
+        CHECK_OK(asp_crease_clip_planes(cloud, NULL, NULL, planes, &clipped, &err), ep(&err));
         CHECK(clipped > cloud->count / 10); // the points within a disc radius of an edge (about 18%)
     }
     asp_renderer *disc = NULL;
