@@ -143,12 +143,7 @@ int asp_gl_context_read_window(asp_gl_context *gl, asp_image *out, asp_error *er
     glReadnPixels(0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_UNSIGNED_BYTE, (GLsizei)(stride * h), img.pixels);
     rc = asp__gl_check(gl, "read the window back", err);
     if (!rc) {
-        for (uint32_t y = 0; y < h / 2; y++) { // GL rows run bottom-up, asp_image top-down
-            uint8_t *a = img.pixels + y * stride, *b = img.pixels + (h - 1 - y) * stride;
-            memcpy(row, a, stride);
-            memcpy(a, b, stride);
-            memcpy(b, row, stride);
-        }
+        asp__image_flip_rows(&img, row);
         // a window is opaque whatever alpha its visual stores (or lacks)
         for (size_t i = 0; i < (size_t)w * h; i++)
             img.pixels[4 * i + 3] = 255;

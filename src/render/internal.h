@@ -60,6 +60,9 @@ void asp__gl_debug_install(asp_gl_context *gl);
 int asp__gl_check(asp_gl_context *gl, const char *what, asp_error *err);
 /* Discards collected errors (before an operation whose errors we want to attribute). */
 void asp__gl_clear_errors(asp_gl_context *gl);
+
+/* Turns GL's bottom-up rows into asp_image's top-down ones in place; row: 4 * width bytes of scratch. */
+void asp__image_flip_rows(asp_image *img, uint8_t *row);
 /* "GL_INVALID_ENUM" for a glGetError code. */
 const char *asp__gl_error_name(GLenum code);
 

@@ -56,7 +56,7 @@ static void unpremultiply(asp_image *img, const uint8_t bg[4])
     }
 }
 
-static void flip_rows(asp_image *img, uint8_t *row)
+void asp__image_flip_rows(asp_image *img, uint8_t *row)
 {
     size_t stride = 4 * (size_t)img->width;
     for (uint32_t y = 0; y < img->height / 2; y++) {
@@ -212,7 +212,7 @@ int asp_render_to_image(asp_gl_context *gl, asp_renderer *r, const asp_camera *c
         asp_image_release(&img);
         return rc;
     }
-    flip_rows(&img, row);
+    asp__image_flip_rows(&img, row);
     asp_free(&gl->actx, row);
     if (desc->background[3] < 255)
         unpremultiply(&img, desc->background);
