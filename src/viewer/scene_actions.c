@@ -55,7 +55,8 @@ int asp__viewer_scene_check_desc(const asp_viewer_desc *desc, asp_error *err)
 int asp__viewer_scene_load(asp_scene *s, const char *path, const asp_viewer_desc *desc, const asp_context *ctx,
                            asp_error *err)
 {
-    asp_scene_desc d = {.amg_color = scene_color(desc->amg_color), .level = desc->amg_level};
+    asp_scene_desc d = {.amg_color = scene_color(desc->amg_color), .level = desc->amg_level,
+                        .texture = desc->texture};
     asp_scene t;
     memset(&t, 0, sizeof t);
     int rc = asp_scene_load(path, &d, ctx, &t, err);

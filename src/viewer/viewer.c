@@ -801,10 +801,16 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
         v.center[k] = (float)(v.scene.frame.center[k] - v.scene.origin[k]);
     v.radius = (float)v.scene.frame.radius;
     v.kind_prim = find_renderer("prim");
-    // a .hier holds splats without their points: the splat renderer draws it
+    // a .hier holds splats without their points: the splat renderer draws it; a mesh is drawn as one
     v.kind = desc->renderer ? find_renderer(desc->renderer)
              : v.scene.hier ? find_renderer("splat")
+             : v.scene.mesh ? find_renderer("mesh")
                             : first_accepted(&v);
+    // the scene loader records missing textures; the viewer says so through its log (issue 14)
+    for (size_t i = 0; v.scene.mesh && i < v.scene.mesh->material_count; i++)
+        if (v.scene.mesh->materials[i].texture_missing)
+            vlog(&v, "warning: texture '%s' of material '%s' not found: drawn in its material colour",
+                 v.scene.mesh->materials[i].texture_path, v.scene.mesh->materials[i].name);
     rc = open_window(&v, err);
     if (!rc) {
         uint32_t w = 0, h = 0;
