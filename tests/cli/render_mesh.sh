@@ -38,6 +38,19 @@ check "$T/missing.png" "$(near '(255, 0, 0)' 1)"
 # the quad fills the middle of the view, the corners stay background
 check "$T/missing.png" "px(0, 0)[:3] == (255, 255, 255) and 0.2 < fg < 0.8"
 
+# view MESH: the mesh renderer by default, the same warning (through the viewer's log) and colour.
+# The viewer needs a display: Xvfb as in view.sh.
+viewer() {
+  if command -v xvfb-run >/dev/null; then xvfb-run -a -s "-screen 0 1024x768x24" "$AMGSPLAT" view "$@"
+  elif [[ -n "${DISPLAY:-}" ]]; then "$AMGSPLAT" view "$@"
+  else fail "no xvfb-run and no DISPLAY: install xvfb (scripts/bootstrap.sh) to run the viewer"; fi
+}
+viewer "$T/missing.obj" --frames 2 --screenshot "$T/view.png" --size 96x96 --view 0,0 --json >"$T/view.json" \
+  2>"$T/view.err" || fail "view of a mesh failed: $(cat "$T/view.err")"
+grep -F '"renderer": "mesh"' "$T/view.json" >/dev/null || fail "view does not draw the mesh: $(cat "$T/view.json")"
+grep -F "no_such_texture.png" "$T/view.err" >/dev/null || fail "view does not warn: $(cat "$T/view.err")"
+check "$T/view.png" "$(near '(255, 0, 0)' 1)"
+
 # OBJ without UVs or materials: the point renderers' light grey 200
 "$AMGSPLAT" render "$T/nouv.obj" -o "$T/nouv.png" --size 64x64 --view 0,0 -q
 check "$T/nouv.png" "$(near '(200, 200, 200)' 1)"
