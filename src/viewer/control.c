@@ -19,6 +19,7 @@ const asp__viewer_key asp__viewer_keys[] = {
     {'2', ASP__VIEWER_PICK_RENDERER, 1, "renderer 2"},
     {'3', ASP__VIEWER_PICK_RENDERER, 2, "renderer 3"},
     {'4', ASP__VIEWER_PICK_RENDERER, 3, "renderer 4"},
+    {'5', ASP__VIEWER_PICK_RENDERER, 4, "renderer 5"},
     {'+', ASP__VIEWER_TAU_UP, 0, "raise the screen tolerance tau (also =)"},
     {'=', ASP__VIEWER_TAU_UP, 0, NULL},
     {'-', ASP__VIEWER_TAU_DOWN, 0, "lower the screen tolerance tau"},
