@@ -17,6 +17,7 @@
 #include "mesh.h"
 #include "prim.h"
 #include "render.h"
+#include "sample.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -97,12 +98,19 @@ int asp_scene_load(const char *path, const asp_scene_desc *desc, const asp_conte
  */
 int asp_scene_recolor(asp_scene *s, asp_scene_amg_color color, size_t level, asp_error *err);
 
+/** Points asp_scene_load_source samples from a mesh (area sampling, `amgsplat sample` defaults otherwise). */
+#define ASP_SCENE_MESH_POINTS 200000
+
 /**
  * .dps scenes: loads the source points the file names (asp_dps.source, an
  * .amg or point file, tried as stored and next to the .dps) into s->cloud,
- * moved into the primitives' frame (s->origin) so one camera shows both. A
- * no-op when s->cloud is already there. Returns 0, ASP_EINVAL (not a .dps
- * scene), ASP_EUNSUPPORTED (no usable source name) or the loaders' errors.
+ * moved into the primitives' frame (s->origin) so one camera shows both.
+ * Mesh scenes: samples ASP_SCENE_MESH_POINTS points from the mesh
+ * (asp_sample_mesh, ASP_SAMPLE_AREA, seed 0, so the points `amgsplat sample
+ * --method area --points 200000` writes) into s->cloud, in the mesh's frame.
+ * A no-op when s->cloud is already there (a PLY with faces). Returns 0,
+ * ASP_EINVAL (neither a .dps nor a mesh scene), ASP_EUNSUPPORTED (no usable
+ * source name) or the loaders' and the sampler's errors.
  */
 int asp_scene_load_source(asp_scene *s, asp_error *err);
 

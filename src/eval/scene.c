@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "amgsplat/geom.h"
+#include "amgsplat/sample.h"
 #include "amgsplat/scene.h"
 #include "util/banned.h"
 
@@ -331,12 +332,20 @@ int asp_scene_load(const char *path, const asp_scene_desc *desc, const asp_conte
 
 int asp_scene_load_source(asp_scene *s, asp_error *err)
 {
-    if (!s->dps)
-        return asp_error_set(err, ASP_EINVAL, "'%s' is not a .dps file: its points are drawn already", s->path);
+    if (!s->dps && !s->mesh)
+        return asp_error_set(err, ASP_EINVAL, "'%s' is not a .dps file or a mesh: its points are drawn already",
+                             s->path);
     if (s->cloud)
         return 0;
     asp_cloud *cloud = NULL;
-    int rc = load_dps_source_cloud(s, &cloud, err);
+    int rc;
+    if (s->mesh) {
+        // area samples, as `amgsplat sample --method area`: the points the mesh is compared with (issue 14)
+        asp_sample_desc sd = {.method = ASP_SAMPLE_AREA, .points = ASP_SCENE_MESH_POINTS};
+        rc = asp_sample_mesh(s->mesh, &sd, &s->ctx, &cloud, NULL, err);
+    } else {
+        rc = load_dps_source_cloud(s, &cloud, err);
+    }
     if (rc)
         return rc;
     // into the primitives' frame: world = origin + position stays true

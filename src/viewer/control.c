@@ -31,7 +31,7 @@ const asp__viewer_key asp__viewer_keys[] = {
     {'.', ASP__VIEWER_ALPHA_UP, 0, ".dps: raise the alpha reference by 0.05"},
     {'o', ASP__VIEWER_OUTLINE, 0, ".dps: toggle the primitives' outlines"},
     {'k', ASP__VIEWER_CREASES, 0, ".dps: toggle crease clipping (flat primitives meeting at > 60 degrees)"},
-    {'p', ASP__VIEWER_POINTS, 0, ".dps: toggle the source points (disc renderer) and the primitives"},
+    {'p', ASP__VIEWER_POINTS, 0, ".dps: toggle the source points (disc renderer) and the primitives; mesh: its points and the mesh"},
     {'s', ASP__VIEWER_SCREENSHOT, 0, "screenshot to <input>-NNN.png in the current directory"},
     {'v', ASP__VIEWER_PRINT_VIEW, 0, "print the view as --view AZ,EL,DIST"},
     {'h', ASP__VIEWER_HELP, 0, "print the keys (also ?)"},

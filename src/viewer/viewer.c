@@ -488,29 +488,38 @@ static void prim_action(viewer *v, enum asp__viewer_action a)
     set_prim_options(v, &old);
 }
 
-/* p on a .dps: the source points (loaded once, drawn as discs) or the primitives again */
+/*
+ * p on a .dps: the source points (loaded once, drawn as discs) or the primitives again; on a mesh:
+ * points sampled from it (ASP_SCENE_MESH_POINTS, once) or the mesh again, one model in one frame.
+ */
 static void toggle_points(viewer *v)
 {
-    if (!is_dps(v)) {
-        vlog(v, "p applies to .dps input only");
+    if (!is_dps(v) && !v->scene.mesh) {
+        vlog(v, "p applies to .dps and mesh input only");
         return;
     }
-    size_t to = v->kind_prim;
-    if (v->kind == v->kind_prim) {
+    size_t main_kind = is_dps(v) ? v->kind_prim : find_renderer("mesh");
+    const char *main_name = is_dps(v) ? "primitives" : "mesh";
+    size_t to = main_kind;
+    if (v->kind == main_kind) {
         char note[LOG_CAP] = "";
         asp_error e = {0, ""};
+        int had_points = v->scene.cloud != NULL;
+        double t0 = asp_time_now();
         int rc = asp__viewer_scene_action(&v->scene, ASP__VIEWER_POINTS, note, sizeof note, &e);
         if (rc <= 0) {
             vlog(v, "%s", rc < 0 ? e.msg : note);
             return;
         }
+        if (!had_points && v->scene.mesh)
+            vlog(v, "sampled %zu points from the mesh in %.2f s", v->scene.cloud->count, asp_time_now() - t0);
         to = find_renderer("disc");
     }
     asp_error e = {0, ""};
     if (switch_renderer(v, to, &e))
         vlog(v, "renderer '%s' unavailable: %s", K(to)->name, e.msg);
     else
-        vlog(v, "showing the %s", to == v->kind_prim ? "primitives" : "source points");
+        vlog(v, "showing the %s", to == main_kind ? main_name : is_dps(v) ? "source points" : "points");
 }
 
 static void scene_action(viewer *v, enum asp__viewer_action a)

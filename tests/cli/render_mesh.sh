@@ -114,6 +114,16 @@ fp = json.load(open(d + '/p0.json'))['frame']
 r = fm[3]
 assert all(abs(a - b) < 0.02 * r for a, b in zip(fm, fp)), 'frames differ: %s %s' % (fm, fp)
 PY
+  # view: p shows 200,000 area samples of the mesh as discs in the mesh's frame, p again the mesh
+  viewer "$D/spot_triangulated.obj" --texture "$D/spot_texture.png" --frames 3 --keys p --size 128x128 \
+    --view 30,20 --screenshot "$T/vp.png" --json -q >"$T/vp.json" || fail "view p on a mesh failed"
+  grep -F '"renderer": "disc"' "$T/vp.json" >/dev/null && grep -F '"count": 200000,' "$T/vp.json" >/dev/null ||
+    fail "p on a mesh does not show its 200000 points: $(cat "$T/vp.json")"
+  "$AMGSPLAT" imgdiff "$T/vp.png" "$T/m0.png" --json >"$T/vpd.json"
+  python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['ssim'] >= 0.93 and d['iou'] >= 0.95, d" \
+    "$T/vpd.json" || fail "the viewer's points are not the mesh's picture: $(cat "$T/vpd.json")"
+  viewer "$D/spot_triangulated.obj" --frames 3 --keys pp --size 64x64 --json -q >"$T/vpp.json"
+  grep -F '"renderer": "mesh"' "$T/vpp.json" >/dev/null || fail "p twice does not return to the mesh"
   # the texture is drawn: the spot's black patches and its white skin both appear
   check "$T/m0.png" "any(px(x, y)[0] < 80 for x in range(w) for y in range(h)) and any(px(x, y)[0] > 220 and px(x, y)[:3] != (255, 255, 255) for x in range(w) for y in range(h))"
 fi
