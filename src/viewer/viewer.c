@@ -495,7 +495,7 @@ static void prim_action(viewer *v, enum asp__viewer_action a)
 static void toggle_points(viewer *v)
 {
     if (!is_dps(v) && !v->scene.mesh) {
-        vlog(v, "p applies to .dps and mesh input only");
+        vlog(v, "p applies to .dps input only, and to meshes");
         return;
     }
     size_t main_kind = is_dps(v) ? v->kind_prim : find_renderer("mesh");
