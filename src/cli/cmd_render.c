@@ -439,6 +439,11 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                                      : (unsigned)ASP_RENDER_INPUT_POINTS;
     if (asp_renderer_kind_find(o.dps_input ? "prim" : o.renderer ? o.renderer : dflt, inputs, &kind, &err))
         return cli_usage_error(env, "%s", err.msg);
+    // a PLY with faces holds its vertices as points; other meshes hold triangles only
+    if (o.mesh_input && !(kind->inputs & ASP_RENDER_INPUT_MESH) && strcmp(type.format, "ply") != 0)
+        return cli_usage_error(env, "renderer '%s' draws points; sample the mesh to points first (amgsplat sample "
+                                    "'%s' -o points.ply) or draw it with --renderer mesh",
+                               kind->name, argv[0]);
     if (o.budget && !kind->has_lod)
         return cli_usage_error(env, "--budget needs --renderer splat or square (the %s renderer draws every %s)",
                                kind->name, o.dps_input ? "primitive" : "point");

@@ -79,6 +79,9 @@ check "$T/off.png" "$(near '(153, 153, 153)' 1) or $(near '(200, 200, 200)' 1)"
 check "$T/flat.png" "abs(px(48, 46)[0] - px(48, 70)[0]) <= 1 and px(48, 46)[0] in (152, 153, 154, 199, 200, 201)"
 check "$T/smooth.png" "px(48, 46)[0] - px(48, 70)[0] >= 6"
 
+# point renderers on a mesh that is not a PLY: told to sample it
+expect_fail 2 "sample the mesh to points first" "$AMGSPLAT" render "$T/quad.off" -o "$T/x.png" --renderer splat
+
 # mesh-only options on points are refused
 python3 -c "print('ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0')" >"$T/pts.ply"
 expect_fail 2 "need a mesh input" "$AMGSPLAT" render "$T/pts.ply" -o "$T/x.png" --flat
