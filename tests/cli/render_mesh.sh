@@ -5,7 +5,7 @@ source "$(dirname "$0")/common.sh"
 
 # A unit quad in the xy plane facing +z (the camera at --view 0,0): under the headlight its lit colour
 # is exactly its colour. OBJ with a material whose texture file is missing (Kd = red), OBJ without
-# UVs or materials, PLY with faces and one vertex colour per corner, OFF, and an octahedron.
+# UVs or materials, PLY with faces and one vertex colour per corner, OFF, glTF, and an octahedron.
 python3 - "$T" <<'PY'
 import sys
 d = sys.argv[1]
@@ -22,6 +22,16 @@ with open(d + '/quad.ply', 'w') as f:
         f.write('%d %d 0 40 160 90\n' % (x, y))
     f.write('3 0 1 2\n3 0 2 3\n')
 open(d + '/quad.off', 'w').write('OFF\n4 2 0\n-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n3 0 2 3\n')
+import base64, json, struct
+b = struct.pack('<12f', -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0) + struct.pack('<6H', 0, 1, 2, 0, 2, 3) + b'\0\0'
+json.dump({'asset': {'version': '2.0'}, 'scenes': [{'nodes': [0]}], 'scene': 0, 'nodes': [{'mesh': 0}],
+           'meshes': [{'primitives': [{'attributes': {'POSITION': 0}, 'indices': 1, 'material': 0}]}],
+           'materials': [{'pbrMetallicRoughness': {'baseColorFactor': [0, 0, 1, 1]}}],
+           'buffers': [{'byteLength': len(b), 'uri': 'data:application/octet-stream;base64,' + base64.b64encode(b).decode()}],
+           'bufferViews': [{'buffer': 0, 'byteOffset': 0, 'byteLength': 48}, {'buffer': 0, 'byteOffset': 48, 'byteLength': 12}],
+           'accessors': [{'bufferView': 0, 'componentType': 5126, 'count': 4, 'type': 'VEC3', 'min': [-1, -1, 0], 'max': [1, 1, 0]},
+                         {'bufferView': 1, 'componentType': 5123, 'count': 6, 'type': 'SCALAR'}]},
+          open(d + '/quad.gltf', 'w'))
 v = ['1 0 0', '-1 0 0', '0 1 0', '0 -1 0', '0 0 1', '0 0 -1']
 faces = [(0, 2, 4), (2, 1, 4), (1, 3, 4), (3, 0, 4), (2, 0, 5), (1, 2, 5), (3, 1, 5), (0, 3, 5)]
 open(d + '/octa.off', 'w').write('OFF\n6 8 0\n' + '\n'.join(v) + '\n' +
@@ -70,6 +80,10 @@ check "$T/ply_disc.png" "fg > 0.01"
 # (255 Kd); should the loader come to treat it as no colour, the light grey 200 of colourless points
 "$AMGSPLAT" render "$T/quad.off" -o "$T/off.png" --size 64x64 --view 0,0 -q
 check "$T/off.png" "$(near '(153, 153, 153)' 1) or $(near '(200, 200, 200)' 1)"
+
+# glTF: the base colour factor (blue)
+"$AMGSPLAT" render "$T/quad.gltf" -o "$T/gltf.png" --size 64x64 --view 0,0 -q
+check "$T/gltf.png" "$(near '(0, 0, 255)' 1)"
 
 # Flat normals: seen along (1, 1, 1), the octahedron's face (+x, +y, +z) faces the eye. With --flat
 # it shows one shade, its full colour (153 or 200, as the OFF above); without, the vertex normals
