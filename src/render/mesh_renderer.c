@@ -274,6 +274,7 @@ int asp_mesh_renderer_create(asp_gl_context *gl, const asp_render_mesh *mesh, co
                              asp_renderer **out, asp_error *err)
 {
     ASP_ASSERT(gl && mesh && out);
+    ASP_ASSERT(mesh->positions && mesh->triangles && (mesh->materials || mesh->material_count == 0));
     static const asp_mesh_renderer_desc zero_desc;
     if (!desc)
         desc = &zero_desc;
