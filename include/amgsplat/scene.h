@@ -78,14 +78,16 @@ typedef struct asp_scene {
  * OFF, STL, glTF/GLB, 3DS) through asp_mesh_load with missing textures
  * allowed (listed in out->mesh->materials[i].texture_missing, for the caller
  * to warn about) and desc->texture; a PLY with faces loads its vertices as
- * points too (asp_cloud_load), so the point renderers draw it as well. A .dps that records no frame is framed by its
- * source points (asp_dps.source, tried as stored and next to the .dps) when
+ * points too (asp_cloud_load), so the point renderers draw it as well. A
+ * .dps that records no frame is framed by its source points (asp_dps.source, tried as stored and next to the .dps) when
  * they load, else by the level's support rectangles. desc may be NULL; ctx
  * (NULL = defaults) gives threads and allocator and is kept in out->ctx.
  * Returns 0; the loaders' errors (ASP_EIO, ASP_EFORMAT naming the file);
  * ASP_EUNSUPPORTED for an image; ASP_EINVAL (a level the file does
  * not have, input colours asked of points without colours is not an error);
- * ASP_EDEGENERATE (nothing to frame); ASP_ENOMEM. Reentrant.
+ * ASP_EDEGENERATE (nothing to frame); ASP_ENOMEM. Reentrant, except that
+ * two meshes must not load at once (asp_mesh_load keeps assimp's error
+ * message in a process-wide string).
  */
 int asp_scene_load(const char *path, const asp_scene_desc *desc, const asp_context *ctx, asp_scene *out,
                    asp_error *err);
