@@ -79,8 +79,9 @@ typedef struct asp_scene {
  * allowed (listed in out->mesh->materials[i].texture_missing, for the caller
  * to warn about) and desc->texture; a PLY with faces loads its vertices as
  * points too (asp_cloud_load), so the point renderers draw it as well. A
- * .dps that records no frame is framed by its source points (asp_dps.source, tried as stored and next to the .dps) when
- * they load, else by the level's support rectangles. desc may be NULL; ctx
+ * .dps that records no frame is framed by its source points (asp_dps.source,
+ * tried as stored and next to the .dps) when they load, else by the level's
+ * support rectangles. desc may be NULL; ctx
  * (NULL = defaults) gives threads and allocator and is kept in out->ctx.
  * Returns 0; the loaders' errors (ASP_EIO, ASP_EFORMAT naming the file);
  * ASP_EUNSUPPORTED for an image; ASP_EINVAL (a level the file does
