@@ -643,13 +643,82 @@ const char *asp_prim_render_method_name(asp_prim_render_method m);
 int asp_prim_render_method_parse(const char *name, asp_prim_render_method *out, asp_error *err);
 
 /* ------------------------------------------------------------------------ */
+/* Triangle meshes (issue 14: the textured-mesh baseline of seed 004 2.2-2.3) */
+/* ------------------------------------------------------------------------ */
+
+/**
+ * A material of asp_render_mesh: where a triangle gets its colour. The rule
+ * is the mesh sampler's (asp__surface_point), so samples of a mesh and the
+ * mesh itself show one colour: the texture when the mesh has UVs and the
+ * material a texture, else the vertex colours when the mesh has them, else
+ * color.
+ */
+typedef struct asp_render_material {
+    float color[4];           /* RGBA in 0..1, sRGB-encoded (an OBJ Kd as the sampler reads it: 255 Kd) */
+    const asp_image *texture; /* diffuse texture or NULL; rows top first, UV v = 0 is its bottom row */
+} asp_render_material;
+
+/**
+ * A triangle mesh as plain arrays (render knows no files: the scene loader
+ * fills this from an asp_mesh, mesh.h). Everything is borrowed for the
+ * create call only.
+ */
+typedef struct asp_render_mesh {
+    size_t vertex_count, triangle_count;
+    double origin[3];             /* world position = origin + positions[i] */
+    const float *positions;       /* 3 * vertex_count */
+    const float *normals;         /* 3 * vertex_count, or NULL: face normals */
+    const float *uvs;             /* 2 * vertex_count, or NULL (GL convention: v = 0 is the image bottom) */
+    const uint8_t *colors;        /* 4 * vertex_count sRGB RGBA, or NULL */
+    const uint32_t *triangles;    /* 3 * triangle_count vertex indices */
+    const uint32_t *material_ids; /* triangle_count indices into materials, or NULL: material 0 */
+    size_t material_count;        /* 0 = one light grey material (200, 200, 200), like the point renderers */
+    const asp_render_material *materials;
+} asp_render_mesh;
+
+/** Flags for asp_mesh_renderer_desc.flags; 0 is the default. */
+enum asp_mesh_renderer_flags {
+    /* Light each triangle by its face normal (faceted), not the interpolated vertex normals. */
+    ASP_MESH_RENDER_FLAT = 1 << 0
+};
+
+/** Options of the mesh renderer; the zero value means defaults. */
+typedef struct asp_mesh_renderer_desc {
+    unsigned flags;    /* asp_mesh_renderer_flags */
+    double origin[3];  /* world point the renderer's frame is centred on (as asp_prim_renderer_desc.origin):
+                          vertices are drawn at mesh->origin + position - origin; zero = world origin */
+} asp_mesh_renderer_desc;
+
+/**
+ * Uploads mesh to GL (one vertex buffer per array, one index buffer with the
+ * triangles grouped by material, each texture as a GL_SRGB8_ALPHA8 texture
+ * with a full mipmap chain, trilinear filtering and GL_REPEAT wrapping) and
+ * returns a renderer drawing the opaque, depth-tested, two-sided triangles.
+ * Colours follow asp_render_material's rule; shading is that of
+ * asp_render_to_image (colour * (0.25 + 0.75 |n . l|) in linear light,
+ * ASP_RENDER_UNLIT, the light of asp_render_desc) with n the interpolated
+ * vertex normal, or the face normal with ASP_MESH_RENDER_FLAT or without
+ * normals, so a mesh and discs sampled from it light alike. Texture alpha is
+ * ignored (opaque, like the discs). asp_renderer_count gives the triangles.
+ * mesh is only read during the call. Makes gl current.
+ * Returns 0; ASP_EDEGENERATE (no triangles); ASP_EFORMAT (a vertex index or
+ * material id out of range, a non-finite position, naming it); ASP_EUNSUPPORTED
+ * (more than 2^31 - 1 indices, a texture larger than GL_MAX_TEXTURE_SIZE);
+ * ASP_EGL; ASP_ENOMEM. *out is unchanged on failure; free it with
+ * asp_renderer_destroy.
+ */
+int asp_mesh_renderer_create(asp_gl_context *gl, const asp_render_mesh *mesh, const asp_mesh_renderer_desc *desc,
+                             asp_renderer **out, asp_error *err);
+
+/* ------------------------------------------------------------------------ */
 /* The renderer table (STYLE.md 9b: one table, owned by render)             */
 /* ------------------------------------------------------------------------ */
 
 /** What a renderer of the table can draw (asp_renderer_kind.inputs). */
 enum asp_render_input_bits {
     ASP_RENDER_INPUT_POINTS = 1 << 0, /* asp_render_source.cloud or .hier: points, splats */
-    ASP_RENDER_INPUT_PRIMS = 1 << 1   /* asp_render_source.level: domain primitives */
+    ASP_RENDER_INPUT_PRIMS = 1 << 1,  /* asp_render_source.level: domain primitives */
+    ASP_RENDER_INPUT_MESH = 1 << 2    /* asp_render_source.mesh: a triangle mesh */
 };
 
 /**
@@ -663,7 +732,8 @@ typedef struct asp_render_source {
                                     square draw it instead of building one; NULL = built from cloud */
     const float *clip_planes;    /* 8 floats per point of cloud (asp_crease_clip_planes), NULL = none */
     const asp_dps_level *level;  /* domain primitives (the prim renderer) */
-    double origin[3];            /* the frame the primitives are drawn in (asp_prim_renderer_desc.origin);
+    const asp_render_mesh *mesh; /* a triangle mesh (the mesh renderer), drawn in the frame of origin */
+    double origin[3];            /* the frame primitives and meshes are drawn in (asp_prim_renderer_desc.origin);
                                     for points it is cloud->origin (or asp_hier_origin), which the point
                                     renderers use by themselves */
 } asp_render_source;
@@ -674,12 +744,13 @@ typedef struct asp_renderer_options {
     asp_splat_renderer_desc splat;   /* clip_planes comes from the source */
     asp_square_renderer_desc square;
     asp_prim_render_options prim;
+    asp_mesh_renderer_desc mesh;     /* origin comes from the source */
 } asp_renderer_options;
 
 /** One row of the renderer table. */
 typedef struct asp_renderer_kind {
-    const char *name;   /* "disc", "splat", "square", "prim" */
-    const char *noun;   /* what asp_renderer_count counts: "points", "splats", "primitives" */
+    const char *name;   /* "disc", "splat", "square", "prim", "mesh" */
+    const char *noun;   /* what asp_renderer_count counts: "points", "splats", "primitives", "triangles" */
     unsigned inputs;    /* asp_render_input_bits it draws */
     int has_lod;        /* draws a cut of the point hierarchy: tau and budgets apply (asp_renderer_set_lod) */
     /*
@@ -695,7 +766,8 @@ typedef struct asp_renderer_kind {
 
 /**
  * Row i of the renderer table, in the order "disc", "splat", "square",
- * "prim" (the viewer's 1..9 keys follow it), or NULL past the end. Thread safe.
+ * "prim", "mesh" (the viewer's 1..9 keys follow it), or NULL past the end.
+ * Thread safe.
  */
 const asp_renderer_kind *asp_renderer_kind_at(size_t i);
 

@@ -34,7 +34,8 @@ typedef void (*asp_viewer_log_fn)(void *user, const char *line);
 /** Options of asp_viewer_run; the zero value means defaults. */
 typedef struct asp_viewer_desc {
     uint32_t width, height;  /* window client area, 1..16384; 0 = 1280 x 800 */
-    const char *renderer;    /* first renderer: a name of asp_viewer_renderer_name; NULL = "disc" */
+    const char *renderer;    /* first renderer: a name of asp_viewer_renderer_name; NULL = "mesh" for a mesh,
+                                "splat" for a .hier, else the first row that draws the input ("disc") */
     float tolerance;         /* screen tolerance tau in pixels for renderers that take one, >= 0 */
     int set_view;            /* nonzero: start at azimuth/elevation/distance below, else 30, 20, fitted */
     float azimuth;           /* degrees (asp_camera conventions) */
@@ -48,6 +49,8 @@ typedef struct asp_viewer_desc {
     unsigned prim_method;    /* .dps input: first blending method, an asp_prim_render_method (0 = normalized) */
     float prim_alpha_ref;    /* .dps input: first alpha reference as asp_prim_render_options.alpha_ref
                                 (0 = 0.1, < 0 = exactly 0, at most 1) */
+    const char *texture;     /* mesh input: image used as the texture of materials that name none or whose
+                                file is missing (asp_scene_desc.texture); NULL = none */
     uint8_t background[4];   /* sRGB; alpha 0 = default opaque white */
     size_t frames;           /* 0 = interactive until closed; N = scripted: draw N frames, then return */
     const char *screenshot;  /* scripted: PNG written from the last frame's back buffer; may be NULL */

@@ -14,12 +14,13 @@
 static const char usage[] =
     "usage: amgsplat view FILE [--size WxH] [--view AZ,EL[,DIST]] [--renderer NAME] [--tau PX]\n"
     "                     [--color MODE] [--level L] [--method NAME] [--alpha-ref X] [--unlit]\n"
-    "                     [--background R,G,B] [--verbose]\n"
+    "                     [--background R,G,B] [--texture IMG] [--verbose]\n"
     "       amgsplat view FILE --frames N [--screenshot OUT.png] [--keys KEYS] [options above]\n"
     "\n"
     "Opens a window on a point file (.ply, .xyz, .pts, .txt), an AMG decomposition (.amg,\n"
-    "coloured by classifier or domains) or domain primitives (.dps, one level at a time, blended\n"
-    "by --method as in amgsplat render). Left drag orbits, the wheel or right drag zooms, middle\n"
+    "coloured by classifier or domains), domain primitives (.dps, one level at a time, blended\n"
+    "by --method as in amgsplat render) or a mesh (OBJ+MTL, PLY with faces, OFF, STL, glTF, 3DS;\n"
+    "--texture as in amgsplat sample). Left drag orbits, the wheel or right drag zooms, middle\n"
     "drag or shift + left drag pans; press h in the window for the keys (docs/cli/view.md).\n"
     "With --frames N the viewer draws N frames, pressing KEYS one per frame, saves the last\n"
     "frame to OUT.png and exits (needs a display: run under xvfb-run without one).";
@@ -33,6 +34,7 @@ struct view_opts {
     const char *renderer;
     const char *color;
     const char *level;
+    const char *texture;
     const char *background;
     const char *screenshot;
     const char *keys;
@@ -112,6 +114,7 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
     }
     d->renderer = o->renderer;
     d->amg_level = o->level;
+    d->texture = o->texture;
     d->frames = o->frames;
     d->screenshot = o->screenshot;
     d->keys = o->keys;
@@ -159,12 +162,13 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "first view as in 'amgsplat render' (default 30,20)"},
         {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y (default), z (scans, CAD), x, -y, -z or -x"},
-        {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "first renderer (default disc; 'h' in the window lists them)"},
+        {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "first renderer (default disc, mesh for meshes; 'h' in the window lists them)"},
         {"tau", 0, CLI_DOUBLE, &o.tau, "PX", "screen tolerance of the hierarchy renderers in pixels (default 0)"},
         {"color", 0, CLI_STRING, &o.color, "MODE", ".amg: classifier (default), domains, strict or input"},
         {"level", 0, CLI_STRING, &o.level, "L", ".amg: level for domain colours: L, L-2 or an index (default L); .dps: level drawn (default the finest in the file)"},
         {"method", 0, CLI_STRING, &o.method, "NAME", ".dps: how primitives blend (default normalized; m cycles)"},
         {"alpha-ref", 0, CLI_DOUBLE, &o.alpha_ref, "X", ".dps: alpha reference, 0..1 (default 0.1; ',' '.' step it)"},
+        {"texture", 0, CLI_STRING, &o.texture, "IMG", "mesh: texture of materials that name none or whose file is missing"},
         {"unlit", 0, CLI_FLAG, &o.unlit, NULL, "start with lighting off"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B", "background colour, 0..255 (default 255,255,255)"},
         {"verbose", 'v', CLI_FLAG, &o.verbose, NULL, "print frame time and primitive count once a second"},

@@ -6,10 +6,12 @@
  * It lives in eval, the lowest module above render, because it needs io, amg,
  * prim and hier as well as render's types; render itself knows no files.
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "amgsplat/geom.h"
+#include "amgsplat/sample.h"
 #include "amgsplat/scene.h"
 #include "util/banned.h"
 
@@ -194,6 +196,92 @@ static int load_dps(asp_scene *s, const asp_scene_desc *d, asp_error *err)
     return 0;
 }
 
+int asp_scene_mesh_frame(const asp_mesh *mesh, asp_frame *out, asp_error *err)
+{
+    ASP_ASSERT(mesh && out);
+    size_t n = mesh->vertex_count;
+    if (n == 0)
+        return asp_error_set(err, ASP_EDEGENERATE, "cannot frame a mesh without vertices");
+    // float bounds and double distances, as asp_cloud_frame computes them, so the two frames agree
+    float lo[3], hi[3];
+    for (int k = 0; k < 3; k++)
+        lo[k] = hi[k] = mesh->positions[k];
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            float v = mesh->positions[3 * i + k];
+            if (!isfinite(v))
+                return asp_error_set(err, ASP_EFORMAT, "mesh vertex %zu: position is not finite", i);
+            lo[k] = v < lo[k] ? v : lo[k];
+            hi[k] = v > hi[k] ? v : hi[k];
+        }
+    double c[3], max_d2 = 0;
+    for (int k = 0; k < 3; k++)
+        c[k] = 0.5 * ((double)lo[k] + hi[k]);
+    for (size_t i = 0; i < n; i++) {
+        const float *p = mesh->positions + 3 * i;
+        double dx = p[0] - c[0], dy = p[1] - c[1], dz = p[2] - c[2];
+        double d2 = dx * dx + dy * dy + dz * dz;
+        max_d2 = d2 > max_d2 ? d2 : max_d2;
+    }
+    if (!(max_d2 > 0))
+        return asp_error_set(err, ASP_EDEGENERATE, "cannot frame a mesh whose %zu vertices are at one position", n);
+    for (int k = 0; k < 3; k++)
+        out->center[k] = mesh->origin[k] + c[k];
+    out->radius = sqrt(max_d2);
+    return 0;
+}
+
+/* The mesh's arrays as render's plain description; the sampler's colour rule decides the material colours. */
+static int describe_mesh(asp_scene *s, asp_error *err)
+{
+    const asp_mesh *m = s->mesh;
+    s->materials = asp_calloc(&s->ctx, m->material_count, sizeof *s->materials);
+    if (!s->materials)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu materials", m->material_count);
+    for (size_t i = 0; i < m->material_count; i++) {
+        const asp_material *mt = &m->materials[i];
+        for (int c = 0; c < 4; c++) {
+            // a material without a colour of its own is drawn like points without colours: light grey
+            float v = mt->has_color ? mt->diffuse[c] : (c < 3 ? 200.0f / 255.0f : 1.0f);
+            s->materials[i].color[c] = v < 0 ? 0 : v > 1 ? 1 : v;
+        }
+        s->materials[i].texture = mt->texture.pixels ? &mt->texture : NULL;
+    }
+    asp_render_mesh *r = &s->render_mesh;
+    r->vertex_count = m->vertex_count;
+    r->triangle_count = m->triangle_count;
+    memcpy(r->origin, m->origin, sizeof r->origin);
+    r->positions = m->positions;
+    r->normals = m->normals;
+    r->uvs = m->uvs;
+    r->colors = m->colors;
+    r->triangles = m->triangles;
+    r->material_ids = m->material_ids;
+    r->material_count = m->material_count;
+    r->materials = s->materials;
+    return 0;
+}
+
+/* Meshes: drawn in their own frame; a PLY's vertices are points as well. */
+static int load_mesh(asp_scene *s, const asp_scene_desc *d, asp_error *err)
+{
+    asp_mesh_load_desc md = {.texture_override = d->texture, .allow_missing_textures = 1};
+    int rc = asp_mesh_load(s->path, &md, &s->ctx, &s->mesh, err);
+    if (!rc)
+        rc = asp_scene_mesh_frame(s->mesh, &s->frame, err);
+    if (!rc)
+        rc = describe_mesh(s, err);
+    if (rc)
+        return rc;
+    memcpy(s->origin, s->mesh->origin, sizeof s->origin);
+    if (strcmp(s->type.format, "ply") != 0)
+        return 0;
+    rc = asp_cloud_load(s->path, &s->ctx, &s->cloud, err);
+    if (!rc)
+        memcpy(s->origin, s->cloud->origin, sizeof s->origin);
+    return rc ? rc : load_clip_planes(s, d, err);
+}
+
 static int load_hier(asp_scene *s, asp_error *err)
 {
     int rc = asp_hier_load(s->path, &s->ctx, &s->hier, err);
@@ -227,18 +315,9 @@ int asp_scene_load(const char *path, const asp_scene_desc *desc, const asp_conte
     case ASP_FILE_AMG: rc = load_amg(&s, d, err); break;
     case ASP_FILE_DPS: rc = load_dps(&s, d, err); break;
     case ASP_FILE_HIER: rc = load_hier(&s, err); break;
-    case ASP_FILE_MESH:
-        // a PLY with faces still holds its vertices as points (asp_cloud_load reads them)
-        if (strcmp(s.type.format, "ply") == 0) {
-            rc = load_points(&s, d, err);
-            break;
-        }
-        rc = asp_error_set(err, ASP_EUNSUPPORTED,
-                           "cannot draw '%s': a mesh (%s); sample it to points first (amgsplat sample)", path,
-                           s.type.format);
-        break;
+    case ASP_FILE_MESH: rc = load_mesh(&s, d, err); break;
     default:
-        rc = asp_error_set(err, ASP_EUNSUPPORTED, "cannot draw '%s': %s %s, not points, .amg, .dps or .hier", path,
+        rc = asp_error_set(err, ASP_EUNSUPPORTED, "cannot draw '%s': %s %s, not points, a mesh, .amg, .dps or .hier", path,
                            s.type.kind == ASP_FILE_IMAGE ? "an image" : "a file of kind",
                            s.type.kind == ASP_FILE_IMAGE ? s.type.format : asp_file_kind_name(s.type.kind));
         break;
@@ -253,12 +332,20 @@ int asp_scene_load(const char *path, const asp_scene_desc *desc, const asp_conte
 
 int asp_scene_load_source(asp_scene *s, asp_error *err)
 {
-    if (!s->dps)
-        return asp_error_set(err, ASP_EINVAL, "'%s' is not a .dps file: its points are drawn already", s->path);
+    if (!s->dps && !s->mesh)
+        return asp_error_set(err, ASP_EINVAL, "'%s' is not a .dps file or a mesh: its points are drawn already",
+                             s->path);
     if (s->cloud)
         return 0;
     asp_cloud *cloud = NULL;
-    int rc = load_dps_source_cloud(s, &cloud, err);
+    int rc;
+    if (s->mesh) {
+        // area samples, as `amgsplat sample --method area`: the points the mesh is compared with (issue 14)
+        asp_sample_desc sd = {.method = ASP_SAMPLE_AREA, .points = ASP_SCENE_MESH_POINTS};
+        rc = asp_sample_mesh(s->mesh, &sd, &s->ctx, &cloud, NULL, err);
+    } else {
+        rc = load_dps_source_cloud(s, &cloud, err);
+    }
     if (rc)
         return rc;
     // into the primitives' frame: world = origin + position stays true
@@ -282,13 +369,14 @@ void asp_scene_render_source(const asp_scene *s, asp_render_source *out)
     out->hier = s->hier;
     out->clip_planes = s->clip_planes;
     out->level = asp_scene_dps_level(s);
+    out->mesh = s->mesh ? &s->render_mesh : NULL;
     memcpy(out->origin, s->origin, sizeof out->origin);
 }
 
 unsigned asp_scene_inputs(const asp_scene *s)
 {
     return (s->cloud || s->hier ? (unsigned)ASP_RENDER_INPUT_POINTS : 0u) |
-           (s->dps ? (unsigned)ASP_RENDER_INPUT_PRIMS : 0u);
+           (s->dps ? (unsigned)ASP_RENDER_INPUT_PRIMS : 0u) | (s->mesh ? (unsigned)ASP_RENDER_INPUT_MESH : 0u);
 }
 
 void asp_scene_release(asp_scene *s)
@@ -298,5 +386,7 @@ void asp_scene_release(asp_scene *s)
     asp_amg_destroy(s->amg);
     asp_dps_destroy(s->dps);
     asp_hier_destroy(s->hier);
+    asp_free(&s->ctx, s->materials);
+    asp_mesh_destroy(s->mesh);
     memset(s, 0, sizeof *s);
 }

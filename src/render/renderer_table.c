@@ -3,7 +3,7 @@
  * by name here instead of each keeping a list. Rows: opaque discs (Pajarola
  * et al. 2003 section 5), blended splats and squares of the point hierarchy
  * (seed 001 section 5, seed 004 3.2.6), the domain primitives of a .dps level
- * (journal section 4).
+ * (journal section 4), textured triangle meshes (seed 004 2.2-2.3).
  */
 #include <stdio.h>
 #include <string.h>
@@ -67,11 +67,25 @@ static int make_prim(asp_gl_context *gl, const asp_render_source *src, const asp
     return asp_prim_renderer_create(gl, src->level, &d, out, err);
 }
 
+static int make_mesh(asp_gl_context *gl, const asp_render_source *src, const asp_renderer_options *o,
+                     const asp_context *ctx, asp_renderer **out, asp_error *err)
+{
+    (void)ctx;
+    if (!src->mesh)
+        return asp_error_set(err, ASP_EUNSUPPORTED,
+                             "renderer 'mesh' draws triangle meshes (OBJ, PLY with faces, OFF, STL, glTF, 3DS)");
+    asp_mesh_renderer_desc d = o ? o->mesh : (asp_mesh_renderer_desc){0};
+    // the mesh shares the frame of its scene, so one camera fits it and the points sampled from it
+    memcpy(d.origin, src->origin, sizeof d.origin);
+    return asp_mesh_renderer_create(gl, src->mesh, &d, out, err);
+}
+
 static const asp_renderer_kind kinds[] = {
     {"disc", "points", ASP_RENDER_INPUT_POINTS, 0, make_disc},
     {"splat", "splats", ASP_RENDER_INPUT_POINTS, 1, make_splat},
     {"square", "splats", ASP_RENDER_INPUT_POINTS, 1, make_square},
     {"prim", "primitives", ASP_RENDER_INPUT_PRIMS, 0, make_prim},
+    {"mesh", "triangles", ASP_RENDER_INPUT_MESH, 0, make_mesh},
 };
 enum { N_KINDS = sizeof kinds / sizeof kinds[0] };
 

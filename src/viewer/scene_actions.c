@@ -55,7 +55,8 @@ int asp__viewer_scene_check_desc(const asp_viewer_desc *desc, asp_error *err)
 int asp__viewer_scene_load(asp_scene *s, const char *path, const asp_viewer_desc *desc, const asp_context *ctx,
                            asp_error *err)
 {
-    asp_scene_desc d = {.amg_color = scene_color(desc->amg_color), .level = desc->amg_level};
+    asp_scene_desc d = {.amg_color = scene_color(desc->amg_color), .level = desc->amg_level,
+                        .texture = desc->texture};
     asp_scene t;
     memset(&t, 0, sizeof t);
     int rc = asp_scene_load(path, &d, ctx, &t, err);
@@ -143,5 +144,14 @@ int asp__viewer_scene_action(asp_scene *s, enum asp__viewer_action act, char *no
         return amg_action(s, act, note, cap, err);
     if (s->dps)
         return dps_action(s, act, note, cap, err);
+    if (s->mesh && act == ASP__VIEWER_POINTS) {
+        // points sampled from the mesh (or a PLY's own vertices), drawn in the mesh's frame
+        asp_error e = {0, ""};
+        if (asp_scene_load_source(s, &e)) {
+            snprintf(note, cap, "cannot sample points from the mesh: %s", e.msg);
+            return 0;
+        }
+        return 1;
+    }
     return 0;
 }

@@ -488,29 +488,38 @@ static void prim_action(viewer *v, enum asp__viewer_action a)
     set_prim_options(v, &old);
 }
 
-/* p on a .dps: the source points (loaded once, drawn as discs) or the primitives again */
+/*
+ * p on a .dps: the source points (loaded once, drawn as discs) or the primitives again; on a mesh:
+ * points sampled from it (ASP_SCENE_MESH_POINTS, once) or the mesh again, one model in one frame.
+ */
 static void toggle_points(viewer *v)
 {
-    if (!is_dps(v)) {
-        vlog(v, "p applies to .dps input only");
+    if (!is_dps(v) && !v->scene.mesh) {
+        vlog(v, "p applies to .dps input only, and to meshes");
         return;
     }
-    size_t to = v->kind_prim;
-    if (v->kind == v->kind_prim) {
+    size_t main_kind = is_dps(v) ? v->kind_prim : find_renderer("mesh");
+    const char *main_name = is_dps(v) ? "primitives" : "mesh";
+    size_t to = main_kind;
+    if (v->kind == main_kind) {
         char note[LOG_CAP] = "";
         asp_error e = {0, ""};
+        int had_points = v->scene.cloud != NULL;
+        double t0 = asp_time_now();
         int rc = asp__viewer_scene_action(&v->scene, ASP__VIEWER_POINTS, note, sizeof note, &e);
         if (rc <= 0) {
             vlog(v, "%s", rc < 0 ? e.msg : note);
             return;
         }
+        if (!had_points && v->scene.mesh)
+            vlog(v, "sampled %zu points from the mesh in %.2f s", v->scene.cloud->count, asp_time_now() - t0);
         to = find_renderer("disc");
     }
     asp_error e = {0, ""};
     if (switch_renderer(v, to, &e))
         vlog(v, "renderer '%s' unavailable: %s", K(to)->name, e.msg);
     else
-        vlog(v, "showing the %s", to == v->kind_prim ? "primitives" : "source points");
+        vlog(v, "showing the %s", to == main_kind ? main_name : is_dps(v) ? "source points" : "points");
 }
 
 static void scene_action(viewer *v, enum asp__viewer_action a)
@@ -801,10 +810,16 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
         v.center[k] = (float)(v.scene.frame.center[k] - v.scene.origin[k]);
     v.radius = (float)v.scene.frame.radius;
     v.kind_prim = find_renderer("prim");
-    // a .hier holds splats without their points: the splat renderer draws it
+    // a .hier holds splats without their points: the splat renderer draws it; a mesh is drawn as one
     v.kind = desc->renderer ? find_renderer(desc->renderer)
              : v.scene.hier ? find_renderer("splat")
+             : v.scene.mesh ? find_renderer("mesh")
                             : first_accepted(&v);
+    // the scene loader records missing textures; the viewer says so through its log (issue 14)
+    for (size_t i = 0; v.scene.mesh && i < v.scene.mesh->material_count; i++)
+        if (v.scene.mesh->materials[i].texture_missing)
+            vlog(&v, "warning: texture '%s' of material '%s' not found: drawn in its material colour",
+                 v.scene.mesh->materials[i].texture_path, v.scene.mesh->materials[i].name);
     rc = open_window(&v, err);
     if (!rc) {
         uint32_t w = 0, h = 0;
