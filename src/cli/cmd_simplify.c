@@ -116,9 +116,10 @@ int cmd_simplify(int argc, char **argv, struct cli_env *env)
                bo.texture);
     }
     if (st.short_of_target)
-        cli_info(env, "amgsplat simplify: note: stopped at %zu triangles, more than 5%% above the target %zu "
-                      "(topology%s); --sloppy can go further",
-                 st.output_triangles, st.target_triangles, max_error > 0.0 ? " or --error" : " and UV seams");
+        cli_info(env, "amgsplat simplify: note: stopped at %zu triangles, more than 5%% above the target %zu (%s)%s",
+                 st.output_triangles, st.target_triangles,
+                 max_error > 0.0 ? "--error or the topology" : "the topology and UV seams",
+                 sloppy ? "; the sloppy fallback got no closer" : "; --sloppy can go further");
     asp_mesh_destroy(simple);
     asp_mesh_destroy(mesh);
     return 0;
