@@ -11,6 +11,7 @@ packages=(
   libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri   # OpenGL 4.5 core via EGL (Mesa llvmpipe headless)
   libglfw3-dev                     # viewer windows
   libassimp-dev                    # mesh formats
+  libmeshoptimizer-dev             # simplified meshes (amgsplat simplify; 0.18 in Debian 12)
   libstb-dev                       # PNG/JPEG read and write
   zlib1g-dev                       # CRC-32 of the .amg and .dps files
   libflann-dev                     # k-NN baseline for bench/bench_knn.c

@@ -8,6 +8,7 @@
 #define AMGSPLAT_GEOM_H
 
 #include "cloud.h"
+#include "mesh.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -287,6 +288,75 @@ typedef struct asp_crease_desc {
  */
 int asp_crease_clip_planes(const asp_cloud *cloud, const asp_crease_desc *desc, const asp_context *ctx, float *dst,
                            size_t *clipped, asp_error *err);
+
+/* ---- mesh simplification (src/geom/mesh_simplify.c, meshoptimizer) ---- */
+
+/** Bits of asp_mesh_simplify_desc.flags; 0 is the safe default. */
+enum asp_mesh_simplify_flags {
+    /*
+     * When the topology-preserving simplifier stops more than 5% above
+     * target_triangles, run meshopt_simplifySloppy (vertex clustering, ignores
+     * topology and UV seams: textures can tear) and keep its result when it is
+     * closer to the target. stats->sloppy says whether it was used.
+     */
+    ASP_MESH_SIMPLIFY_SLOPPY_FALLBACK = 1 << 0,
+    /* Recompute area-weighted normals on the simplified mesh instead of keeping the original vertices' normals. */
+    ASP_MESH_SIMPLIFY_RECOMPUTE_NORMALS = 1 << 1,
+    /* Never move vertices on an open border (for meshes that are parts of a larger one). */
+    ASP_MESH_SIMPLIFY_LOCK_BORDER = 1 << 2
+};
+
+/** Options for asp_mesh_simplify; the zero value keeps the mesh as it is (no target). */
+typedef struct asp_mesh_simplify_desc {
+    size_t target_triangles; /* triangles to reach; 0: only target_error limits the simplification */
+    /*
+     * Largest error allowed, relative to the mesh extent as meshoptimizer
+     * measures it (0.01 = 1% of the largest bounding-box side); 0: no limit,
+     * so target_triangles alone decides.
+     */
+    double target_error;
+    unsigned flags; /* asp_mesh_simplify_flags */
+} asp_mesh_simplify_desc;
+
+/** What asp_mesh_simplify did. */
+typedef struct asp_mesh_simplify_stats {
+    size_t input_triangles, input_vertices;
+    size_t output_triangles, output_vertices;
+    size_t target_triangles; /* the target asked (desc->target_triangles) */
+    double error;            /* meshoptimizer's result error, relative to the extent (largest over materials) */
+    double error_world;      /* the same in world units (error times meshopt_simplifyScale) */
+    int short_of_target;     /* 1: output_triangles exceeds the target by more than 5% */
+    int sloppy;              /* 1: the sloppy fallback produced the result */
+    size_t material_groups;  /* materials simplified separately (their borders locked) */
+} asp_mesh_simplify_stats;
+
+/**
+ * Simplifies mesh into a new mesh (*out; free with asp_mesh_destroy) of about
+ * desc->target_triangles triangles with meshoptimizer's edge-collapse
+ * simplifier (meshopt_simplify: quadric error metric, Garland and Heckbert
+ * 1997). Vertices never move (a collapse keeps one end), so every output
+ * vertex is an input vertex with its position, UV, colour and normal
+ * (recomputed with ASP_MESH_SIMPLIFY_RECOMPUTE_NORMALS). Materials and their
+ * textures are copied; material ids follow the triangles.
+ *
+ * UV seams: asp_mesh splits vertices at seams (same position, different UV).
+ * meshoptimizer 0.18 finds such vertices by their bit-identical positions and
+ * collapses seam vertices only along the seam and both sides together, so
+ * seams neither tear nor drift; the cost is that seam-heavy meshes may stop
+ * above the target (stats->short_of_target). With more than one material in
+ * use, each material's triangles are simplified on their own with their
+ * borders locked (meshopt_SimplifyLockBorder), so material boundaries stay
+ * closed; the target is shared in proportion to triangle counts.
+ *
+ * target_triangles at or above the input count gives a copy (compacted to the
+ * vertices in use). desc may be NULL (copy); stats may be NULL.
+ * Errors: ASP_EFORMAT (a triangle index out of range), ASP_ENOMEM. On failure
+ * *out is unchanged. meshoptimizer allocates its scratch with operator new,
+ * outside the context's allocator (NEEDSWORK: its global meshopt_setAllocator
+ * is not thread safe, so it is left alone). Reentrant; mesh is only read.
+ */
+int asp_mesh_simplify(const asp_mesh *mesh, const asp_mesh_simplify_desc *desc, const asp_context *ctx,
+                      asp_mesh **out, asp_mesh_simplify_stats *stats, asp_error *err);
 
 #ifdef __cplusplus
 }

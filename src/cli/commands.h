@@ -18,6 +18,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env);
 int cmd_build(int argc, char **argv, struct cli_env *env);
 int cmd_view(int argc, char **argv, struct cli_env *env);
 int cmd_eval(int argc, char **argv, struct cli_env *env);
+int cmd_simplify(int argc, char **argv, struct cli_env *env);
 int cmd_bench_paper(int argc, char **argv, struct cli_env *env);
 
 #endif

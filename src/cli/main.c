@@ -24,6 +24,7 @@ static const struct cli_command commands[] = {
     {"render", cmd_render, "render points to PNG headlessly (EGL)"},
     {"imgdiff", cmd_imgdiff, "compare two images: PSNR, SSIM, silhouette IoU"},
     {"decompose", cmd_decompose, "multiscale AMG decomposition of a point set into domains"},
+    {"simplify", cmd_simplify, "simplify a mesh to N triangles (meshoptimizer), keeping UVs and textures"},
     {"build", cmd_build, "domain primitives (textured polygons) of AMG levels into a .dps file"},
     {"view", cmd_view, "open a window on points or an .amg decomposition (interactive viewer)"},
     {"eval", cmd_eval, "measure every representation against the reference: PSNR, SSIM, IoU, frame time"},

@@ -1,0 +1,126 @@
+/*
+ * amgsplat simplify: a mesh simplified to N triangles through meshoptimizer
+ * (asp_mesh_simplify), written as OBJ+MTL or PLY (asp_mesh_save): the
+ * polygon baseline issue #14 measures domain primitives against.
+ */
+static const char usage[] =
+    "usage: amgsplat simplify MESH --triangles N -o OUT.obj|OUT.ply [--error X] [--texture FILE]\n"
+    "                         [--up AXIS] [--sloppy] [--recompute-normals] [--lock-border] [--json]\n"
+    "\n"
+    "Simplifies a mesh (OBJ+MTL, PLY, OFF, STL, glTF/GLB, 3DS, ... via assimp) to about N\n"
+    "triangles with meshoptimizer's edge collapse, keeping UVs (seams stay closed), vertex\n"
+    "colours, normals, materials and textures. OUT.obj gets OUT.mtl and OUT.png beside it;\n"
+    "OUT.ply holds faces, uvs and colours and names OUT.png. --error X stops once the error\n"
+    "would exceed X (relative to the mesh extent, 0.01 = 1%). The collapse may stop above N\n"
+    "to keep the topology; --sloppy then tries meshoptimizer's clustering simplifier, which\n"
+    "reaches N but may tear UV seams. Prints triangles, vertices, the error and GPU bytes\n"
+    "(vertex + index + mipmapped texture bytes, as in docs/cli/simplify.md).";
+
+#include <stdio.h>
+
+#include "cli/cli.h"
+#include "cli/commands.h"
+#include "util/banned.h"
+
+static void print_json(const char *in, const char *out, const asp_mesh_simplify_stats *st, const asp_mesh_bytes *bi,
+                       const asp_mesh_bytes *bo)
+{
+    printf("{\"input\": ");
+    cli_json_string(stdout, in);
+    printf(", \"output\": ");
+    cli_json_string(stdout, out);
+    printf(", \"target_triangles\": %zu, \"input_triangles\": %zu, \"input_vertices\": %zu, "
+           "\"triangles\": %zu, \"vertices\": %zu, \"error\": %.9g, \"error_world\": %.9g, "
+           "\"short_of_target\": %s, \"sloppy\": %s, \"material_groups\": %zu, "
+           "\"input_bytes\": {\"vertex\": %zu, \"index\": %zu, \"texture\": %zu, \"total\": %zu}, "
+           "\"bytes\": {\"vertex\": %zu, \"index\": %zu, \"texture\": %zu, \"total\": %zu}}\n",
+           st->target_triangles, st->input_triangles, st->input_vertices, st->output_triangles, st->output_vertices,
+           st->error, st->error_world, st->short_of_target ? "true" : "false", st->sloppy ? "true" : "false",
+           st->material_groups, bi->vertex, bi->index, bi->texture, bi->total, bo->vertex, bo->index, bo->texture,
+           bo->total);
+}
+
+int cmd_simplify(int argc, char **argv, struct cli_env *env)
+{
+    const char *output = NULL, *texture = NULL, *up = NULL;
+    size_t triangles = 0;
+    double max_error = 0.0;
+    int sloppy = 0, recompute = 0, lock_border = 0;
+    const struct cli_option opts[] = {
+        {"triangles", 'n', CLI_SIZE, &triangles, "N", "target triangle count (1 to the mesh's count - 1)"},
+        {"output", 'o', CLI_STRING, &output, "FILE", "output mesh (.obj with .mtl and .png, or .ply)"},
+        {"error", 'e', CLI_DOUBLE, &max_error, "X", "largest error relative to the extent (0 < X <= 1)"},
+        {"texture", 't', CLI_STRING, &texture, "FILE", "texture for materials that have none (e.g. Spot's OBJ)"},
+        {"up", 0, CLI_STRING, &up, "AXIS", "the file's up axis: y (default), z, x, -y, -z or -x"},
+        {"sloppy", 0, CLI_FLAG, &sloppy, NULL, "fall back to clustering when the collapse stops above N"},
+        {"recompute-normals", 0, CLI_FLAG, &recompute, NULL, "normals of the simplified surface"},
+        {"lock-border", 0, CLI_FLAG, &lock_border, NULL, "keep open borders where they are"},
+        {0},
+    };
+    int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
+    if (rc)
+        return rc > 0 ? 0 : 2;
+    if (npos != 1)
+        return cli_usage_error(env, "expected one mesh file, got %d; see 'amgsplat simplify -h'", npos);
+    if (!output)
+        return cli_usage_error(env, "missing -o OUT.obj or OUT.ply");
+    if (!asp_file_name_is(output, "obj") && !asp_file_name_is(output, "ply"))
+        return cli_usage_error(env, "output '%s' must end in .obj or .ply", output);
+    if (triangles == 0 && max_error == 0.0)
+        return cli_usage_error(env, "missing --triangles N (or --error X)");
+    if (max_error < 0.0 || max_error > 1.0)
+        return cli_usage_error(env, "--error must be in 0..1 (a fraction of the mesh extent), got %g", max_error);
+    asp_up_axis up_axis = ASP_UP_Y;
+    if (up && cli_parse_up(up, &up_axis) != 0)
+        return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", up);
+
+    asp_error err = {0};
+    asp_mesh *mesh = NULL;
+    if (asp_mesh_load(argv[0], &(asp_mesh_load_desc){.texture_override = texture, .up = up_axis}, &env->ctx, &mesh,
+                      &err))
+        return cli_fail(env, &err);
+    if (triangles && triangles >= mesh->triangle_count) {
+        size_t have = mesh->triangle_count;
+        asp_mesh_destroy(mesh);
+        return cli_usage_error(env, "--triangles must be 1 to %zu ('%s' has %zu triangles), got %zu",
+                               have > 1 ? have - 1 : 1, argv[0], have, triangles);
+    }
+    asp_mesh_simplify_desc desc = {
+        .target_triangles = triangles,
+        .target_error = max_error,
+        .flags = (sloppy ? ASP_MESH_SIMPLIFY_SLOPPY_FALLBACK : 0u) |
+                 (recompute ? ASP_MESH_SIMPLIFY_RECOMPUTE_NORMALS : 0u) |
+                 (lock_border ? ASP_MESH_SIMPLIFY_LOCK_BORDER : 0u),
+    };
+    asp_mesh *simple = NULL;
+    asp_mesh_simplify_stats st = {0};
+    if (asp_mesh_simplify(mesh, &desc, &env->ctx, &simple, &st, &err) ||
+        asp_mesh_save(simple, output, NULL, &err)) {
+        asp_mesh_destroy(simple);
+        asp_mesh_destroy(mesh);
+        return cli_fail(env, &err);
+    }
+    cli_progress_end(env);
+    asp_mesh_bytes bi, bo;
+    asp_mesh_gpu_bytes(mesh, &bi);
+    asp_mesh_gpu_bytes(simple, &bo);
+    if (env->json) {
+        print_json(argv[0], output, &st, &bi, &bo);
+    } else if (!env->quiet) {
+        printf("simplified '%s' -> '%s': %zu -> %zu triangles (target %zu), %zu -> %zu vertices\n", argv[0],
+               output, st.input_triangles, st.output_triangles, st.target_triangles, st.input_vertices,
+               st.output_vertices);
+        printf("error %.3g of the extent (%.3g world units)%s\n", st.error, st.error_world,
+               st.sloppy ? ", sloppy fallback (UV seams may tear)" : "");
+        printf("GPU bytes %zu -> %zu (vertex %zu, index %zu, texture %zu)\n", bi.total, bo.total, bo.vertex, bo.index,
+               bo.texture);
+    }
+    if (st.short_of_target)
+        cli_info(env, "amgsplat simplify: note: stopped at %zu triangles, more than 5%% above the target %zu (%s)%s",
+                 st.output_triangles, st.target_triangles,
+                 max_error > 0.0 ? "--error or the topology" : "the topology and UV seams",
+                 sloppy ? "; the sloppy fallback got no closer" : "; --sloppy can go further");
+    asp_mesh_destroy(simple);
+    asp_mesh_destroy(mesh);
+    return 0;
+}
