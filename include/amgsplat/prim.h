@@ -11,6 +11,7 @@
 #include "amg.h"
 #include "cloud.h"
 #include "image.h"
+#include "mesh.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -268,6 +269,17 @@ typedef struct asp_dps_summary {
  * (so a caller can see that rows were left out); prints nothing. Thread-safe.
  */
 size_t asp_dps_summarize(const asp_dps *dps, asp_dps_summary *rows, size_t capacity);
+
+/**
+ * GPU bytes of a level drawn as textured quads, counted as asp_mesh_gpu_bytes
+ * counts a mesh (mesh.h) so the two compare: per primitive 4 vertices x (12
+ * position + 12 normal + 8 uv) and 6 indices x 4; the colour atlas width *
+ * height * 4 * 4 / 3 (RGBA8 with its mipmap chain), and the normal atlas the
+ * same way when the level has one. The renderer's own buffers (storage
+ * buffers of primitives and neighbours) are not counted: they replace the
+ * vertex buffers, not add to them. out may be NULL; returns the total. Pure.
+ */
+size_t asp_dps_level_gpu_bytes(const asp_dps_level *level, asp_mesh_bytes *out);
 
 /** Writes the name of dps->levels[index] ("L", "L-3") to name. Thread-safe. */
 void asp_dps_level_name(const asp_dps *dps, size_t index, char name[16]);

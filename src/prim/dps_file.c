@@ -452,6 +452,23 @@ int asp_dps_load(const char *path, const asp_context *ctx, asp_dps **out, asp_er
     return rc;
 }
 
+static size_t mipmapped_rgba8(const asp_image *img)
+{
+    return (size_t)img->width * img->height * 4 * 4 / 3;
+}
+
+size_t asp_dps_level_gpu_bytes(const asp_dps_level *level, asp_mesh_bytes *out)
+{
+    asp_mesh_bytes b;
+    b.vertex = level->prim_count * 4 * (12 + 12 + 8);
+    b.index = level->prim_count * 6 * 4;
+    b.texture = mipmapped_rgba8(&level->atlas) + (level->normal_atlas.width ? mipmapped_rgba8(&level->normal_atlas) : 0);
+    b.total = b.vertex + b.index + b.texture;
+    if (out)
+        *out = b;
+    return b.total;
+}
+
 void asp_dps_level_name(const asp_dps *dps, size_t index, char name[16])
 {
     uint32_t top = dps->amg_levels ? dps->amg_levels - 1 : 0;

@@ -118,6 +118,11 @@ static void test_round_trip_and_damage(void)
         CHECK(fabs(b->prims[0].centre[0] - 1000.5) < 1); /* world coordinates */
         asp_dps_summary row;
         CHECK(asp_dps_summarize(back, &row, 1) == 1);
+        asp_mesh_bytes bytes;
+        size_t total = asp_dps_level_gpu_bytes(b, &bytes);
+        CHECK(bytes.vertex == 4 * 128 && bytes.index == 4 * 24); // 4 primitives
+        CHECK(bytes.texture == 2 * ((size_t)b->atlas.width * b->atlas.height * 16 / 3) && total == bytes.vertex +
+              bytes.index + bytes.texture); // colour and normal atlas, same size, with mipmaps
         size_t index = 9;
         CHECK(asp_dps_level_parse(back, "L-2", &index, NULL) == 0 && index == 0);
         CHECK(asp_dps_level_parse(back, "L-3", &index, NULL) == ASP_EINVAL && index == 0);
