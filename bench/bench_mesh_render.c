@@ -179,7 +179,8 @@ static void row(bench_view *v, asp_renderer *r, const double origin[3], const be
         snprintf(tri, sizeof tri, "%zu", triangles);
     if (drawn[0] != count || drawn[2] != count)
         snprintf(cut, sizeof cut, " (drawn at 128/256/512: %zu/%zu/%zu)", drawn[0], drawn[1], drawn[2]);
-    printf("| %s%s | %zu | %s | %zu | %.2f | %.2f | %.2f | %.3f |\n", what, cut, count, tri, bytes, ms[0], ms[1], ms[2], ssim);
+    printf("| %s%s | %zu | %s | %zu | %.2f | %.2f | %.2f | %.3f |\n", what, cut, count, tri, bytes, ms[0], ms[1], ms[2],
+           ssim);
     fflush(stdout);
 }
 
