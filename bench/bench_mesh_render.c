@@ -71,34 +71,6 @@ static void view_camera(asp_camera *cam, const asp_frame *frame, const double or
     asp_camera_frame(cam, frame, origin, 1.0f, 0.0f);
 }
 
-/*
- * An asp_mesh as render's plain description, with the colour rule of the
- * scene loader (src/eval/scene.c describe_mesh): a material without a colour
- * of its own is light grey, like points without colours. mats has
- * mesh->material_count entries; the arrays stay borrowed from mesh.
- */
-static void describe_mesh(const asp_mesh *m, asp_render_material *mats, asp_render_mesh *r)
-{
-    for (size_t i = 0; i < m->material_count; i++) {
-        const asp_material *mt = &m->materials[i];
-        for (int c = 0; c < 4; c++) {
-            float v = mt->has_color ? mt->diffuse[c] : (c < 3 ? 200.0f / 255.0f : 1.0f);
-            mats[i].color[c] = v < 0 ? 0 : v > 1 ? 1 : v;
-        }
-        mats[i].texture = mt->texture.pixels ? &mt->texture : NULL;
-    }
-    *r = (asp_render_mesh){.vertex_count = m->vertex_count,
-                           .triangle_count = m->triangle_count,
-                           .origin = {m->origin[0], m->origin[1], m->origin[2]},
-                           .positions = m->positions,
-                           .normals = m->normals,
-                           .uvs = m->uvs,
-                           .colors = m->colors,
-                           .triangles = m->triangles,
-                           .material_ids = m->material_ids,
-                           .material_count = m->material_count,
-                           .materials = mats};
-}
 
 /* Median frame time in ms of r at size x size; NAN after printing the error. */
 static double frame_ms(const bench_view *v, asp_renderer *r, const double origin[3], uint32_t size, int frames)
@@ -203,7 +175,7 @@ static void simplified_row(bench_view *v, const asp_mesh *mesh, size_t target, c
         return;
     }
     asp_render_mesh rm;
-    describe_mesh(s, mats, &rm);
+    asp_scene_describe_mesh(s, mats, &rm);
     asp_mesh_renderer_desc md = {.origin = {s->origin[0], s->origin[1], s->origin[2]}};
     if (asp_mesh_renderer_create(v->gl, &rm, &md, &r, &err)) {
         fprintf(stderr, "bench_mesh_render: %s\n", err.msg);
@@ -268,7 +240,7 @@ static int bench_model(asp_gl_context *gl, const char *path, const char *texture
     printf("|---|---|---|---|---|---|---|---|\n");
 
     asp_render_mesh rm;
-    describe_mesh(mesh, mats, &rm);
+    asp_scene_describe_mesh(mesh, mats, &rm);
     asp_mesh_renderer_desc md = {.origin = {mesh->origin[0], mesh->origin[1], mesh->origin[2]}};
     if (asp_mesh_renderer_create(gl, &rm, &md, &r, &err)) {
         fprintf(stderr, "bench_mesh_render: %s\n", err.msg);
