@@ -87,8 +87,9 @@ struct eval_state {
     asp_frame frame;     /* the one camera framing (asp_camera_frame): the cloud's, or the mesh's with one */
     const asp_mesh *mesh;            /* the true surface (asp_eval_desc.mesh) or NULL */
     asp_mesh *tris[MAX_LEVELS];      /* per level of dps: the mesh at <= the level's primitive count */
-    asp_mesh *bytes[MAX_LEVELS];     /* per level: the mesh at <= the level's GPU bytes, NULL: see note */
-    char bytes_note[MAX_LEVELS][96];
+    asp_mesh *bytes[MAX_LEVELS];     /* per level: the mesh at <= the level's GPU bytes */
+    char tris_note[MAX_LEVELS][96];  /* why tris[l] is NULL */
+    char bytes_note[MAX_LEVELS][96]; /* why bytes[l] is NULL */
     float elevation;
     float crease_angle;  /* resolved: degrees, or -1 for none */
     size_t views, frames;
@@ -400,9 +401,13 @@ static int simplify_fit(struct eval_state *s, size_t limit, int by_bytes, asp_me
         asp_mesh_destroy(best);
         return rc;
     }
-    if (!best)
-        snprintf(note, 96, "smallest simplification %zu triangles %zu %s exceeds %zu", fail_tris, fail_measure,
-                 by_bytes ? "bytes" : "triangles", limit);
+    if (!best) {
+        if (by_bytes)
+            snprintf(note, 96, "smallest simplification %zu triangles %zu bytes exceeds %zu", fail_tris, fail_measure,
+                     limit);
+        else
+            snprintf(note, 96, "smallest simplification %zu triangles exceeds %zu", fail_tris, limit);
+    }
     *out = best;
     return 0;
 }
@@ -414,11 +419,7 @@ static int simplify_levels(struct eval_state *s, asp_eval_result *res, asp_error
     int rc = 0;
     for (size_t l = 0; l < s->dps->level_count && !rc; l++) {
         const asp_dps_level *lv = &s->dps->levels[l];
-        char note[96];
-        rc = simplify_fit(s, lv->prim_count, 0, &s->tris[l], note, err);
-        if (!rc && !s->tris[l])
-            rc = asp_error_set(err, ASP_EDEGENERATE, "cannot simplify the mesh to %zu triangles: %s", lv->prim_count,
-                               note);
+        rc = simplify_fit(s, lv->prim_count, 0, &s->tris[l], s->tris_note[l], err);
         if (!rc)
             rc = simplify_fit(s, asp_dps_level_gpu_bytes(lv, NULL), 1, &s->bytes[l], s->bytes_note[l], err);
         if (!rc)
@@ -527,9 +528,9 @@ static int run_size(struct eval_state *s, uint32_t size, asp_eval_result *res, s
             const struct rep *rp = &s->reps[k];
             size_t r = *row;
             const asp_mesh *mesh = rp->kind == REP_MESH_TRIS ? s->tris[l] : rp->kind == REP_MESH_BYTES ? s->bytes[l] : NULL;
-            if (rp->kind == REP_MESH_BYTES && !mesh)
-                row_without_figures(s, rp, lv, size, s->bytes_note[l], &res->rows[r], res->ssim + r * s->views,
-                                    res->psnr + r * s->views);
+            if ((rp->kind == REP_MESH_TRIS || rp->kind == REP_MESH_BYTES) && !mesh)
+                row_without_figures(s, rp, lv, size, rp->kind == REP_MESH_TRIS ? s->tris_note[l] : s->bytes_note[l],
+                                    &res->rows[r], res->ssim + r * s->views, res->psnr + r * s->views);
             else
                 rc = measure(s, rp, lv, mesh, size, refs, NULL, sh, k, l + 1, &res->rows[r], res->ssim + r * s->views,
                              res->psnr + r * s->views, err);
