@@ -106,14 +106,26 @@ static void print_table(const asp_eval_result *res)
     }
 }
 
+/* The row of representation rep at the size and level of row at, or SIZE_MAX; rows without figures do not count. */
+static size_t find_row(const asp_eval_result *res, const asp_eval_row *at, const char *rep)
+{
+    for (size_t j = 0; j < res->row_count; j++) {
+        const asp_eval_row *r = &res->rows[j];
+        if (r->size == at->size && r->level == at->level && strcmp(r->representation, rep) == 0 && !r->note[0])
+            return j;
+    }
+    return SIZE_MAX;
+}
+
 /*
  * Thesis Fig. 1.1's claim per size and level: the best domain-primitive
  * method (highest mean SSIM) against the point cut to the same count, and in
- * how many views it wins; as text lines or JSON objects.
+ * how many views it wins; with a mesh also against the mesh simplified to the
+ * same count and to the same bytes (issue 14); as text lines or JSON objects.
  */
 static void print_claim(const asp_eval_result *res, FILE *fp, int json)
 {
-    int first = 1;
+    int first = 1, mesh = res->mesh_triangles > 0;
     for (size_t i = 0; i < res->row_count; i++) {
         const asp_eval_row *pt = &res->rows[i];
         if (strcmp(pt->representation, "points") != 0)
@@ -129,18 +141,37 @@ static void print_claim(const asp_eval_result *res, FILE *fp, int json)
             continue;
         const asp_eval_row *b = &res->rows[best];
         size_t wins = asp_eval_ssim_wins(res, best, i);
+        size_t mt = mesh ? find_row(res, pt, "mesh-tris") : SIZE_MAX, mb = mesh ? find_row(res, pt, "mesh-bytes") : SIZE_MAX;
         if (json) {
             fprintf(fp, "%s{\"size\": %u, \"level_name\": \"%s\", \"primitives\": %zu, \"best\": \"%s\", "
-                        "\"best_ssim\": %.6f, \"points_ssim\": %.6f, \"wins\": %zu, \"views\": %zu}",
+                        "\"best_ssim\": %.6f, \"points_ssim\": %.6f, \"wins\": %zu, \"views\": %zu",
                     first ? "" : ", ", pt->size, pt->level_name, pt->primitives, b->representation, b->ssim_mean,
                     pt->ssim_mean, wins, res->views);
+            if (mt != SIZE_MAX)
+                fprintf(fp, ", \"mesh_tris_ssim\": %.6f, \"wins_mesh_tris\": %zu", res->rows[mt].ssim_mean,
+                        asp_eval_ssim_wins(res, best, mt));
+            if (mb != SIZE_MAX)
+                fprintf(fp, ", \"mesh_bytes_ssim\": %.6f, \"wins_mesh_bytes\": %zu", res->rows[mb].ssim_mean,
+                        asp_eval_ssim_wins(res, best, mb));
+            fputc('}', fp);
         } else {
             if (first)
-                fprintf(fp, "\nbest domain-primitive method against the point cut (thesis Fig. 1.1):\n"
-                            "%5s %-6s %10s %-18s %9s %9s %9s\n",
-                        "size", "level", "primitives", "best method", "SSIM", "points", "wins");
-            fprintf(fp, "%5u %-6s %10zu %-18s %9.4f %9.4f %5zu/%zu\n", pt->size, pt->level_name, pt->primitives,
+                fprintf(fp, "\nbest domain-primitive method against the point cut (thesis Fig. 1.1)%s:\n"
+                            "%5s %-6s %10s %-18s %9s %9s %9s%s\n",
+                        mesh ? " and the simplified mesh at equal triangles and equal bytes" : "", "size", "level",
+                        "primitives", "best method", "SSIM", "points", "wins",
+                        mesh ? "  mesh-tris      wins mesh-bytes      wins" : "");
+            fprintf(fp, "%5u %-6s %10zu %-18s %9.4f %9.4f %5zu/%zu", pt->size, pt->level_name, pt->primitives,
                     b->representation, b->ssim_mean, pt->ssim_mean, wins, res->views);
+            const size_t other[2] = {mt, mb};
+            for (int k = 0; k < 2 && mesh; k++) {
+                if (other[k] == SIZE_MAX)
+                    fprintf(fp, " %10s %9s", "-", "-");
+                else
+                    fprintf(fp, " %10.4f %5zu/%zu", res->rows[other[k]].ssim_mean,
+                            asp_eval_ssim_wins(res, best, other[k]), res->views);
+            }
+            fputc('\n', fp);
         }
         first = 0;
     }

@@ -115,6 +115,10 @@ for r in rows:
         continue
     assert 0 < float(r["ssim_min"]) <= float(r["ssim_mean"]) <= 1, r
     assert 0 <= float(r["iou_min"]) <= float(r["iou_mean"]) <= 1 and float(r["frame_ms"]) > 0, r
+# the claim compares the best method with both simplified meshes, where they exist
+claim = json.load(open(sys.argv[1].replace("eval.csv", "../mesh.json")))["claim"]
+assert len(claim) == len(levels) and all("mesh_bytes_ssim" in c for c in claim), claim
+assert any("mesh_tris_ssim" in c and 0 <= c["wins_mesh_tris"] <= 2 for c in claim), claim
 for r in rows:
     lv = levels.get(r["level_name"])
     if r["representation"] == "mesh-tris" and r["note"]:
