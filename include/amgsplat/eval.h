@@ -231,7 +231,9 @@ typedef struct asp_eval_row {
 /** Result of asp_eval_run; free with asp_eval_result_destroy. */
 typedef struct asp_eval_result {
     size_t row_count;
-    asp_eval_row *rows;        /* by size, then representation, then level (fewest primitives last) */
+    asp_eval_row *rows;        /* by size, then representation (reference, full-discs, full-splats with a
+                                  mesh, points, dp-*, mesh-tris, mesh-bytes), then level (fewest
+                                  primitives last) */
     size_t views;
     double *ssim;              /* row_count * views: SSIM of row r at view v is ssim[r * views + v] */
     double *psnr;              /* likewise, dB (99 for identical images) */
@@ -261,7 +263,17 @@ typedef struct asp_eval_result {
  * largest projected size refined first), and the domain primitives with each
  * rendering method this build has. Each image is compared to the reference
  * of the same camera (PSNR, SSIM, silhouette IoU), and frame times are timed
- * at view 0. Creates its own headless GL context on the calling thread.
+ * at view 0. With desc->mesh (the surface cloud was sampled from, in the same
+ * world coordinates) the reference is the mesh drawn by the mesh renderer and
+ * the cameras are framed on asp_scene_mesh_frame, so the pictures are those of
+ * `amgsplat render MESH`; the full point set is measured as discs and as
+ * splats; and each level gains the mesh simplified (asp_mesh_simplify with the
+ * sloppy fallback) to the most triangles with at most the level's primitive
+ * count, and to the most triangles whose asp_mesh_gpu_bytes are at most the
+ * level's asp_dps_level_gpu_bytes, each target found by bisection; a row that
+ * no simplification fits (e.g. the texture alone exceeds the bytes) has NaN
+ * figures and says why in asp_eval_row.note. Progress stage "simplify" then
+ * comes after "primitives". Creates its own headless GL context on the calling thread.
  * *out receives the result (free with asp_eval_result_destroy).
  * Returns 0; ASP_EINVAL (bad option); the errors of asp_amg_decompose,
  * asp_prim_build, asp_gl_context_create_headless and the renderers;
