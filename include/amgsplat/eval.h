@@ -316,7 +316,8 @@ int asp_eval_save_json(const asp_eval_result *res, const char *model, const char
  * per representation (log x axis; the reference is a single marker). dst as
  * asp_chart_draw. With a mesh the two simplified-mesh curves are lines like
  * the others and the full point set rows are single markers at the point
- * count; rows without figures (asp_eval_row.note) are left out. Returns 0, ASP_EINVAL (no rows of that size, which not 0
+ * count; rows without figures (asp_eval_row.note) are left out. Returns 0,
+ * ASP_EINVAL (no rows of that size, which not 0
  * or 1), ASP_ENOMEM.
  */
 int asp_eval_chart(const asp_eval_result *res, uint32_t size, int which, asp_image *dst, asp_error *err);

@@ -141,7 +141,8 @@ static void print_claim(const asp_eval_result *res, FILE *fp, int json)
             continue;
         const asp_eval_row *b = &res->rows[best];
         size_t wins = asp_eval_ssim_wins(res, best, i);
-        size_t mt = mesh ? find_row(res, pt, "mesh-tris") : SIZE_MAX, mb = mesh ? find_row(res, pt, "mesh-bytes") : SIZE_MAX;
+        size_t mt = mesh ? find_row(res, pt, "mesh-tris") : SIZE_MAX;
+        size_t mb = mesh ? find_row(res, pt, "mesh-bytes") : SIZE_MAX;
         if (json) {
             fprintf(fp, "%s{\"size\": %u, \"level_name\": \"%s\", \"primitives\": %zu, \"best\": \"%s\", "
                         "\"best_ssim\": %.6f, \"points_ssim\": %.6f, \"wins\": %zu, \"views\": %zu",

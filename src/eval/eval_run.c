@@ -527,7 +527,9 @@ static int run_size(struct eval_state *s, uint32_t size, asp_eval_result *res, s
             const asp_dps_level *lv = &s->dps->levels[l];
             const struct rep *rp = &s->reps[k];
             size_t r = *row;
-            const asp_mesh *mesh = rp->kind == REP_MESH_TRIS ? s->tris[l] : rp->kind == REP_MESH_BYTES ? s->bytes[l] : NULL;
+            const asp_mesh *mesh = rp->kind == REP_MESH_TRIS    ? s->tris[l]
+                                   : rp->kind == REP_MESH_BYTES ? s->bytes[l]
+                                                                : NULL;
             if ((rp->kind == REP_MESH_TRIS || rp->kind == REP_MESH_BYTES) && !mesh)
                 row_without_figures(s, rp, lv, size, rp->kind == REP_MESH_TRIS ? s->tris_note[l] : s->bytes_note[l],
                                     &res->rows[r], res->ssim + r * s->views, res->psnr + r * s->views);
