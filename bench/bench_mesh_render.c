@@ -175,7 +175,7 @@ static void simplified_row(bench_view *v, const asp_mesh *mesh, size_t target, c
         return;
     }
     asp_render_mesh rm;
-    asp_scene_describe_mesh(s, mats, &rm);
+    asp_scene_mesh_describe(s, mats, &rm);
     asp_mesh_renderer_desc md = {.origin = {s->origin[0], s->origin[1], s->origin[2]}};
     if (asp_mesh_renderer_create(v->gl, &rm, &md, &r, &err)) {
         fprintf(stderr, "bench_mesh_render: %s\n", err.msg);
@@ -240,7 +240,7 @@ static int bench_model(asp_gl_context *gl, const char *path, const char *texture
     printf("|---|---|---|---|---|---|---|---|\n");
 
     asp_render_mesh rm;
-    asp_scene_describe_mesh(mesh, mats, &rm);
+    asp_scene_mesh_describe(mesh, mats, &rm);
     asp_mesh_renderer_desc md = {.origin = {mesh->origin[0], mesh->origin[1], mesh->origin[2]}};
     if (asp_mesh_renderer_create(gl, &rm, &md, &r, &err)) {
         fprintf(stderr, "bench_mesh_render: %s\n", err.msg);

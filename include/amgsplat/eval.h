@@ -8,6 +8,7 @@
 
 #include "amg.h"
 #include "image.h"
+#include "mesh.h"
 #include "prim.h"
 #include "render.h"
 
@@ -116,7 +117,7 @@ typedef struct asp_chart_desc {
  * Draws a line chart into dst (initialised here, opaque white background,
  * release with asp_image_release): axes with "nice" 1-2-5 ticks (decades on
  * log axes), a light grid, one coloured polyline with square markers per
- * series (series i gets palette colour i mod 8), a legend right of the plot
+ * series (series i gets palette colour i mod 12), a legend right of the plot
  * area, the title and axis labels in stb_easy_font's bitmap font. Axis
  * ranges cover every finite point (padded by 5%); a single value gets a unit
  * range around it. nseries may be 0 (axes only, range 0..1). Deterministic.
@@ -145,6 +146,19 @@ int asp_chart_draw(const asp_chart_series *series, size_t nseries, const asp_cha
 int asp_eval_load_model(const char *model, size_t points, const char *texture, const asp_context *ctx,
                         asp_cloud **out, asp_error *err);
 
+/**
+ * As asp_eval_load_model, and when MODEL is a mesh (asp_file_recognise says
+ * ASP_FILE_MESH, a PLY with faces included) *mesh receives it as well (free
+ * with asp_mesh_destroy), for asp_eval_desc.mesh: the points are its area
+ * samples (points, 0 = 100000, seed 1), where asp_eval_load_model reads a
+ * PLY's vertices as points even when it has faces. A texture the mesh names but that
+ * cannot be found fails the load (ASP_EIO naming it): the samples would lose
+ * its colours. For other inputs *mesh is set to NULL. mesh may be NULL (then
+ * a mesh is only sampled). *out and *mesh are unchanged on failure.
+ */
+int asp_eval_load_model_mesh(const char *model, size_t points, const char *texture, const asp_context *ctx,
+                             asp_cloud **out, asp_mesh **mesh, asp_error *err);
+
 /* ------------------------------------------------------------------------ */
 /* Evaluation: representations against the reference (src/eval/eval_run.c) */
 /* ------------------------------------------------------------------------ */
@@ -167,28 +181,59 @@ typedef struct asp_eval_desc {
                                   creases (asp_crease_clip_planes; skipped for a cloud without normals) and the
                                   primitives use it as asp_prim_render_options.crease_angle; 0 = 60; < 0 = no
                                   clipping anywhere (the seeds' renders) */
+    /*
+     * The true surface the cloud was sampled from (issue 14), or NULL. When
+     * given, the reference is the mesh's own render (the mesh renderer) and
+     * the cameras are framed on the mesh's frame (asp_scene_mesh_frame); the
+     * full point set becomes two rows ("full-discs", "full-splats") and every
+     * level gains "mesh-tris" (the mesh simplified to at most the level's
+     * primitive count of triangles, asp_mesh_simplify) and "mesh-bytes" (the
+     * mesh simplified to at most the level's GPU bytes, asp_dps_level_gpu_bytes
+     * against asp_mesh_gpu_bytes). Borrowed for the call.
+     */
+    const asp_mesh *mesh;
 } asp_eval_desc;
 
 /** Figures of one representation at one level and image size, over all views. */
 typedef struct asp_eval_row {
     char representation[32];   /* "reference", "points" (the hierarchy cut) or "dp-<method>", e.g.
-                                  "dp-normalized" (asp_prim_render_method_name) */
-    uint32_t level;            /* AMG level index (0 for the reference) */
-    char level_name[16];       /* "L-3"; "points" for the reference */
+                                  "dp-normalized" (asp_prim_render_method_name); with a mesh also
+                                  "full-discs", "full-splats" (every point, tolerance 0), "mesh-tris"
+                                  and "mesh-bytes" (asp_eval_desc.mesh) */
+    uint32_t level;            /* AMG level index (0 for the reference and the full point set) */
+    char level_name[16];       /* "L-3"; "points" for the point reference and the full point set, "mesh"
+                                  for the mesh reference */
     uint32_t size;             /* image side, pixels */
-    size_t primitives;         /* primitives of the level (the cut's target; the point count for the reference) */
-    double drawn;              /* mean primitives actually drawn over the views */
+    size_t primitives;         /* primitives of the level (the cut's and the simplified meshes' target; the
+                                  point count for the point reference and the full point set, the triangle
+                                  count for the mesh reference) */
+    double drawn;              /* mean primitives actually drawn over the views (triangles for meshes) */
     uint64_t texels;           /* texels of the level's textures; 0 for splats */
     double psnr_mean, psnr_min; /* dB over RGB; a view identical to the reference counts as 99 dB */
     double ssim_mean, ssim_min;
     double iou_mean, iou_min;  /* silhouette IoU (alpha) */
     double frame_ms;           /* median time of a finished frame at view 0 */
+    /*
+     * GPU bytes of what the row draws: asp_mesh_gpu_bytes for meshes,
+     * asp_dps_level_gpu_bytes for domain primitives, 32 per drawn point for
+     * splats and discs (12 position + 12 normal + 4 RGBA8 + 4 radius, what
+     * asp_cloud holds per point; a cut counts the splats it draws, not the
+     * hierarchy it is cut from)
+     */
+    uint64_t bytes;
+    /*
+     * Why a row has no figures (then its metrics and frame_ms are NaN, drawn 0),
+     * e.g. "texture alone 1398101 bytes exceeds 52160"; "" otherwise. No commas.
+     */
+    char note[96];
 } asp_eval_row;
 
 /** Result of asp_eval_run; free with asp_eval_result_destroy. */
 typedef struct asp_eval_result {
     size_t row_count;
-    asp_eval_row *rows;        /* by size, then representation, then level (fewest primitives last) */
+    asp_eval_row *rows;        /* by size, then representation (reference, full-discs, full-splats with a
+                                  mesh, points, dp-*, mesh-tris, mesh-bytes), then level (fewest
+                                  primitives last) */
     size_t views;
     double *ssim;              /* row_count * views: SSIM of row r at view v is ssim[r * views + v] */
     double *psnr;              /* likewise, dB (99 for identical images) */
@@ -198,6 +243,8 @@ typedef struct asp_eval_result {
     char gl_renderer[128];     /* GL_RENDERER of the context used */
     float crease_angle;        /* the crease angle used, degrees; -1 = no clipping */
     size_t clipped_points;     /* points whose reference splat was clipped at a crease */
+    size_t mesh_triangles;     /* triangles of asp_eval_desc.mesh; 0 without one */
+    double t_simplify;         /* seconds spent simplifying the mesh (both mesh rows, every level) */
     asp_image sheet;           /* contact sheet of view 0 at sheet_size: one row per representation,
                                   the reference first, then the levels; width 0 when not made */
     uint32_t sheet_cols, sheet_rows;
@@ -216,7 +263,17 @@ typedef struct asp_eval_result {
  * largest projected size refined first), and the domain primitives with each
  * rendering method this build has. Each image is compared to the reference
  * of the same camera (PSNR, SSIM, silhouette IoU), and frame times are timed
- * at view 0. Creates its own headless GL context on the calling thread.
+ * at view 0. With desc->mesh (the surface cloud was sampled from, in the same
+ * world coordinates) the reference is the mesh drawn by the mesh renderer and
+ * the cameras are framed on asp_scene_mesh_frame, so the pictures are those of
+ * `amgsplat render MESH`; the full point set is measured as discs and as
+ * splats; and each level gains the mesh simplified (asp_mesh_simplify with the
+ * sloppy fallback) to the most triangles with at most the level's primitive
+ * count, and to the most triangles whose asp_mesh_gpu_bytes are at most the
+ * level's asp_dps_level_gpu_bytes, each target found by bisection; a row that
+ * no simplification fits (e.g. the texture alone exceeds the bytes) has NaN
+ * figures and says why in asp_eval_row.note. Progress stage "simplify" then
+ * comes after "primitives". Creates its own headless GL context on the calling thread.
  * *out receives the result (free with asp_eval_result_destroy).
  * Returns 0; ASP_EINVAL (bad option); the errors of asp_amg_decompose,
  * asp_prim_build, asp_gl_context_create_headless and the renderers;
@@ -240,7 +297,8 @@ size_t asp_eval_ssim_wins(const asp_eval_result *res, size_t a, size_t b);
 /**
  * Writes the rows as CSV (header line, one line per row; columns:
  * representation,level,level_name,size,primitives,drawn,texels,psnr_mean,
- * psnr_min,ssim_mean,ssim_min,iou_mean,iou_min,frame_ms) atomically.
+ * psnr_min,ssim_mean,ssim_min,iou_mean,iou_min,frame_ms,bytes,note)
+ * atomically; NaN figures are written as empty fields.
  * Returns 0 or ASP_EIO.
  */
 int asp_eval_save_csv(const asp_eval_result *res, const char *path, asp_error *err);
@@ -256,7 +314,10 @@ int asp_eval_save_json(const asp_eval_result *res, const char *model, const char
  * Draws the charts of res at image side size: which = 0 gives SSIM against
  * primitive count, which = 1 frame time (ms) against primitive count, one line
  * per representation (log x axis; the reference is a single marker). dst as
- * asp_chart_draw. Returns 0, ASP_EINVAL (no rows of that size, which not 0
+ * asp_chart_draw. With a mesh the two simplified-mesh curves are lines like
+ * the others and the full point set rows are single markers at the point
+ * count; rows without figures (asp_eval_row.note) are left out. Returns 0,
+ * ASP_EINVAL (no rows of that size, which not 0
  * or 1), ASP_ENOMEM.
  */
 int asp_eval_chart(const asp_eval_result *res, uint32_t size, int which, asp_image *dst, asp_error *err);

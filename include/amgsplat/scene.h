@@ -138,13 +138,13 @@ void asp_scene_render_source(const asp_scene *s, asp_render_source *out);
 int asp_scene_mesh_frame(const asp_mesh *mesh, asp_frame *out, asp_error *err);
 
 /**
- * mesh as the mesh renderer's plain description (render.h keeps no io
- * types): materials[0 .. mesh->material_count - 1] (caller's array) get the
- * diffuse colour, or light grey 200 (as points without colours) for a material
- * without a colour of its own, and the texture when loaded; out borrows every
- * array of mesh, which must outlive it. Pure.
+ * render's plain description of mesh (what the mesh renderer draws): out
+ * borrows mesh's arrays (valid while mesh lives) and points at materials,
+ * mesh->material_count entries the caller provides, which receive each
+ * material's colour (light grey for a material without one, as points without
+ * colours) and texture (borrowed from mesh). Pure.
  */
-void asp_scene_describe_mesh(const asp_mesh *mesh, asp_render_material *materials, asp_render_mesh *out);
+void asp_scene_mesh_describe(const asp_mesh *mesh, asp_render_material *materials, asp_render_mesh *out);
 
 /**
  * The asp_render_input_bits s can feed: points when it has a cloud or

@@ -25,7 +25,10 @@ static const char usage[] =
     "cut to the same number of splats as the level has primitives. For each: primitives, texels,\n"
     "PSNR, SSIM and silhouette IoU (mean and worst view) and the median frame time. MODEL is a\n"
     "point file (.ply .xyz .pts .txt), a synthetic shape (octahedron, cube, sphere, torus,\n"
-    "checker-plane) or a mesh (sampled to --points points, default 100000). 512 x 512 views take\n"
+    "checker-plane) or a mesh (sampled to --points points, default 100000).\n"
+    "Given a mesh, the reference is the mesh's own render instead (the true surface), the full point set\n"
+    "is measured as discs and as splats, and every level gains the mesh simplified to the level's\n"
+    "primitive count in triangles (mesh-tris) and to its GPU bytes (mesh-bytes). 512 x 512 views take\n"
     "about four times as long as 256 x 256 on a CPU rasteriser: ask for them with --sizes. Writes into DIR\n"
     "(default eval-<model name>): eval.csv, eval.json, ssim-<size>.png, frametime-<size>.png and\n"
     "sheet.png (view 0: one row per representation, the reference first, then the levels).\n"
@@ -89,24 +92,40 @@ static void default_dir(const char *model, char *out, size_t cap)
 
 static void print_table(const asp_eval_result *res)
 {
-    printf("%-16s %-6s %5s %10s %9s %9s %8s %7s %7s %7s %7s %9s\n", "representation", "level", "size", "primitives",
-           "drawn", "texels", "PSNR", "SSIM", "worst", "IoU", "worst", "frame ms");
+    printf("%-16s %-6s %5s %10s %9s %9s %8s %7s %7s %7s %7s %9s %10s\n", "representation", "level", "size",
+           "primitives", "drawn", "texels", "PSNR", "SSIM", "worst", "IoU", "worst", "frame ms", "bytes");
     for (size_t i = 0; i < res->row_count; i++) {
         const asp_eval_row *r = &res->rows[i];
-        printf("%-16s %-6s %5u %10zu %9.1f %9llu %8.2f %7.4f %7.4f %7.4f %7.4f %9.3f\n", r->representation,
+        if (r->note[0]) {
+            printf("%-16s %-6s %5u %10zu  (%s)\n", r->representation, r->level_name, r->size, r->primitives, r->note);
+            continue;
+        }
+        printf("%-16s %-6s %5u %10zu %9.1f %9llu %8.2f %7.4f %7.4f %7.4f %7.4f %9.3f %10llu\n", r->representation,
                r->level_name, r->size, r->primitives, r->drawn, (unsigned long long)r->texels, r->psnr_mean,
-               r->ssim_mean, r->ssim_min, r->iou_mean, r->iou_min, r->frame_ms);
+               r->ssim_mean, r->ssim_min, r->iou_mean, r->iou_min, r->frame_ms, (unsigned long long)r->bytes);
     }
+}
+
+/* The row of representation rep at the size and level of row at, or SIZE_MAX; rows without figures do not count. */
+static size_t find_row(const asp_eval_result *res, const asp_eval_row *at, const char *rep)
+{
+    for (size_t j = 0; j < res->row_count; j++) {
+        const asp_eval_row *r = &res->rows[j];
+        if (r->size == at->size && r->level == at->level && strcmp(r->representation, rep) == 0 && !r->note[0])
+            return j;
+    }
+    return SIZE_MAX;
 }
 
 /*
  * Thesis Fig. 1.1's claim per size and level: the best domain-primitive
  * method (highest mean SSIM) against the point cut to the same count, and in
- * how many views it wins; as text lines or JSON objects.
+ * how many views it wins; with a mesh also against the mesh simplified to the
+ * same count and to the same bytes (issue 14); as text lines or JSON objects.
  */
 static void print_claim(const asp_eval_result *res, FILE *fp, int json)
 {
-    int first = 1;
+    int first = 1, mesh = res->mesh_triangles > 0;
     for (size_t i = 0; i < res->row_count; i++) {
         const asp_eval_row *pt = &res->rows[i];
         if (strcmp(pt->representation, "points") != 0)
@@ -122,18 +141,38 @@ static void print_claim(const asp_eval_result *res, FILE *fp, int json)
             continue;
         const asp_eval_row *b = &res->rows[best];
         size_t wins = asp_eval_ssim_wins(res, best, i);
+        size_t mt = mesh ? find_row(res, pt, "mesh-tris") : SIZE_MAX;
+        size_t mb = mesh ? find_row(res, pt, "mesh-bytes") : SIZE_MAX;
         if (json) {
             fprintf(fp, "%s{\"size\": %u, \"level_name\": \"%s\", \"primitives\": %zu, \"best\": \"%s\", "
-                        "\"best_ssim\": %.6f, \"points_ssim\": %.6f, \"wins\": %zu, \"views\": %zu}",
+                        "\"best_ssim\": %.6f, \"points_ssim\": %.6f, \"wins\": %zu, \"views\": %zu",
                     first ? "" : ", ", pt->size, pt->level_name, pt->primitives, b->representation, b->ssim_mean,
                     pt->ssim_mean, wins, res->views);
+            if (mt != SIZE_MAX)
+                fprintf(fp, ", \"mesh_tris_ssim\": %.6f, \"wins_mesh_tris\": %zu", res->rows[mt].ssim_mean,
+                        asp_eval_ssim_wins(res, best, mt));
+            if (mb != SIZE_MAX)
+                fprintf(fp, ", \"mesh_bytes_ssim\": %.6f, \"wins_mesh_bytes\": %zu", res->rows[mb].ssim_mean,
+                        asp_eval_ssim_wins(res, best, mb));
+            fputc('}', fp);
         } else {
             if (first)
-                fprintf(fp, "\nbest domain-primitive method against the point cut (thesis Fig. 1.1):\n"
-                            "%5s %-6s %10s %-18s %9s %9s %9s\n",
-                        "size", "level", "primitives", "best method", "SSIM", "points", "wins");
-            fprintf(fp, "%5u %-6s %10zu %-18s %9.4f %9.4f %5zu/%zu\n", pt->size, pt->level_name, pt->primitives,
+                fprintf(fp, "\nbest domain-primitive method against the point cut (thesis Fig. 1.1)%s:\n"
+                            "%5s %-6s %10s %-18s %9s %9s %9s%s\n",
+                        mesh ? " and the simplified mesh at equal triangles and equal bytes" : "", "size", "level",
+                        "primitives", "best method", "SSIM", "points", "wins",
+                        mesh ? "  mesh-tris      wins mesh-bytes      wins" : "");
+            fprintf(fp, "%5u %-6s %10zu %-18s %9.4f %9.4f %5zu/%zu", pt->size, pt->level_name, pt->primitives,
                     b->representation, b->ssim_mean, pt->ssim_mean, wins, res->views);
+            const size_t other[2] = {mt, mb};
+            for (int k = 0; k < 2 && mesh; k++) {
+                if (other[k] == SIZE_MAX)
+                    fprintf(fp, " %10s %9s", "-", "-");
+                else
+                    fprintf(fp, " %10.4f %5zu/%zu", res->rows[other[k]].ssim_mean,
+                            asp_eval_ssim_wins(res, best, other[k]), res->views);
+            }
+            fputc('\n', fp);
         }
         first = 0;
     }
@@ -218,17 +257,19 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
 
     asp_error err = {0};
     asp_cloud *cloud = NULL;
-    rc = asp_eval_load_model(argv[0], points, texture, &env->ctx, &cloud, &err);
+    asp_mesh *mesh = NULL;
+    rc = asp_eval_load_model_mesh(argv[0], points, texture, &env->ctx, &cloud, &mesh, &err);
     if (rc)
         return cli_fail(env, &err);
     if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
         asp_cloud_destroy(cloud);
+        asp_mesh_destroy(mesh);
         asp_error_set(&err, ASP_EIO, "cannot create directory '%s': %s", dir, strerror(errno));
         return cli_fail(env, &err);
     }
     asp_eval_desc desc = {.views = views, .sizes = sizes, .size_count = nsizes, .max_primitives = max_prims,
                           .frames = frames, .elevation = (float)elevation, .crease_angle = (float)crease,
-                          .methods = methods_text ? methods : NULL, .method_count = nmethods};
+                          .methods = methods_text ? methods : NULL, .method_count = nmethods, .mesh = mesh};
     double t0 = asp_time_now();
     asp_eval_result *res = NULL;
     rc = asp_eval_run(cloud, &desc, &env->ctx, &res, &err);
@@ -236,6 +277,7 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
         rc = save_outputs(res, argv[0], dir, sizes, nsizes, &err);
     double seconds = asp_time_now() - t0;
     asp_cloud_destroy(cloud);
+    asp_mesh_destroy(mesh);
     asp_amg_shutdown();
     cli_progress_end(env);
     if (rc) {
@@ -247,18 +289,20 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
         cli_json_string(stdout, argv[0]);
         printf(", \"output\": ");
         cli_json_string(stdout, dir);
-        printf(", \"points\": %zu, \"views\": %zu, \"rows\": %zu, \"seconds\": %.2f, \"gl_renderer\": ", res->points,
-               res->views, res->row_count, seconds);
+        printf(", \"points\": %zu, \"mesh_triangles\": %zu, \"views\": %zu, \"rows\": %zu, \"seconds\": %.2f, "
+               "\"gl_renderer\": ",
+               res->points, res->mesh_triangles, res->views, res->row_count, seconds);
         cli_json_string(stdout, res->gl_renderer);
         printf(", \"claim\": [");
         print_claim(res, stdout, 1);
         printf("]}\n");
     } else {
         if (!env->quiet)
-            printf("%s: %zu points, %zu levels, %zu views, %s; decomposition %.2f s, primitives %.2f s, "
-                   "rendering %.2f s; written to %s/\n",
-                   argv[0], res->points, res->level_count, res->views, res->gl_renderer, res->t_decompose,
-                   res->t_build, res->t_render, dir);
+            printf("%s: %zu points%s, %zu levels, %zu views, %s; decomposition %.2f s, primitives %.2f s, "
+                   "simplification %.2f s, rendering %.2f s; written to %s/\n",
+                   argv[0], res->points, res->mesh_triangles ? " sampled from the mesh (the reference)" : "",
+                   res->level_count, res->views, res->gl_renderer, res->t_decompose, res->t_build, res->t_simplify,
+                   res->t_render, dir);
         print_table(res);
         print_claim(res, stdout, 0);
     }

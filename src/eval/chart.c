@@ -24,9 +24,10 @@
 
 enum { MAX_TICKS = 32, FONT_H = 7 };
 
-static const uint8_t palette[8][3] = {
-    {31, 119, 180}, {214, 39, 40}, {44, 160, 44}, {255, 127, 14},
-    {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {23, 190, 207},
+// 12 colours: an evaluation with a mesh draws up to 10 series, each needs its own
+static const uint8_t palette[12][3] = {
+    {31, 119, 180}, {214, 39, 40}, {44, 160, 44}, {255, 127, 14}, {148, 103, 189}, {140, 86, 75},
+    {227, 119, 194}, {23, 190, 207}, {188, 189, 34}, {0, 0, 0}, {127, 127, 127}, {255, 187, 120},
 };
 
 struct canvas {
@@ -272,7 +273,7 @@ static void draw_legend(const struct canvas *c, const struct plot *p, const asp_
     for (size_t s = 0; s < n; s++) {
         if (!(series[s].name && series[s].name[0]))
             continue;
-        rect(c, x, y + 2, x + 14, y + 5, palette[s % 8]);
+        rect(c, x, y + 2, x + 14, y + 5, palette[s % 12]);
         text(c, x + 18, y, series[s].name, ink);
         y += 12;
     }
@@ -315,7 +316,7 @@ int asp_chart_draw(const asp_chart_series *series, size_t nseries, const asp_cha
     axis_range(&p.ay, series, nseries, 0, d.y_min, d.y_max);
     draw_axes(&c, &p, &d);
     for (size_t s = 0; s < nseries; s++)
-        draw_series(&c, &p, &series[s], palette[s % 8]);
+        draw_series(&c, &p, &series[s], palette[s % 12]);
     draw_legend(&c, &p, series, nseries);
     *dst = img;
     return 0;

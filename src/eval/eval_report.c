@@ -36,7 +36,15 @@ static void json_str(FILE *fp, const char *s)
 }
 
 static const char csv_header[] = "representation,level,level_name,size,primitives,drawn,texels,psnr_mean,psnr_min,"
-                                 "ssim_mean,ssim_min,iou_mean,iou_min,frame_ms\n";
+                                 "ssim_mean,ssim_min,iou_mean,iou_min,frame_ms,bytes,note\n";
+
+/* A CSV number; NaN (a row without figures, asp_eval_row.note) is an empty field. */
+static void csv_num(FILE *fp, double v, const char *fmt)
+{
+    fputc(',', fp);
+    if (!isnan(v))
+        fprintf(fp, fmt, v);
+}
 
 int asp_eval_save_csv(const asp_eval_result *res, const char *path, asp_error *err)
 {
@@ -47,9 +55,16 @@ int asp_eval_save_csv(const asp_eval_result *res, const char *path, asp_error *e
     fputs(csv_header, f.fp);
     for (size_t i = 0; i < res->row_count; i++) {
         const asp_eval_row *r = &res->rows[i];
-        fprintf(f.fp, "%s,%u,%s,%u,%zu,%.1f,%llu,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f,%.4f\n", r->representation, r->level,
-                r->level_name, r->size, r->primitives, r->drawn, (unsigned long long)r->texels, r->psnr_mean,
-                r->psnr_min, r->ssim_mean, r->ssim_min, r->iou_mean, r->iou_min, r->frame_ms);
+        fprintf(f.fp, "%s,%u,%s,%u,%zu,%.1f,%llu", r->representation, r->level, r->level_name, r->size, r->primitives,
+                r->drawn, (unsigned long long)r->texels);
+        csv_num(f.fp, r->psnr_mean, "%.4f");
+        csv_num(f.fp, r->psnr_min, "%.4f");
+        csv_num(f.fp, r->ssim_mean, "%.6f");
+        csv_num(f.fp, r->ssim_min, "%.6f");
+        csv_num(f.fp, r->iou_mean, "%.6f");
+        csv_num(f.fp, r->iou_min, "%.6f");
+        csv_num(f.fp, r->frame_ms, "%.4f");
+        fprintf(f.fp, ",%llu,%s\n", (unsigned long long)r->bytes, r->note);
     }
     return asp__atomic_commit(&f, err);
 }
@@ -67,6 +82,7 @@ int asp_eval_save_json(const asp_eval_result *res, const char *model, const char
             res->level_count);
     json_str(fp, res->gl_renderer);
     fprintf(fp, ", \"crease_angle\": %g, \"clipped_points\": %zu", (double)res->crease_angle, res->clipped_points);
+    fprintf(fp, ", \"mesh_triangles\": %zu, \"simplify_seconds\": %.4f", res->mesh_triangles, res->t_simplify);
     fprintf(fp, ", \"decompose_seconds\": %.4f, \"build_seconds\": %.4f, \"render_seconds\": %.4f,\n \"rows\": [",
             res->t_decompose, res->t_build, res->t_render);
     for (size_t i = 0; i < res->row_count; i++) {
@@ -77,6 +93,8 @@ int asp_eval_save_json(const asp_eval_result *res, const char *model, const char
         json_str(fp, r->level_name);
         fprintf(fp, ", \"size\": %u, \"primitives\": %zu, \"drawn\": %.1f, \"texels\": %llu", r->size, r->primitives,
                 r->drawn, (unsigned long long)r->texels);
+        fprintf(fp, ", \"bytes\": %llu, \"note\": ", (unsigned long long)r->bytes);
+        json_str(fp, r->note);
         const char *names[7] = {"psnr_mean", "psnr_min", "ssim_mean", "ssim_min", "iou_mean", "iou_min", "frame_ms"};
         const double vals[7] = {r->psnr_mean, r->psnr_min, r->ssim_mean, r->ssim_min,
                                 r->iou_mean,  r->iou_min,  r->frame_ms};
@@ -119,7 +137,7 @@ int asp_eval_chart(const asp_eval_result *res, uint32_t size, int which, asp_ima
     size_t ns = 0, k = 0;
     for (size_t i = 0; i < res->row_count; i++) {
         const asp_eval_row *r = &res->rows[i];
-        if (r->size != size)
+        if (r->size != size || r->note[0])
             continue;
         if (ns == 0 || strcmp(series[ns - 1].name, r->representation) != 0) {
             if (ns == MAX_SERIES)

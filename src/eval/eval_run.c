@@ -1,10 +1,11 @@
 /*
  * The measuring stick of the evaluation: render the reference (all points as
- * blended, normalised splats, seed 001 section 5, tolerance 0) and every
- * representation from the same cameras, and compare images (journal section 6
- * asks for an image difference metric). The representations are a table of
- * (name, create function); the point-hierarchy cut to a level's primitive
- * count is the comparison of thesis Fig. 1.1.
+ * blended, normalised splats, seed 001 section 5, tolerance 0; or, given the
+ * mesh the points were sampled from, the mesh itself: issue 14, seed 004
+ * 2.2-2.3) and every representation from the same cameras, and compare images
+ * (journal section 6 asks for an image difference metric). The point-hierarchy
+ * cut to a level's primitive count is the comparison of thesis Fig. 1.1; the
+ * mesh simplified to the level's count and bytes is what users ship today.
  */
 #include <math.h>
 #include <stdio.h>
@@ -15,6 +16,7 @@
 #include "amgsplat/geom.h"
 #include "amgsplat/hier.h"
 #include "amgsplat/render.h"
+#include "amgsplat/scene.h"
 #include "util/banned.h"
 
 void asp_eval_result_destroy(asp_eval_result *res)
@@ -51,7 +53,10 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_co
 
 #else
 
-enum { MAX_SIZES = 8, MAX_VIEWS = 256, MAX_FRAMES = 1000, MAX_REPS = 17 };
+enum { MAX_SIZES = 8, MAX_VIEWS = 256, MAX_FRAMES = 1000, MAX_REPS = 19, MAX_LEVELS = 64 };
+
+/* asp_eval_row.bytes of a point: 12 position + 12 normal + 4 RGBA8 + 4 radius, as asp_cloud holds it */
+#define POINT_BYTES 32
 
 /* Identical images have infinite PSNR; a finite stand-in keeps means and CSV numbers usable. */
 #define PSNR_IDENTICAL 99.0
@@ -61,8 +66,11 @@ enum { MAX_SIZES = 8, MAX_VIEWS = 256, MAX_FRAMES = 1000, MAX_REPS = 17 };
  * count (prim = 0, drawn by the shared splat renderer), or the level's domain
  * primitives drawn with one method (journal section 4, thesis 4.4).
  */
+enum rep_kind { REP_CUT, REP_PRIM, REP_MESH_TRIS, REP_MESH_BYTES, REP_FULL_DISCS, REP_FULL_SPLATS };
+
 struct rep {
     char name[32];
+    enum rep_kind kind;
     int prim;
     asp_prim_render_method method;
 };
@@ -74,8 +82,14 @@ struct eval_state {
     asp_gl_context *gl;
     asp_hier *hier;
     asp_renderer *splat; /* the reference at tolerance 0; the point cut with a splat budget */
+    asp_renderer *disc;  /* with a mesh: the full point set as discs */
     asp_dps *dps;
-    asp_frame frame;     /* the one camera framing (asp_camera_frame), in the cloud's local frame */
+    asp_frame frame;     /* the one camera framing (asp_camera_frame): the cloud's, or the mesh's with one */
+    const asp_mesh *mesh;            /* the true surface (asp_eval_desc.mesh) or NULL */
+    asp_mesh *tris[MAX_LEVELS];      /* per level of dps: the mesh at <= the level's primitive count */
+    asp_mesh *bytes[MAX_LEVELS];     /* per level: the mesh at <= the level's GPU bytes */
+    char tris_note[MAX_LEVELS][96];  /* why tris[l] is NULL */
+    char bytes_note[MAX_LEVELS][96]; /* why bytes[l] is NULL */
     float elevation;
     float crease_angle;  /* resolved: degrees, or -1 for none */
     size_t views, frames;
@@ -95,6 +109,34 @@ static int create_prim(struct eval_state *s, const struct rep *rep, const asp_dp
     memcpy(src.origin, s->cloud->origin, sizeof src.origin);
     asp_renderer_options o = {.prim = {.method = rep->method, .crease_angle = s->crease_angle}};
     return prim->create(s->gl, &src, &o, s->ctx, out, err);
+}
+
+static int create_mesh(struct eval_state *s, const asp_mesh *m, asp_renderer **out, asp_error *err)
+{
+    const asp_renderer_kind *kind = NULL;
+    int rc = asp_renderer_kind_find("mesh", 0, &kind, err);
+    if (rc)
+        return rc;
+    asp_render_material *mats = asp_calloc(s->ctx, m->material_count, sizeof *mats);
+    if (!mats)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu materials", m->material_count);
+    asp_render_mesh rm;
+    asp_scene_mesh_describe(m, mats, &rm);
+    // drawn in the cloud's frame, so the camera is the points' camera
+    asp_render_source src = {.mesh = &rm};
+    memcpy(src.origin, s->cloud->origin, sizeof src.origin);
+    rc = kind->create(s->gl, &src, NULL, s->ctx, out, err);
+    asp_free(s->ctx, mats);
+    return rc;
+}
+
+static uint64_t mesh_texels(const asp_mesh *m)
+{
+    uint64_t t = 0;
+    for (size_t i = 0; i < m->material_count; i++)
+        if (m->materials[i].texture.pixels)
+            t += (uint64_t)m->materials[i].texture.width * m->materials[i].texture.height;
+    return t;
 }
 
 static void view_camera(const struct eval_state *s, size_t v, asp_camera *cam)
@@ -161,17 +203,27 @@ static int keep_tile(const struct eval_state *s, struct sheet *sh, size_t row, s
     return 0;
 }
 
-/* One row: every view of representation rep at level lv (NULL: the reference), figures into row. */
-static int measure(struct eval_state *s, const struct rep *rep, const asp_dps_level *lv, uint32_t size,
-                   const asp_image *refs, asp_image *ref_out, struct sheet *sh, size_t sheet_row, size_t sheet_col,
-                   asp_eval_row *row, double *ssim_views, double *psnr_views, asp_error *err)
+/*
+ * One row: every view of representation rep at level lv (rep NULL: the
+ * reference; lv NULL: the whole model), drawing mesh instead when it is given
+ * (the mesh reference and the simplified meshes), figures into row.
+ */
+static int measure(struct eval_state *s, const struct rep *rep, const asp_dps_level *lv, const asp_mesh *mesh,
+                   uint32_t size, const asp_image *refs, asp_image *ref_out, struct sheet *sh, size_t sheet_row,
+                   size_t sheet_col, asp_eval_row *row, double *ssim_views, double *psnr_views, asp_error *err)
 {
     asp_renderer *r = s->splat;
     int rc = 0;
-    if (rep && rep->prim && (rc = create_prim(s, rep, lv, &r, err)))
+    if (mesh)
+        rc = create_mesh(s, mesh, &r, err);
+    else if (rep && rep->prim)
+        rc = create_prim(s, rep, lv, &r, err);
+    else if (rep && rep->kind == REP_FULL_DISCS)
+        r = s->disc;
+    if (rc)
         return rc;
     int cut = r == s->splat;
-    size_t target = lv ? lv->prim_count : s->cloud->count;
+    size_t target = lv ? lv->prim_count : mesh ? mesh->triangle_count : s->cloud->count;
     asp_render_desc rd = {.width = size, .height = size};
     double drawn = 0, psnr_sum = 0, ssim_sum = 0, iou_sum = 0;
     row->psnr_min = row->ssim_min = row->iou_min = INFINITY;
@@ -202,7 +254,7 @@ static int measure(struct eval_state *s, const struct rep *rep, const asp_dps_le
             row->ssim_min = ssim < row->ssim_min ? ssim : row->ssim_min;
             row->iou_min = iou < row->iou_min ? iou : row->iou_min;
         }
-        if (!rc && v == 0 && sh->tiles && size == sh->tiles[0].width) {
+        if (!rc && v == 0 && sh && sh->tiles && size == sh->tiles[0].width) {
             asp_image copy = {0};
             rc = asp_image_init(&copy, img.width, img.height, err);
             if (!rc) {
@@ -216,7 +268,7 @@ static int measure(struct eval_state *s, const struct rep *rep, const asp_dps_le
         else
             asp_image_release(&img);
     }
-    if (r != s->splat)
+    if (r != s->splat && r != s->disc)
         asp_renderer_destroy(r);
     if (rc)
         return rc;
@@ -224,11 +276,33 @@ static int measure(struct eval_state *s, const struct rep *rep, const asp_dps_le
     row->size = size;
     row->primitives = target;
     row->drawn = drawn / (double)s->views;
-    row->texels = lv && !cut ? lv->texels : 0; // splats have no texture
+    // splats have no texture
+    row->texels = mesh ? mesh_texels(mesh) : rep && rep->prim ? lv->texels : 0;
+    if (mesh)
+        row->bytes = asp_mesh_gpu_bytes(mesh, NULL);
+    else if (rep && rep->prim)
+        row->bytes = asp_dps_level_gpu_bytes(lv, NULL);
+    else
+        row->bytes = (uint64_t)llround(row->drawn) * POINT_BYTES;
     row->psnr_mean = psnr_sum / (double)s->views;
     row->ssim_mean = ssim_sum / (double)s->views;
     row->iou_mean = iou_sum / (double)s->views;
     return 0;
+}
+
+/* A row that could not be made honestly (e.g. no mesh fits the bytes): NaN figures and the reason. */
+static void row_without_figures(const struct eval_state *s, const struct rep *rep, const asp_dps_level *lv,
+                                uint32_t size, const char *note, asp_eval_row *row, double *ssim_views,
+                                double *psnr_views)
+{
+    snprintf(row->representation, sizeof row->representation, "%s", rep->name);
+    snprintf(row->note, sizeof row->note, "%s", note);
+    row->size = size;
+    row->primitives = lv->prim_count;
+    row->psnr_mean = row->psnr_min = row->ssim_mean = row->ssim_min = NAN;
+    row->iou_mean = row->iou_min = row->frame_ms = NAN;
+    for (size_t v = 0; v < s->views; v++)
+        ssim_views[v] = psnr_views[v] = NAN;
 }
 
 static int check_desc(const asp_eval_desc *d, const uint32_t *sizes, size_t nsizes, asp_error *err)
@@ -240,8 +314,9 @@ static int check_desc(const asp_eval_desc *d, const uint32_t *sizes, size_t nsiz
     for (size_t i = 0; i < nsizes; i++)
         if (sizes[i] < 16 || sizes[i] > 2048)
             return asp_error_set(err, ASP_EINVAL, "image size %u is outside 16..2048", sizes[i]);
-    if (d->methods && d->method_count > MAX_REPS - 1)
-        return asp_error_set(err, ASP_EINVAL, "at most %d rendering methods, got %zu", MAX_REPS - 1, d->method_count);
+    // the reps: the point cut, the methods, and the two simplified meshes
+    if (d->methods && d->method_count > MAX_REPS - 3)
+        return asp_error_set(err, ASP_EINVAL, "at most %d rendering methods, got %zu", MAX_REPS - 3, d->method_count);
     for (size_t i = 0; d->methods && i < d->method_count; i++)
         if (!asp_prim_render_method_name(d->methods[i]))
             return asp_error_set(err, ASP_EINVAL, "unknown rendering method %d", (int)d->methods[i]);
@@ -267,6 +342,93 @@ static size_t pick_levels(const asp_amg *amg, size_t max, size_t *levels)
     return n;
 }
 
+static size_t mesh_measure(const asp_mesh *m, int by_bytes)
+{
+    return by_bytes ? asp_mesh_gpu_bytes(m, NULL) : m->triangle_count;
+}
+
+/*
+ * The simplified mesh with the most triangles whose triangle count (or GPU
+ * bytes, by_bytes) is at most limit: asp_mesh_simplify at a target found by
+ * bisection, since meshoptimizer may stop above a target (seams, sloppy
+ * fallback) and bytes are known only after simplifying. Neither measure is
+ * strictly monotone in the target, but every result kept was checked against
+ * limit. Stops once the bracket is within 1% of the target. *out NULL with
+ * note filled when no simplification fits.
+ */
+static int simplify_fit(struct eval_state *s, size_t limit, int by_bytes, asp_mesh **out, char note[96],
+                        asp_error *err)
+{
+    const asp_mesh *m = s->mesh;
+    size_t full = m->triangle_count, lo = 0, hi = full + 1, guess = by_bytes ? 0 : limit;
+    size_t fail_tris = 0, fail_measure = 0;
+    asp_mesh *best = NULL;
+    *out = NULL;
+    if (by_bytes) {
+        asp_mesh_bytes b;
+        asp_mesh_gpu_bytes(m, &b);
+        // the texture is not simplified: when it alone is over the budget no triangle count helps
+        if (b.texture >= limit) {
+            snprintf(note, 96, "texture alone %zu bytes exceeds %zu", b.texture, limit);
+            return 0;
+        }
+        // bytes per triangle of the full mesh, for a first guess near the answer
+        double per = (double)(b.vertex + b.index) / (double)full;
+        guess = (size_t)((double)(limit - b.texture) / per);
+    }
+    guess = guess < 1 ? 1 : guess > full ? full : guess;
+    int rc = 0;
+    for (size_t t = guess; !rc && lo + 1 < hi && !(lo && hi - lo <= lo / 100); t = lo + (hi - lo) / 2) {
+        asp_mesh *cand = NULL;
+        rc = asp_mesh_simplify(m,
+                               &(asp_mesh_simplify_desc){.target_triangles = t,
+                                                         .flags = ASP_MESH_SIMPLIFY_SLOPPY_FALLBACK},
+                               s->ctx, &cand, NULL, err);
+        if (rc)
+            break;
+        if (mesh_measure(cand, by_bytes) <= limit) {
+            asp_mesh_destroy(best);
+            best = cand;
+            lo = t;
+        } else {
+            fail_tris = cand->triangle_count;
+            fail_measure = mesh_measure(cand, by_bytes);
+            asp_mesh_destroy(cand);
+            hi = t;
+        }
+    }
+    if (rc) {
+        asp_mesh_destroy(best);
+        return rc;
+    }
+    if (!best) {
+        if (by_bytes)
+            snprintf(note, 96, "smallest simplification %zu triangles %zu bytes exceeds %zu", fail_tris, fail_measure,
+                     limit);
+        else
+            snprintf(note, 96, "smallest simplification %zu triangles exceeds %zu", fail_tris, limit);
+    }
+    *out = best;
+    return 0;
+}
+
+/* The two simplified meshes of every level (issue 14): at its primitive count and at its GPU bytes. */
+static int simplify_levels(struct eval_state *s, asp_eval_result *res, asp_error *err)
+{
+    double t0 = asp_time_now();
+    int rc = 0;
+    for (size_t l = 0; l < s->dps->level_count && !rc; l++) {
+        const asp_dps_level *lv = &s->dps->levels[l];
+        rc = simplify_fit(s, lv->prim_count, 0, &s->tris[l], s->tris_note[l], err);
+        if (!rc)
+            rc = simplify_fit(s, asp_dps_level_gpu_bytes(lv, NULL), 1, &s->bytes[l], s->bytes_note[l], err);
+        if (!rc)
+            rc = asp_progress(s->ctx, "simplify", (double)(l + 1) / (double)s->dps->level_count);
+    }
+    res->t_simplify = asp_time_now() - t0;
+    return rc;
+}
+
 static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result *res, asp_error *err)
 {
     double t0 = asp_time_now();
@@ -283,8 +445,11 @@ static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result
     asp_amg_destroy(amg);
     if (!rc)
         rc = asp_hier_build(s->cloud, NULL, s->ctx, &s->hier, err);
+    if (!rc && s->mesh)
+        rc = simplify_levels(s, res, err);
+    // with a mesh, every picture is framed as `render MESH` frames it
     if (!rc)
-        rc = asp_cloud_frame(s->cloud, &s->frame, err);
+        rc = s->mesh ? asp_scene_mesh_frame(s->mesh, &s->frame, err) : asp_cloud_frame(s->cloud, &s->frame, err);
     if (!rc)
         rc = asp_gl_context_create_headless(NULL, s->ctx, &s->gl, err);
     // the reference's splats cut at creases, so its sharp edges are the surface's, not the sampling's
@@ -300,6 +465,9 @@ static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result
     if (!rc)
         rc = asp_renderer_kind_at(1)->create(s->gl, &(asp_render_source){.hier = s->hier, .clip_planes = planes},
                                              NULL, s->ctx, &s->splat, err); // row 1: "splat"
+    if (!rc && s->mesh)
+        rc = asp_renderer_kind_at(0)->create(s->gl, &(asp_render_source){.cloud = s->cloud, .clip_planes = planes},
+                                             NULL, s->ctx, &s->disc, err); // row 0: "disc"
     asp_free(s->ctx, planes);
     if (!rc)
         snprintf(res->gl_renderer, sizeof res->gl_renderer, "%s", asp_gl_context_renderer(s->gl));
@@ -309,9 +477,24 @@ static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result
 static void state_release(struct eval_state *s)
 {
     asp_renderer_destroy(s->splat);
+    asp_renderer_destroy(s->disc);
+    for (size_t l = 0; l < MAX_LEVELS; l++) {
+        asp_mesh_destroy(s->tris[l]);
+        asp_mesh_destroy(s->bytes[l]);
+    }
     asp_gl_context_destroy(s->gl);
     asp_hier_destroy(s->hier);
     asp_dps_destroy(s->dps);
+}
+
+static void name_level(const struct eval_state *s, const asp_dps_level *lv, asp_eval_row *row)
+{
+    row->level = lv->level;
+    uint32_t coarse = s->dps->amg_levels - 1 - lv->level;
+    if (coarse)
+        snprintf(row->level_name, sizeof row->level_name, "L-%u", coarse);
+    else
+        snprintf(row->level_name, sizeof row->level_name, "L");
 }
 
 static int run_size(struct eval_state *s, uint32_t size, asp_eval_result *res, size_t *row, struct sheet *sh,
@@ -321,26 +504,41 @@ static int run_size(struct eval_state *s, uint32_t size, asp_eval_result *res, s
     if (!refs)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu reference images", s->views);
     size_t r0 = *row;
-    int rc = measure(s, NULL, NULL, size, NULL, refs, sh, 0, 0, &res->rows[r0], res->ssim + r0 * s->views,
+    int rc = measure(s, NULL, NULL, s->mesh, size, NULL, refs, sh, 0, 0, &res->rows[r0], res->ssim + r0 * s->views,
                      res->psnr + r0 * s->views, err);
     if (!rc) {
-        snprintf(res->rows[r0].level_name, sizeof res->rows[r0].level_name, "points");
+        snprintf(res->rows[r0].level_name, sizeof res->rows[r0].level_name, "%s", s->mesh ? "mesh" : "points");
         (*row)++;
+    }
+    // against the true surface the full point set is a representation too, as discs and as splats
+    static const struct rep full[2] = {{.name = "full-discs", .kind = REP_FULL_DISCS},
+                                       {.name = "full-splats", .kind = REP_FULL_SPLATS}};
+    for (int k = 0; k < 2 && s->mesh && !rc; k++) {
+        size_t r = *row;
+        rc = measure(s, &full[k], NULL, NULL, size, refs, NULL, NULL, 0, 0, &res->rows[r], res->ssim + r * s->views,
+                     res->psnr + r * s->views, err);
+        if (!rc) {
+            snprintf(res->rows[r].level_name, sizeof res->rows[r].level_name, "points");
+            (*row)++;
+        }
     }
     for (size_t k = 0; k < s->nreps && !rc; k++)
         for (size_t l = 0; l < s->dps->level_count && !rc; l++) {
             const asp_dps_level *lv = &s->dps->levels[l];
+            const struct rep *rp = &s->reps[k];
             size_t r = *row;
-            rc = measure(s, &s->reps[k], lv, size, refs, NULL, sh, k, l + 1, &res->rows[r], res->ssim + r * s->views,
-                         res->psnr + r * s->views, err);
+            const asp_mesh *mesh = rp->kind == REP_MESH_TRIS    ? s->tris[l]
+                                   : rp->kind == REP_MESH_BYTES ? s->bytes[l]
+                                                                : NULL;
+            if ((rp->kind == REP_MESH_TRIS || rp->kind == REP_MESH_BYTES) && !mesh)
+                row_without_figures(s, rp, lv, size, rp->kind == REP_MESH_TRIS ? s->tris_note[l] : s->bytes_note[l],
+                                    &res->rows[r], res->ssim + r * s->views, res->psnr + r * s->views);
+            else
+                rc = measure(s, rp, lv, mesh, size, refs, NULL, sh, k, l + 1, &res->rows[r], res->ssim + r * s->views,
+                             res->psnr + r * s->views, err);
             if (rc)
                 break;
-            res->rows[r].level = lv->level;
-            uint32_t coarse = s->dps->amg_levels - 1 - lv->level;
-            if (coarse)
-                snprintf(res->rows[r].level_name, sizeof res->rows[r].level_name, "L-%u", coarse);
-            else
-                snprintf(res->rows[r].level_name, sizeof res->rows[r].level_name, "L");
+            name_level(s, lv, &res->rows[r]);
             (*row)++;
             rc = asp_progress(s->ctx, "render", (double)*row / (double)res->row_count);
         }
@@ -384,7 +582,8 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_co
                              cloud ? cloud->count : (size_t)0);
     struct eval_state s = {.ctx = ctx, .cloud = cloud, .elevation = d.elevation ? d.elevation : 20.0f,
                            .views = d.views ? d.views : 16, .frames = d.frames ? d.frames : 5,
-                           .crease_angle = d.crease_angle == 0 ? 60.0f : d.crease_angle < 0 ? -1.0f : d.crease_angle};
+                           .crease_angle = d.crease_angle == 0 ? 60.0f : d.crease_angle < 0 ? -1.0f : d.crease_angle,
+                           .mesh = d.mesh};
     asp_eval_result *res = asp_calloc(ctx, 1, sizeof *res);
     if (!res)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the evaluation result");
@@ -393,6 +592,7 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_co
     res->views = s.views;
     res->points = cloud->count;
     res->crease_angle = s.crease_angle;
+    res->mesh_triangles = d.mesh ? d.mesh->triangle_count : 0;
     struct sheet sh = {0};
     static const asp_prim_render_method default_methods[4] = {ASP_PRIM_RENDER_NORMALIZED, ASP_PRIM_RENDER_PREFIX,
                                                               ASP_PRIM_RENDER_OVERLAP, ASP_PRIM_RENDER_TWO_PASS};
@@ -403,12 +603,17 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_co
     for (size_t i = 0; i < nmethods; i++, s.nreps++) {
         s.reps[s.nreps].prim = 1;
         s.reps[s.nreps].method = methods[i];
+        s.reps[s.nreps].kind = REP_PRIM;
         snprintf(s.reps[s.nreps].name, sizeof s.reps[s.nreps].name, "dp-%s", asp_prim_render_method_name(methods[i]));
+    }
+    if (d.mesh) {
+        s.reps[s.nreps++] = (struct rep){.name = "mesh-tris", .kind = REP_MESH_TRIS};
+        s.reps[s.nreps++] = (struct rep){.name = "mesh-bytes", .kind = REP_MESH_BYTES};
     }
     rc = prepare(&s, &d, res, err);
     if (!rc) {
         res->level_count = s.dps->level_count;
-        res->row_count = nsizes * (1 + s.nreps * s.dps->level_count);
+        res->row_count = nsizes * (1 + (d.mesh ? 2 : 0) + s.nreps * s.dps->level_count);
         res->rows = asp_calloc(ctx, res->row_count, sizeof *res->rows);
         res->ssim = asp_calloc(ctx, res->row_count * s.views, sizeof *res->ssim);
         res->psnr = asp_calloc(ctx, res->row_count * s.views, sizeof *res->psnr);

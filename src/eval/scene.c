@@ -231,37 +231,40 @@ int asp_scene_mesh_frame(const asp_mesh *mesh, asp_frame *out, asp_error *err)
     return 0;
 }
 
-/* The mesh's arrays as render's plain description; the sampler's colour rule decides the material colours. */
-void asp_scene_describe_mesh(const asp_mesh *m, asp_render_material *mats, asp_render_mesh *r)
+void asp_scene_mesh_describe(const asp_mesh *m, asp_render_material *materials, asp_render_mesh *r)
 {
+    ASP_ASSERT(m && r && (materials || m->material_count == 0));
     for (size_t i = 0; i < m->material_count; i++) {
         const asp_material *mt = &m->materials[i];
         for (int c = 0; c < 4; c++) {
             // a material without a colour of its own is drawn like points without colours: light grey
             float v = mt->has_color ? mt->diffuse[c] : (c < 3 ? 200.0f / 255.0f : 1.0f);
-            mats[i].color[c] = v < 0 ? 0 : v > 1 ? 1 : v;
+            materials[i].color[c] = v < 0 ? 0 : v > 1 ? 1 : v;
         }
-        mats[i].texture = mt->texture.pixels ? &mt->texture : NULL;
+        materials[i].texture = mt->texture.pixels ? &mt->texture : NULL;
     }
-    *r = (asp_render_mesh){.vertex_count = m->vertex_count,
-                           .triangle_count = m->triangle_count,
-                           .origin = {m->origin[0], m->origin[1], m->origin[2]},
-                           .positions = m->positions,
-                           .normals = m->normals,
-                           .uvs = m->uvs,
-                           .colors = m->colors,
-                           .triangles = m->triangles,
-                           .material_ids = m->material_ids,
-                           .material_count = m->material_count,
-                           .materials = mats};
+    memset(r, 0, sizeof *r);
+    r->vertex_count = m->vertex_count;
+    r->triangle_count = m->triangle_count;
+    memcpy(r->origin, m->origin, sizeof r->origin);
+    r->positions = m->positions;
+    r->normals = m->normals;
+    r->uvs = m->uvs;
+    r->colors = m->colors;
+    r->triangles = m->triangles;
+    r->material_ids = m->material_ids;
+    r->material_count = m->material_count;
+    r->materials = materials;
 }
 
+/* The mesh's arrays as render's plain description; the sampler's colour rule decides the material colours. */
 static int describe_mesh(asp_scene *s, asp_error *err)
 {
-    s->materials = asp_calloc(&s->ctx, s->mesh->material_count, sizeof *s->materials);
+    const asp_mesh *m = s->mesh;
+    s->materials = asp_calloc(&s->ctx, m->material_count, sizeof *s->materials);
     if (!s->materials)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu materials", s->mesh->material_count);
-    asp_scene_describe_mesh(s->mesh, s->materials, &s->render_mesh);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu materials", m->material_count);
+    asp_scene_mesh_describe(m, s->materials, &s->render_mesh);
     return 0;
 }
 

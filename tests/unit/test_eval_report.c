@@ -1,4 +1,5 @@
 /* Evaluation results: CSV and JSON files, SSIM win counts and charts from a hand-made result. */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -99,4 +100,46 @@ static void test_chart(void)
     asp_eval_result_destroy(r);
 }
 
-TEST_MAIN(TEST_CASE(test_wins), TEST_CASE(test_csv_json), TEST_CASE(test_chart))
+/* A row without figures (issue 14: no simplified mesh fits the bytes): empty CSV fields, JSON nulls, the note. */
+static void test_row_without_figures(void)
+{
+    asp_eval_result *r = make_result();
+    asp_eval_row *row = &r->rows[2];
+    snprintf(row->representation, sizeof row->representation, "mesh-bytes");
+    snprintf(row->note, sizeof row->note, "texture alone 5592405 bytes exceeds 1000");
+    row->psnr_mean = row->psnr_min = row->ssim_mean = row->ssim_min = NAN;
+    row->iou_mean = row->iou_min = row->frame_ms = NAN;
+    r->rows[1].bytes = 256;
+    for (int v = 0; v < 4; v++)
+        r->ssim[8 + v] = r->psnr[8 + v] = NAN;
+    char csv[64], json[64];
+    snprintf(csv, sizeof csv, "/tmp/asp_eval_nofig_%d.csv", (int)getpid());
+    snprintf(json, sizeof json, "/tmp/asp_eval_nofig_%d.json", (int)getpid());
+    asp_error err = {0};
+    CHECK_OK(asp_eval_save_csv(r, csv, &err), &err);
+    char *text = slurp(csv);
+    CHECK(text && strstr(text, ",frame_ms,bytes,note\n") != NULL);
+    CHECK(text && strstr(text, "\nmesh-bytes,0,L,64,8,0.0,0,,,,,,,,0,texture alone 5592405 bytes exceeds 1000\n"));
+    CHECK(text && strstr(text, "\npoints,0,L,64,8,0.0,0,0.0000,0.0000,0.500000,0.000000,0.000000,0.000000,1.5000,256,\n"));
+    CHECK_OK(asp_eval_save_json(r, NULL, json, &err), &err);
+    text = slurp(json);
+    CHECK(text && strstr(text, "\"note\": \"texture alone 5592405 bytes exceeds 1000\", \"psnr_mean\": null") != NULL);
+    CHECK(text && strstr(text, "\"ssim_views\": [null, null, null, null]") != NULL);
+    unlink(csv);
+    unlink(json);
+    /* the chart leaves the row out: the same picture as without it */
+    asp_image with = {0}, without = {0};
+    CHECK_OK(asp_eval_chart(r, 64, 0, &with, &err), &err);
+    r->row_count = 2;
+    CHECK_OK(asp_eval_chart(r, 64, 0, &without, &err), &err);
+    CHECK(with.width == without.width && with.height == without.height);
+    size_t differ = 0;
+    for (size_t i = 0; i < (size_t)with.width * with.height * 4; i++)
+        differ += with.pixels[i] != without.pixels[i];
+    CHECK(differ == 0);
+    asp_image_release(&with);
+    asp_image_release(&without);
+    asp_eval_result_destroy(r);
+}
+
+TEST_MAIN(TEST_CASE(test_wins), TEST_CASE(test_csv_json), TEST_CASE(test_chart), TEST_CASE(test_row_without_figures))
