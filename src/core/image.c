@@ -14,6 +14,7 @@
 
 #include "amgsplat/image.h"
 #include "util/atomic_file.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 /* 16k x 16k RGBA is 1 GiB: anything larger is a lying header or a mistake. */
@@ -52,9 +53,9 @@ void asp_image_fill(asp_image *img, const uint8_t rgba[4])
 int asp_image_load(asp_image *img, const char *path, asp_error *err)
 {
     ASP_ASSERT(img && path);
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = asp__regular_file_open(path, err);
     if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+        return ASP_EIO;
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_file(fp, &w, &h, &comp)) {
         fclose(fp);

@@ -9,6 +9,7 @@
 #include <sys/types.h>
 
 #include "io/buffered_source.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 enum { WINDOW_BYTES = 4 << 20 };
@@ -51,9 +52,9 @@ int asp__src_open_file(asp__src *s, const char *path, const asp_context *ctx, as
     memset(s, 0, sizeof *s);
     s->ctx = ctx;
     s->name = path;
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = asp__regular_file_open(path, err);
     if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+        return ASP_EIO;
     off_t size = -1;
     if (fseeko(fp, 0, SEEK_END) == 0) {
         size = ftello(fp);

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "amgsplat/io.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 enum { HEAD_BYTES = 4096 }; /* a PLY header's element lines fit in far less */
@@ -182,7 +183,9 @@ int asp_file_recognise_memory(const void *head, size_t size, const char *name, a
 
 int asp_file_recognise(const char *path, asp_file_type *out, asp_error *err)
 {
-    // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it
+    if (asp__regular_file_check(path, err))
+        return ASP_EIO;
+    // O_NONBLOCK still: a FIFO swapped in after the check must not wait for a writer; fstat then refuses it
     int fd = open(path, O_RDONLY | O_NONBLOCK);
     if (fd < 0)
         return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));

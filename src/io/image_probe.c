@@ -10,13 +10,14 @@
 #include <stb/stb_image.h>
 
 #include "amgsplat/io.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 int asp_image_probe(const char *path, asp_image_header *out, asp_error *err)
 {
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = asp__regular_file_open(path, err);
     if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+        return ASP_EIO;
     int w = 0, h = 0, comp = 0;
     int ok = stbi_info_from_file(fp, &w, &h, &comp);
     fclose(fp);

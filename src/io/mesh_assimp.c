@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <assimp/cimport.h>
 #include <assimp/material.h>
@@ -18,6 +19,7 @@
 
 #include "amgsplat/io.h"
 #include "amgsplat/mesh.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 enum { MAX_NODE_DEPTH = 256 };
@@ -268,13 +270,14 @@ static int load_embedded(const struct aiScene *scene, const char *ref, const cha
     return 0;
 }
 
+/*
+ * Whether something exists at p: a FIFO or directory named by map_Kd counts,
+ * so asp_image_load then refuses it by name instead of "No such file".
+ */
 static int readable(const char *p)
 {
-    FILE *fp = fopen(p, "rb");
-    if (!fp)
-        return 0;
-    fclose(fp);
-    return 1;
+    struct stat st;
+    return stat(p, &st) == 0;
 }
 
 /* Texture references are relative to the model file; exporters often write Windows separators or stale folders. */
@@ -313,8 +316,6 @@ static int resolve_texture(const char *model, const char *ref, char *out, size_t
 static int load_override(const char *override, const char *material, asp_material *mat, asp_error *err)
 {
     asp_error e = {0};
-    if (!readable(override))
-        return asp_error_set(err, ASP_EIO, "cannot open texture '%s': %s", override, strerror(errno));
     int rc = asp_image_load(&mat->texture, override, &e);
     if (rc)
         return asp_error_set(err, rc, "%s (texture for material '%s')", e.msg, material);
@@ -555,9 +556,9 @@ int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_co
                   asp_error *err)
 {
     asp_mesh_load_desc d = desc ? *desc : (asp_mesh_load_desc){0};
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = asp__regular_file_open(path, err);
     if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+        return ASP_EIO;
     fclose(fp);
     /* unknown extensions go on to assimp, which reads more formats than the recogniser names */
     asp_file_type type = {.kind = ASP_FILE_MESH};

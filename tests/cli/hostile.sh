@@ -1,0 +1,71 @@
+# Hostile and damaged input (issue #13): every command that reads a file is given a FIFO (which
+# fopen would wait on forever) and a directory, and must fail at once, naming the file; the
+# damaged files of tests/data/bad give their expected messages.
+source "$(dirname "$0")/common.sh"
+
+# a tiny valid mesh, point cloud and image, so the FIFO is the only thing wrong in each call
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n' >"$T/tri.obj"
+printf '0 0 0\n1 0 0\n0 1 0\n0 0 1\n' >"$T/p.xyz"
+python3 - "$T/img.png" <<'PY'
+import struct, zlib, sys
+def chunk(t, b): return struct.pack('>I', len(b)) + t + b + struct.pack('>I', zlib.crc32(t + b) & 0xffffffff)
+raw = b''.join(b'\x00' + b'\x80\x80\x80' * 2 for _ in range(2))
+open(sys.argv[1], 'wb').write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', 2, 2, 8, 2, 0, 0, 0))
+                              + chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b''))
+PY
+
+# fifo_fails EXT cmd...: FIFO.EXT (written as @F in cmd) must make cmd exit non-zero within 5 s
+# (timeout's 124 would be a hang), with the FIFO named and "not a regular file" on stderr.
+fifo_fails() {
+  local ext=$1; shift
+  local f="$T/fifo.$ext"
+  rm -f "$f"; mkfifo "$f"
+  local args=() a
+  for a in "$@"; do args+=("${a//@F/$f}"); done
+  local st=0 t0=$SECONDS
+  timeout 5 "${args[@]}" >"$T/out" 2>"$T/err" || st=$?
+  ((st != 0 && st != 124 && st < 128)) || fail "'${args[*]}' exited $st (124: hung on the FIFO); stderr: $(cat "$T/err")"
+  ((SECONDS - t0 <= 2)) || fail "'${args[*]}' took $((SECONDS - t0)) s to refuse a FIFO"
+  grep -qF "'$f': not a regular file (a FIFO)" "$T/err" || fail "'${args[*]}' stderr lacks the FIFO: $(cat "$T/err")"
+  rm -f "$f"
+}
+A=$AMGSPLAT
+for ext in ply xyz pts obj off stl png amg dps hier; do
+  fifo_fails "$ext" "$A" info @F
+done
+fifo_fails ply "$A" convert @F "$T/o.xyz"
+fifo_fails xyz "$A" convert @F "$T/o.ply"
+fifo_fails pts "$A" convert @F "$T/o.ply"
+fifo_fails obj "$A" sample @F -o "$T/o.ply" --points 10
+fifo_fails off "$A" sample @F -o "$T/o.ply" --points 10
+fifo_fails ply "$A" sample @F -o "$T/o.ply" --points 10
+fifo_fails png "$A" sample "$T/tri.obj" -o "$T/o.ply" --points 10 --texture @F
+fifo_fails xyz "$A" estimate @F -o "$T/o.ply"
+fifo_fails ply "$A" decompose @F -o "$T/o.amg"
+fifo_fails xyz "$A" decompose @F -o "$T/o.amg"
+fifo_fails amg "$A" build @F -o "$T/o.dps"
+fifo_fails ply "$A" build @F -o "$T/o.dps"
+fifo_fails ply "$A" render @F -o "$T/o.png" --size 16x16
+fifo_fails dps "$A" render @F -o "$T/o.png" --size 16x16
+fifo_fails ply "$A" view @F --frames 1
+fifo_fails png "$A" imgdiff @F "$T/img.png"
+fifo_fails png "$A" imgdiff "$T/img.png" @F
+fifo_fails obj "$A" eval @F -o "$T/evalout"
+fifo_fails ply "$A" eval @F -o "$T/evalout"
+fifo_fails png "$A" eval "$T/tri.obj" -o "$T/evalout" --texture @F
+
+# an .mtl whose map_Kd names a FIFO: the texture is refused by name, not "No such file"
+mkfifo "$T/skin.png"
+printf 'newmtl m\nmap_Kd skin.png\n' >"$T/fifo_tex.mtl"
+printf 'mtllib fifo_tex.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n' >"$T/fifo_tex.obj"
+st=0; timeout 5 "$A" sample "$T/fifo_tex.obj" -o "$T/o.ply" --points 10 >"$T/out" 2>"$T/err" || st=$?
+((st != 0 && st != 124)) || fail "map_Kd FIFO: exit $st"
+grep -qF "'$T/skin.png': not a regular file (a FIFO)" "$T/err" || fail "map_Kd FIFO: $(cat "$T/err")"
+rm -f "$T/skin.png"
+
+# directories named like files
+mkdir -p "$T/dir.obj" "$T/dir.png" "$T/dir.xyz"
+expect_fail 1 "'$T/dir.obj': is a directory, expected a file" "$A" sample "$T/dir.obj" -o "$T/o.ply"
+expect_fail 1 "'$T/dir.png': is a directory, expected a file" "$A" imgdiff "$T/dir.png" "$T/img.png"
+expect_fail 1 "'$T/dir.xyz': is a directory, expected a file" "$A" convert "$T/dir.xyz" "$T/o.ply"
+expect_fail 1 "'$T/dir.png': is a directory, expected a file" "$A" sample "$T/tri.obj" -o "$T/o.ply" --texture "$T/dir.png"
