@@ -45,6 +45,8 @@ int cmd_estimate(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat estimate -h'", npos);
     if (!output)
         return cli_usage_error(env, "missing -o OUT");
+    if (cli_check_output(env, output, NULL, 0, (const char *const[]){argv[0]}, 1))
+        return 2;
     if (k < 1 || radius_k < 1)
         return cli_usage_error(env, "--k and --radius-k must be at least 1");
     if (!(radius_factor > 0.0) || radius_factor > 1e6)

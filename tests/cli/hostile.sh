@@ -69,3 +69,35 @@ expect_fail 1 "'$T/dir.obj': is a directory, expected a file" "$A" sample "$T/di
 expect_fail 1 "'$T/dir.png': is a directory, expected a file" "$A" imgdiff "$T/dir.png" "$T/img.png"
 expect_fail 1 "'$T/dir.xyz': is a directory, expected a file" "$A" convert "$T/dir.xyz" "$T/o.ply"
 expect_fail 1 "'$T/dir.png': is a directory, expected a file" "$A" sample "$T/tri.obj" -o "$T/o.ply" --texture "$T/dir.png"
+
+# options: a given 0 that the library would take as "default" is refused with the valid range
+python3 -c "
+import random; random.seed(1)
+print(''.join('%f %f %f\n' % (random.random(), random.random(), 0.1 * random.random()) for _ in range(300)), end='')" >"$T/pts.xyz"
+cp "$T/pts.xyz" "$T/pts.keep"
+expect_fail 2 "--primitives expects 1..4294967295, got 0" "$A" build "$T/pts.xyz" -o "$T/o.dps" --primitives 0
+expect_fail 2 "--k expects 3..1024, got 0" "$A" decompose "$T/pts.xyz" -o "$T/o.amg" --k 0
+expect_fail 2 "--k-max expects 24 (k_min)..1024, got 4" "$A" decompose "$T/pts.xyz" -o "$T/o.amg" --k-max 4
+expect_fail 2 "--max-levels expects 2..100, got 0" "$A" decompose "$T/pts.xyz" -o "$T/o.amg" --max-levels 0
+expect_fail 2 "--threads expects a count from 0 (all cores) to 4096, got ''" "$A" info --threads '' "$T/pts.xyz"
+expect_fail 2 "--threads expects a count from 0 (all cores) to 4096, got 'x'" "$A" info --threads=x "$T/pts.xyz"
+expect_fail 2 "--alpha expects a finite number, got 'inf'" "$A" decompose "$T/pts.xyz" -o "$T/o.amg" --alpha inf
+# outputs: never an input, and the extension says what is written
+expect_fail 2 "output '$T/pts.xyz' is the input '$T/pts.xyz'" "$A" decompose "$T/pts.xyz" -o "$T/pts.xyz"
+expect_fail 2 "output '$T/./pts.xyz' is the input '$T/pts.xyz'" "$A" estimate "$T/pts.xyz" -o "$T/./pts.xyz"
+expect_fail 2 "output '$T/tri.obj' is the input '$T/tri.obj'" "$A" sample "$T/tri.obj" -o "$T/tri.obj"
+cmp -s "$T/pts.xyz" "$T/pts.keep" || fail "an input was overwritten"
+expect_fail 2 "output '$T/x.ply': this command writes .dps, not '.ply'" "$A" build "$T/pts.xyz" -o "$T/x.ply"
+expect_fail 2 "output '$T/x.ply': this command writes .amg, not '.ply'" "$A" decompose "$T/pts.xyz" -o "$T/x.ply"
+expect_fail 2 "output '$T/x': this command writes .amg, not a name without extension" "$A" decompose "$T/pts.xyz" -o "$T/x"
+[[ ! -e "$T/x.ply" && ! -e "$T/x" ]] || fail "a refused output was written"
+# build writes its .dps and atlases all or none
+expect_fail 1 "cannot create '$T/nodir/a.png.tmp." "$A" build "$T/pts.xyz" -o "$T/all.dps" --primitives 10 --atlas "$T/nodir/a.png"
+[[ ! -e "$T/all.dps" ]] || fail "build left its .dps after the atlas failed"
+
+# voxel grid bounded by memory, with the estimate: this used to run for minutes and write GBs
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n' >"$T/tet.obj"
+expect_fail 1 "--grid 100000 on '$T/tet.obj' makes at least 1.05e+10 points needing" timeout 5 "$A" sample "$T/tet.obj" -o "$T/v.ply" --method voxel --grid 100000
+grep -qE "GB free .*try --grid [0-9]+ or less" "$T/err" || fail "voxel estimate: $(cat "$T/err")"
+[[ ! -e "$T/v.ply" ]] || fail "refused voxel sampling wrote a file"
+expect_fail 2 "output '$T/pts.xyz' is the input" "$A" convert "$T/pts.xyz" "$T/pts.xyz"
