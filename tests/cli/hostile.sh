@@ -101,3 +101,11 @@ expect_fail 1 "--grid 100000 on '$T/tet.obj' makes at least 1.05e+10 points need
 grep -qE "GB free .*try --grid [0-9]+ or less" "$T/err" || fail "voxel estimate: $(cat "$T/err")"
 [[ ! -e "$T/v.ply" ]] || fail "refused voxel sampling wrote a file"
 expect_fail 2 "output '$T/pts.xyz' is the input" "$A" convert "$T/pts.xyz" "$T/pts.xyz"
+
+# eval that fails leaves no output directory it created, and keeps one that was there
+printf '1 1 1\n1 1 1\n1 1 1\n1 1 1\n1 1 1\n' >"$T/same.xyz"
+expect_fail 1 "cannot decompose: all 5 points are equal" "$A" eval "$T/same.xyz" -o "$T/ev" --views 1 --sizes 16 --frames 1
+[[ ! -e "$T/ev" ]] || fail "failed eval left '$T/ev'"
+mkdir "$T/ev_old"
+expect_fail 1 "cannot decompose: all 5 points are equal" "$A" eval "$T/same.xyz" -o "$T/ev_old" --views 1 --sizes 16 --frames 1
+[[ -d "$T/ev_old" ]] || fail "failed eval removed a directory it did not create"
