@@ -135,18 +135,34 @@ size_t asp__src_fill(asp__src *s, size_t n)
     return s->len - s->pos;
 }
 
+/* The first '\n', or with cr the first '\n' or '\r', in p[0..n). */
+static const uint8_t *find_eol(const uint8_t *p, size_t n, int cr)
+{
+    if (!cr)
+        return memchr(p, '\n', n);
+    for (size_t i = 0; i < n; i++)
+        if (p[i] == '\n' || p[i] == '\r')
+            return p + i;
+    return NULL;
+}
+
 int asp__src_line(asp__src *s, size_t max_len, const char **line, size_t *len)
 {
     size_t scanned = 0;
     for (;;) {
         size_t avail = s->len - s->pos;
         const uint8_t *p = s->data + s->pos;
-        const uint8_t *nl = avail > scanned ? memchr(p + scanned, '\n', avail - scanned) : NULL;
+        const uint8_t *nl = avail > scanned ? find_eol(p + scanned, avail - scanned, s->cr_lines) : NULL;
+        // a CR last in the window may be the first half of a CRLF: read on before deciding
+        int split_crlf = nl && *nl == '\r' && nl + 1 == p + avail && s->fp && asp__src_remaining(s) > avail;
+        if (split_crlf)
+            nl = NULL;
         if (nl || (!s->fp && avail > 0) || avail > max_len) {
             size_t n = nl ? (size_t)(nl - p) : avail;
             if (n > max_len)
                 return -1;
-            s->pos += nl ? n + 1 : n;
+            size_t eol = !nl ? 0 : (*nl == '\r' && n + 1 < avail && nl[1] == '\n') ? 2 : 1;
+            s->pos += n + eol;
             if (n > 0 && p[n - 1] == '\r')
                 n--;
             *line = (const char *)p;
@@ -155,7 +171,7 @@ int asp__src_line(asp__src *s, size_t max_len, const char **line, size_t *len)
         }
         if (!s->fp)
             return s->io_errno || s->nomem ? -2 : 0;
-        scanned = avail;
+        scanned = split_crlf ? avail - 1 : avail;
         size_t want = avail + 65536;
         uint64_t rem = asp__src_remaining(s);
         if (want > rem)

@@ -20,6 +20,7 @@
 
 #include "amgsplat/io.h"
 #include "amgsplat/mesh.h"
+#include "io/mesh_precheck.h"
 #include "util/regular_file.h"
 #include "util/banned.h"
 
@@ -637,6 +638,8 @@ int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_co
                      aiProcess_ValidateDataStructure;
     char tmp_path[4096] = "";
     if (rc == 0 && strcmp(type.format, "ply") == 0 && (rc = ply_precheck(path, ctx, tmp_path, sizeof tmp_path, err)))
+        return rc;
+    if (rc == 0 && (rc = asp__mesh_precheck(path, type.format, ctx, err)))
         return rc;
     const struct aiScene *scene = aiImportFile(tmp_path[0] ? tmp_path : path, flags);
     if (tmp_path[0])

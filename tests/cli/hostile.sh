@@ -109,3 +109,50 @@ expect_fail 1 "cannot decompose: all 5 points are equal" "$A" eval "$T/same.xyz"
 mkdir "$T/ev_old"
 expect_fail 1 "cannot decompose: all 5 points are equal" "$A" eval "$T/same.xyz" -o "$T/ev_old" --views 1 --sizes 16 --frames 1
 [[ -d "$T/ev_old" ]] || fail "failed eval removed a directory it did not create"
+
+# damaged meshes (tests/data/bad/mesh/expected.txt): each refused at once by sample, with its message
+BAD="${ASP_TEST_SRC:-$(dirname "$0")/..}/data/bad/mesh"
+n=0
+while IFS=$'\t' read -r file want; do
+  [[ -z "$file" || "$file" == \#* ]] && continue
+  expect_fail 1 "cannot read '$BAD/$file': $want" timeout 5 "$A" sample "$BAD/$file" -o "$T/m.ply" --points 10
+  [[ ! -e "$T/m.ply" ]] || fail "$file: refused, but wrote $T/m.ply"
+  n=$((n + 1))
+done <"$BAD/expected.txt"
+((n >= 10)) || fail "only $n damaged meshes tried"
+
+# a PLY whose faces are triangle strips samples all of the strip's triangles, not one
+cat >"$T/strip.ply" <<'PLY'
+ply
+format ascii 1.0
+element vertex 6
+property float x
+property float y
+property float z
+element tristrips 1
+property list int int vertex_indices
+end_header
+0 0 0
+1 0 0
+0 1 0
+1 1 0
+0 2 0
+1 2 0
+9 0 1 2 3 -1 2 3 4 5
+PLY
+"$A" sample "$T/strip.ply" -o "$T/s.ply" --points 100 >"$T/out"
+grep -qF "100 points (area) from 4 triangles, area 2," "$T/out" || fail "tristrips: $(cat "$T/out")"
+"$A" info "$T/strip.ply" >"$T/out"
+grep -q "^faces *4 (triangles)" "$T/out" || fail "tristrips info: $(cat "$T/out")"
+
+# text point files: CR, LF and CRLF line ends; a .pts count must match the points that follow
+printf '0 0 0\r1 0 0\r0 1 0\r0 0 1\r' >"$T/cr.xyz"
+printf '0 0 0\r\n1 0 0\r\n0 1 0\r\n0 0 1\r\n' >"$T/crlf.xyz"
+for f in cr crlf; do
+  "$A" info "$T/$f.xyz" >"$T/out"
+  grep -q "^points *4$" "$T/out" || fail "$f line ends: $(cat "$T/out")"
+done
+printf '10\n0 0 0\n1 0 0\n0 1 0\n' >"$T/ten.pts"
+expect_fail 1 "cannot read '$T/ten.pts': line 1 declares 10 points, but 3 follow" "$A" info "$T/ten.pts"
+printf '1000000000000\n0 0 0\n1 0 0\n0 1 0\n' >"$T/huge.pts"
+expect_fail 1 "line 1 declares 1000000000000 points, but 3 follow" "$A" convert "$T/huge.pts" "$T/h.ply"
