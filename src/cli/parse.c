@@ -16,6 +16,14 @@
 
 static int progress_cb(void *user, const char *stage, double fraction);
 
+/* The library's warnings (asp_warn) as one line each, unless --quiet. */
+static void warning_cb(void *user, const char *message)
+{
+    struct cli_env *env = user;
+    if (!env->quiet)
+        fprintf(stderr, "amgsplat %s: warning: %s\n", env->cmd, message);
+}
+
 static const char *type_arg(const struct cli_option *o)
 {
     if (o->arg)
@@ -170,6 +178,8 @@ int cli_parse(int argc, char **argv, const struct cli_option *opts, const char *
     }
     *npos = n;
     env->ctx.threads = env->threads;
+    env->ctx.warning = warning_cb;
+    env->ctx.warning_user = env;
     if (!env->quiet && isatty(STDERR_FILENO)) {
         env->ctx.progress = progress_cb;
         env->ctx.progress_user = env;

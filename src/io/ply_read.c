@@ -364,6 +364,17 @@ static int read_header(reader *r)
             if (!seen_format)
                 return FAIL_LINE(r, r->line, "no 'format' line before 'end_header'");
             return 0;
+        } else if (r->nelems == 0) {
+            /*
+             * Blender 2.4x writes "Created by Blender ..." without 'comment'.
+             * Before the first element such a line cannot shift any column,
+             * so it is kept as a comment, with a warning; among properties a
+             * misspelt 'property' would, so there it stays an error.
+             */
+            char buf[40];
+            asp_warn(r->ctx, "'%s': line %zu: header line starting '%s' has no 'comment' keyword; kept as a comment",
+                     r->name, r->line, excerpt(buf, kw, kl));
+            rc = add_note(r, 'c', kw);
         } else {
             char buf[40];
             rc = FAIL_LINE(r, r->line, "unknown header keyword '%s'", excerpt(buf, kw, kl));

@@ -156,3 +156,12 @@ printf '10\n0 0 0\n1 0 0\n0 1 0\n' >"$T/ten.pts"
 expect_fail 1 "cannot read '$T/ten.pts': line 1 declares 10 points, but 3 follow" "$A" info "$T/ten.pts"
 printf '1000000000000\n0 0 0\n1 0 0\n0 1 0\n' >"$T/huge.pts"
 expect_fail 1 "line 1 declares 1000000000000 points, but 3 follow" "$A" convert "$T/huge.pts" "$T/h.ply"
+
+# a Blender 2.4x header line without 'comment': read, with a warning naming the line, as points and as a mesh
+printf 'ply\nformat ascii 1.0\nCreated by Blender 2.49b\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >"$T/blender.ply"
+expect_exit 0 "$A" sample "$T/blender.ply" -o "$T/b.ply" --points 10
+grep -qF "warning: '$T/blender.ply': line 3: header line starting 'Created' has no 'comment' keyword; kept as a comment" "$T/err" \
+  || fail "blender warning: $(cat "$T/err")"
+grep -qF "10 points (area) from 1 triangles" "$T/out" || fail "blender sample: $(cat "$T/out")"
+expect_exit 0 "$A" convert "$T/blender.ply" "$T/b.xyz"
+grep -qF "kept as a comment" "$T/err" || fail "blender convert warning: $(cat "$T/err")"

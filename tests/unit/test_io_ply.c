@@ -576,7 +576,47 @@ static void test_refuses_a_pipe(void)
     close(fds[0]);
 }
 
-TEST_MAIN(TEST_CASE(test_refuses_a_pipe), TEST_CASE(test_positions_every_type_and_encoding), TEST_CASE(test_round_trip_every_type_every_encoding),
+struct warnings {
+    int count;
+    char last[256];
+};
+
+static void collect_warning(void *user, const char *message)
+{
+    struct warnings *w = user;
+    w->count++;
+    snprintf(w->last, sizeof w->last, "%s", message);
+}
+
+/*
+ * Blender 2.4x writes "Created by Blender ..." without 'comment': before the
+ * first element it is kept as a comment with one warning; after an element
+ * an unknown word (a misspelt 'property') is still an error.
+ */
+static void test_header_line_without_comment_keyword(void)
+{
+    const char *ply = "ply\nformat ascii 1.0\nCreated by Blender 2.49b - www.blender.org\nelement vertex 2\n"
+                      "property float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 2 3\n";
+    struct warnings w = {0};
+    asp_context ctx = {.warning = collect_warning, .warning_user = &w};
+    asp_cloud *c = NULL;
+    asp_error err_ = {0}, *err = &err_;
+    CHECK_OK(asp_ply_read_memory(ply, strlen(ply), "blender.ply", &ctx, &c, err), err);
+    CHECK(c && c->count == 2 && c->positions[5] == 3.0f);
+    CHECK(c && c->comment_count == 1 && strcmp(c->comments[0], "Created by Blender 2.49b - www.blender.org") == 0);
+    CHECK_MSG(w.count == 1 && strstr(w.last, "'blender.ply': line 3: header line starting 'Created' has no 'comment' "
+                                             "keyword; kept as a comment"),
+              "%d warnings, last '%s'", w.count, w.last);
+    asp_cloud_destroy(c);
+    c = NULL;
+    const char *typo = "ply\nformat ascii 1.0\nelement vertex 1\nCreated by Blender\nproperty float x\n"
+                       "property float y\nproperty float z\nend_header\n0 0 0\n";
+    CHECK(asp_ply_read_memory(typo, strlen(typo), "typo.ply", &ctx, &c, err) == ASP_EFORMAT && c == NULL);
+    CHECK_MSG(strstr(err->msg, "line 4: unknown header keyword 'Created'"), "%s", err->msg);
+    CHECK(w.count == 1);
+}
+
+TEST_MAIN(TEST_CASE(test_header_line_without_comment_keyword), TEST_CASE(test_refuses_a_pipe), TEST_CASE(test_positions_every_type_and_encoding), TEST_CASE(test_round_trip_every_type_every_encoding),
           TEST_CASE(test_big_endian_matches_little_endian_bytes), TEST_CASE(test_double_origin_far_from_zero),
           TEST_CASE(test_faces_and_skipped_lists), TEST_CASE(test_face_index_out_of_range),
           TEST_CASE(test_large_file_streams), TEST_CASE(test_progress_can_cancel_and_outputs_stay),
