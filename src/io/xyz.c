@@ -5,6 +5,7 @@
  * the pipeline (journal Sect. 1, Fig. 2). The column count of the first data line decides the layout.
  */
 #include <ctype.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -141,10 +142,17 @@ static int parse_lines(text_reader *t)
                                  t->name, lineno, t->cols, n > MAX_COLS ? "more than " : "",
                                  n > MAX_COLS ? MAX_COLS : n);
         }
-        for (int k = 0; k < 3; k++)
+        for (int k = 0; k < 3; k++) {
             if (!isfinite(v[k]))
                 return asp_error_set(t->err, ASP_EFORMAT, "cannot read '%s': line %zu: coordinate %c is %s",
                                      t->name, lineno, "xyz"[k], isnan(v[k]) ? "NaN" : "infinite");
+            // positions are float offsets: a value past FLT_MAX would become infinite (found by fuzz_xyz)
+            if (fabs(v[k]) > FLT_MAX)
+                return asp_error_set(t->err, ASP_EFORMAT,
+                                     "cannot read '%s': line %zu: coordinate %c %.9g is outside the float range "
+                                     "(magnitude at most %.9g)",
+                                     t->name, lineno, "xyz"[k], v[k], (double)FLT_MAX);
+        }
         if (t->cols >= 6)
             colour_evidence(t, v + t->cols - 3, lineno);
         if ((rc = push_row(t, v)))

@@ -158,6 +158,7 @@ static void test_errors_name_the_line(void)
         {"0 0 0 1 2 3 0.5 0.5 2\n", "line 1: colour values must be integers 0..255 or all in 0..1, got 0.5"},
         {"", "no points in the file"},
         {"12\n", "line 1 declares 12 points, but 0 follow"},
+        {"1 1 1\n0 1 1\n1 1 1.7e74\n", "line 3: coordinate z 1.7e+74 is outside the float range"},
         {"10\n0 0 0\n1 0 0\n0 1 0\n", "line 1 declares 10 points, but 3 follow"},
         {"1000000000000\n0 0 0\n1 0 0\n0 1 0\n", "line 1 declares 1000000000000 points, but 3 follow"},
         {"# c\n\n2\n0 0 0\n", "line 3 declares 2 points, but 1 follow"},
