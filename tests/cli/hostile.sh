@@ -165,3 +165,13 @@ grep -qF "warning: '$T/blender.ply': line 3: header line starting 'Created' has 
 grep -qF "10 points (area) from 1 triangles" "$T/out" || fail "blender sample: $(cat "$T/out")"
 expect_exit 0 "$A" convert "$T/blender.ply" "$T/b.xyz"
 grep -qF "kept as a comment" "$T/err" || fail "blender convert warning: $(cat "$T/err")"
+
+# a killed run's OUT.tmp.<pid> is removed by the next write to OUT; a live process's is kept
+true & dead=$!; wait "$dead"
+printf 'partial' >"$T/st.ply.tmp.$dead"
+sleep 30 & live=$!
+printf 'partial' >"$T/st.ply.tmp.$live"
+"$A" convert "$T/pts.xyz" "$T/st.ply" >/dev/null
+[[ ! -e "$T/st.ply.tmp.$dead" ]] || fail "stale temporary of dead process $dead left"
+[[ -e "$T/st.ply.tmp.$live" ]] || fail "temporary of live process $live removed"
+kill "$live" 2>/dev/null || true
