@@ -189,7 +189,14 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         asp_prim_normalise_parse(norm, &desc.normalise, &err))
         return cli_usage_error(env, "%s", err.msg);
     if (texel < 0 || width < 0 || tau < 0 || fraction < 0 || flat < 0 || angle < 0)
-        return cli_usage_error(env, "option values must not be negative");
+        return cli_usage_error(env, "--%s must not be negative, got %g",
+                               texel < 0   ? "texel-size"
+                               : width < 0 ? "width"
+                               : tau < 0   ? "tau"
+                               : fraction < 0 ? "neighbours"
+                               : flat < 0     ? "merge-flatness"
+                                              : "merge-angle",
+                               texel < 0 ? texel : width < 0 ? width : tau < 0 ? tau : fraction < 0 ? fraction : flat < 0 ? flat : angle);
 
     double t0 = asp_time_now(), t_dec = 0;
     asp_amg *amg = NULL;

@@ -175,3 +175,5 @@ printf 'partial' >"$T/st.ply.tmp.$live"
 [[ ! -e "$T/st.ply.tmp.$dead" ]] || fail "stale temporary of dead process $dead left"
 [[ -e "$T/st.ply.tmp.$live" ]] || fail "temporary of live process $live removed"
 kill "$live" 2>/dev/null || true
+expect_fail 2 "--k expects 1..1024, got 100000000" "$A" estimate "$T/pts.xyz" -o "$T/e.ply" --k 100000000
+expect_fail 2 "--tau must not be negative, got -1" "$A" build "$T/pts.xyz" -o "$T/t.dps" --tau -1
