@@ -177,3 +177,20 @@ printf 'partial' >"$T/st.ply.tmp.$live"
 kill "$live" 2>/dev/null || true
 expect_fail 2 "--k expects 1..1024, got 100000000" "$A" estimate "$T/pts.xyz" -o "$T/e.ply" --k 100000000
 expect_fail 2 "--tau must not be negative, got -1" "$A" build "$T/pts.xyz" -o "$T/t.dps" --tau -1
+
+# image files described by what is wrong with them, not "unknown image type"
+python3 - "$T" <<'PY'
+import struct, zlib, sys
+d = sys.argv[1]
+def chunk(t, b): return struct.pack('>I', len(b)) + t + b + struct.pack('>I', zlib.crc32(t + b) & 0xffffffff)
+open(d + '/huge.png', 'wb').write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', 100000, 100000, 8, 2, 0, 0, 0))
+                                   + chunk(b'IDAT', zlib.compress(b'\0' * 100)) + chunk(b'IEND', b''))
+open(d + '/noidat.png', 'wb').write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', 4, 4, 8, 2, 0, 0, 0)))
+open(d + '/text.png', 'w').write('hello, not an image\n')
+open(d + '/empty.png', 'w').write('')
+PY
+expect_fail 1 "cannot read image '$T/huge.png': PNG header says 100000x100000, outside the 1..16384 pixels a side" "$A" imgdiff "$T/huge.png" "$T/img.png"
+expect_fail 1 "cannot read '$T/huge.png': PNG of 100000x100000 that stb_image refuses" "$A" info "$T/huge.png"
+expect_fail 1 "cannot decode image '$T/noidat.png': PNG of 4x4: damaged image data" "$A" imgdiff "$T/noidat.png" "$T/img.png"
+expect_fail 1 "'$T/text.png': not an image: no PNG, JPEG, GIF, BMP or PSD signature" "$A" imgdiff "$T/img.png" "$T/text.png"
+expect_fail 1 "cannot read image '$T/empty.png': empty file" "$A" sample "$T/tri.obj" -o "$T/o.ply" --texture "$T/empty.png"
