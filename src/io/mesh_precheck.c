@@ -10,9 +10,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "io/mesh_precheck.h"
 #include "util/byte_io.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 /* The smallest vertex line "0 0 0\n" and face line "3 0 1 2\n": what the counts must fit in. */
@@ -195,6 +197,55 @@ int asp__mesh_precheck_memory(const void *data, size_t size, const char *name, c
     return 0;
 }
 
+/* Refuses name (relative to the OBJ's directory) when it exists and is not a regular file. */
+static int check_side_file(const char *obj, const char *name, size_t len, asp_error *err)
+{
+    const char *slash = strrchr(obj, '/');
+    char full[4096];
+    if (len == 0 || len >= 2048)
+        return 0;
+    if (name[0] == '/' || !slash)
+        snprintf(full, sizeof full, "%.*s", (int)len, name);
+    else
+        snprintf(full, sizeof full, "%.*s/%.*s", (int)(slash - obj), obj, (int)len, name);
+    struct stat st;
+    if (stat(full, &st) != 0)
+        return 0; // a missing .mtl is assimp's to report (it carries on without materials)
+    return S_ISREG(st.st_mode) ? 0 : asp__regular_file_check(full, err);
+}
+
+/*
+ * assimp opens an OBJ's material libraries itself, and would block on a
+ * FIFO named by 'mtllib' (issue #13): each one is checked first, as the whole
+ * rest of the line and word by word (assimp's reading of names with spaces).
+ */
+static int check_mtllibs(const char *path, const char *b, size_t size, asp_error *err)
+{
+    cursor c = {b, b + size, 0};
+    const char *s, *e;
+    while (next_line(&c, &s, &e)) {
+        if (e - s < 8 || memcmp(s, "mtllib", 6) != 0 || (s[6] != ' ' && s[6] != '\t'))
+            continue;
+        const char *p = s + 7;
+        while (p < e && (*p == ' ' || *p == '\t'))
+            p++;
+        asp_error why = {0};
+        int rc = check_side_file(path, p, (size_t)(e - p), &why);
+        for (const char *w = p; rc == 0 && w < e;) {
+            const char *we = w;
+            while (we < e && *we != ' ' && *we != '\t')
+                we++;
+            rc = check_side_file(path, w, (size_t)(we - w), &why);
+            w = we;
+            while (w < e && (*w == ' ' || *w == '\t'))
+                w++;
+        }
+        if (rc)
+            return asp_error_set(err, rc, "%s (the material library of '%s', line %zu)", why.msg, path, c.line);
+    }
+    return 0;
+}
+
 int asp__mesh_precheck(const char *path, const char *format, const asp_context *ctx, asp_error *err)
 {
     if (strcmp(format, "off") != 0 && strcmp(format, "stl") != 0 && strcmp(format, "obj") != 0)
@@ -205,6 +256,8 @@ int asp__mesh_precheck(const char *path, const char *format, const asp_context *
     if (rc)
         return rc;
     rc = asp__mesh_precheck_memory(buf, size, path, format, err);
+    if (rc == 0 && strcmp(format, "obj") == 0)
+        rc = check_mtllibs(path, (const char *)buf, size, err);
     asp_free(ctx, buf);
     return rc;
 }

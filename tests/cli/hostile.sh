@@ -194,3 +194,10 @@ expect_fail 1 "cannot read '$T/huge.png': PNG of 100000x100000 that stb_image re
 expect_fail 1 "cannot decode image '$T/noidat.png': PNG of 4x4: damaged image data" "$A" imgdiff "$T/noidat.png" "$T/img.png"
 expect_fail 1 "'$T/text.png': not an image: no PNG, JPEG, GIF, BMP or PSD signature" "$A" imgdiff "$T/img.png" "$T/text.png"
 expect_fail 1 "cannot read image '$T/empty.png': empty file" "$A" sample "$T/tri.obj" -o "$T/o.ply" --texture "$T/empty.png"
+
+# an OBJ whose mtllib names a FIFO: assimp would open it and wait; refused by name first
+rm -f "$T/pipe.mtl"; mkfifo "$T/pipe.mtl"
+printf 'mtllib pipe.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$T/fifo_mtl.obj"
+expect_fail 1 "cannot read '$T/pipe.mtl': not a regular file (a FIFO) (the material library of '$T/fifo_mtl.obj', line 1)" \
+  timeout 5 "$A" sample "$T/fifo_mtl.obj" -o "$T/o.ply" --points 10
+rm -f "$T/pipe.mtl"
