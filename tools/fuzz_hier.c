@@ -4,7 +4,10 @@
  * crash, leak or huge allocation (STYLE.md section 11).
  *   ./fuzz_hier -max_total_time=300 -rss_limit_mb=2048 corpus
  * Seed the corpus with a small saved hierarchy (asp_hier_save; version 2, and a
- * version-1 file for the old-header path).
+ * version-1 file for the old-header path). Each input is also tried with its
+ * payload size and both FNV-1a checksums made consistent (issue #13): random
+ * mutations almost never keep them, and without the fix none of the checks
+ * behind them is reached.
  */
 #include <math.h>
 #include <stdint.h>
@@ -13,7 +16,7 @@
 
 #include "amgsplat/hier.h"
 
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+static void one(const uint8_t *data, size_t size)
 {
     asp_hier *h = NULL;
     asp_error err = {0};
@@ -36,9 +39,46 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 abort();
         }
         asp_hier_destroy(h);
-        return 0;
+        return;
     }
     if (h || err.msg[0] == '\0')
         abort();
+}
+
+/* docs/hier.md: FNV-1a 64 over the payload (stored at byte 88) and over the header before its last 8 bytes. */
+static uint64_t fnv1a(const uint8_t *p, size_t n)
+{
+    uint64_t h = 0xcbf29ce484222325ULL;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ULL;
+    }
+    return h;
+}
+
+static void put64(uint8_t *p, uint64_t v)
+{
+    for (int k = 0; k < 8; k++)
+        p[k] = (uint8_t)(v >> (8 * k));
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    one(data, size);
+    if (size < 12 || memcmp(data, "ASPHIER", 8) != 0)
+        return 0;
+    const size_t hsize = data[8] == 1 && !data[9] && !data[10] && !data[11] ? 128 : 160;
+    if (size < hsize)
+        return 0;
+    uint8_t *fixed = malloc(size);
+    if (!fixed)
+        return 0;
+    memcpy(fixed, data, size);
+    put64(fixed + 80, size - hsize);
+    put64(fixed + 88, fnv1a(fixed + hsize, size - hsize));
+    put64(fixed + hsize - 8, fnv1a(fixed, hsize - 8));
+    if (memcmp(fixed, data, size) != 0)
+        one(fixed, size);
+    free(fixed);
     return 0;
 }

@@ -84,6 +84,14 @@ typedef struct asp_allocator {
 typedef int (*asp_progress_fn)(void *user, const char *stage, double fraction);
 
 /**
+ * Warning callback: a file was read or written, but something in it was
+ * repaired or left out (message in the asp_error style, naming the file).
+ * The library never prints (STYLE.md 4); the caller decides where it goes.
+ * Called only from the thread that called the library function.
+ */
+typedef void (*asp_warning_fn)(void *user, const char *message);
+
+/**
  * Execution context, owned by the caller; the zero value (or a NULL pointer
  * wherever a `const asp_context *` is taken) means: all OpenMP threads, the C
  * allocator, no progress reporting.
@@ -93,6 +101,8 @@ typedef struct asp_context {
     asp_allocator allocator;
     asp_progress_fn progress;  /* may be NULL */
     void *progress_user;
+    asp_warning_fn warning;    /* may be NULL: warnings are then dropped */
+    void *warning_user;
 } asp_context;
 
 /** Thread count a kernel should use under ctx (>= 1). */
@@ -109,6 +119,13 @@ void *asp_realloc(const asp_context *ctx, void *ptr, size_t old_size, size_t new
 
 /** Reports progress if ctx has a callback; returns ASP_ECANCELED if it asked to stop, else 0. */
 int asp_progress(const asp_context *ctx, const char *stage, double fraction);
+
+/** Formats a warning and hands it to ctx's warning callback, if any (the text is cut at 256 bytes). */
+void asp_warn(const asp_context *ctx, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 
 /** Seconds on a monotonic clock, for timings reported by the library. */
 double asp_time_now(void);

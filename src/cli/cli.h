@@ -68,6 +68,17 @@ void cli_info(const struct cli_env *env, const char *fmt, ...)
 /* Ends a progress bar line if one is drawn (call before printing results). */
 void cli_progress_end(struct cli_env *env);
 
+/*
+ * Output checks shared by the commands that write files (issue #13): refuses
+ * (usage error, 2) an output that is the same file as an input (same device
+ * and inode, so "./in.ply" and links are caught) and an output whose
+ * extension names another format than `format` (a recogniser format name:
+ * "amg", "dps", "png"). A name without extension is accepted when
+ * allow_bare is set. Returns 0 when the output is fine.
+ */
+int cli_check_output(const struct cli_env *env, const char *output, const char *format, int allow_bare,
+                     const char *const *inputs, size_t ninputs);
+
 /* Parses "a,b[,c]" doubles into out (up to max); returns how many, -1 on junk. */
 int cli_parse_doubles(const char *s, double *out, int max);
 /* Parses --up: "y", "z", "x", "-y", "-z" or "-x" ("+y" = "y"); returns 0 or -1. */

@@ -2,6 +2,7 @@
  * amgsplat build: domain primitives (textured support rectangles) for one or
  * more AMG levels, written as a .dps file (journal section 3, thesis ch. 3).
  */
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -135,7 +136,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
 {
     const char *output = NULL, *level_text = NULL, *method = "affine", *shape = "linear", *norm = "positive";
     const char *atlas = NULL;
-    size_t budget = 0, max_texture = 0, padding = 0;
+    size_t budget = SIZE_MAX, max_texture = 0, padding = 0; // SIZE_MAX: not given, so a given 0 is refused
     double texel = 0, width = 0, tau = 0, fraction = 0, flat = 0, angle = 0;
     int unweighted = 0, project = 0, no_extend = 0, normals = 0, merge = 0;
     const struct cli_option opts[] = {
@@ -168,8 +169,15 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat build -h'", npos);
     if (!output)
         return cli_usage_error(env, "missing -o OUT.dps");
-    if (level_text && budget)
+    if (level_text && budget != SIZE_MAX)
         return cli_usage_error(env, "--level and --primitives exclude each other");
+    if (budget == 0 || (budget != SIZE_MAX && budget > UINT32_MAX))
+        return cli_usage_error(env, "--primitives expects 1..4294967295, got %zu", budget);
+    {
+        const char *const inputs[] = {argv[0], atlas};
+        if (cli_check_output(env, output, "dps", 0, inputs, 2) || cli_check_output(env, atlas, "png", 1, inputs, 1))
+            return 2;
+    }
     if (max_texture > 8192 || padding > 64)
         return cli_usage_error(env, "--max-texture must be at most 8192 and --padding at most 64");
     asp_error err = {0};
@@ -181,7 +189,14 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         asp_prim_normalise_parse(norm, &desc.normalise, &err))
         return cli_usage_error(env, "%s", err.msg);
     if (texel < 0 || width < 0 || tau < 0 || fraction < 0 || flat < 0 || angle < 0)
-        return cli_usage_error(env, "option values must not be negative");
+        return cli_usage_error(env, "--%s must not be negative, got %g",
+                               texel < 0   ? "texel-size"
+                               : width < 0 ? "width"
+                               : tau < 0   ? "tau"
+                               : fraction < 0 ? "neighbours"
+                               : flat < 0     ? "merge-flatness"
+                                              : "merge-angle",
+                               texel < 0 ? texel : width < 0 ? width : tau < 0 ? tau : fraction < 0 ? fraction : flat < 0 ? flat : angle);
 
     double t0 = asp_time_now(), t_dec = 0;
     asp_amg *amg = NULL;
@@ -198,7 +213,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         t_dec = asp_time_now() - t0;
     }
     size_t levels[64], nlevels = 0;
-    if (!rc && budget)
+    if (!rc && budget != SIZE_MAX)
         rc = asp_prim_level_for_budget(amg, budget, &levels[nlevels++], &err);
     else if (!rc)
         rc = parse_levels(amg, level_text ? level_text : "L-3", levels, &nlevels, 64, &err);
@@ -210,8 +225,8 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     asp_dps_summary rows[64];
     if (!rc)
         asp_dps_summarize(dps, rows, 64);
-    if (!rc && atlas)
-        rc = save_atlases(atlas, dps, rows, &err);
+    if (!rc && atlas && (rc = save_atlases(atlas, dps, rows, &err)) != 0)
+        remove(output); // all outputs or none (issue #13): the .dps just written goes with the failed atlas
     double t_total = asp_time_now() - t0;
     asp_amg_destroy(amg);
     asp_cloud_destroy(cloud);

@@ -74,6 +74,8 @@ int cmd_convert(int argc, char **argv, struct cli_env *env)
     const char *in = argv[0], *out = argv[1];
     if (ascii && big_endian)
         return cli_usage_error(env, "--ascii and --big-endian exclude each other");
+    if (cli_check_output(env, out, NULL, 0, (const char *const[]){in}, 1))
+        return 2;
     asp_file_type out_type;
     const char *out_fmt = asp_file_type_of_name(out, &out_type, NULL) == 0 ? out_type.format : NULL;
     if ((ascii || big_endian) && out_fmt && strcmp(out_fmt, "ply") != 0)

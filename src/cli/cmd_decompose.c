@@ -2,6 +2,7 @@
  * amgsplat decompose: multiscale AMG decomposition of a point set into
  * quasi-flat domains (Reniers & Telea 2006, section 2; thesis chapter 2).
  */
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -123,11 +124,47 @@ static int export_colors(struct cli_env *env, const asp_amg *amg, int mode, cons
     return rc;
 }
 
+#define UNSET SIZE_MAX
+
+/* The library's ranges (src/amg/neighbourhood.c), checked here so the message names the option. */
+static int check_counts(const struct cli_env *env, size_t k, size_t k_max, size_t fan_k, size_t max_levels,
+                        size_t max_coarse)
+{
+    if (k != UNSET && (k < 3 || k > 1024))
+        return cli_usage_error(env, "--k expects 3..1024, got %zu", k);
+    size_t k_min = k == UNSET ? 24 : k;
+    if (k_max != UNSET && (k_max < k_min || k_max > 1024))
+        return cli_usage_error(env, "--k-max expects %zu (k_min)..1024, got %zu", k_min, k_max);
+    if (fan_k != UNSET && (fan_k < 3 || fan_k > 1024))
+        return cli_usage_error(env, "--fan-k expects 3..1024, got %zu", fan_k);
+    if (max_levels != UNSET && (max_levels < 2 || max_levels > 100))
+        return cli_usage_error(env, "--max-levels expects 2..100, got %zu", max_levels);
+    if (max_coarse != UNSET && max_coarse < 1)
+        return cli_usage_error(env, "--max-coarse expects at least 1, got %zu", max_coarse);
+    return 0;
+}
+
+static int check_output_name(const struct cli_env *env, const char *input, const char *output,
+                             const char *colors_out)
+{
+    const char *const inputs[] = {input};
+    if (cli_check_output(env, output, "amg", 0, inputs, 1) ||
+        cli_check_output(env, colors_out, NULL, 0, inputs, 1))
+        return 2;
+    const char *const out_in[] = {output};
+    if (output && colors_out && cli_check_output(env, colors_out, NULL, 0, out_in, 1))
+        return 2;
+    if (output && colors_out && strcmp(output, colors_out) == 0)
+        return cli_usage_error(env, "-o and --colors-out name the same file '%s'", output);
+    return 0;
+}
+
 int cmd_decompose(int argc, char **argv, struct cli_env *env)
 {
     const char *output = NULL, *classifier = "variation", *coarsen = "rs", *interp = "classical";
     const char *export_mode = NULL, *level_name = "L-3", *colors_out = NULL;
-    size_t k = 0, k_max = 0, fan_k = 0, max_levels = 0, max_coarse = 0;
+    /* UNSET, not 0: 0 means "default" to the library, so a given 0 would pass silently */
+    size_t k = UNSET, k_max = UNSET, fan_k = UNSET, max_levels = UNSET, max_coarse = UNSET;
     double epsilon = 0, alpha = 0, beta = 0, strong = 0, trunc = 0, weak = 0, drop = 0, tau = 0.05, crease = 0;
     int stats = 0;
     const struct cli_option opts[] = {
@@ -166,6 +203,12 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     asp_file_type type;
     int from_amg = asp_file_recognise(input, &type, NULL) == 0 && type.kind == ASP_FILE_AMG;
     int color_mode = 0;
+    if (check_counts(env, k, k_max, fan_k, max_levels, max_coarse))
+        return 2;
+    if (check_output_name(env, input, output, colors_out))
+        return 2;
+    k = k == UNSET ? 0 : k, k_max = k_max == UNSET ? 0 : k_max, fan_k = fan_k == UNSET ? 0 : fan_k;
+    max_levels = max_levels == UNSET ? 0 : max_levels, max_coarse = max_coarse == UNSET ? 0 : max_coarse;
     asp_amg_desc desc = {.k_min = k, .k_max = k_max, .epsilon = epsilon, .fan_k = fan_k, .alpha = alpha,
                          .beta = beta, .strong_threshold = strong, .trunc_factor = trunc, .max_levels = max_levels,
                          .max_coarse = max_coarse, .weak_coupling = weak, .drop_tol = drop,

@@ -45,8 +45,13 @@ int cmd_estimate(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat estimate -h'", npos);
     if (!output)
         return cli_usage_error(env, "missing -o OUT");
-    if (k < 1 || radius_k < 1)
-        return cli_usage_error(env, "--k and --radius-k must be at least 1");
+    if (cli_check_output(env, output, NULL, 0, (const char *const[]){argv[0]}, 1))
+        return 2;
+    // 1024: the k-NN graph takes n k entries; the neighbourhoods a tangent plane needs are tens
+    if (k < 1 || k > 1024)
+        return cli_usage_error(env, "--k expects 1..1024, got %zu", k);
+    if (radius_k < 1 || radius_k > 1024)
+        return cli_usage_error(env, "--radius-k expects 1..1024, got %zu", radius_k);
     if (!(radius_factor > 0.0) || radius_factor > 1e6)
         return cli_usage_error(env, "--radius-factor must be in (0, 1e6], got %g", radius_factor);
     double view[3] = {0, 0, 0};

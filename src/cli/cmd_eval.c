@@ -4,11 +4,13 @@
  * the same cameras as the reference, compared by PSNR, SSIM and silhouette
  * IoU, timed, and written as CSV, JSON, charts and a contact sheet.
  */
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "cli/cli.h"
 #include "cli/commands.h"
@@ -202,6 +204,27 @@ static int save_outputs(const asp_eval_result *res, const char *model, const cha
     return rc;
 }
 
+/*
+ * A failed run leaves no directory it created (issue #13): everything in it
+ * is this run's output, so its plain files go, then the directory.
+ */
+static void remove_directory(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        char path[4096 + 256];
+        while ((e = readdir(d)) != NULL) {
+            if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+                continue;
+            snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+            remove(path);
+        }
+        closedir(d);
+    }
+    rmdir(dir);
+}
+
 int cmd_eval(int argc, char **argv, struct cli_env *env)
 {
     const char *out_dir = NULL, *sizes_text = NULL, *methods_text = NULL, *texture = NULL, *crease_text = NULL;
@@ -261,7 +284,8 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
     rc = asp_eval_load_model_mesh(argv[0], points, texture, &env->ctx, &cloud, &mesh, &err);
     if (rc)
         return cli_fail(env, &err);
-    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+    int created = mkdir(dir, 0777) == 0;
+    if (!created && errno != EEXIST) {
         asp_cloud_destroy(cloud);
         asp_mesh_destroy(mesh);
         asp_error_set(&err, ASP_EIO, "cannot create directory '%s': %s", dir, strerror(errno));
@@ -282,6 +306,8 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
     cli_progress_end(env);
     if (rc) {
         asp_eval_result_destroy(res);
+        if (created)
+            remove_directory(dir);
         return cli_fail(env, &err);
     }
     if (env->json) {

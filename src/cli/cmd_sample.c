@@ -2,7 +2,9 @@
  * amgsplat sample: turn a triangle mesh into a point set (vertices as in
  * QSplat, area-stratified samples, or the voxel sampler of Schwarz 2004 3.1).
  */
+#include <math.h>
 #include <stdio.h>
+#include <unistd.h>
 
 #include "cli/cli.h"
 #include "cli/commands.h"
@@ -21,6 +23,48 @@ static const char usage[] =
     "The points come out y-up, as render shows them by default. The file's own\n"
     "coordinates are taken as y-up for every format (3DS too: assimp's z-up turn is\n"
     "undone); --up z (or x, -y ...) names the file's up axis for files that differ.";
+
+/*
+ * Memory per voxel sample: two 16-byte cell hits while sorting plus the
+ * cloud's position, normal, radius and colour (about 32 bytes), rounded up.
+ */
+#define VOXEL_BYTES_PER_POINT 64.0
+
+/*
+ * --grid is bounded by what the machine can hold (issue #13: --grid 10000 on
+ * a 4-triangle mesh took 6.4 GB). The estimate is a lower bound: a surface
+ * of area A crosses at least A / h^2 cells of side h = 2 D / n, D the largest
+ * distance of a vertex from the mean vertex per axis (the library's cube,
+ * Schwarz 2004 3.1.1). Refused when it needs more than half the memory free
+ * now, or more points than a cloud can index.
+ */
+static int check_voxel_grid(const struct cli_env *env, const char *path, const asp_mesh *m, size_t grid)
+{
+    double mean[3] = {0, 0, 0}, dmax = 0;
+    for (size_t v = 0; v < m->vertex_count; v++)
+        for (int a = 0; a < 3; a++)
+            mean[a] += m->positions[3 * v + a];
+    for (int a = 0; a < 3; a++)
+        mean[a] /= (double)(m->vertex_count ? m->vertex_count : 1);
+    for (size_t v = 0; v < m->vertex_count; v++)
+        for (int a = 0; a < 3; a++)
+            dmax = fmax(dmax, fabs(m->positions[3 * v + a] - mean[a]));
+    if (!(dmax > 0))
+        return 0; // the library names the degenerate mesh
+    double h = 2 * dmax / (double)grid, points = asp_mesh_area(m) / (h * h), bytes = points * VOXEL_BYTES_PER_POINT;
+    long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    double avail = pages > 0 && page > 0 ? (double)pages * (double)page : INFINITY;
+    if (points >= 4294967295.0 || bytes > 0.5 * avail) {
+        asp_error e = {0};
+        asp_error_set(&e, ASP_EINVAL,
+                      "--grid %zu on '%s' makes at least %.3g points needing %.3g GB; this machine has %.3g GB free "
+                      "(at most half used, and fewer than 2^32 points); try --grid %.0f or less",
+                      grid, path, points, bytes / 1e9, avail / 1e9,
+                      floor((double)grid * sqrt(fmin(4294967294.0, 0.5 * avail / VOXEL_BYTES_PER_POINT) / points)));
+        return cli_fail(env, &e);
+    }
+    return 0;
+}
 
 int cmd_sample(int argc, char **argv, struct cli_env *env)
 {
@@ -57,7 +101,12 @@ int cmd_sample(int argc, char **argv, struct cli_env *env)
     if (grid < 1 || grid > (1u << 20))
         return cli_usage_error(env, "--grid must be 1 to 1048576, got %zu", grid);
     if (!(radius_scale > 0.0) || radius_scale > 1e6)
-        return cli_usage_error(env, "--radius-scale must be positive, got %g", radius_scale);
+        return cli_usage_error(env, "--radius-scale expects a value in (0, 1e6], got %g", radius_scale);
+    {
+        const char *const inputs[] = {argv[0], texture};
+        if (cli_check_output(env, output, NULL, 0, inputs, 2))
+            return 2;
+    }
 
     asp_up_axis up_axis = ASP_UP_Y;
     if (up && cli_parse_up(up, &up_axis) != 0)
@@ -69,6 +118,10 @@ int cmd_sample(int argc, char **argv, struct cli_env *env)
                       &err))
         return cli_fail(env, &err);
     double t_load = asp_time_now() - t0;
+    if (method == ASP_SAMPLE_VOXEL && (rc = check_voxel_grid(env, argv[0], mesh, grid)) != 0) {
+        asp_mesh_destroy(mesh);
+        return rc;
+    }
     asp_sample_desc desc = {.method = method, .points = points, .grid = (uint32_t)grid, .seed = seed,
                             .radius_scale = (float)radius_scale, .with_uvs = uvs, .with_labels = labels};
     asp_cloud *cloud = NULL;

@@ -4,15 +4,25 @@
  */
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "cli/cli.h"
 #include "util/banned.h"
 
 static int progress_cb(void *user, const char *stage, double fraction);
+
+/* The library's warnings (asp_warn) as one line each, unless --quiet. */
+static void warning_cb(void *user, const char *message)
+{
+    struct cli_env *env = user;
+    if (!env->quiet)
+        fprintf(stderr, "amgsplat %s: warning: %s\n", env->cmd, message);
+}
 
 static const char *type_arg(const struct cli_option *o)
 {
@@ -75,8 +85,8 @@ static int set_value(struct cli_env *env, const struct cli_option *o, const char
     }
     case CLI_DOUBLE: {
         double d = strtod(v, &end);
-        if (errno || end == v || *end || d != d)
-            return cli_usage_error(env, "--%s expects a number, got '%s'", o->name, v);
+        if (errno || end == v || *end || !isfinite(d))
+            return cli_usage_error(env, "--%s expects a finite number, got '%s'", o->name, v);
         *(double *)o->value = d;
         return 0;
     }
@@ -129,8 +139,10 @@ int cli_parse(int argc, char **argv, const struct cli_option *opts, const char *
                 const char *v = inline_value ? inline_value : (i + 1 < argc ? argv[++i] : NULL);
                 char *end;
                 long t = v ? strtol(v, &end, 10) : -1;
-                if (!v || *end || t < 0 || t > 4096)
-                    return cli_usage_error(env, "--threads expects a count from 0 to 4096"), -1;
+                if (!v || end == v || *end || t < 0 || t > 4096)
+                    return cli_usage_error(env, "--threads expects a count from 0 (all cores) to 4096, got '%s'",
+                                           v ? v : "(nothing)"),
+                           -1;
                 env->threads = (int)t;
                 continue;
             }
@@ -166,6 +178,8 @@ int cli_parse(int argc, char **argv, const struct cli_option *opts, const char *
     }
     *npos = n;
     env->ctx.threads = env->threads;
+    env->ctx.warning = warning_cb;
+    env->ctx.warning_user = env;
     if (!env->quiet && isatty(STDERR_FILENO)) {
         env->ctx.progress = progress_cb;
         env->ctx.progress_user = env;
@@ -305,4 +319,27 @@ void cli_json_string(FILE *fp, const char *s)
             fputc(c, fp);
     }
     fputc('"', fp);
+}
+
+int cli_check_output(const struct cli_env *env, const char *output, const char *format, int allow_bare,
+                     const char *const *inputs, size_t ninputs)
+{
+    struct stat so;
+    if (output && stat(output, &so) == 0)
+        for (size_t i = 0; i < ninputs; i++) {
+            struct stat si;
+            if (inputs[i] && stat(inputs[i], &si) == 0 && si.st_dev == so.st_dev && si.st_ino == so.st_ino)
+                return cli_usage_error(env, "output '%s' is the input '%s'; write to another file", output,
+                                       inputs[i]);
+        }
+    if (!output || !format)
+        return 0;
+    const char *slash = strrchr(output, '/'), *dot = strrchr(output, '.');
+    int bare = !dot || (slash && dot < slash) || dot == (slash ? slash + 1 : output);
+    if (bare && allow_bare)
+        return 0;
+    if (!asp_file_name_is(output, format))
+        return cli_usage_error(env, "output '%s': this command writes .%s, not %s%s%s", output, format,
+                               bare ? "a name without extension" : "'", bare ? "" : dot, bare ? "" : "'");
+    return 0;
 }

@@ -3,6 +3,8 @@
  * Allocations are 64-byte aligned (STYLE.md section 6) so every array can be
  * bound as a GL buffer or read with aligned SIMD loads.
  */
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -76,6 +78,18 @@ int asp_progress(const asp_context *ctx, const char *stage, double fraction)
     if (ctx && ctx->progress && ctx->progress(ctx->progress_user, stage, fraction))
         return ASP_ECANCELED;
     return 0;
+}
+
+void asp_warn(const asp_context *ctx, const char *fmt, ...)
+{
+    if (!ctx || !ctx->warning)
+        return;
+    char msg[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    ctx->warning(ctx->warning_user, msg);
 }
 
 double asp_time_now(void)

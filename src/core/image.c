@@ -14,6 +14,8 @@
 
 #include "amgsplat/image.h"
 #include "util/atomic_file.h"
+#include "util/image_header.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 /* 16k x 16k RGBA is 1 GiB: anything larger is a lying header or a mistake. */
@@ -52,13 +54,15 @@ void asp_image_fill(asp_image *img, const uint8_t rgba[4])
 int asp_image_load(asp_image *img, const char *path, asp_error *err)
 {
     ASP_ASSERT(img && path);
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = asp__regular_file_open(path, err);
     if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+        return ASP_EIO;
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_file(fp, &w, &h, &comp)) {
+        char why[160];
+        asp__image_problem(fp, stbi_failure_reason(), ASP_IMAGE_MAX_SIDE, why, sizeof why);
         fclose(fp);
-        return asp_error_set(err, ASP_EFORMAT, "cannot read image '%s': %s", path, stbi_failure_reason());
+        return asp_error_set(err, ASP_EFORMAT, "cannot read image '%s': %s", path, why);
     }
     if (w <= 0 || h <= 0 || w > ASP_IMAGE_MAX_SIDE || h > ASP_IMAGE_MAX_SIDE) {
         fclose(fp);
@@ -66,9 +70,13 @@ int asp_image_load(asp_image *img, const char *path, asp_error *err)
                              ASP_IMAGE_MAX_SIDE);
     }
     unsigned char *data = stbi_load_from_file(fp, &w, &h, &comp, 4);
+    if (!data) {
+        char why[160];
+        asp__image_problem(fp, stbi_failure_reason(), ASP_IMAGE_MAX_SIDE, why, sizeof why);
+        fclose(fp);
+        return asp_error_set(err, ASP_EFORMAT, "cannot decode image '%s': %s", path, why);
+    }
     fclose(fp);
-    if (!data)
-        return asp_error_set(err, ASP_EFORMAT, "cannot decode image '%s': %s", path, stbi_failure_reason());
     memset(img, 0, sizeof *img);
     img->pixels = malloc((size_t)w * h * 4);
     if (!img->pixels) {

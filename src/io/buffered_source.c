@@ -9,6 +9,7 @@
 #include <sys/types.h>
 
 #include "io/buffered_source.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 enum { WINDOW_BYTES = 4 << 20 };
@@ -51,9 +52,9 @@ int asp__src_open_file(asp__src *s, const char *path, const asp_context *ctx, as
     memset(s, 0, sizeof *s);
     s->ctx = ctx;
     s->name = path;
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = asp__regular_file_open(path, err);
     if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+        return ASP_EIO;
     off_t size = -1;
     if (fseeko(fp, 0, SEEK_END) == 0) {
         size = ftello(fp);
@@ -134,18 +135,34 @@ size_t asp__src_fill(asp__src *s, size_t n)
     return s->len - s->pos;
 }
 
+/* The first '\n', or with cr the first '\n' or '\r', in p[0..n). */
+static const uint8_t *find_eol(const uint8_t *p, size_t n, int cr)
+{
+    if (!cr)
+        return memchr(p, '\n', n);
+    for (size_t i = 0; i < n; i++)
+        if (p[i] == '\n' || p[i] == '\r')
+            return p + i;
+    return NULL;
+}
+
 int asp__src_line(asp__src *s, size_t max_len, const char **line, size_t *len)
 {
     size_t scanned = 0;
     for (;;) {
         size_t avail = s->len - s->pos;
         const uint8_t *p = s->data + s->pos;
-        const uint8_t *nl = avail > scanned ? memchr(p + scanned, '\n', avail - scanned) : NULL;
+        const uint8_t *nl = avail > scanned ? find_eol(p + scanned, avail - scanned, s->cr_lines) : NULL;
+        // a CR last in the window may be the first half of a CRLF: read on before deciding
+        int split_crlf = nl && *nl == '\r' && nl + 1 == p + avail && s->fp && asp__src_remaining(s) > avail;
+        if (split_crlf)
+            nl = NULL;
         if (nl || (!s->fp && avail > 0) || avail > max_len) {
             size_t n = nl ? (size_t)(nl - p) : avail;
             if (n > max_len)
                 return -1;
-            s->pos += nl ? n + 1 : n;
+            size_t eol = !nl ? 0 : (*nl == '\r' && n + 1 < avail && nl[1] == '\n') ? 2 : 1;
+            s->pos += n + eol;
             if (n > 0 && p[n - 1] == '\r')
                 n--;
             *line = (const char *)p;
@@ -154,7 +171,7 @@ int asp__src_line(asp__src *s, size_t max_len, const char **line, size_t *len)
         }
         if (!s->fp)
             return s->io_errno || s->nomem ? -2 : 0;
-        scanned = avail;
+        scanned = split_crlf ? avail - 1 : avail;
         size_t want = avail + 65536;
         uint64_t rem = asp__src_remaining(s);
         if (want > rem)

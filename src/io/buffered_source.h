@@ -21,6 +21,7 @@ typedef struct asp__src {
     uint64_t size;        /* total input size in bytes */
     int io_errno;         /* errno of a failed read, else 0 */
     int nomem;            /* a window could not grow */
+    int cr_lines;         /* asp__src_line also ends a line at a lone CR (old Mac text; set by the text readers) */
     const asp_context *ctx;
     const char *name;     /* for messages */
 } asp__src;

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "amgsplat/io.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 enum { HEAD_BYTES = 4096 }; /* a PLY header's element lines fit in far less */
@@ -82,7 +83,7 @@ static void fill(asp_file_type *out, asp_file_kind kind, const char *format, int
 }
 
 /*
- * A PLY header (within the bytes given) declaring a face element with a
+ * A PLY header (within the bytes given) declaring a face (or tristrips) element with a
  * non-zero count makes a mesh. A header longer than the bytes read is taken
  * as points: its vertex element comes first in every exporter we know.
  */
@@ -96,11 +97,13 @@ static int ply_has_faces(const char *h, size_t n)
         size_t len = e - i;
         if (len >= 10 && memcmp(h + i, "end_header", 10) == 0)
             return 0;
-        if (len > 13 && memcmp(h + i, "element face ", 13) == 0) {
-            for (size_t k = i + 13; k < e; k++)
+        size_t skip = len > 13 && memcmp(h + i, "element face ", 13) == 0         ? 13
+                      : len > 18 && memcmp(h + i, "element tristrips ", 18) == 0 ? 18
+                                                                                  : 0;
+        if (skip) {
+            for (size_t k = i + skip; k < e; k++)
                 if (h[k] >= '1' && h[k] <= '9')
                     return 1;
-            return 0;
         }
         i = e + 1;
     }
@@ -182,7 +185,9 @@ int asp_file_recognise_memory(const void *head, size_t size, const char *name, a
 
 int asp_file_recognise(const char *path, asp_file_type *out, asp_error *err)
 {
-    // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it
+    if (asp__regular_file_check(path, err))
+        return ASP_EIO;
+    // O_NONBLOCK still: a FIFO swapped in after the check must not wait for a writer; fstat then refuses it
     int fd = open(path, O_RDONLY | O_NONBLOCK);
     if (fd < 0)
         return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));

@@ -9,6 +9,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <assimp/cimport.h>
 #include <assimp/material.h>
@@ -18,6 +20,8 @@
 
 #include "amgsplat/io.h"
 #include "amgsplat/mesh.h"
+#include "io/mesh_precheck.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 enum { MAX_NODE_DEPTH = 256 };
@@ -268,13 +272,14 @@ static int load_embedded(const struct aiScene *scene, const char *ref, const cha
     return 0;
 }
 
+/*
+ * Whether something exists at p: a FIFO or directory named by map_Kd counts,
+ * so asp_image_load then refuses it by name instead of "No such file".
+ */
 static int readable(const char *p)
 {
-    FILE *fp = fopen(p, "rb");
-    if (!fp)
-        return 0;
-    fclose(fp);
-    return 1;
+    struct stat st;
+    return stat(p, &st) == 0;
 }
 
 /* Texture references are relative to the model file; exporters often write Windows separators or stale folders. */
@@ -313,8 +318,6 @@ static int resolve_texture(const char *model, const char *ref, char *out, size_t
 static int load_override(const char *override, const char *material, asp_material *mat, asp_error *err)
 {
     asp_error e = {0};
-    if (!readable(override))
-        return asp_error_set(err, ASP_EIO, "cannot open texture '%s': %s", override, strerror(errno));
     int rc = asp_image_load(&mat->texture, override, &e);
     if (rc)
         return asp_error_set(err, rc, "%s (texture for material '%s')", e.msg, material);
@@ -551,13 +554,72 @@ static int refuse_non_mesh(const char *path, const asp_file_type *t, asp_error *
                          t->kind == ASP_FILE_IMAGE ? "an" : "a", asp_file_kind_name(t->kind), t->format);
 }
 
+/* Whether the PLY header at path declares a tristrips element (read up to end_header, at most 64 KB). */
+static int ply_has_strips(const char *path)
+{
+    FILE *fp = asp__regular_file_open(path, NULL);
+    if (!fp)
+        return 0;
+    char line[512];
+    int found = 0;
+    for (int n = 0; n < 1024 && fgets(line, sizeof line, fp); n++) {
+        if (strncmp(line, "end_header", 10) == 0)
+            break;
+        if (strncmp(line, "element tristrips ", 18) == 0)
+            found = 1;
+    }
+    fclose(fp);
+    return found;
+}
+
+/*
+ * PLY meshes go through amgsplat's own reader first (issue #13): it checks
+ * the declared counts against the file size before allocating, every face
+ * index against the vertex count, and truncated bodies, so assimp never
+ * allocates for a lying header (10^12 vertices: std::bad_alloc) nor samples
+ * an out-of-range face. Triangle strips, which assimp reads as one triangle,
+ * are written out as triangles to *tmp_path for assimp to read instead.
+ */
+static int ply_precheck(const char *path, const asp_context *ctx, char *tmp_path, size_t cap, asp_error *err)
+{
+    tmp_path[0] = '\0';
+    asp_cloud *c = NULL;
+    int rc = asp_ply_read(path, ctx, &c, err);
+    if (rc)
+        return rc;
+    if (c->face_count == 0) {
+        asp_cloud_destroy(c);
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': its face elements hold no triangles", path);
+    }
+    if (ply_has_strips(path)) {
+        const char *dir = getenv("TMPDIR");
+        snprintf(tmp_path, cap, "%s/amgsplat-strips-XXXXXX", dir && *dir ? dir : "/tmp");
+        int fd = mkstemp(tmp_path);
+        if (fd < 0) {
+            asp_cloud_destroy(c);
+            tmp_path[0] = '\0';
+            return asp_error_set(err, ASP_EIO, "cannot read '%s': no temporary file for its triangle strips: %s", path,
+                                 strerror(errno));
+        }
+        close(fd);
+        // the writer renames over the name: a .ply suffix is not needed, assimp reads the magic
+        rc = asp_ply_write(c, tmp_path, NULL, err);
+        if (rc) {
+            unlink(tmp_path);
+            tmp_path[0] = '\0';
+        }
+    }
+    asp_cloud_destroy(c);
+    return rc;
+}
+
 int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_context *ctx, asp_mesh **out,
                   asp_error *err)
 {
     asp_mesh_load_desc d = desc ? *desc : (asp_mesh_load_desc){0};
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = asp__regular_file_open(path, err);
     if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+        return ASP_EIO;
     fclose(fp);
     /* unknown extensions go on to assimp, which reads more formats than the recogniser names */
     asp_file_type type = {.kind = ASP_FILE_MESH};
@@ -574,7 +636,14 @@ int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_co
      */
     unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
                      aiProcess_ValidateDataStructure;
-    const struct aiScene *scene = aiImportFile(path, flags);
+    char tmp_path[4096] = "";
+    if (rc == 0 && strcmp(type.format, "ply") == 0 && (rc = ply_precheck(path, ctx, tmp_path, sizeof tmp_path, err)))
+        return rc;
+    if (rc == 0 && (rc = asp__mesh_precheck(path, type.format, ctx, err)))
+        return rc;
+    const struct aiScene *scene = aiImportFile(tmp_path[0] ? tmp_path : path, flags);
+    if (tmp_path[0])
+        unlink(tmp_path);
     if (!scene) {
         const char *why = aiGetErrorString();
         return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': %s", path, why && *why ? why : "unknown format");

@@ -18,7 +18,7 @@
 #include "util/banned.h"
 
 enum { ENC_ASCII, ENC_LE, ENC_BE };
-enum { D_SKIP, D_POS, D_NORMAL, D_COLOR, D_RADIUS, D_UV, D_LABEL, D_EXTRA, D_FACE };
+enum { D_SKIP, D_POS, D_NORMAL, D_COLOR, D_RADIUS, D_UV, D_LABEL, D_EXTRA, D_FACE, D_STRIP };
 enum { NAME_MAX_LEN = 63, HEADER_LINE_MAX = 1 << 16, BODY_LINE_MAX = 1 << 24, CHUNK_RECORDS = 1 << 14 };
 
 typedef struct ply_prop {
@@ -364,6 +364,17 @@ static int read_header(reader *r)
             if (!seen_format)
                 return FAIL_LINE(r, r->line, "no 'format' line before 'end_header'");
             return 0;
+        } else if (r->nelems == 0) {
+            /*
+             * Blender 2.4x writes "Created by Blender ..." without 'comment'.
+             * Before the first element such a line cannot shift any column,
+             * so it is kept as a comment, with a warning; among properties a
+             * misspelt 'property' would, so there it stays an error.
+             */
+            char buf[40];
+            asp_warn(r->ctx, "'%s': line %zu: header line starting '%s' has no 'comment' keyword; kept as a comment",
+                     r->name, r->line, excerpt(buf, kw, kl));
+            rc = add_note(r, 'c', kw);
         } else {
             char buf[40];
             rc = FAIL_LINE(r, r->line, "unknown header keyword '%s'", excerpt(buf, kw, kl));
@@ -457,16 +468,21 @@ static int map_vertex(reader *r, unsigned *attrs)
     return 0;
 }
 
+/*
+ * Faces come as polygons ("face", fan-triangulated) or as triangle strips
+ * ("tristrips", a scanner export; -1 restarts a strip). Taking a strip for
+ * one polygon would sample a fan of the wrong triangles (issue #13).
+ */
 static void map_other(ply_element *e)
 {
-    int is_face = strcmp(e->name, "face") == 0;
+    int kind = strcmp(e->name, "face") == 0 ? D_FACE : strcmp(e->name, "tristrips") == 0 ? D_STRIP : D_SKIP;
     for (size_t i = 0; i < e->nprops; i++) {
         ply_prop *p = &e->props[i];
         p->dest = D_SKIP;
-        if (is_face && p->count_type && asp__scalar_is_int(p->type) &&
+        if (kind != D_SKIP && p->count_type && asp__scalar_is_int(p->type) &&
             (strcmp(p->name, "vertex_indices") == 0 || strcmp(p->name, "vertex_index") == 0)) {
-            p->dest = D_FACE;
-            is_face = 0; /* only the first index list */
+            p->dest = kind;
+            kind = D_SKIP; /* only the first index list */
         }
     }
 }
@@ -628,10 +644,16 @@ static int add_triangle(reader *r, uint32_t a, uint32_t b, uint32_t c)
     return 0;
 }
 
-/* Fan triangulation state for one polygon (first vertex, previous vertex, items seen). */
+/*
+ * Triangulation state for one polygon (a fan from its first vertex) or one
+ * triangle strip (each vertex with the two before it, every second triangle
+ * turned round so all keep the strip's winding; repeated vertices make the
+ * zero-area joins between strips and are dropped).
+ */
 typedef struct fan {
     uint32_t first, prev;
     uint64_t seen;
+    int strip;
 } fan;
 
 static int fan_push(reader *r, fan *f, uint32_t idx)
@@ -639,8 +661,12 @@ static int fan_push(reader *r, fan *f, uint32_t idx)
     int rc = 0;
     if (f->seen == 0)
         f->first = idx;
-    else if (f->seen >= 2)
+    else if (f->seen >= 2 && !f->strip)
         rc = add_triangle(r, f->first, f->prev, idx);
+    else if (f->seen >= 2 && f->first != f->prev && f->prev != idx && f->first != idx)
+        rc = (f->seen & 1) ? add_triangle(r, f->prev, f->first, idx) : add_triangle(r, f->first, f->prev, idx);
+    if (f->strip && f->seen >= 1)
+        f->first = f->prev;
     f->prev = idx;
     f->seen++;
     return rc;
@@ -794,14 +820,18 @@ static int bin_list(reader *r, const ply_element *e, uint64_t index, const ply_p
     if (bytes > asp__src_remaining(&r->src))
         return fail_bin(r, e, index, at, "list '%s' declares %.0f items, but only %llu bytes remain", p->name, n,
                         (unsigned long long)asp__src_remaining(&r->src));
-    if (p->dest != D_FACE)
+    if (p->dest != D_FACE && p->dest != D_STRIP)
         return bin_skip(r, e, index, bytes);
-    fan f = {0, 0, 0};
+    fan f = {0, 0, 0, p->dest == D_STRIP};
     for (uint64_t k = 0; k < (uint64_t)n; k++) {
         at = asp__src_offset(&r->src);
         if ((rc = bin_scalar(r, e, index, p->type, raw)))
             return rc;
         double v = asp__scalar_load(raw, p->type);
+        if (v == -1 && f.strip) {
+            f = (fan){0, 0, 0, 1}; // -1 ends one strip and starts the next
+            continue;
+        }
         if (v < 0 || v >= (double)r->cloud->count)
             return fail_bin(r, e, index, at, "vertex index %.0f is not below the vertex count %zu", v,
                             r->cloud->count);
@@ -937,13 +967,17 @@ static int read_element_ascii(reader *r, ply_element *e)
                 double n = asp__scalar_load(raw, q->count_type);
                 if (n < 0)
                     return FAIL_LINE(r, r->line, "list '%s' has negative count %.0f", q->name, n);
-                fan f = {0, 0, 0};
+                fan f = {0, 0, 0, q->dest == D_STRIP};
                 for (double k = 0; k < n; k++) {
                     if ((rc = ascii_value(r, e, &p, q->type, q->name, used++, raw)))
                         return rc;
-                    if (q->dest != D_FACE)
+                    if (q->dest != D_FACE && q->dest != D_STRIP)
                         continue;
                     double v = asp__scalar_load(raw, q->type);
+                    if (v == -1 && f.strip) {
+                        f = (fan){0, 0, 0, 1}; // -1 ends one strip and starts the next
+                        continue;
+                    }
                     if (v < 0 || v >= (double)r->cloud->count)
                         return FAIL_LINE(r, r->line, "vertex index %.0f is not below the vertex count %zu", v,
                                          r->cloud->count);

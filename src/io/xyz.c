@@ -5,6 +5,7 @@
  * the pipeline (journal Sect. 1, Fig. 2). The column count of the first data line decides the layout.
  */
 #include <ctype.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -30,6 +31,8 @@ typedef struct text_reader {
     size_t not_byte_line, not_unit_line;
     double not_byte_value, not_unit_value;
     int all_unit_triples; /* six columns: every last triple is (1,0,0), (0,1,0) or (0,0,1) */
+    double declared;      /* the leading point count (.pts), -1 when there is none */
+    size_t declared_line;
 } text_reader;
 
 static int fail(text_reader *t, size_t line, const char *what, double v)
@@ -70,6 +73,18 @@ static void colour_evidence(text_reader *t, const double *c, size_t line)
         t->all_unit_triples = 0;
 }
 
+/*
+ * A .pts count that disagrees with the points that follow means a cut-off
+ * or mislabelled file; both numbers go in the message (issue #13).
+ */
+static int check_declared(const text_reader *t)
+{
+    if (t->declared < 0 || t->declared == (double)t->rows)
+        return 0;
+    return asp_error_set(t->err, ASP_EFORMAT, "cannot read '%s': line %zu declares %.0f points, but %zu follow",
+                         t->name, t->declared_line, t->declared, t->rows);
+}
+
 static int parse_lines(text_reader *t)
 {
     size_t lineno = 0;
@@ -80,7 +95,7 @@ static int parse_lines(text_reader *t)
         int got = asp__src_line(&t->src, LINE_MAX_BYTES, &raw, &len);
         lineno++;
         if (got == 0)
-            return 0;
+            return check_declared(t);
         if (got == -1)
             return asp_error_set(t->err, ASP_EFORMAT, "cannot read '%s': line %zu: longer than %d bytes", t->name,
                                  lineno, LINE_MAX_BYTES);
@@ -111,6 +126,8 @@ static int parse_lines(text_reader *t)
             continue; /* only separators */
         if (first && n == 1 && v[0] >= 0 && v[0] == floor(v[0])) {
             first = 0; /* a point count, as .pts files start with */
+            t->declared = v[0];
+            t->declared_line = lineno;
             continue;
         }
         first = 0;
@@ -125,10 +142,17 @@ static int parse_lines(text_reader *t)
                                  t->name, lineno, t->cols, n > MAX_COLS ? "more than " : "",
                                  n > MAX_COLS ? MAX_COLS : n);
         }
-        for (int k = 0; k < 3; k++)
+        for (int k = 0; k < 3; k++) {
             if (!isfinite(v[k]))
                 return asp_error_set(t->err, ASP_EFORMAT, "cannot read '%s': line %zu: coordinate %c is %s",
                                      t->name, lineno, "xyz"[k], isnan(v[k]) ? "NaN" : "infinite");
+            // positions are float offsets: a value past FLT_MAX would become infinite (found by fuzz_xyz)
+            if (fabs(v[k]) > FLT_MAX)
+                return asp_error_set(t->err, ASP_EFORMAT,
+                                     "cannot read '%s': line %zu: coordinate %c %.9g is outside the float range "
+                                     "(magnitude at most %.9g)",
+                                     t->name, lineno, "xyz"[k], v[k], (double)FLT_MAX);
+        }
         if (t->cols >= 6)
             colour_evidence(t, v + t->cols - 3, lineno);
         if ((rc = push_row(t, v)))
@@ -205,6 +229,8 @@ static int build_cloud(text_reader *t, asp_cloud **out)
 static int read_text(text_reader *t, asp_cloud **out)
 {
     int rc = 0;
+    t->declared = -1;
+    t->src.cr_lines = 1; // CR, LF and CRLF all end a line: a CR-only file is not one point (issue #13)
     t->all_unit_triples = 1;
     t->line = asp_alloc(t->ctx, LINE_MAX_BYTES + 1);
     if (!t->line)

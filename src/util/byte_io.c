@@ -10,6 +10,7 @@
 #include <sys/types.h>
 
 #include "util/byte_io.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 void asp__put_u32(asp__crc_writer *w, uint32_t v)
@@ -106,15 +107,9 @@ double asp__get_f64(asp__byte_reader *r)
 int asp__byte_slurp(const char *path, const asp_context *ctx, uint8_t **buf, size_t *size, asp_error *err)
 {
     // checked before opening: fopen blocks on a FIFO until a writer comes, and a directory opens on Linux
-    struct stat st;
-    if (stat(path, &st) != 0)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
-    if (!S_ISREG(st.st_mode))
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path,
-                             S_ISDIR(st.st_mode) ? "is a directory, expected a file" : "not a regular file");
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = asp__regular_file_open(path, err);
     if (!fp)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+        return ASP_EIO;
     off_t end = -1;
     if (fseeko(fp, 0, SEEK_END) == 0)
         end = ftello(fp);

@@ -86,7 +86,7 @@ expect_fail 1 "$T/nodir/x.ply" "$AMGSPLAT" estimate "$T/scan.xyz" -o "$T/nodir/x
 expect_fail 2 "missing -o" "$AMGSPLAT" estimate "$T/scan.xyz"
 expect_fail 2 "expected one input" "$AMGSPLAT" estimate -o "$T/x.ply"
 expect_fail 2 "--orient-to expects x,y,z" "$AMGSPLAT" estimate "$T/scan.xyz" -o "$T/x.ply" --orient-to 1,2
-expect_fail 2 "at least 1" "$AMGSPLAT" estimate "$T/scan.xyz" -o "$T/x.ply" --k 0
+expect_fail 2 "--k expects 1..1024, got 0" "$AMGSPLAT" estimate "$T/scan.xyz" -o "$T/x.ply" --k 0
 expect_fail 2 "--radius-factor" "$AMGSPLAT" estimate "$T/scan.xyz" -o "$T/x.ply" --radius-factor -1
 expect_fail 2 "--keep-orientation needs normals" "$AMGSPLAT" estimate "$T/scan.xyz" -o "$T/x.ply" --force --keep-orientation
 [[ ! -e "$T/x.ply" ]] || fail "failed runs left an output"

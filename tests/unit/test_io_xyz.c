@@ -157,7 +157,11 @@ static void test_errors_name_the_line(void)
         {"1 2 3\n1 inf 3\n", "line 2: coordinate y is infinite"},
         {"0 0 0 1 2 3 0.5 0.5 2\n", "line 1: colour values must be integers 0..255 or all in 0..1, got 0.5"},
         {"", "no points in the file"},
-        {"12\n", "no points in the file"},
+        {"12\n", "line 1 declares 12 points, but 0 follow"},
+        {"1 1 1\n0 1 1\n1 1 1.7e74\n", "line 3: coordinate z 1.7e+74 is outside the float range"},
+        {"10\n0 0 0\n1 0 0\n0 1 0\n", "line 1 declares 10 points, but 3 follow"},
+        {"1000000000000\n0 0 0\n1 0 0\n0 1 0\n", "line 1 declares 1000000000000 points, but 3 follow"},
+        {"# c\n\n2\n0 0 0\n", "line 3 declares 2 points, but 1 follow"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         asp_cloud *c = NULL;
@@ -170,6 +174,45 @@ static void test_errors_name_the_line(void)
     }
 }
 
-TEST_MAIN(TEST_CASE(test_three_columns_comments_count_crlf), TEST_CASE(test_six_columns_normals_or_colours),
+/*
+ * CR-only (old Mac), LF and CRLF line ends, alone and mixed, from memory and
+ * from a file long enough that a CRLF falls across the reader's 64 KB window
+ * (issue #13: a CR-only file loaded as one point).
+ */
+static void test_cr_lf_crlf_line_ends(void)
+{
+    static const char *const eols[] = {"\r", "\n", "\r\n"};
+    for (int k = 0; k < 3; k++) {
+        char text[128];
+        snprintf(text, sizeof text, "3%s1 2 3%s4 5 6%s7 8 9%s", eols[k], eols[k], eols[k], eols[k]);
+        asp_cloud *c = parse(text);
+        CHECK_MSG(c && c->count == 3 && c->positions[8] == 9.0f, "line end %d: %zu points", k, c ? c->count : 0);
+        asp_cloud_destroy(c);
+    }
+    asp_cloud *c = parse("1 2 3\r4 5 6\n7 8 9\r\n10 11 12");
+    CHECK(c && c->count == 4 && c->positions[11] == 12.0f);
+    asp_cloud_destroy(c);
+    char path[64];
+    snprintf(path, sizeof path, "/tmp/asp_test_cr_%d.xyz", (int)getpid());
+    for (int k = 0; k < 3; k++) {
+        FILE *f = fopen(path, "wb");
+        CHECK(f != NULL);
+        if (!f)
+            return;
+        const size_t n = 50000; // about 1 MB: many window refills, some splitting a CRLF
+        for (size_t i = 0; i < n; i++)
+            fprintf(f, "%zu 0.125 %zu%s", i, i % 7, eols[k]);
+        fclose(f);
+        asp_cloud *d = NULL;
+        asp_error e = {0}, *err = &e;
+        CHECK_OK(asp_xyz_read(path, NULL, &d, err), err);
+        CHECK_MSG(d && d->count == n && d->positions[3 * (n - 1)] == (float)(n - 1) - (float)d->origin[0],
+                  "line end %d: %zu points", k, d ? d->count : 0);
+        asp_cloud_destroy(d);
+    }
+    remove(path);
+}
+
+TEST_MAIN(TEST_CASE(test_cr_lf_crlf_line_ends), TEST_CASE(test_three_columns_comments_count_crlf), TEST_CASE(test_six_columns_normals_or_colours),
           TEST_CASE(test_pts_intensity_and_nine_columns), TEST_CASE(test_far_coordinates_get_an_origin),
           TEST_CASE(test_round_trip_through_every_extension), TEST_CASE(test_errors_name_the_line))

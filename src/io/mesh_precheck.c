@@ -1,0 +1,263 @@
+/*
+ * Mesh pre-checks (see mesh_precheck.h). OFF is read line by line (Geomview's
+ * OFF: keyword, "nv nf ne", nv vertex lines, nf face lines "k i1 .. ik [colour]",
+ * '#' comments); binary STL's triangle count must fit its size (80-byte
+ * header, count, 50 bytes a triangle); an OBJ must not end inside a face or
+ * vertex line, the mark of a file cut off.
+ */
+#include <errno.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "io/mesh_precheck.h"
+#include "util/byte_io.h"
+#include "util/regular_file.h"
+#include "util/banned.h"
+
+/* The smallest vertex line "0 0 0\n" and face line "3 0 1 2\n": what the counts must fit in. */
+#define OFF_MIN_VERTEX_BYTES 6
+#define OFF_MIN_FACE_BYTES 8
+
+typedef struct cursor {
+    const char *p, *end;
+    size_t line;
+} cursor;
+
+/* The next line with its comment cut and not blank; 0 at the end of the bytes. */
+static int next_line(cursor *c, const char **s, const char **e)
+{
+    while (c->p < c->end) {
+        const char *b = c->p, *nl = memchr(b, '\n', (size_t)(c->end - b));
+        const char *le = nl ? nl : c->end;
+        c->p = nl ? nl + 1 : c->end;
+        c->line++;
+        const char *hash = memchr(b, '#', (size_t)(le - b));
+        if (hash)
+            le = hash;
+        while (b < le && (*b == ' ' || *b == '\t' || *b == '\r'))
+            b++;
+        while (le > b && (le[-1] == ' ' || le[-1] == '\t' || le[-1] == '\r'))
+            le--;
+        if (b < le) {
+            *s = b, *e = le;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Parses a non-negative integer word at *s (advancing past it and following blanks); -1 if there is none. */
+static long long take_count(const char **s, const char *e)
+{
+    const char *p = *s;
+    long long v = 0;
+    int digits = 0;
+    while (p < e && *p >= '0' && *p <= '9' && digits < 19) {
+        v = 10 * v + (*p++ - '0');
+        digits++;
+    }
+    if (!digits || (p < e && *p != ' ' && *p != '\t'))
+        return -1;
+    while (p < e && (*p == ' ' || *p == '\t'))
+        p++;
+    *s = p;
+    return v;
+}
+
+static int check_off(const char *b, size_t size, const char *name, asp_error *err)
+{
+    cursor c = {b, b + size, 0};
+    const char *s, *e;
+    if (!next_line(&c, &s, &e))
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': empty OFF file", name);
+    const char *kw = s;
+    while (s < e && *s != ' ' && *s != '\t')
+        s++;
+    size_t kl = (size_t)(s - kw);
+    if (kl < 3 || memcmp(kw + kl - 3, "OFF", 3) != 0)
+        return 0; // no keyword: assimp decides what this is
+    for (size_t i = 0; i + 3 < kl; i++)
+        if (kw[i] == '4' || kw[i] == 'n')
+            return 0; // 4OFF / nOFF: other dimensions, left to assimp
+    while (s < e && (*s == ' ' || *s == '\t'))
+        s++;
+    if (e - s >= 6 && memcmp(s, "BINARY", 6) == 0)
+        return 0;
+    if (s == e && !next_line(&c, &s, &e))
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': OFF file ends before its vertex and face counts",
+                             name);
+    size_t count_line = c.line;
+    long long nv = take_count(&s, e), nf = nv < 0 ? -1 : take_count(&s, e);
+    if (nv < 0 || nf < 0)
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu: expected the counts 'vertices faces edges'",
+                             name, count_line);
+    size_t left = (size_t)(c.end - c.p);
+    if ((unsigned long long)nv > left / OFF_MIN_VERTEX_BYTES ||
+        (unsigned long long)nf > (left - (size_t)nv * OFF_MIN_VERTEX_BYTES) / OFF_MIN_FACE_BYTES)
+        return asp_error_set(err, ASP_EFORMAT,
+                             "cannot read '%s': line %zu declares %lld vertices and %lld faces, but only %zu bytes "
+                             "follow (each vertex needs at least %d, each face %d)",
+                             name, count_line, nv, nf, left, OFF_MIN_VERTEX_BYTES, OFF_MIN_FACE_BYTES);
+    if (nv >= UINT32_MAX || nf >= UINT32_MAX)
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': %lld vertices and %lld faces exceed 2^32-1", name,
+                             nv, nf);
+    for (long long v = 0; v < nv; v++)
+        if (!next_line(&c, &s, &e))
+            return asp_error_set(err, ASP_EFORMAT,
+                                 "cannot read '%s': holds %lld of the %lld vertices it declares: the file is cut off",
+                                 name, v, nv);
+    for (long long f = 0; f < nf; f++) {
+        if (!next_line(&c, &s, &e))
+            return asp_error_set(err, ASP_EFORMAT,
+                                 "cannot read '%s': holds %lld of the %lld faces it declares: the file is cut off", name,
+                                 f, nf);
+        long long k = take_count(&s, e);
+        if (k < 0)
+            return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu: face %lld: expected a vertex count",
+                                 name, c.line, f);
+        for (long long i = 0; i < k; i++) {
+            long long idx = take_count(&s, e);
+            if (idx < 0)
+                return asp_error_set(err, ASP_EFORMAT,
+                                     "cannot read '%s': line %zu: face %lld: expected %lld vertex indices", name,
+                                     c.line, f, k);
+            if (idx >= nv)
+                return asp_error_set(err, ASP_EFORMAT,
+                                     "cannot read '%s': line %zu: face %lld references vertex %lld of %lld (indices "
+                                     "0..%lld)",
+                                     name, c.line, f, idx, nv, nv - 1);
+        }
+    }
+    return 0;
+}
+
+static int check_stl(const unsigned char *b, size_t size, const char *name, asp_error *err)
+{
+    if (size >= 5 && memcmp(b, "solid", 5) == 0) {
+        // ASCII STL, unless a binary header happens to start with "solid": then "facet" is absent early on
+        size_t look = size < 1024 ? size : 1024;
+        for (size_t i = 0; i + 5 <= look; i++)
+            if (memcmp(b + i, "facet", 5) == 0)
+                return 0;
+    }
+    if (size < 84)
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': %zu bytes, too short for binary STL (84 at least)",
+                             name, size);
+    uint32_t n = (uint32_t)b[80] | (uint32_t)b[81] << 8 | (uint32_t)b[82] << 16 | (uint32_t)b[83] << 24;
+    if ((uint64_t)n * 50 > size - 84)
+        return asp_error_set(err, ASP_EFORMAT,
+                             "cannot read '%s': binary STL declares %u triangles (%llu bytes), but %zu bytes follow its "
+                             "header",
+                             name, n, (unsigned long long)n * 50, size - 84);
+    return 0;
+}
+
+static int check_obj(const char *b, size_t size, const char *name, asp_error *err)
+{
+    if (size == 0 || b[size - 1] == '\n')
+        return 0;
+    const char *s = b + size;
+    while (s > b && s[-1] != '\n')
+        s--;
+    size_t line = 1;
+    for (const char *p = b; p < s; p++)
+        line += *p == '\n';
+    const char *e = b + size;
+    int face = e - s >= 2 && s[0] == 'f' && (s[1] == ' ' || s[1] == '\t');
+    int vert = e - s >= 2 && s[0] == 'v' && (s[1] == ' ' || s[1] == '\t');
+    if (!face && !vert)
+        return 0;
+    int words = 0;
+    for (const char *p = s + 1; p < e;) {
+        while (p < e && (*p == ' ' || *p == '\t' || *p == '\r'))
+            p++;
+        if (p < e)
+            words++;
+        while (p < e && *p != ' ' && *p != '\t' && *p != '\r')
+            p++;
+    }
+    if (words >= 3)
+        return 0;
+    return asp_error_set(err, ASP_EFORMAT,
+                         "cannot read '%s': line %zu: the file ends inside a %s line ('%.*s'): it is cut off", name,
+                         line, face ? "face" : "vertex", (int)(e - s < 40 ? e - s : 40), s);
+}
+
+int asp__mesh_precheck_memory(const void *data, size_t size, const char *name, const char *format, asp_error *err)
+{
+    if (strcmp(format, "off") == 0)
+        return check_off(data, size, name, err);
+    if (strcmp(format, "stl") == 0)
+        return check_stl(data, size, name, err);
+    if (strcmp(format, "obj") == 0)
+        return check_obj(data, size, name, err);
+    return 0;
+}
+
+/* Refuses name (relative to the OBJ's directory) when it exists and is not a regular file. */
+static int check_side_file(const char *obj, const char *name, size_t len, asp_error *err)
+{
+    const char *slash = strrchr(obj, '/');
+    char full[4096];
+    if (len == 0 || len >= 2048)
+        return 0;
+    if (name[0] == '/' || !slash)
+        snprintf(full, sizeof full, "%.*s", (int)len, name);
+    else
+        snprintf(full, sizeof full, "%.*s/%.*s", (int)(slash - obj), obj, (int)len, name);
+    struct stat st;
+    if (stat(full, &st) != 0)
+        return 0; // a missing .mtl is assimp's to report (it carries on without materials)
+    return S_ISREG(st.st_mode) ? 0 : asp__regular_file_check(full, err);
+}
+
+/*
+ * assimp opens an OBJ's material libraries itself, and would block on a
+ * FIFO named by 'mtllib' (issue #13): each one is checked first, as the whole
+ * rest of the line and word by word (assimp's reading of names with spaces).
+ */
+static int check_mtllibs(const char *path, const char *b, size_t size, asp_error *err)
+{
+    cursor c = {b, b + size, 0};
+    const char *s, *e;
+    while (next_line(&c, &s, &e)) {
+        if (e - s < 8 || memcmp(s, "mtllib", 6) != 0 || (s[6] != ' ' && s[6] != '\t'))
+            continue;
+        const char *p = s + 7;
+        while (p < e && (*p == ' ' || *p == '\t'))
+            p++;
+        asp_error why = {0};
+        int rc = check_side_file(path, p, (size_t)(e - p), &why);
+        for (const char *w = p; rc == 0 && w < e;) {
+            const char *we = w;
+            while (we < e && *we != ' ' && *we != '\t')
+                we++;
+            rc = check_side_file(path, w, (size_t)(we - w), &why);
+            w = we;
+            while (w < e && (*w == ' ' || *w == '\t'))
+                w++;
+        }
+        if (rc)
+            return asp_error_set(err, rc, "%s (the material library of '%s', line %zu)", why.msg, path, c.line);
+    }
+    return 0;
+}
+
+int asp__mesh_precheck(const char *path, const char *format, const asp_context *ctx, asp_error *err)
+{
+    if (strcmp(format, "off") != 0 && strcmp(format, "stl") != 0 && strcmp(format, "obj") != 0)
+        return 0;
+    uint8_t *buf = NULL;
+    size_t size = 0;
+    int rc = asp__byte_slurp(path, ctx, &buf, &size, err);
+    if (rc)
+        return rc;
+    rc = asp__mesh_precheck_memory(buf, size, path, format, err);
+    if (rc == 0 && strcmp(format, "obj") == 0)
+        rc = check_mtllibs(path, (const char *)buf, size, err);
+    asp_free(ctx, buf);
+    return rc;
+}

@@ -1,0 +1,22 @@
+/*
+ * What is wrong with an image file that stb_image refuses, told from its
+ * first bytes (issue #13: a 100000x100000 PNG and a text file both got
+ * "unknown image type"). Shared by asp_image_load and asp_image_probe.
+ * Not public API.
+ */
+#ifndef ASP_UTIL_IMAGE_HEADER_H
+#define ASP_UTIL_IMAGE_HEADER_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+/*
+ * Writes a description of why fp (rewound first; its position is left at
+ * the start) is not a decodable image into out: "empty file", "PNG header
+ * says 100000x100000, beyond the 1..16384 pixels a side read here", "not an
+ * image: no PNG, JPEG, GIF, BMP or PSD signature", or stb's own reason
+ * (passed in) when the header looks right.
+ */
+void asp__image_problem(FILE *fp, const char *stb_reason, unsigned max_side, char *out, size_t cap);
+
+#endif

@@ -1,0 +1,29 @@
+/*
+ * The one check every reader makes before opening a path for reading (issue
+ * #13): the path names a regular file. fopen blocks on a FIFO until a writer
+ * comes and opens a directory on Linux, so both are refused by name first.
+ * Not public API.
+ */
+#ifndef ASP_UTIL_REGULAR_FILE_H
+#define ASP_UTIL_REGULAR_FILE_H
+
+#include <stdio.h>
+
+#include "amgsplat/core.h"
+
+/*
+ * 0 when path is a regular file (after following links). Otherwise fails
+ * with ASP_EIO: "cannot open '<path>': <strerror>" when stat fails, "cannot
+ * read '<path>': is a directory, expected a file" or "cannot read '<path>':
+ * not a regular file (a FIFO|socket|device)".
+ */
+int asp__regular_file_check(const char *path, asp_error *err);
+
+/*
+ * asp__regular_file_check, then fopen(path, "rb"); NULL with err filled on
+ * failure. Between the check and the open a FIFO could replace the file; the
+ * open is then O_NONBLOCK-free but that race needs a hostile local writer.
+ */
+FILE *asp__regular_file_open(const char *path, asp_error *err);
+
+#endif
