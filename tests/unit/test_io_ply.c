@@ -65,7 +65,7 @@ static void put_value(sbuf *b, int enc, asp_scalar_type t, double v, int last)
         sb_put(b, last ? "\n" : " ", 1);
         return;
     }
-    uint8_t raw[8];
+    uint8_t raw[8] = {0}; // every byte is written below; gcc -O3 cannot see it through the switch
     size_t n = asp_scalar_size(t);
     switch (t) {
     case ASP_SCALAR_INT8: { int8_t x = (int8_t)v; memcpy(raw, &x, 1); break; }
