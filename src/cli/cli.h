@@ -83,6 +83,12 @@ int cli_check_output(const struct cli_env *env, const char *output, const char *
 int cli_parse_doubles(const char *s, double *out, int max);
 /* Parses --up: "y", "z", "x", "-y", "-z" or "-x" ("+y" = "y"); returns 0 or -1. */
 int cli_parse_up(const char *s, asp_up_axis *out);
+
+/*
+ * --view AZ,EL[,DIST] of render and view: AZ in -36000..36000 degrees, EL in -90..90, DIST in
+ * (0, 1e6] bounding-sphere radii (0 when not given: fit). Prints the usage error and returns 2.
+ */
+int cli_parse_view(struct cli_env *env, const char *s, double *az, double *el, double *dist);
 /* Parses "WxH"; returns 0 or -1. */
 int cli_parse_size2(const char *s, unsigned *w, unsigned *h);
 /* Writes s as a JSON string literal (quotes and escapes). */

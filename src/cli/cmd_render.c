@@ -201,7 +201,8 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
 /* Options of .dps inputs (asp_prim_render_options). */
 static int parse_prim_options(struct cli_env *env, struct render_opts *o)
 {
-    int given = o->method || o->alpha_ref >= 0 || o->transparency >= 0 || o->depth_window >= 0 || o->outline ||
+    // NaN marks "not given": the option parser refuses non-finite values, so no user value collides with it
+    int given = o->method || !isnan(o->alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
                 o->no_normal_map;
     if (!o->dps_input) {
         if (given)
@@ -222,26 +223,20 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
     asp_error err = {0, ""};
     if (o->method && asp_prim_render_method_parse(o->method, &p->method, &err))
         return cli_usage_error(env, "--method: %s", err.msg);
-    if (o->alpha_ref >= 0) {
-        if (!(o->alpha_ref <= 1))
+    if (!isnan(o->alpha_ref)) {
+        if (!(o->alpha_ref >= 0 && o->alpha_ref <= 1))
             return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
         p->alpha_ref = o->alpha_ref > 0 ? (float)o->alpha_ref : -1.0f; // the library's "exactly 0"
-    } else if (o->alpha_ref != -1) {
-        return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
     }
-    if (o->transparency >= 0) {
+    if (!isnan(o->transparency)) {
         if (!(o->transparency > 0 && o->transparency <= 1))
             return cli_usage_error(env, "--transparency expects an opacity in (0, 1], got %g", o->transparency);
         p->transparency = (float)o->transparency;
-    } else if (o->transparency != -1) {
-        return cli_usage_error(env, "--transparency expects an opacity in (0, 1], got %g", o->transparency);
     }
-    if (o->depth_window >= 0) {
-        if (!isfinite(o->depth_window))
+    if (!isnan(o->depth_window)) {
+        if (!(o->depth_window >= 0 && isfinite(o->depth_window)))
             return cli_usage_error(env, "--depth-window expects world units >= 0, got %g", o->depth_window);
         p->depth_window = o->depth_window > 0 ? (float)o->depth_window : -1.0f; // 0 = no window
-    } else if (o->depth_window != -1) {
-        return cli_usage_error(env, "--depth-window expects world units >= 0, got %g", o->depth_window);
     }
     if (o->crease_angle) {
         double deg = 0;
@@ -269,17 +264,8 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
     if (o->size && (cli_parse_size2(o->size, &o->width, &o->height) != 0 || o->width == 0 || o->height == 0 ||
                     o->width > MAX_SIDE || o->height > MAX_SIDE))
         return cli_usage_error(env, "--size expects WxH with sides in 1..%d, got '%s'", MAX_SIDE, o->size);
-    if (o->view) {
-        double v[3] = {0, 0, 0};
-        int n = cli_parse_doubles(o->view, v, 3);
-        if (n < 2 || !(v[1] >= -90 && v[1] <= 90) || (n == 3 && !(v[2] > 0)) || !isfinite(v[0]))
-            return cli_usage_error(env,
-                                   "--view expects AZ,EL[,DIST] with EL in -90..90 and DIST > 0 (radii), got '%s'",
-                                   o->view);
-        o->az = v[0];
-        o->el = v[1];
-        o->dist = n == 3 ? v[2] : 0;
-    }
+    if (o->view && cli_parse_view(env, o->view, &o->az, &o->el, &o->dist))
+        return 2;
     if (o->views < 1 || o->views > MAX_VIEWS)
         return cli_usage_error(env, "--views expects 1..%d, got %zu", MAX_VIEWS, o->views);
     if (o->samples > 64)
@@ -374,10 +360,10 @@ static void print_json(const struct render_opts *o, size_t count, const asp_scen
 
 int cmd_render(int argc, char **argv, struct cli_env *env)
 {
-    // -1 marks the .dps numbers as not given
+    // NaN marks the .dps numbers as not given
     struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .width = 512, .height = 512,
-                            .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0, .alpha_ref = -1,
-                            .transparency = -1, .depth_window = -1, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
+                            .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0, .alpha_ref = NAN,
+                            .transparency = NAN, .depth_window = NAN, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
         {"size", 0, CLI_STRING, &o.size, "WxH", "image size of one view (default 512x512)"},

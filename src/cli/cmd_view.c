@@ -59,15 +59,13 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
                     d->width > 16384 || d->height > 16384))
         return cli_usage_error(env, "--size expects WxH with sides in 1..16384, got '%s'", o->size);
     if (o->view) {
-        double v[3] = {0, 0, 0};
-        int n = cli_parse_doubles(o->view, v, 3);
-        if (n < 2 || !isfinite(v[0]) || !(v[1] >= -90 && v[1] <= 90) || (n == 3 && !(v[2] > 0 && isfinite(v[2]))))
-            return cli_usage_error(env, "--view expects AZ,EL[,DIST] with EL in -90..90 and DIST > 0 (radii), got '%s'",
-                                   o->view);
+        double az, el, dist;
+        if (cli_parse_view(env, o->view, &az, &el, &dist))
+            return 2;
         d->set_view = 1;
-        d->azimuth = (float)v[0];
-        d->elevation = (float)v[1];
-        d->distance = (float)v[2];
+        d->azimuth = (float)az;
+        d->elevation = (float)el;
+        d->distance = (float)dist;
     }
     if (o->up && cli_parse_up(o->up, &d->up) != 0)
         return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
@@ -98,7 +96,7 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
     if (asp_file_recognise(path, &type, NULL) != 0)
         asp_file_type_of_name(path, &type, NULL);
     int dps = type.kind == ASP_FILE_DPS;
-    if ((o->method || o->alpha_ref != -1) && !dps)
+    if ((o->method || !isnan(o->alpha_ref)) && !dps)
         return cli_usage_error(env, "--method and --alpha-ref need a .dps input (amgsplat build makes one)");
     if (o->method) {
         asp_prim_render_method m;
@@ -107,7 +105,7 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
             return cli_usage_error(env, "--method: %s", merr.msg);
         d->prim_method = (unsigned)m;
     }
-    if (o->alpha_ref != -1) {
+    if (!isnan(o->alpha_ref)) {
         if (!(o->alpha_ref >= 0 && o->alpha_ref <= 1))
             return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
         d->prim_alpha_ref = o->alpha_ref > 0 ? (float)o->alpha_ref : -1.0f; // the library's "exactly 0"
@@ -157,7 +155,7 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
 #else
 int cmd_view(int argc, char **argv, struct cli_env *env)
 {
-    struct view_opts o = {.alpha_ref = -1}; // -1: not given
+    struct view_opts o = {.alpha_ref = NAN}; // NaN: not given (the parser refuses non-finite values)
     const struct cli_option opts[] = {
         {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "first view as in 'amgsplat render' (default 30,20)"},

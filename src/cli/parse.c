@@ -343,3 +343,19 @@ int cli_check_output(const struct cli_env *env, const char *output, const char *
                                bare ? "a name without extension" : "'", bare ? "" : dot, bare ? "" : "'");
     return 0;
 }
+
+int cli_parse_view(struct cli_env *env, const char *s, double *az, double *el, double *dist)
+{
+    double v[3] = {0, 0, 0};
+    int n = cli_parse_doubles(s, v, 3);
+    // bounded so that a float camera stays finite: 1e300 degrees or radii would turn into inf and NaN
+    if (n < 2 || !(fabs(v[0]) <= 36000) || !(v[1] >= -90 && v[1] <= 90) || (n == 3 && !(v[2] > 0 && v[2] <= 1e6)))
+        return cli_usage_error(env,
+                               "--view expects AZ,EL[,DIST] with AZ in -36000..36000, EL in -90..90 and DIST in "
+                               "(0, 1e6] radii, got '%s'",
+                               s);
+    *az = v[0];
+    *el = v[1];
+    *dist = n == 3 ? v[2] : 0;
+    return 0;
+}

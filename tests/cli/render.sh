@@ -155,6 +155,9 @@ expect_fail 2 "must end in .png" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.jpg
 expect_fail 2 "--size expects WxH" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --size 0x10
 expect_fail 2 "--view expects AZ,EL" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --view 10,95
 expect_fail 2 "--view expects AZ,EL" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --view 10
+# values a float camera cannot hold are refused by name (issue 13: "distance inf ... near -nan")
+expect_fail 2 "AZ in -36000..36000" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --view 1e300,0
+expect_fail 2 "DIST in (0, 1e6]" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --view 0,0,1e300
 expect_fail 2 "--views expects 1..256" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --views 0
 expect_fail 2 "exclude each other" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --transparent --background 1,2,3
 expect_fail 2 "--background expects" "$AMGSPLAT" render "$T/sphere.ply" -o "$T/x.png" --background 1,2,300

@@ -61,6 +61,10 @@ expect_fail 2 "need a .dps input" "$AMGSPLAT" render "$T/o.ply" -o "$T/x.png" --
 expect_fail 2 "--renderer is for point inputs" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --renderer splat
 expect_fail 2 "--alpha-ref expects" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --alpha-ref 2
 expect_fail 2 "--transparency expects" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --transparency 0
+# -1 was the "not given" marker and so accepted silently (issue 13)
+expect_fail 2 "--transparency expects" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --transparency -1
+expect_fail 2 "--depth-window expects" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --depth-window -1
+expect_fail 2 "--alpha-ref expects" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --alpha-ref -1
 expect_fail 2 "--color-by on a .dps input expects domain" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --color-by strict
 expect_fail 1 "has no level 'L-3'" "$AMGSPLAT" render "$T/o.dps" -o "$T/x.png" --level L-3
 head -c 2000 "$T/o.dps" >"$T/cut.dps"

@@ -214,6 +214,7 @@ mv "$T/o.amg.away" "$T/o.amg"
 expect_fail 1 "has no level 'L-5'" view "$T/o.dps" --frames 1 --level L-5
 expect_fail 2 "--method:" "$AMGSPLAT" view "$T/o.dps" --method blob
 expect_fail 2 "--alpha-ref expects" "$AMGSPLAT" view "$T/o.dps" --alpha-ref 1.5
+expect_fail 2 "--alpha-ref expects" "$AMGSPLAT" view "$T/o.dps" --alpha-ref -1
 expect_fail 2 "need a .dps input" "$AMGSPLAT" view "$T/sphere.ply" --method prefix
 expect_fail 1 "renderer 'prim' cannot draw points input" view "$T/sphere.ply" --frames 1 --renderer prim
 expect_fail 1 "renderer 'disc' cannot draw dps input" view "$T/o.dps" --frames 1 --renderer disc
