@@ -171,14 +171,7 @@ static const asp__renderer_vtable disc_vtable = {"disc", disc_draw, disc_destroy
 static void upload(disc_renderer *d, int attr, const void *data, size_t bytes, GLint comps, GLenum type,
                    GLboolean normalized, GLsizei stride)
 {
-    GLuint vao = d->vao.id;
-    glCreateBuffers(1, &d->buffers[attr].id);
-    glNamedBufferStorage(d->buffers[attr].id, (GLsizeiptr)bytes, data, 0);
-    glVertexArrayVertexBuffer(vao, (GLuint)attr, d->buffers[attr].id, 0, stride);
-    glVertexArrayAttribFormat(vao, (GLuint)attr, comps, type, normalized, 0);
-    glVertexArrayAttribBinding(vao, (GLuint)attr, (GLuint)attr);
-    glVertexArrayBindingDivisor(vao, (GLuint)attr, 1);
-    glEnableVertexArrayAttrib(vao, (GLuint)attr);
+    asp__gl_attrib_buffer(d->vao, (GLuint)attr, &d->buffers[attr], data, bytes, comps, type, normalized, stride, 1);
     d->has[attr] = 1;
 }
 

@@ -61,6 +61,13 @@ int asp__gl_check(asp_gl_context *gl, const char *what, asp_error *err);
 /* Discards collected errors (before an operation whose errors we want to attribute). */
 void asp__gl_clear_errors(asp_gl_context *gl);
 
+/*
+ * Uploads one attribute array into a new immutable buffer (*buf) and binds it to vao at binding ==
+ * location attr; divisor 1 advances it once per instance (discs), 0 once per vertex (meshes).
+ */
+void asp__gl_attrib_buffer(asp__gl_vertex_array vao, GLuint attr, asp__gl_buffer *buf, const void *data, size_t bytes,
+                           GLint comps, GLenum type, GLboolean normalized, GLsizei stride, GLuint divisor);
+
 /* Turns GL's bottom-up rows into asp_image's top-down ones in place; row: 4 * width bytes of scratch. */
 void asp__image_flip_rows(asp_image *img, uint8_t *row);
 /* "GL_INVALID_ENUM" for a glGetError code. */

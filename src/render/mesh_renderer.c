@@ -155,13 +155,7 @@ static const asp__renderer_vtable mesh_vtable = {"mesh", mesh_draw, mesh_destroy
 static void upload(mesh_renderer *m, int attr, const void *data, size_t bytes, GLint comps, GLenum type,
                    GLboolean normalized, GLsizei stride)
 {
-    GLuint vao = m->vao.id;
-    glCreateBuffers(1, &m->buffers[attr].id);
-    glNamedBufferStorage(m->buffers[attr].id, (GLsizeiptr)bytes, data, 0);
-    glVertexArrayVertexBuffer(vao, (GLuint)attr, m->buffers[attr].id, 0, stride);
-    glVertexArrayAttribFormat(vao, (GLuint)attr, comps, type, normalized, 0);
-    glVertexArrayAttribBinding(vao, (GLuint)attr, (GLuint)attr);
-    glEnableVertexArrayAttrib(vao, (GLuint)attr);
+    asp__gl_attrib_buffer(m->vao, (GLuint)attr, &m->buffers[attr], data, bytes, comps, type, normalized, stride, 0);
 }
 
 static int check_input(const asp_render_mesh *mesh, asp_error *err)

@@ -56,6 +56,18 @@ static void unpremultiply(asp_image *img, const uint8_t bg[4])
     }
 }
 
+void asp__gl_attrib_buffer(asp__gl_vertex_array vao, GLuint attr, asp__gl_buffer *buf, const void *data, size_t bytes,
+                           GLint comps, GLenum type, GLboolean normalized, GLsizei stride, GLuint divisor)
+{
+    glCreateBuffers(1, &buf->id);
+    glNamedBufferStorage(buf->id, (GLsizeiptr)bytes, data, 0);
+    glVertexArrayVertexBuffer(vao.id, attr, buf->id, 0, stride);
+    glVertexArrayAttribFormat(vao.id, attr, comps, type, normalized, 0);
+    glVertexArrayAttribBinding(vao.id, attr, attr);
+    glVertexArrayBindingDivisor(vao.id, attr, divisor);
+    glEnableVertexArrayAttrib(vao.id, attr);
+}
+
 void asp__image_flip_rows(asp_image *img, uint8_t *row)
 {
     size_t stride = 4 * (size_t)img->width;
