@@ -103,6 +103,13 @@ fuzz_smoke() {
   "$A" decompose "$seeds/oct.ply" -o "$seeds/oct.amg" -q
   "$A" build "$seeds/oct.amg" -o "$seeds/oct.dps" --primitives 8 -q >/dev/null
   build/seed_hier "$seeds/oct.ply" "$seeds/oct.hier"
+  "$A" render "$seeds/oct.ply" -o "$seeds/oct.png" --size 32x32 -q
+  # seeds: regular files only, from files and folders (tests/data/bad has subfolders per kind)
+  seed() {
+    local dst=$1
+    shift
+    find "$@" -type f -exec cp --backup=numbered -t "$dst" {} +   # same names in two folders: both kept
+  }
   local f name corpus
   for f in build-fuzz/fuzz_*; do
     [[ -x $f && -f $f ]] || continue
@@ -110,11 +117,14 @@ fuzz_smoke() {
     corpus=build-fuzz/corpus/$name
     mkdir -p "$corpus"
     case $name in
-      fuzz_ply) cp "$seeds"/*.ply "$seeds"/*.xyz tests/data/bad/* "$corpus"/ ;;
-      fuzz_amg) cp "$seeds"/*.amg "$corpus"/ ;;
-      fuzz_dps) cp "$seeds"/*.dps "$corpus"/ ;;
-      fuzz_hier) cp "$seeds"/*.hier "$corpus"/ ;;
-      *) cp "$seeds"/* tests/data/bad/* "$corpus"/ ;; # a new target: every format as a start
+      fuzz_ply) seed "$corpus" "$seeds"/*.ply "$seeds"/*.xyz tests/data/bad ;;
+      fuzz_xyz) seed "$corpus" "$seeds"/*.xyz tests/data/bad ;;
+      fuzz_amg) seed "$corpus" "$seeds"/*.amg ;;
+      fuzz_dps) seed "$corpus" "$seeds"/*.dps ;;
+      fuzz_hier) seed "$corpus" "$seeds"/*.hier ;;
+      fuzz_image) seed "$corpus" "$seeds"/*.png ;;
+      fuzz_mesh) seed "$corpus" "$seeds"/*.ply tests/data/bad/mesh ;;
+      *) seed "$corpus" "$seeds" tests/data/bad ;; # a new target: every format as a start
     esac
     local nseeds
     nseeds=$(ls "$corpus" | wc -l)
