@@ -49,13 +49,17 @@ static int next_line(cursor *c, const char **s, const char **e)
     return 0;
 }
 
-/* Parses a non-negative integer word at *s (advancing past it and following blanks); -1 if there is none. */
+/*
+ * Parses a non-negative integer word at *s (advancing past it and following blanks); -1 if there is
+ * none. At most 18 digits (10^18 - 1 fits a long long with room for the next * 10): a longer count
+ * is no count at all, which the callers refuse (found by fuzz_mesh: 19 nines overflowed).
+ */
 static long long take_count(const char **s, const char *e)
 {
     const char *p = *s;
     long long v = 0;
     int digits = 0;
-    while (p < e && *p >= '0' && *p <= '9' && digits < 19) {
+    while (p < e && *p >= '0' && *p <= '9' && digits < 18) {
         v = 10 * v + (*p++ - '0');
         digits++;
     }
