@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "amgsplat/hier.h"
+#include "util/checksum.h"
 
 static void one(const uint8_t *data, size_t size)
 {
@@ -45,17 +46,6 @@ static void one(const uint8_t *data, size_t size)
         abort();
 }
 
-/* docs/hier.md: FNV-1a 64 over the payload (stored at byte 88) and over the header before its last 8 bytes. */
-static uint64_t fnv1a(const uint8_t *p, size_t n)
-{
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (size_t i = 0; i < n; i++) {
-        h ^= p[i];
-        h *= 0x100000001b3ULL;
-    }
-    return h;
-}
-
 static void put64(uint8_t *p, uint64_t v)
 {
     for (int k = 0; k < 8; k++)
@@ -75,8 +65,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     memcpy(fixed, data, size);
     put64(fixed + 80, size - hsize);
-    put64(fixed + 88, fnv1a(fixed + hsize, size - hsize));
-    put64(fixed + hsize - 8, fnv1a(fixed, hsize - 8));
+    // docs/hier.md: FNV-1a 64 over the payload (stored at byte 88) and over the header before its last 8 bytes
+    put64(fixed + 88, asp__fnv1a64(ASP__FNV1A64_START, fixed + hsize, size - hsize));
+    put64(fixed + hsize - 8, asp__fnv1a64(ASP__FNV1A64_START, fixed, hsize - 8));
     if (memcmp(fixed, data, size) != 0)
         one(fixed, size);
     free(fixed);

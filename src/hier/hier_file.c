@@ -14,6 +14,7 @@
 #include "hier/internal.h"
 #include "util/atomic_file.h"
 #include "util/byte_io.h"
+#include "util/checksum.h"
 #include "util/banned.h"
 
 #define MAGIC "ASPHIER"
@@ -27,17 +28,6 @@ enum { VERSION = 2, HEADER_SIZE = 160, HEADER_V1 = 128, FRAME_AT = 96, NODE_REC 
        COV_REC = 8 * ASP_HIER_COV };
 enum { CHUNK = 1 << 16 };
 
-#define FNV_OFFSET 0xcbf29ce484222325ULL
-#define FNV_PRIME 0x100000001b3ULL
-
-static uint64_t fnv1a(uint64_t h, const uint8_t *p, size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        h ^= p[i];
-        h *= FNV_PRIME;
-    }
-    return h;
-}
 
 static int host_is_le(void)
 {
@@ -103,7 +93,7 @@ static int put_array(writer *w, const void *src, size_t bytes, size_t word, size
             swap_words(w->buf, n, word, rec, skip_word);
             p = w->buf;
         }
-        w->hash = fnv1a(w->hash, p, n);
+        w->hash = asp__fnv1a64(w->hash, p, n);
         if (fwrite(p, 1, n, w->fp) != n)
             return -1;
     }
@@ -131,7 +121,7 @@ static void encode_header(const asp_hier *h, uint64_t payload, uint64_t payload_
         putf64(hd + FRAME_AT + 8 * i, h->frame.center[i]);
     putf64(hd + FRAME_AT + 24, h->frame.radius);
     /* bytes 128-151 are reserved (zero); the header checksum covers everything before it */
-    put64(hd + HEADER_SIZE - 8, fnv1a(FNV_OFFSET, hd, HEADER_SIZE - 8));
+    put64(hd + HEADER_SIZE - 8, asp__fnv1a64(ASP__FNV1A64_START, hd, HEADER_SIZE - 8));
 }
 
 static uint64_t payload_size(uint64_t nodes, uint64_t points)
@@ -151,7 +141,7 @@ int asp_hier_save(const asp_hier *hier, const char *path, asp_error *err)
         return asp_error_set(err, ASP_ENOMEM, "cannot write '%s': out of memory", path);
     }
     w->fp = f.fp;
-    w->hash = FNV_OFFSET;
+    w->hash = ASP__FNV1A64_START;
     uint8_t hd[HEADER_SIZE];
     size_t ns = hier->node_count + hier->point_count;
     uint64_t payload = payload_size(hier->node_count, hier->point_count);
@@ -311,7 +301,7 @@ static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': truncated header: %zu of %zu bytes", r->path,
                              r->size, hsize);
     r->at = hsize - 8;
-    if (asp__get_u64(r) != fnv1a(FNV_OFFSET, r->buf, hsize - 8))
+    if (asp__get_u64(r) != asp__fnv1a64(ASP__FNV1A64_START, r->buf, hsize - 8))
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': header checksum mismatch (bytes 0-%zu)",
                              r->path, hsize - 9);
     r->at = 12;
@@ -362,7 +352,7 @@ static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
         }
     }
     /* the whole payload is hashed before anything large is allocated */
-    if (fnv1a(FNV_OFFSET, r->buf + hsize, (size_t)payload) != payload_hash)
+    if (asp__fnv1a64(ASP__FNV1A64_START, r->buf + hsize, (size_t)payload) != payload_hash)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': payload checksum mismatch (bytes %zu-%llu)",
                              r->path, hsize, (unsigned long long)(hsize + payload - 1));
     asp_hier *h = NULL;

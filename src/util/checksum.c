@@ -29,3 +29,13 @@ void asp__crc_put(asp__crc_writer *w, const void *data, size_t len)
     if (fwrite(data, 1, len, w->fp) != len)
         w->failed = 1;
 }
+
+uint64_t asp__fnv1a64(uint64_t h, const void *data, size_t len)
+{
+    const uint8_t *p = data;
+    for (size_t i = 0; i < len; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ULL; // the 64-bit FNV prime
+    }
+    return h;
+}

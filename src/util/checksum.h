@@ -13,6 +13,13 @@
 uint32_t asp__crc32(uint32_t crc, const void *data, size_t len);
 
 /*
+ * FNV-1a 64 of the .hier format (docs/hier.md). Chaining: start with
+ * ASP__FNV1A64_START and pass the previous value back in.
+ */
+#define ASP__FNV1A64_START 0xcbf29ce484222325ULL
+uint64_t asp__fnv1a64(uint64_t h, const void *data, size_t len);
+
+/*
  * A file writer that keeps the running CRC-32 of everything written and
  * remembers the first write failure, so format writers check once at the end.
  */

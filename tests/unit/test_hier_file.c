@@ -9,6 +9,7 @@
 
 #include "amgsplat/hier.h"
 #include "harness.h"
+#include "util/checksum.h"
 
 static char tmpdir[512];
 
@@ -50,16 +51,6 @@ static uint8_t *read_all(const char *path, size_t *size)
     return b;
 }
 
-static uint64_t fnv(const uint8_t *p, size_t n)
-{
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (size_t i = 0; i < n; i++) {
-        h ^= p[i];
-        h *= 0x100000001b3ULL;
-    }
-    return h;
-}
-
 static void put64le(uint8_t *p, uint64_t v)
 {
     for (int i = 0; i < 8; i++)
@@ -75,8 +66,8 @@ static void put32le(uint8_t *p, uint32_t v)
 /* recompute both checksums, as a forger would, for a header of hsize bytes (160; 128 in version 1) */
 static void reseal_header(uint8_t *b, size_t size, size_t hsize)
 {
-    put64le(b + 88, fnv(b + hsize, size - hsize));
-    put64le(b + hsize - 8, fnv(b, hsize - 8));
+    put64le(b + 88, asp__fnv1a64(ASP__FNV1A64_START, b + hsize, size - hsize));
+    put64le(b + hsize - 8, asp__fnv1a64(ASP__FNV1A64_START, b, hsize - 8));
 }
 
 static void reseal(uint8_t *b, size_t size)
