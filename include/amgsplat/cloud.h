@@ -175,6 +175,18 @@ float asp_cloud_default_radius(const asp_cloud *cloud);
  */
 int asp_cloud_frame(const asp_cloud *cloud, asp_frame *out, asp_error *err);
 
+/**
+ * The frame of count float positions (3 each, offsets from origin): centre of
+ * their float bounding box, radius = largest distance from it plus radius
+ * (the largest splat radius; 0 for mesh vertices). asp_cloud_frame and the
+ * mesh frame of the scene loader both come from here, so a mesh and the points
+ * sampled from it frame alike. Returns 0; ASP_EDEGENERATE (count 0, or all
+ * positions equal with radius 0); ASP_EFORMAT (a non-finite position, naming
+ * it). *out is unchanged on failure. Thread safe.
+ */
+int asp_positions_frame(const float *positions, size_t count, const double origin[3], double radius, asp_frame *out,
+                        asp_error *err);
+
 #ifdef __cplusplus
 }
 #endif

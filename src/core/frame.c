@@ -26,6 +26,44 @@ float asp_cloud_default_radius(const asp_cloud *cloud)
     return isfinite(longest) ? (float)(longest / n) : 0.0f;
 }
 
+int asp_positions_frame(const float *positions, size_t count, const double origin[3], double radius, asp_frame *out,
+                        asp_error *err)
+{
+    ASP_ASSERT((positions || count == 0) && origin && out);
+    if (count == 0)
+        return asp_error_set(err, ASP_EDEGENERATE, "cannot frame an empty point set");
+    // float bounds (as asp_cloud_bounds) and double distances: one frame whoever asks
+    float lo[3], hi[3];
+    for (int k = 0; k < 3; k++)
+        lo[k] = hi[k] = positions[k];
+    for (size_t i = 0; i < count; i++)
+        for (int k = 0; k < 3; k++) {
+            float v = positions[3 * i + k];
+            if (!isfinite(v))
+                return asp_error_set(err, ASP_EFORMAT, "point %zu: coordinate %c is not finite", i, "xyz"[k]);
+            lo[k] = v < lo[k] ? v : lo[k];
+            hi[k] = v > hi[k] ? v : hi[k];
+        }
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = 0.5 * ((double)lo[k] + hi[k]);
+    double max_d2 = 0;
+    for (size_t i = 0; i < count; i++) {
+        const float *p = positions + 3 * i;
+        double dx = p[0] - c[0], dy = p[1] - c[1], dz = p[2] - c[2];
+        double d2 = dx * dx + dy * dy + dz * dz;
+        max_d2 = d2 > max_d2 ? d2 : max_d2;
+    }
+    double r = sqrt(max_d2) + radius;
+    if (!(r > 0) || !isfinite(r))
+        return asp_error_set(err, ASP_EDEGENERATE,
+                             "cannot frame %zu points: they are all at the same position and have no radius", count);
+    for (int k = 0; k < 3; k++)
+        out->center[k] = origin[k] + c[k];
+    out->radius = r;
+    return 0;
+}
+
 int asp_cloud_frame(const asp_cloud *cloud, asp_frame *out, asp_error *err)
 {
     ASP_ASSERT(cloud && out);
@@ -34,31 +72,12 @@ int asp_cloud_frame(const asp_cloud *cloud, asp_frame *out, asp_error *err)
     int rc = asp_cloud_validate(cloud, err);
     if (rc)
         return rc;
-    float lo[3], hi[3];
-    rc = asp_cloud_bounds(cloud, lo, hi, err);
-    if (rc)
-        return rc;
-    double c[3];
-    for (int k = 0; k < 3; k++)
-        c[k] = 0.5 * ((double)lo[k] + hi[k]);
-    double max_d2 = 0, max_r = 0;
-    for (size_t i = 0; i < cloud->count; i++) {
-        const float *p = cloud->positions + 3 * i;
-        double dx = p[0] - c[0], dy = p[1] - c[1], dz = p[2] - c[2];
-        double d2 = dx * dx + dy * dy + dz * dz;
-        max_d2 = d2 > max_d2 ? d2 : max_d2;
-        if (cloud->radii && cloud->radii[i] > max_r)
-            max_r = cloud->radii[i];
-    }
-    if (!cloud->radii)
+    double max_r = 0;
+    if (cloud->radii) {
+        for (size_t i = 0; i < cloud->count; i++)
+            max_r = cloud->radii[i] > max_r ? cloud->radii[i] : max_r;
+    } else {
         max_r = asp_cloud_default_radius(cloud);
-    double r = sqrt(max_d2) + max_r;
-    if (!(r > 0) || !isfinite(r))
-        return asp_error_set(err, ASP_EDEGENERATE,
-                             "cannot frame %zu points: they are all at the same position and have no radius",
-                             cloud->count);
-    for (int k = 0; k < 3; k++)
-        out->center[k] = cloud->origin[k] + c[k];
-    out->radius = r;
-    return 0;
+    }
+    return asp_positions_frame(cloud->positions, cloud->count, cloud->origin, max_r, out, err);
 }

@@ -199,36 +199,8 @@ static int load_dps(asp_scene *s, const asp_scene_desc *d, asp_error *err)
 int asp_scene_mesh_frame(const asp_mesh *mesh, asp_frame *out, asp_error *err)
 {
     ASP_ASSERT(mesh && out);
-    size_t n = mesh->vertex_count;
-    if (n == 0)
-        return asp_error_set(err, ASP_EDEGENERATE, "cannot frame a mesh without vertices");
-    // float bounds and double distances, as asp_cloud_frame computes them, so the two frames agree
-    float lo[3], hi[3];
-    for (int k = 0; k < 3; k++)
-        lo[k] = hi[k] = mesh->positions[k];
-    for (size_t i = 0; i < n; i++)
-        for (int k = 0; k < 3; k++) {
-            float v = mesh->positions[3 * i + k];
-            if (!isfinite(v))
-                return asp_error_set(err, ASP_EFORMAT, "mesh vertex %zu: position is not finite", i);
-            lo[k] = v < lo[k] ? v : lo[k];
-            hi[k] = v > hi[k] ? v : hi[k];
-        }
-    double c[3], max_d2 = 0;
-    for (int k = 0; k < 3; k++)
-        c[k] = 0.5 * ((double)lo[k] + hi[k]);
-    for (size_t i = 0; i < n; i++) {
-        const float *p = mesh->positions + 3 * i;
-        double dx = p[0] - c[0], dy = p[1] - c[1], dz = p[2] - c[2];
-        double d2 = dx * dx + dy * dy + dz * dz;
-        max_d2 = d2 > max_d2 ? d2 : max_d2;
-    }
-    if (!(max_d2 > 0))
-        return asp_error_set(err, ASP_EDEGENERATE, "cannot frame a mesh whose %zu vertices are at one position", n);
-    for (int k = 0; k < 3; k++)
-        out->center[k] = mesh->origin[k] + c[k];
-    out->radius = sqrt(max_d2);
-    return 0;
+    // the vertices framed as points of radius 0 (asp_positions_frame is asp_cloud_frame's core)
+    return asp_positions_frame(mesh->positions, mesh->vertex_count, mesh->origin, 0.0, out, err);
 }
 
 void asp_scene_mesh_describe(const asp_mesh *m, asp_render_material *materials, asp_render_mesh *r)
