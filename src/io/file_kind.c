@@ -5,11 +5,8 @@
  * file for info, decompose and render alike, and a PLY with faces is a mesh.
  */
 #include <errno.h>
-#include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "amgsplat/io.h"
 #include "util/regular_file.h"
@@ -185,40 +182,16 @@ int asp_file_recognise_memory(const void *head, size_t size, const char *name, a
 
 int asp_file_recognise(const char *path, asp_file_type *out, asp_error *err)
 {
-    if (asp__regular_file_check(path, err))
+    FILE *fp = asp__regular_file_open(path, err);
+    if (!fp)
         return ASP_EIO;
-    // O_NONBLOCK still: a FIFO swapped in after the check must not wait for a writer; fstat then refuses it
-    int fd = open(path, O_RDONLY | O_NONBLOCK);
-    if (fd < 0)
-        return asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
-    struct stat st;
-    if (fstat(fd, &st) != 0) {
-        int e = errno;
-        close(fd);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, strerror(e));
-    }
-    if (!S_ISREG(st.st_mode)) {
-        int dir = S_ISDIR(st.st_mode);
-        close(fd);
-        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path,
-                             dir ? "is a directory, expected a file" : "not a regular file");
-    }
     unsigned char head[HEAD_BYTES];
-    size_t n = 0;
-    while (n < sizeof head) {
-        ssize_t got = read(fd, head + n, sizeof head - n);
-        if (got < 0 && errno == EINTR)
-            continue;
-        if (got < 0) {
-            int e = errno;
-            close(fd);
-            return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, strerror(e));
-        }
-        if (got == 0)
-            break;
-        n += (size_t)got;
-    }
-    close(fd);
+    size_t n = fread(head, 1, sizeof head, fp);
+    int failed = ferror(fp);
+    int e = errno;
+    fclose(fp);
+    if (failed)
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, strerror(e));
     return asp_file_recognise_memory(head, n, path, out, err);
 }
 

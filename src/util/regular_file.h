@@ -20,9 +20,10 @@
 int asp__regular_file_check(const char *path, asp_error *err);
 
 /*
- * asp__regular_file_check, then fopen(path, "rb"); NULL with err filled on
- * failure. Between the check and the open a FIFO could replace the file; the
- * open is then O_NONBLOCK-free but that race needs a hostile local writer.
+ * asp__regular_file_check, then the file opened for reading in binary mode;
+ * NULL with err filled on failure. The open is non-blocking and the opened
+ * descriptor is checked again, so a FIFO that replaces the file between the
+ * check and the open is refused too, never waited on.
  */
 FILE *asp__regular_file_open(const char *path, asp_error *err);
 
