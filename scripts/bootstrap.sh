@@ -19,7 +19,16 @@ packages=(
   glmark2-data                     # ships the Stanford bunny (demo model)
   clang libclang-rt-14-dev         # the clang build and the libFuzzer targets (scripts/test.sh)
   python3                          # tests/cli/png_check.py and the JSON checks of tests/cli
+  libcjson-dev                     # the one JSON library (reading and writing)
+  libgsl-dev                       # statistics of the perceptual experiment (t distribution)
+  chromium                         # the web page's test in headless Chromium (puppeteer-core)
 )
+# Node.js and npm for the web page and its tests (three.js, gltf-validator, puppeteer-core, loaders.gl,
+# pinned in web/package-lock.json). Debian's packages when no node is on the PATH; a node that is
+# already installed (another distribution of it) is kept, since Debian's npm would conflict with it.
+if ! command -v npm >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -27,7 +36,19 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
+
+# npm packages from the lock file, when they are missing or the lock file changed since (idempotent).
+npm_ci() {
+  local root
+  root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+  if [[ ! -f "$root/web/node_modules/.package-lock.json" || "$root/web/package-lock.json" -nt "$root/web/node_modules/.package-lock.json" ]]; then
+    echo "bootstrap: npm ci in web/ (packages pinned in web/package-lock.json)" >&2
+    (cd "$root/web" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+  fi
+}
+
 if ((${#missing[@]} == 0)); then
+  npm_ci
   exit 0
 fi
 
@@ -38,3 +59,4 @@ fi
 echo "bootstrap: installing ${missing[*]}" >&2
 $SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
 $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+npm_ci
