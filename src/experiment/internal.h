@@ -1,0 +1,99 @@
+/*
+ * Private parts of the experiment module: the seeded generator every draw of
+ * the study uses (so one seed gives one study on every machine), the
+ * prepared scenes and the per-frame log writer.
+ */
+#ifndef ASP_EXPERIMENT_INTERNAL_H
+#define ASP_EXPERIMENT_INTERNAL_H
+
+#include <stdio.h>
+
+#include "amgsplat/amgsplat.h"
+#include "amgsplat/experiment.h"
+
+/* splitmix64 (Steele et al. 2014): 64-bit state, integer only, so draws match across compilers */
+static inline uint64_t asp__exp_next(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* uniform in [0, n) by rejection (no modulo bias) */
+static inline uint64_t asp__exp_below(uint64_t *state, uint64_t n)
+{
+    uint64_t limit = UINT64_MAX - UINT64_MAX % n;
+    uint64_t x;
+    do
+        x = asp__exp_next(state);
+    while (x >= limit);
+    return x % n;
+}
+
+/* uniform double in [0, 1) from the top 53 bits */
+static inline double asp__exp_uniform(uint64_t *state)
+{
+    return (double)(asp__exp_next(state) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* a stream for (seed, a, b): independent draws per subject and purpose */
+static inline uint64_t asp__exp_stream(uint64_t seed, uint64_t a, uint64_t b)
+{
+    uint64_t s = seed ^ (a * 0xD1B54A32D192ED03ull) ^ (b * 0x8CB92BA72F3D8DD7ull);
+    (void)asp__exp_next(&s);
+    return s;
+}
+
+/* ---- prepared scene of one test: every condition's renderer ---- */
+
+typedef struct exp_prepared {
+    asp_experiment_scene scene;
+    asp_experiment_world world;      /* navigation tests */
+    asp_mesh *mesh;                  /* the polygon model (world.mesh for navigation) */
+    asp_render_material *materials;
+    asp_render_mesh render_mesh;
+    asp_cloud *cloud;                /* sampled points */
+    asp_dps *dps;                    /* domain primitives */
+    size_t dps_level;
+    asp_renderer *renderer[ASP_EXPERIMENT_CONDITION_COUNT]; /* blank: NULL */
+    double origin[ASP_EXPERIMENT_CONDITION_COUNT][3];       /* each renderer's local frame */
+    asp_frame frame;                 /* object: the mesh's framing sphere (world) */
+    size_t triangles, points, primitives;
+    char model_name[32];
+    char points_file[2200], dps_file[2200];
+} exp_prepared;
+
+int asp__exp_prepare(const asp_experiment_scenes *scenes, asp_experiment_test test, const char *cache_dir,
+                     int short_tests, asp_gl_context *gl, const asp_experiment_desc *desc, const asp_context *ctx,
+                     exp_prepared *out, asp_error *err);
+void asp__exp_prepared_release(exp_prepared *p);
+
+/* ---- recognition observer: reference features of the candidates ---- */
+
+#define EXP_REF_YAWS 8
+#define EXP_MASK 24
+#define EXP_HIST 64
+
+typedef struct exp_features {
+    int empty;                       /* nothing but background */
+    uint8_t mask[EXP_MASK * EXP_MASK];
+    float hist[EXP_HIST];            /* normalised colour histogram of the foreground (4 x 4 x 4 bins) */
+} exp_features;
+
+void asp__exp_features(const asp_image *img, const uint8_t background[4], exp_features *out);
+float asp__exp_feature_score(const exp_features *a, const exp_features *b);
+
+/* ---- log writer ---- */
+
+typedef struct exp_log {
+    FILE *fp;
+    char path[4096];
+} exp_log;
+
+int asp__exp_log_open(exp_log *log, const char *path, asp_error *err);
+/* writes one cJSON object as one line, flushed; takes ownership of obj */
+int asp__exp_log_write(exp_log *log, void *cjson_obj, asp_error *err);
+void asp__exp_log_close(exp_log *log);
+
+#endif
