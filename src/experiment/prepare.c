@@ -44,9 +44,14 @@ static int make_points(exp_prepared *p, const asp_context *ctx, asp_error *err)
     asp_cloud_destroy(p->cloud);
     p->cloud = NULL;
     asp_sample_desc sd = {.method = ASP_SAMPLE_AREA, .points = p->scene.points, .seed = 1};
-    int rc = asp_sample_mesh(p->mesh, &sd, ctx, &p->cloud, NULL, err);
+    asp_cloud *fresh = NULL;
+    int rc = asp_sample_mesh(p->mesh, &sd, ctx, &fresh, NULL, err);
     if (!rc)
-        rc = asp_cloud_save(p->cloud, p->points_file, NULL, err);
+        rc = asp_cloud_save(fresh, p->points_file, NULL, err);
+    asp_cloud_destroy(fresh);
+    /* always draw what the cache holds, so a first run and a cached run show the same points */
+    if (!rc)
+        rc = asp_cloud_load(p->points_file, ctx, &p->cloud, err);
     return rc;
 }
 
@@ -66,6 +71,10 @@ static int make_primitives(exp_prepared *p, const asp_context *ctx, asp_error *e
     asp_amg_destroy(amg);
     if (!rc)
         rc = asp_dps_save(p->dps, p->dps_file, err);
+    asp_dps_destroy(p->dps);
+    p->dps = NULL;
+    if (!rc)
+        rc = asp_dps_load(p->dps_file, ctx, &p->dps, err);
     return rc;
 }
 

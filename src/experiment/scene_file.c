@@ -38,10 +38,10 @@ void asp_experiment_scenes_default(asp_experiment_scenes *out)
         .kind = 0, .answer = "horse", .distance_radii = 2.2f, .time_limit = 20.0f, .points = 30000,
         .primitives = 600};
     out->tests[ASP_EXPERIMENT_LOWSPEED] = (asp_experiment_scene){
-        .kind = 1, .seed = 4, .grid = 161, .size = 160.0f, .half_width = 2.5f, .relief = 5.0f, .speed = 3.0f,
+        .kind = 1, .seed = 4, .grid = 161, .size = 160.0f, .half_width = 1.5f, .relief = 5.0f, .speed = 3.0f,
         .eye_height = 1.7f, .time_limit = 60.0f, .points = 120000, .primitives = 3000};
     out->tests[ASP_EXPERIMENT_HIGHSPEED] = (asp_experiment_scene){
-        .kind = 2, .seed = 5, .grid = 161, .size = 200.0f, .half_width = 5.0f, .relief = 14.0f, .speed = 10.0f,
+        .kind = 2, .seed = 5, .grid = 161, .size = 200.0f, .half_width = 4.0f, .relief = 14.0f, .speed = 10.0f,
         .eye_height = 2.5f, .time_limit = 20.0f, .points = 120000, .primitives = 3000};
 }
 
