@@ -59,6 +59,9 @@ typedef struct exp_prepared {
     asp_renderer *renderer[ASP_EXPERIMENT_CONDITION_COUNT]; /* blank: NULL */
     double origin[ASP_EXPERIMENT_CONDITION_COUNT][3];       /* each renderer's local frame */
     asp_frame frame;                 /* object: the mesh's framing sphere (world) */
+    asp_hier_adapt adapt;            /* points with desc->adapt: the depth controller of seed 004 3.2.5 */
+    int adapting;
+    float tau;                       /* points: the cut's screen tolerance */
     size_t triangles, points, primitives;
     char model_name[32];
     char points_file[2200], dps_file[2200];

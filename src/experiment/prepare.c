@@ -89,6 +89,14 @@ static int make_renderers(exp_prepared *p, asp_gl_context *gl, const asp_experim
     asp_square_renderer_desc sq = {.tolerance = desc->coarse_tau > 0.0f ? desc->coarse_tau : 1.0f};
     if (!rc)
         rc = asp_square_renderer_create(gl, p->cloud, &sq, ctx, &p->renderer[ASP_EXPERIMENT_POINTS], err);
+    p->tau = sq.tolerance;
+    if (!rc && desc->adapt) {
+        /* Fig. 3.5 with the band of an interactive rate: refine below 1/60 s, coarsen above 1/30 s */
+        asp_hier_adapt_desc ad = {.f_min = 1.0 / 60.0, .f_max = 1.0 / 30.0, .mode = ASP_HIER_ADAPT_DEPTH,
+                                  .depth_min = desc->depth_limit ? desc->depth_limit : 1};
+        rc = asp_hier_adapt_init(&p->adapt, &ad, err);
+        p->adapting = !rc;
+    }
     if (!rc && desc->depth_limit)
         rc = asp_renderer_set_lod(p->renderer[ASP_EXPERIMENT_POINTS], sq.tolerance, desc->depth_limit, err);
     memcpy(p->origin[ASP_EXPERIMENT_POINTS], p->cloud->origin, sizeof p->origin[0]);
@@ -145,6 +153,12 @@ int asp__exp_prepare(const asp_experiment_scenes *scenes, asp_experiment_test te
              (unsigned long long)key);
     snprintf(p.dps_file, sizeof p.dps_file, "%s/%s-%016llx.dps", cache_dir, asp_experiment_test_name(test),
              (unsigned long long)key);
+    char mesh_file[2300];
+    snprintf(mesh_file, sizeof mesh_file, "%s/%s-%016llx-mesh.ply", cache_dir, asp_experiment_test_name(test),
+             (unsigned long long)key);
+    /* the generated worlds as files too, for a look in `amgsplat view` or another program */
+    if (!rc && p.scene.kind != 0 && !file_exists(mesh_file))
+        rc = asp_mesh_save(p.mesh, mesh_file, NULL, err);
     if (!rc)
         rc = make_points(&p, ctx, err);
     if (!rc)

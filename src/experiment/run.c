@@ -158,12 +158,19 @@ static int draw(exp_study *st, exp_prepared *p, asp_experiment_condition c, cons
             asp_image_fill(img, bg);
         *drawn = 0;
     } else {
+        if (c == ASP_EXPERIMENT_POINTS && p->adapting) {
+            rc = asp_renderer_set_lod(p->renderer[c], p->tau, p->adapt.depth, err);
+            if (rc)
+                return rc;
+        }
         asp_render_desc rd = {.width = st->width, .height = st->height, .light_elevation = 45.0f};
         memcpy(rd.background, bg, 4);
         rc = asp_render_to_image(st->gl, p->renderer[c], cam, &rd, img, err);
         *drawn = rc ? 0 : asp_renderer_count(p->renderer[c]);
     }
     *ms = 1000.0 * (asp_time_now() - t0);
+    if (!rc && c == ASP_EXPERIMENT_POINTS && p->adapting)
+        asp_hier_adapt_update(&p->adapt, *ms / 1000.0, 1); // every frame of a run moves the view: an event
     return rc;
 }
 
