@@ -226,6 +226,9 @@ typedef struct asp_experiment_desc {
                                       (not reproducible) */
     int realtime;                  /* observer: simulated time step = measured frame time (not reproducible);
                                       default a fixed 1/30 s */
+    const char *keys;              /* person: scripted keys for tests, one per frame ("W", "A", "S", "D" held,
+                                      '>' Enter, '<' Backspace, '!' Esc, lowercase letters typed, '.' none);
+                                      when they run out, Esc; NULL = the keyboard */
     const char *screenshots_dir;   /* write PNGs of the first frame of each test and condition; NULL = none */
     asp_experiment_run_fn on_run;
     asp_experiment_log_fn log;

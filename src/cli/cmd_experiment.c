@@ -5,7 +5,7 @@
  * and compare. This file is the dispatcher and the `run` options.
  */
 static const char usage[] =
-    "usage: amgsplat experiment run --observer [--subjects N] | --subject ID  -o DIR [options]\n"
+    "usage: amgsplat experiment run --observer [--subjects N] | --subject ID [--practice]  -o DIR [options]\n"
     "       amgsplat experiment analyze DIR -o REPORT   (see 'amgsplat experiment analyze -h')\n"
     "       amgsplat experiment ttest N1,MEAN1,SD1 N2,MEAN2,SD2\n"
     "\n"
@@ -99,7 +99,7 @@ static int parse_conditions(struct cli_env *env, const char *text, asp_experimen
 static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
 {
     const char *output = NULL, *scenes = NULL, *cache = NULL, *subject = NULL, *conditions = NULL, *group = NULL,
-               *size = NULL, *shots = NULL;
+               *size = NULL, *shots = NULL, *keys = NULL;
     size_t subjects = 0, seed = 1, depth = 0;
     int observer = 0, short_tests = 0, resume = 0, practice = 0, adapt = 0, realtime = 0;
     double tau = 0.0;
@@ -122,6 +122,7 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
         {"screenshots", 0, CLI_STRING, &shots, "DIR", "PNG of every test in every condition"},
         {"resume", 0, CLI_FLAG, &resume, NULL, "add the missing runs to existing subject directories"},
         {"practice", 0, CLI_FLAG, &practice, NULL, "person: a short practice run first (not logged)"},
+        {"keys", 0, CLI_STRING, &keys, "KEYS", "person: scripted keys, one per frame (tests; docs/cli/experiment.md)"},
         {0},
     };
     int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -133,6 +134,8 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "missing -o DIR");
     if (observer == !!subject)
         return cli_usage_error(env, "give either --observer or --subject ID");
+    if (keys && !subject)
+        return cli_usage_error(env, "--keys scripts a person's session (--subject ID)");
     if (subject && subjects)
         return cli_usage_error(env, "--subjects is for the observer; a person is one --subject");
     if (tau < 0.0 || tau > 1024.0)
@@ -143,7 +146,7 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
                              .observer = observer, .subjects = subjects, .subject = subject,
                              .short_tests = short_tests, .resume = resume, .practice = practice,
                              .coarse_tau = (float)tau, .adapt = adapt, .realtime = realtime,
-                             .screenshots_dir = shots};
+                             .screenshots_dir = shots, .keys = keys};
     asp_experiment_condition conds[ASP_EXPERIMENT_CONDITION_COUNT];
     size_t nconds = 0;
     if (conditions) {

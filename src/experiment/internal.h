@@ -99,4 +99,65 @@ int asp__exp_log_open(exp_log *log, const char *path, asp_error *err);
 int asp__exp_log_write(exp_log *log, void *cjson_obj, asp_error *err);
 void asp__exp_log_close(exp_log *log);
 
+/* ---- the study and one run (run.c; window.c for people) ---- */
+
+#define DEG (3.14159265358979f / 180.0f)
+#define FIXED_DT (1.0 / 30.0)
+
+extern const uint8_t asp__exp_sky[4], asp__exp_backdrop[4];
+
+typedef struct exp_refs {
+    exp_features f[ASP_EXPERIMENT_MAX_CANDIDATES][EXP_REF_YAWS];
+    size_t count;
+} exp_refs;
+
+typedef struct exp_study {
+    const asp_experiment_desc *desc;
+    const asp_context *ctx;
+    asp_gl_context *gl;
+    asp_experiment_scenes scenes;
+    exp_prepared prep[ASP_EXPERIMENT_TEST_COUNT];
+    exp_refs refs;
+    uint32_t width, height;
+    char cache_dir[4096];
+    void *window;                    /* people: the GLFW window (window.c) */
+    int aborted;                     /* people: Esc ended the session */
+} exp_study;
+
+/* one run's running state */
+typedef struct exp_run {
+    exp_study *st;
+    exp_prepared *p;
+    asp_experiment_test test;
+    asp_experiment_condition cond;
+    char run;
+    const char *subject;
+    uint64_t rng;
+    exp_log log;
+    asp_experiment_run_result res;
+    double frame_ms_sum;
+    double last_t;                   /* t of the last frame logged */
+} exp_run;
+
+
+void asp__exp_first_person(asp_camera *cam, const double origin[3], const float eye[3], float yaw, float pitch,
+                           float aspect, float far_plane);
+void asp__exp_object_camera(asp_camera *cam, const exp_prepared *p, const double origin[3], float yaw, float pitch,
+                            float distance_radii, float aspect);
+int asp__exp_draw(exp_study *st, exp_prepared *p, asp_experiment_condition c, const asp_camera *cam,
+                  const uint8_t bg[4], asp_image *img, double *ms, size_t *drawn, asp_error *err);
+int asp__exp_write_header(exp_run *r, int variable, asp_error *err);
+int asp__exp_write_frame(exp_run *r, size_t i, double t, double ms, const float pos[3], const float dir[3],
+                         size_t drawn, const char *keys, const float *rot, asp_error *err);
+int asp__exp_write_event(exp_run *r, double t, const char *what, const char *text, asp_error *err);
+int asp__exp_nav_move(exp_run *r, float *x, float *z, float *yaw, double turn, double speed, double dt, double t,
+                      float *along, asp_error *err);
+
+/* people (window.c): the window, instruction screens and the two kinds of run driven by the keyboard */
+int asp__exp_window_open(exp_study *st, asp_error *err);
+void asp__exp_window_close(exp_study *st);
+int asp__exp_window_instructions(exp_study *st, asp_experiment_test test, int practice, asp_error *err);
+int asp__exp_window_navigation(exp_run *r, asp_error *err);
+int asp__exp_window_recognition(exp_run *r, asp_error *err);
+
 #endif

@@ -19,41 +19,9 @@
 #include "util/atomic_file.h"
 #include "util/banned.h"
 
-#define DEG (3.14159265358979f / 180.0f)
-#define FIXED_DT (1.0 / 30.0)
 
-static const uint8_t sky[4] = {150, 190, 230, 255};     /* navigation background: bluish, never sandy */
-static const uint8_t backdrop[4] = {40, 40, 48, 255};   /* recognition background */
-
-typedef struct exp_refs {
-    exp_features f[ASP_EXPERIMENT_MAX_CANDIDATES][EXP_REF_YAWS];
-    size_t count;
-} exp_refs;
-
-typedef struct exp_study {
-    const asp_experiment_desc *desc;
-    const asp_context *ctx;
-    asp_gl_context *gl;
-    asp_experiment_scenes scenes;
-    exp_prepared prep[ASP_EXPERIMENT_TEST_COUNT];
-    exp_refs refs;
-    uint32_t width, height;
-    char cache_dir[4096];
-} exp_study;
-
-/* one run's running state */
-typedef struct exp_run {
-    exp_study *st;
-    exp_prepared *p;
-    asp_experiment_test test;
-    asp_experiment_condition cond;
-    char run;
-    const char *subject;
-    uint64_t rng;
-    exp_log log;
-    asp_experiment_run_result res;
-    double frame_ms_sum;
-} exp_run;
+const uint8_t asp__exp_sky[4] = {150, 190, 230, 255};      /* navigation background: bluish, never sandy */
+const uint8_t asp__exp_backdrop[4] = {40, 40, 48, 255};    /* recognition background */
 
 static void say(const exp_study *st, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -119,7 +87,7 @@ static cJSON *vec3(const float v[3])
 /* ---------------------------------------------------------------- drawing */
 
 /* the first-person camera: eye at eye (world), heading yaw (0 = +z), pitch (negative looks down) */
-static void first_person(asp_camera *cam, const double origin[3], const float eye[3], float yaw, float pitch,
+void asp__exp_first_person(asp_camera *cam, const double origin[3], const float eye[3], float yaw, float pitch,
                          float aspect, float far_plane)
 {
     asp_camera_init(cam);
@@ -135,7 +103,7 @@ static void first_person(asp_camera *cam, const double origin[3], const float ey
     cam->z_far = far_plane;
 }
 
-static void object_camera(asp_camera *cam, const exp_prepared *p, const double origin[3], float yaw, float pitch,
+void asp__exp_object_camera(asp_camera *cam, const exp_prepared *p, const double origin[3], float yaw, float pitch,
                           float distance_radii, float aspect)
 {
     asp_camera_init(cam);
@@ -146,7 +114,7 @@ static void object_camera(asp_camera *cam, const exp_prepared *p, const double o
 }
 
 /* draws one frame of condition c and reads it back (the observer's only input); blank = background only */
-static int draw(exp_study *st, exp_prepared *p, asp_experiment_condition c, const asp_camera *cam,
+int asp__exp_draw(exp_study *st, exp_prepared *p, asp_experiment_condition c, const asp_camera *cam,
                 const uint8_t bg[4], asp_image *img, double *ms, size_t *drawn, asp_error *err)
 {
     asp_image_release(img);
@@ -184,7 +152,7 @@ static void iso_now(char *buf, size_t cap)
     strftime(buf, cap, "%Y-%m-%dT%H:%M:%SZ", &tmv);
 }
 
-static int write_header(exp_run *r, int variable, asp_error *err)
+int asp__exp_write_header(exp_run *r, int variable, asp_error *err)
 {
     exp_study *st = r->st;
     exp_prepared *p = r->p;
@@ -224,7 +192,7 @@ static int write_header(exp_run *r, int variable, asp_error *err)
     return asp__exp_log_write(&r->log, h, err);
 }
 
-static int write_frame(exp_run *r, size_t i, double t, double ms, const float pos[3], const float dir[3],
+int asp__exp_write_frame(exp_run *r, size_t i, double t, double ms, const float pos[3], const float dir[3],
                        size_t drawn, const char *keys, const float *rot, asp_error *err)
 {
     cJSON *f = cJSON_CreateObject();
@@ -241,12 +209,13 @@ static int write_frame(exp_run *r, size_t i, double t, double ms, const float po
         cJSON_AddItemToObject(f, "rot", cJSON_CreateDoubleArray(d, 2));
     }
     r->frame_ms_sum += ms;
+    r->last_t = t;
     r->res.frames++;
     r->res.drawn = drawn;
     return asp__exp_log_write(&r->log, f, err);
 }
 
-static int write_event(exp_run *r, double t, const char *what, const char *text, asp_error *err)
+int asp__exp_write_event(exp_run *r, double t, const char *what, const char *text, asp_error *err)
 {
     cJSON *e = cJSON_CreateObject();
     cJSON_AddStringToObject(e, "type", "event");
@@ -258,6 +227,49 @@ static int write_event(exp_run *r, double t, const char *what, const char *text,
 }
 
 /* ---------------------------------------------------------------- navigation */
+
+/*
+ * Moves the walker or ship by one step and keeps it on the path: leaving it is
+ * an off_path event (low speed) or a collision (high speed) and a bump back
+ * inside (seed 004 2.3). The world does this, not the observer or the person.
+ */
+int asp__exp_nav_move(exp_run *r, float *px, float *pz, float *pyaw, double turn, double speed, double dt, double t,
+                      float *along, asp_error *err)
+{
+    const asp_experiment_world *w = &r->p->world;
+    int high = r->test == ASP_EXPERIMENT_HIGHSPEED;
+    float x = *px, z = *pz, yaw = *pyaw;
+    int rc = 0;
+    yaw += (float)(turn * dt);
+    x += (float)(speed * dt) * sinf(yaw);
+    z += (float)(speed * dt) * cosf(yaw);
+    float pd[2];
+    float d = asp_experiment_path_nearest(w->path, w->path_count, x, z, along, pd);
+    if (d > w->half_width) {
+        /* bumped back inside (seed 004 2.3: off the path a warning, then back onto it) */
+        float nx = w->path[0], nz = w->path[2], best = INFINITY;
+        for (size_t s = 0; s < w->path_count; s++) {
+            float ddx = w->path[3 * s] - x, ddz = w->path[3 * s + 2] - z, dd = ddx * ddx + ddz * ddz;
+            if (dd < best) {
+                best = dd;
+                nx = w->path[3 * s];
+                nz = w->path[3 * s + 2];
+            }
+        }
+        x = nx + 0.6f * (x - nx) * w->half_width / d;
+        z = nz + 0.6f * (z - nz) * w->half_width / d;
+        /* a wall or the path's edge turns the heading halfway back along the path, as a ship slides along a wall */
+        float along_yaw = atan2f(pd[0], pd[1]), diff = along_yaw - yaw;
+        diff = atan2f(sinf(diff), cosf(diff));
+        yaw += 0.5f * diff;
+        r->res.off_path++;
+        rc = asp__exp_write_event(r, t, high ? "collision" : "off_path", NULL, err);
+    }
+    *px = x;
+    *pz = z;
+    *pyaw = yaw;
+    return rc;
+}
 
 /*
  * The observer walks (low speed) or flies (high speed) where it sees the
@@ -294,11 +306,11 @@ static int run_navigation(exp_run *r, asp_error *err)
         float eye[3] = {x, ground + p->scene.eye_height, z};
         float dir[3] = {sinf(yaw), 0.0f, cosf(yaw)};
         asp_camera cam;
-        first_person(&cam, p->origin[r->cond], eye, yaw, pitch, (float)st->width / (float)st->height,
+        asp__exp_first_person(&cam, p->origin[r->cond], eye, yaw, pitch, (float)st->width / (float)st->height,
                      1.5f * w->size);
         double ms = 0.0;
         size_t drawn = 0;
-        rc = draw(st, p, r->cond, &cam, sky, &img, &ms, &drawn, err);
+        rc = asp__exp_draw(st, p, r->cond, &cam, asp__exp_sky, &img, &ms, &drawn, err);
         if (rc)
             break;
         float frac = 0.0f, steer = 0.0f;
@@ -318,39 +330,15 @@ static int run_navigation(exp_run *r, asp_error *err)
             keys[k++] = 'D';
         keys[k] = 0;
         float logged[3] = {eye[0], ground, eye[2]};
-        rc = write_frame(r, i, t, ms, logged, dir, drawn, keys, NULL, err);
+        rc = asp__exp_write_frame(r, i, t, ms, logged, dir, drawn, keys, NULL, err);
         steer_cmd = steer;
         frac_cmd = frac;
         if (rc)
             break;
         if (st->desc->realtime)
             dt = ms / 1000.0 < 1.0 / 240.0 ? 1.0 / 240.0 : ms / 1000.0 > 0.5 ? 0.5 : ms / 1000.0;
-        yaw += (float)(turn * dt);
-        x += (float)(speed * dt) * sinf(yaw);
-        z += (float)(speed * dt) * cosf(yaw);
         t += dt;
-        float pd[2];
-        float d = asp_experiment_path_nearest(w->path, w->path_count, x, z, &along, pd);
-        if (d > w->half_width) {
-            /* bumped back inside (seed 004 2.3: off the path a warning, then back onto it) */
-            float nx = w->path[0], nz = w->path[2], best = INFINITY;
-            for (size_t s = 0; s < w->path_count; s++) {
-                float ddx = w->path[3 * s] - x, ddz = w->path[3 * s + 2] - z, dd = ddx * ddx + ddz * ddz;
-                if (dd < best) {
-                    best = dd;
-                    nx = w->path[3 * s];
-                    nz = w->path[3 * s + 2];
-                }
-            }
-            x = nx + 0.6f * (x - nx) * w->half_width / d;
-            z = nz + 0.6f * (z - nz) * w->half_width / d;
-            /* a wall or the path's edge turns the heading halfway back along the path, as a ship slides along a wall */
-            float along_yaw = atan2f(pd[0], pd[1]), diff = along_yaw - yaw;
-            diff = atan2f(sinf(diff), cosf(diff));
-            yaw += 0.5f * diff;
-            r->res.off_path++;
-            rc = write_event(r, t, high ? "collision" : "off_path", NULL, err);
-        }
+        rc = asp__exp_nav_move(r, &x, &z, &yaw, turn, speed, dt, t, &along, err);
         if (!rc && along >= 0.995f)
             break;
     }
@@ -385,11 +373,11 @@ static int run_recognition(exp_run *r, asp_error *err)
     int rc = 0;
     for (size_t i = 0; !rc; i++) {
         asp_camera cam;
-        object_camera(&cam, p, p->origin[r->cond], yaw, pitch, p->scene.distance_radii,
+        asp__exp_object_camera(&cam, p, p->origin[r->cond], yaw, pitch, p->scene.distance_radii,
                       (float)st->width / (float)st->height);
         double ms = 0.0;
         size_t drawn = 0;
-        rc = draw(st, p, r->cond, &cam, backdrop, &img, &ms, &drawn, err);
+        rc = asp__exp_draw(st, p, r->cond, &cam, asp__exp_backdrop, &img, &ms, &drawn, err);
         if (rc)
             break;
         int deciding = t_recognised < 0.0;
@@ -402,12 +390,12 @@ static int run_recognition(exp_run *r, asp_error *err)
             eye[k] = (float)(eye[k] + p->origin[r->cond][k]);
         }
         float rot[2] = {yaw, pitch};
-        rc = write_frame(r, i, t, ms, eye, dir, drawn, deciding ? "D" : "", rot, err);
+        rc = asp__exp_write_frame(r, i, t, ms, eye, dir, drawn, deciding ? "D" : "", rot, err);
         if (rc)
             break;
         if (deciding) {
             exp_features f;
-            asp__exp_features(&img, backdrop, &f);
+            asp__exp_features(&img, asp__exp_backdrop, &f);
             if (!f.empty) {
                 for (size_t c = 0; c < nc; c++) {
                     float s = 0.0f;
@@ -433,7 +421,7 @@ static int run_recognition(exp_run *r, asp_error *err)
                 t_recognised = t + dt;
                 naming = 0.7 + 0.08 * (double)strlen(st->scenes.candidates[b].name) +
                          1.5 * (1.0 - fmin(1.0, confidence / (2.0 * threshold))) + 0.1 * fabs(gauss(&r->rng));
-                rc = write_event(r, t_recognised, "recognised", NULL, err);
+                rc = asp__exp_write_event(r, t_recognised, "recognised", NULL, err);
             } else {
                 yaw += (float)(turn_rate * dt);
             }
@@ -443,7 +431,7 @@ static int run_recognition(exp_run *r, asp_error *err)
             r->res.correct = strcmp(answer, p->model_name) == 0;
             r->res.recognition_s = t_recognised;
             r->res.naming_s = t + dt - t_recognised;
-            rc = write_event(r, t + dt, "answer", answer, err);
+            rc = asp__exp_write_event(r, t + dt, "answer", answer, err);
             t += dt;
             break;
         }
@@ -453,7 +441,7 @@ static int run_recognition(exp_run *r, asp_error *err)
     return rc;
 }
 
-static int append_answer(exp_run *r, const char *subject_dir, asp_error *err)
+int asp__exp_append_answer(exp_run *r, const char *subject_dir, asp_error *err)
 {
     char path[4200];
     pathf(path, sizeof path, "%s/answers.jsonl", subject_dir);
@@ -503,17 +491,26 @@ static int run_one(exp_study *st, const char *subject, size_t subject_index, con
     int rc = asp__exp_log_open(&r.log, path, err);
     if (rc)
         return rc;
-    rc = write_header(&r, variable, err);
+    rc = asp__exp_write_header(&r, variable, err);
     double t_end = 0.0;
-    if (!rc)
-        rc = test <= ASP_EXPERIMENT_NEAR ? run_recognition(&r, err) : run_navigation(&r, err);
+    if (!rc && !st->desc->observer)
+        rc = asp__exp_window_instructions(st, test, 0, err);
+    if (!rc && !st->aborted) {
+        if (st->desc->observer)
+            rc = test <= ASP_EXPERIMENT_NEAR ? run_recognition(&r, err) : run_navigation(&r, err);
+        else
+            rc = test <= ASP_EXPERIMENT_NEAR ? asp__exp_window_recognition(&r, err)
+                                             : asp__exp_window_navigation(&r, err);
+    } else if (!rc) {
+        rc = asp__exp_write_event(&r, 0.0, "abort", NULL, err);
+    }
     if (!rc) {
-        t_end = (double)r.res.frames * FIXED_DT;
-        rc = write_event(&r, t_end, "end", NULL, err);
+        t_end = st->desc->observer ? (double)r.res.frames * FIXED_DT : r.last_t;
+        rc = asp__exp_write_event(&r, t_end, "end", NULL, err);
     }
     asp__exp_log_close(&r.log);
-    if (!rc && test <= ASP_EXPERIMENT_NEAR)
-        rc = append_answer(&r, subject_dir, err);
+    if (!rc && test <= ASP_EXPERIMENT_NEAR && r.res.answer[0])
+        rc = asp__exp_append_answer(&r, subject_dir, err);
     if (rc)
         return rc;
     r.res.mean_frame_ms = r.res.frames ? r.frame_ms_sum / (double)r.res.frames : 0.0;
@@ -550,14 +547,14 @@ static int make_references(exp_study *st, asp_error *err)
         for (int y = 0; y < EXP_REF_YAWS && !rc; y++) {
             tmp.renderer[0] = rend;
             asp_camera cam;
-            object_camera(&cam, &tmp, mesh->origin, 360.0f * (float)y / EXP_REF_YAWS, 15.0f, 0.0f,
+            asp__exp_object_camera(&cam, &tmp, mesh->origin, 360.0f * (float)y / EXP_REF_YAWS, 15.0f, 0.0f,
                           (float)st->width / (float)st->height);
             asp_image img = {0};
             double ms;
             size_t drawn;
-            rc = draw(st, &tmp, ASP_EXPERIMENT_POLYGONS, &cam, backdrop, &img, &ms, &drawn, err);
+            rc = asp__exp_draw(st, &tmp, ASP_EXPERIMENT_POLYGONS, &cam, asp__exp_backdrop, &img, &ms, &drawn, err);
             if (!rc)
-                asp__exp_features(&img, backdrop, &st->refs.f[c][y]);
+                asp__exp_features(&img, asp__exp_backdrop, &st->refs.f[c][y]);
             asp_image_release(&img);
         }
         asp_renderer_destroy(rend);
@@ -633,21 +630,21 @@ static int write_screenshots(exp_study *st, asp_error *err)
         exp_prepared *p = &st->prep[t];
         for (int c = 0; c < ASP_EXPERIMENT_CONDITION_COUNT && !rc; c++) {
             asp_camera cam;
-            const uint8_t *bg = p->scene.kind ? sky : backdrop;
+            const uint8_t *bg = p->scene.kind ? asp__exp_sky : asp__exp_backdrop;
             if (p->scene.kind) {
                 const asp_experiment_world *w = &p->world;
                 float yaw = atan2f(w->path[3 * 6] - w->path[0], w->path[3 * 6 + 2] - w->path[2]);
                 float eye[3] = {w->path[0], w->path[1] + p->scene.eye_height, w->path[2]};
-                first_person(&cam, p->origin[c], eye, yaw, (t == ASP_EXPERIMENT_HIGHSPEED ? -8.0f : -14.0f) * DEG,
+                asp__exp_first_person(&cam, p->origin[c], eye, yaw, (t == ASP_EXPERIMENT_HIGHSPEED ? -8.0f : -14.0f) * DEG,
                              (float)st->width / (float)st->height, 1.5f * w->size);
             } else {
-                object_camera(&cam, p, p->origin[c], 30.0f, 15.0f, p->scene.distance_radii,
+                asp__exp_object_camera(&cam, p, p->origin[c], 30.0f, 15.0f, p->scene.distance_radii,
                               (float)st->width / (float)st->height);
             }
             asp_image img = {0};
             double ms;
             size_t drawn;
-            rc = draw(st, p, (asp_experiment_condition)c, &cam, bg, &img, &ms, &drawn, err);
+            rc = asp__exp_draw(st, p, (asp_experiment_condition)c, &cam, bg, &img, &ms, &drawn, err);
             char path[4300];
             pathf(path, sizeof path, "%s/%s-%s.png", st->desc->screenshots_dir,
                      asp_experiment_test_name((asp_experiment_test)t),
@@ -687,6 +684,23 @@ static int has_logs(const char *dir)
     return exists(path);
 }
 
+/* a person's practice: a quarter of the walking test in polygons, shown but not logged */
+static int practice(exp_study *st, asp_error *err)
+{
+    exp_run r;
+    memset(&r, 0, sizeof r);
+    r.st = st;
+    r.p = &st->prep[ASP_EXPERIMENT_LOWSPEED];
+    r.test = ASP_EXPERIMENT_LOWSPEED;
+    r.cond = ASP_EXPERIMENT_POLYGONS;
+    r.run = 'A';
+    r.subject = "practice";
+    int rc = asp__exp_window_instructions(st, ASP_EXPERIMENT_LOWSPEED, 1, err);
+    if (!rc && !st->aborted)
+        rc = asp__exp_window_navigation(&r, err); // r.log.fp NULL: nothing is written
+    return rc;
+}
+
 int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, asp_error *err)
 {
     ASP_ASSERT(desc);
@@ -695,9 +709,8 @@ int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, 
     if ((desc->cache_dir && strlen(desc->cache_dir) >= 2048) ||
         (desc->screenshots_dir && strlen(desc->screenshots_dir) >= 2048))
         return asp_error_set(err, ASP_EINVAL, "cache or screenshot directory over 2047 bytes");
-    if (!desc->observer)
-        return asp_error_set(err, ASP_EUNSUPPORTED,
-                             "the window for people is not built yet: run with the machine observer (--observer)");
+    if (!desc->observer && !desc->subject)
+        return asp_error_set(err, ASP_EINVAL, "a person's session needs a subject id");
     size_t nsubjects = desc->subjects ? desc->subjects : 1;
     if (nsubjects > 999)
         return asp_error_set(err, ASP_EINVAL, "at most 999 subjects, got %zu", nsubjects);
@@ -729,8 +742,8 @@ int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, 
             snprintf(subjects[i], 32, "S%02zu", i + 1);
     st->desc = desc;
     st->ctx = ctx;
-    st->width = desc->width ? desc->width : 160;
-    st->height = desc->height ? desc->height : 120;
+    st->width = desc->width ? desc->width : desc->observer ? 160 : 1024;
+    st->height = desc->height ? desc->height : desc->observer ? 120 : 640;
 
     char path[4200];
     rc = make_dir(desc->output_dir, err);
@@ -761,37 +774,43 @@ int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, 
     if (!rc)
         rc = make_dir(st->cache_dir, err);
     if (!rc)
-        rc = asp_gl_context_create_headless(NULL, ctx, &st->gl, err);
+        rc = desc->observer ? asp_gl_context_create_headless(NULL, ctx, &st->gl, err)
+                            : asp__exp_window_open(st, err);
     for (int t = 0; t < ASP_EXPERIMENT_TEST_COUNT && !rc; t++) {
         say(st, "preparing %s", asp_experiment_test_name((asp_experiment_test)t));
         rc = asp__exp_prepare(&st->scenes, (asp_experiment_test)t, st->cache_dir, desc->short_tests, st->gl, desc,
                               ctx, &st->prep[t], err);
     }
-    if (!rc)
+    if (!rc && desc->observer)
         rc = make_references(st, err);
     pathf(path, sizeof path, "%s/study.json", desc->output_dir);
     if (!rc && !study_exists)
         rc = write_study(st, subjects, nsubjects, path, err);
     if (!rc && desc->screenshots_dir)
         rc = write_screenshots(st, err);
-    for (size_t s = 0; s < nsubjects && !rc; s++) {
+    if (!rc && !desc->observer && desc->practice)
+        rc = practice(st, err);
+    for (size_t s = 0; s < nsubjects && !rc && !st->aborted; s++) {
         asp_experiment_plan plan;
         char dir[4200];
         pathf(dir, sizeof dir, "%s/%s", desc->output_dir, subjects[s]);
         rc = make_dir(dir, err);
         if (!rc)
             rc = asp_experiment_plan_draw(desc->seed, s, variable, nvariable, desc->group_rule, &plan, err);
-        for (int k = 0; k < ASP_EXPERIMENT_TEST_COUNT && !rc; k++) {
+        for (int k = 0; k < ASP_EXPERIMENT_TEST_COUNT && !rc && !st->aborted; k++) {
             asp_experiment_test t = plan.order[k];
             say(st, "%s %s: A polygons, B %s", subjects[s], asp_experiment_test_name(t),
                 asp_experiment_condition_name(plan.run_b[t]));
             rc = run_one(st, subjects[s], s, dir, t, 'A', ASP_EXPERIMENT_POLYGONS, plan.variable[t], err);
-            if (!rc)
+            if (!rc && !st->aborted)
                 rc = run_one(st, subjects[s], s, dir, t, 'B', plan.run_b[t], plan.variable[t], err);
         }
     }
+    if (!rc && st->aborted)
+        say(st, "session stopped by Esc; what was recorded stays");
     for (int t = 0; t < ASP_EXPERIMENT_TEST_COUNT; t++)
         asp__exp_prepared_release(&st->prep[t]);
+    asp__exp_window_close(st);
     asp_gl_context_destroy(st->gl);
     asp_amg_shutdown();
     asp_free(ctx, st);

@@ -142,3 +142,36 @@ expect_exit 0 run -o "$T/a" --resume
 rm "$T/a/S02/far-B.jsonl"
 expect_exit 0 run -o "$T/a" --resume
 head -1 "$T/a/S02/far-B.jsonl" | grep '"type":"header"' >/dev/null || fail "--resume did not rewrite far-B"
+
+# a person's session in a real window (Xvfb + llvmpipe), driven by scripted keys: seed 2 starts with
+# the near test; Enter starts it, W tilts the object, Enter = recognised, "horse" typed, Enter = the
+# answer; the script then runs out, which is Esc: run B is aborted and what was recorded stays
+K=">WWWWWWWWWWWWWWWWWWWWWWWWWWWWWW>horse>"
+person=("$AMGSPLAT" experiment run --subject P-01 --seed 2 --short --cache "$T/cache" -o "$T/p" --size 320x200
+        --keys "$K" --screenshots "$T/pshots")
+if command -v xvfb-run >/dev/null; then
+  expect_exit 0 xvfb-run -a -s "-screen 0 1024x768x24" "${person[@]}"
+elif [[ -n "${DISPLAY:-}" ]]; then
+  expect_exit 0 "${person[@]}"
+else
+  fail "no xvfb-run and no DISPLAY: install xvfb (scripts/bootstrap.sh) to test the window for people"
+fi
+grep -F "stopped by Esc" "$T/err" >/dev/null || fail "no Esc message: $(cat "$T/err")"
+python3 - "$T/p/P-01" <<'PY' || fail "person log checks"
+import json, sys
+d = sys.argv[1]
+L = [json.loads(l) for l in open(d + "/near-A.jsonl")]
+h = L[0]
+assert h["observer"] is False and h["subject"] == "P-01" and h["condition"] == "polygons", h
+frames = [o for o in L if o["type"] == "frame"]
+ev = [o for o in L if o["type"] == "event"]
+assert [e["what"] for e in ev] == ["recognised", "answer", "end"], ev
+assert ev[1]["text"] == "horse" and ev[1]["t"] > ev[0]["t"]
+assert sum(f["keys"] == "W" for f in frames) == 30 and frames[30]["rot"][1] > frames[0]["rot"][1]
+B = [json.loads(l) for l in open(d + "/near-B.jsonl")]
+assert [o.get("what") for o in B if o["type"] == "event"] == ["abort", "end"], B
+A = [json.loads(l) for l in open(d + "/answers.jsonl")]
+assert len(A) == 1 and A[0]["answer"] == "horse" and A[0]["correct"] is True, A
+PY
+# the instruction screen as the window showed it: light text on a dark screen
+check "$T/pshots/instructions-near.png" "sum(1 for x in range(w) for y in range(h) if px(x, y)[0] > 200) > 500"
