@@ -215,7 +215,7 @@ typedef struct asp_experiment_desc {
     const char *subject;           /* person: the subject id (letters, digits, '-', '_') */
     int short_tests;               /* short runs (CI): a fifth of each time limit, smaller meshes */
     int resume;                    /* add missing runs to existing subject directories */
-    int practice;                  /* person: a short practice run before the tests, not logged */
+    int practice;                  /* person: a short practice walk before the tests, not logged */
     uint32_t width, height;        /* frame size; 0 = 160 x 120 (observer), 1024 x 640 (window) */
     const asp_experiment_condition *variable; /* conditions of the variable group; NULL = points, primitives */
     size_t variable_count;
@@ -243,10 +243,13 @@ typedef struct asp_experiment_desc {
  * frame as docs/experiment-log.md says. The observer runs on a headless
  * context (EGL), the person in a GLFW window. A subject directory that
  * already holds logs is refused unless desc->resume, which runs only the
- * missing logs (answers.jsonl is only ever appended to). Returns 0; ASP_EINVAL
- * (bad desc, or a subject directory with logs, naming it); ASP_EUNSUPPORTED
- * (the window for people: not built yet);
- * ASP_EIO; the loaders' and renderers' errors; ASP_EGL; ASP_ENOMEM.
+ * missing logs (answers.jsonl is only ever appended to). A person's session
+ * runs in a GLFW window on the main thread; Esc ends it early, which is not
+ * an error (the runs logged so far stay). The decomposition may start MPI:
+ * call asp_amg_shutdown once at exit, as after asp_amg_decompose.
+ * Returns 0; ASP_EINVAL (bad desc, or a subject directory that holds logs,
+ * naming it); ASP_EIO; ASP_EFORMAT (the scene file); the loaders' and
+ * renderers' errors; ASP_EGL (no context or window); ASP_ENOMEM.
  */
 int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, asp_error *err);
 

@@ -178,6 +178,7 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
     d.user = &table;
     asp_error err = {0};
     rc = asp_experiment_run(&d, &env->ctx, &err);
+    asp_amg_shutdown(); // the primitives' decomposition may have started MPI (once per process)
     if (env->json && table.rows)
         printf("]\n");
     if (rc)

@@ -295,7 +295,7 @@ static int run_navigation(exp_run *r, asp_error *err)
     double search = asp__exp_uniform(&r->rng) < 0.5 ? -1.0 : 1.0;
     float x = w->path[0], z = w->path[2];
     float yaw = atan2f(w->path[3] - w->path[0], w->path[5] - w->path[2]) + (float)(0.1 * gauss(&r->rng));
-    float steer_cmd = 0.0f, frac_cmd = 1.0f; // nothing seen yet: the first frame goes straight ahead
+    float steer_cmd = 0.0f, frac_cmd = 0.0f; // one frame late: before the first frame it has seen nothing, so it waits
     asp_image img = {0};
     char keys[4];
     int rc = 0;
@@ -812,7 +812,6 @@ int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, 
         asp__exp_prepared_release(&st->prep[t]);
     asp__exp_window_close(st);
     asp_gl_context_destroy(st->gl);
-    asp_amg_shutdown();
     asp_free(ctx, st);
     asp_free(ctx, subjects);
     return rc;
