@@ -1,0 +1,110 @@
+// Screenshot of the web viewer in headless Chromium (docs/web.md):
+//   node web/test/screenshot.mjs FILE.glb OUT.png [--view AZ,EL[,DIST]] [--size WxH] [--bg R,G,B]
+//        [--method normalized|blend-all|gltf] [--light off|head] [--level NAME] [--chromium PATH]
+// Serves web/ and FILE over a throwaway HTTP server on 127.0.0.1, opens index.html with the URL
+// parameters, waits until the viewer reports ready, and writes the canvas as PNG. Exit 1 when the
+// page reports an error (printed), 2 on usage errors.
+import fs from 'node:fs';
+import http from 'node:http';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import puppeteer from 'puppeteer-core';
+
+const webRoot = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
+const usage = 'usage: node web/test/screenshot.mjs FILE.glb OUT.png [--view AZ,EL[,DIST]] [--size WxH] ' +
+  '[--bg R,G,B] [--method M] [--light off|head] [--level NAME] [--chromium PATH]';
+
+function parseArgs(argv) {
+  const o = { view: '30,20', size: '256x256', bg: '255,255,255', method: 'normalized', light: 'off', level: null,
+    chromium: process.env.CHROMIUM || '/usr/bin/chromium', pos: [] };
+  for (let i = 0; i < argv.length; i++) {
+    const a = argv[i];
+    if (a.startsWith('--')) {
+      const key = a.slice(2);
+      if (!(key in o) || key === 'pos' || i + 1 >= argv.length) throw new Error(`unknown option or missing value: ${a}`);
+      o[key] = argv[++i];
+    } else o.pos.push(a);
+  }
+  if (o.pos.length !== 2) throw new Error('expected FILE.glb and OUT.png');
+  if (!/^\d+x\d+$/.test(o.size)) throw new Error(`--size expects WxH, got '${o.size}'`);
+  return o;
+}
+
+const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.glb': 'model/gltf-binary',
+  '.gltf': 'model/gltf+json', '.bin': 'application/octet-stream', '.png': 'image/png', '.json': 'application/json' };
+
+// web/ at /, the model's directory at /model/ (so a .gltf finds its .bin and images)
+function serve(modelDir) {
+  const server = http.createServer((req, res) => {
+    const url = decodeURIComponent(new URL(req.url, 'http://localhost').pathname);
+    const [root, rel] = url.startsWith('/model/') ? [modelDir, url.slice(7)] : [webRoot, url.slice(1) || 'index.html'];
+    const file = path.resolve(root, rel);
+    if (!file.startsWith(root + path.sep) || !fs.existsSync(file) || !fs.statSync(file).isFile()) {
+      res.writeHead(404).end('not found');
+      return;
+    }
+    res.writeHead(200, { 'content-type': types[path.extname(file)] || 'application/octet-stream' });
+    fs.createReadStream(file).pipe(res);
+  });
+  return new Promise((resolve) => server.listen(0, '127.0.0.1', () => resolve(server)));
+}
+
+async function main() {
+  let o;
+  try {
+    o = parseArgs(process.argv.slice(2));
+  } catch (e) {
+    console.error(`screenshot: ${e.message}\n${usage}`);
+    process.exit(2);
+  }
+  const [file, out] = o.pos;
+  if (!fs.existsSync(file)) {
+    console.error(`screenshot: cannot read '${file}'`);
+    process.exit(1);
+  }
+  const [w, h] = o.size.split('x').map(Number);
+  const server = await serve(path.resolve(path.dirname(file)));
+  const userDir = fs.mkdtempSync(path.join(process.env.TMPDIR || '/tmp', 'amgsplat-chromium-'));
+  const browser = await puppeteer.launch({
+    executablePath: o.chromium,
+    headless: true,
+    userDataDir: userDir,
+    args: ['--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking',
+      '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  });
+  let code = 0;
+  try {
+    const page = await browser.newPage();
+    const logs = [];
+    page.on('console', (m) => logs.push(`${m.type()}: ${m.text()}`));
+    page.on('pageerror', (e) => logs.push(`pageerror: ${e.message}`));
+    await page.setViewport({ width: w, height: h, deviceScaleFactor: 1 });
+    const q = new URLSearchParams({ file: `/model/${path.basename(file)}`, view: o.view, size: o.size, bg: o.bg,
+      method: o.method, light: o.light, ui: '0' });
+    if (o.level) q.set('level', o.level);
+    const { port } = server.address();
+    await page.goto(`http://127.0.0.1:${port}/index.html?${q}`, { waitUntil: 'load' });
+    await page.waitForFunction('window.amgsplatViewer && window.amgsplatViewer.ready', { timeout: 60000 });
+    const state = await page.evaluate(() => ({ error: window.amgsplatViewer.error, info: window.amgsplatViewer.info }));
+    if (state.error) {
+      console.error(`screenshot: the viewer failed: ${state.error}`);
+      for (const l of logs) console.error(`  ${l}`);
+      code = 1;
+    } else {
+      const canvas = await page.$('canvas');
+      await canvas.screenshot({ path: out, omitBackground: false });
+      console.log(JSON.stringify({ output: out, size: [w, h], ...state.info }));
+      if (process.env.ASP_WEB_DEBUG) for (const l of logs) console.error(`  ${l}`);
+    }
+  } finally {
+    await browser.close();
+    server.close();
+    fs.rmSync(userDir, { recursive: true, force: true });
+  }
+  process.exit(code);
+}
+
+main().catch((e) => {
+  console.error(`screenshot: ${e.message}`);
+  process.exit(1);
+});
