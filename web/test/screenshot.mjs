@@ -91,8 +91,9 @@ async function main() {
       for (const l of logs) console.error(`  ${l}`);
       code = 1;
     } else {
-      const canvas = await page.$('canvas');
-      await canvas.screenshot({ path: out, omitBackground: false });
+      // the canvas's own pixels (preserveDrawingBuffer), as 8-bit RGBA PNG like amgsplat's images
+      const url = await page.evaluate(() => document.querySelector('canvas').toDataURL('image/png'));
+      fs.writeFileSync(out, Buffer.from(url.slice(url.indexOf(',') + 1), 'base64'));
       console.log(JSON.stringify({ output: out, size: [w, h], ...state.info }));
       if (process.env.ASP_WEB_DEBUG) for (const l of logs) console.error(`  ${l}`);
     }
