@@ -64,6 +64,18 @@ if "$AMGSPLAT" render -h 2>&1 | grep -e '--unlit' >/dev/null; then
   ssim "$T/web_unlit.png" "$T/render_unlit.png" 0.9
 fi
 
+# colour: Spot's textured surface (sRGB atlas decoded and blended in linear light on both sides)
+if have_data spot_triangulated.obj spot_texture.png; then
+  "$AMGSPLAT" sample "$ASP_TEST_DATA/spot_triangulated.obj" --texture "$ASP_TEST_DATA/spot_texture.png" --points 30000 \
+    -o "$T/spot.ply" -q
+  ASAN_OPTIONS="$mpi_asan" "$AMGSPLAT" decompose "$T/spot.ply" -o "$T/spot.amg" -q
+  ASAN_OPTIONS="$mpi_asan" "$AMGSPLAT" build "$T/spot.amg" -o "$T/spot.dps" --primitives 400 -q >/dev/null
+  "$AMGSPLAT" export "$T/spot.dps" -o "$T/spot.glb" -q
+  shot "$T/spot.glb" "$T/web_spot.png" --view 60,15 --size 256x256 --light head
+  "$AMGSPLAT" render "$T/spot.dps" -o "$T/render_spot.png" --view 60,15 --size 256x256 --crease-angle off -q
+  ssim "$T/web_spot.png" "$T/render_spot.png" 0.9
+fi
+
 # points: the bunny's 30000 points on black, framed as render frames them
 shot "$T/points.glb" "$T/web_points.png" --view 30,20 --size 256x256 --bg 0,0,0
 python3 "$(dirname "$0")/png_check.py" "$T/web_points.png" \

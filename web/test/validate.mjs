@@ -1,11 +1,11 @@
 // Validates a glTF export with the Khronos glTF-Validator (npm gltf-validator) and exits non-zero on
 // any error, and on any warning other than UNSUPPORTED_EXTENSION (docs/web.md).
-//   node web/test/validate.mjs FILE.glb|FILE.gltf [--json]
+//   node web/test/validate.mjs FILE.glb|FILE.gltf [--json] [--strict]
 // One exception, named in the output: this validator release predates KHR_gaussian_splatting, so it
 // calls that extension's own attribute semantics ("KHR_gaussian_splatting:SCALE", spec section
 // "Attributes") invalid names (MESH_PRIMITIVE_INVALID_ATTRIBUTE). Such an error is counted as an
 // extension issue, not a failure, only when the attribute is prefixed by an extension that the same
-// report lists as unsupported; any other invalid attribute still fails.
+// report lists as unsupported; any other invalid attribute still fails. --strict fails on those too.
 import fs from 'node:fs';
 import path from 'node:path';
 import validator from 'gltf-validator';
@@ -13,7 +13,7 @@ import validator from 'gltf-validator';
 const args = process.argv.slice(2);
 const file = args.find((a) => !a.startsWith('--'));
 if (!file) {
-  console.error('usage: node web/test/validate.mjs FILE.glb|FILE.gltf [--json]');
+  console.error('usage: node web/test/validate.mjs FILE.glb|FILE.gltf [--json] [--strict]');
   process.exit(2);
 }
 let bytes;
@@ -39,8 +39,9 @@ const messages = report.issues.messages;
 const unsupported = new Set(
   messages.filter((m) => m.code === 'UNSUPPORTED_EXTENSION').map((m) => (m.message.match(/'([^']+)'/) || [])[1]),
 );
+const strict = args.includes('--strict');
 const extensionAttribute = (m) => {
-  if (m.code !== 'MESH_PRIMITIVE_INVALID_ATTRIBUTE') return false;
+  if (strict || m.code !== 'MESH_PRIMITIVE_INVALID_ATTRIBUTE') return false;
   const name = decodeURIComponent((m.pointer || '').split('/').pop());
   const colon = name.indexOf(':');
   return colon > 0 && unsupported.has(name.slice(0, colon));
