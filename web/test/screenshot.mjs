@@ -1,16 +1,14 @@
 // Screenshot of the web viewer in headless Chromium (docs/web.md):
 //   node web/test/screenshot.mjs FILE.glb OUT.png [--view AZ,EL[,DIST]] [--size WxH] [--bg R,G,B]
 //        [--method normalized|blend-all|gltf] [--light off|head] [--level NAME] [--chromium PATH]
-// Serves web/ and FILE over a throwaway HTTP server on 127.0.0.1, opens index.html with the URL
+// Serves web/ and FILE's directory over a throwaway web/serve.mjs server on 127.0.0.1, opens index.html with the URL
 // parameters, waits until the viewer reports ready, and writes the canvas as PNG. Exit 1 when the
 // page reports an error (printed), 2 on usage errors.
 import fs from 'node:fs';
-import http from 'node:http';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 import puppeteer from 'puppeteer-core';
+import { serve } from '../serve.mjs';
 
-const webRoot = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const usage = 'usage: node web/test/screenshot.mjs FILE.glb OUT.png [--view AZ,EL[,DIST]] [--size WxH] ' +
   '[--bg R,G,B] [--method M] [--light off|head] [--level NAME] [--chromium PATH]';
 
@@ -28,25 +26,6 @@ function parseArgs(argv) {
   if (o.pos.length !== 2) throw new Error('expected FILE.glb and OUT.png');
   if (!/^\d+x\d+$/.test(o.size)) throw new Error(`--size expects WxH, got '${o.size}'`);
   return o;
-}
-
-const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.glb': 'model/gltf-binary',
-  '.gltf': 'model/gltf+json', '.bin': 'application/octet-stream', '.png': 'image/png', '.json': 'application/json' };
-
-// web/ at /, the model's directory at /model/ (so a .gltf finds its .bin and images)
-function serve(modelDir) {
-  const server = http.createServer((req, res) => {
-    const url = decodeURIComponent(new URL(req.url, 'http://localhost').pathname);
-    const [root, rel] = url.startsWith('/model/') ? [modelDir, url.slice(7)] : [webRoot, url.slice(1) || 'index.html'];
-    const file = path.resolve(root, rel);
-    if (!file.startsWith(root + path.sep) || !fs.existsSync(file) || !fs.statSync(file).isFile()) {
-      res.writeHead(404).end('not found');
-      return;
-    }
-    res.writeHead(200, { 'content-type': types[path.extname(file)] || 'application/octet-stream' });
-    fs.createReadStream(file).pipe(res);
-  });
-  return new Promise((resolve) => server.listen(0, '127.0.0.1', () => resolve(server)));
 }
 
 async function main() {
