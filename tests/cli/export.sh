@@ -110,6 +110,16 @@ assert set(pt['attributes']) >= {'POSITION', 'NORMAL', 'COLOR_0', 'KHR_gaussian_
 " "$T" "$level" || fail "bunny exports: $(cat "$T/b.json")"
   [[ -s "$T/bn.bin" && -s "$T/bn_${level}_atlas.png" && -s "$T/bn_${level}_normal.png" ]] || fail "bn.gltf: files missing"
   expect_fail 1 "no level 'L-9'" "$AMGSPLAT" export "$T/multi.dps" -o "$T/x.glb" --level L-9
+  expect_fail 2 "names level 'L-4' twice" "$AMGSPLAT" export "$T/multi.dps" -o "$T/x.glb" --level L-4,L-4
+  "$AMGSPLAT" export "$T/multi.dps" -o "$T/two.glb" --level L-2,L-6 --json >"$T/two.json"
+  python3 -c "
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r['nodes'] == 2 and r['primitives'] > 18 + 96, r" "$T/two.json" ||
+    fail "--level L-2,L-6: $(cat "$T/two.json")"
+  head -c 5000 "$T/b.dps" >"$T/cut.dps"
+  expect_fail 1 "cut.dps" "$AMGSPLAT" export "$T/cut.dps" -o "$T/x.glb"
+  [[ ! -e "$T/x.glb" ]] || fail "a failed export left an output file"
   for f in b.glb bn.glb bn.gltf mask.glb multi.glb points.glb; do validate "$T/$f"; done
 
   # a .hier (written by tools/seed_hier: no command saves one)
