@@ -202,6 +202,16 @@ class Viewer {
     const loader = new GLTFLoader();
     const gltf = await loader.parseAsync(buffer, resourcePath);
     this.gltf = gltf;
+    // an unlit material (KHR_materials_unlit) becomes a MeshBasicMaterial, which drops the
+    // normalTexture: fetch those textures here for the headlight (light=head)
+    this.normalMaps = new Map();
+    const defs = gltf.parser.json.materials || [];
+    for (let i = 0; i < defs.length; i++)
+      if (defs[i].normalTexture) {
+        const t = await gltf.parser.getDependency('texture', defs[i].normalTexture.index);
+        t.colorSpace = THREE.NoColorSpace; // data, not colour
+        this.normalMaps.set(i, t);
+      }
     const levels = document.getElementById('level');
     levels.replaceChildren(...gltf.scenes.map((s, i) => new Option(s.name || `scene ${i}`, i)));
     let index = gltf.scenes.indexOf(gltf.scene);
@@ -258,7 +268,8 @@ class Viewer {
     const gltfMaterial = mesh.material;
     const extras = mesh.userData.amgsplat || {};
     const map = gltfMaterial.map;
-    const normalMap = gltfMaterial.normalMap || null;
+    const assoc = this.gltf.parser.associations.get(gltfMaterial);
+    const normalMap = (assoc && this.normalMaps.get(assoc.materials)) || gltfMaterial.normalMap || null;
     const depth = new THREE.RawShaderMaterial({
       glslVersion: THREE.GLSL3,
       vertexShader: quadVertex,
