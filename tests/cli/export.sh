@@ -108,6 +108,17 @@ pt = g['points']['meshes'][0]['primitives'][0]
 assert pt['mode'] == 0 and g['points']['accessors'][pt['attributes']['POSITION']]['count'] == 30000
 assert set(pt['attributes']) >= {'POSITION', 'NORMAL', 'COLOR_0', 'KHR_gaussian_splatting:ROTATION', 'KHR_gaussian_splatting:SCALE'}
 " "$T" "$level" || fail "bunny exports: $(cat "$T/b.json")"
+  # an independent reader (assimp, through amgsplat info) sees the quads in world coordinates
+  "$AMGSPLAT" info "$T/b.glb" --json >"$T/info.json"
+  python3 -c "
+import json, sys
+i = json.load(open(sys.argv[1])); g = json.load(open(sys.argv[2]))
+n = g['meshes'][0]['name'].split('(')[1].split()[0]
+f = g['scenes'][0]['extras']['amgsplat']['frame']
+assert i['kind'] == 'mesh' and i['faces'] == 2 * int(n) and i['textures_found'] == 1, i
+c = [(a + b) / 2 for a, b in zip(i['bbox_min'], i['bbox_max'])]
+assert sum((x - y) ** 2 for x, y in zip(c, f['center'])) ** 0.5 < 0.25 * f['radius'], (c, f)
+" "$T/info.json" "$T/b.gltf.json" || fail "assimp's view of b.glb: $(cat "$T/info.json")"
   [[ -s "$T/bn.bin" && -s "$T/bn_${level}_atlas.png" && -s "$T/bn_${level}_normal.png" ]] || fail "bn.gltf: files missing"
   expect_fail 1 "no level 'L-9'" "$AMGSPLAT" export "$T/multi.dps" -o "$T/x.glb" --level L-9
   expect_fail 2 "names level 'L-4' twice" "$AMGSPLAT" export "$T/multi.dps" -o "$T/x.glb" --level L-4,L-4
