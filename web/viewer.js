@@ -3,7 +3,7 @@
 // orbit, near/far from the sphere) and blends domain primitives as the renderer's methods do
 // (docs/render-methods.md): "normalized" (Pajarola et al. 2003 5.3-5.4: front layer, window,
 // division) or "blend-all" (additive), in linear light; points are drawn as three.js points.
-// URL: ?file=URL&view=AZ,EL[,DIST]&size=WxH&bg=R,G,B&level=NAME&method=M&light=off|head&ui=0
+// URL: ?file=URL&view=AZ,EL[,DIST]&size=WxH&bg=R,G,B&level=NAME&method=M&light=off|head&points=splats|points&ui=0
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -30,6 +30,7 @@ function parseParams() {
     light: p.get('light') === 'head',
     ui: p.get('ui') !== '0',
     pointSize: 1,
+    points: p.get('points') || 'splats',
   };
   if (p.get('view')) o.view = numbers(p.get('view'), 2, 3, 'view').concat([0]).slice(0, 3);
   if (p.get('size')) {
@@ -41,6 +42,8 @@ function parseParams() {
   if (p.get('point-size')) o.pointSize = numbers(p.get('point-size'), 1, 1, 'point-size')[0];
   if (!['normalized', 'blend-all', 'gltf'].includes(o.method))
     throw new Error(`method: expected normalized, blend-all or gltf, got '${o.method}'`);
+  if (!['splats', 'points'].includes(o.points))
+    throw new Error(`points: expected splats or points, got '${o.points}'`);
   if (p.get('light') && !['off', 'head'].includes(p.get('light')))
     throw new Error(`light: expected off or head, got '${p.get('light')}'`);
   return o;
@@ -128,6 +131,63 @@ void main() {
   color = vec4(shade(t.rgb) * t.a, t.a);
 }`;
 
+// Points with KHR_gaussian_splatting ellipses, drawn as amgsplat's splat renderer draws seed 001's
+// (src/render/splat_renderer.c): per splat the triangle around its ellipse (grown 5%), the ellipse
+// = 2 sigma of the Gaussian (export.md); pass 1 writes the depth pushed epsilon = 1 major
+// semi-axis away from the eye (5.3, Fig. 15), pass 2 adds (psi c, psi) of what lies in front of it
+// with psi(r) = exp(-6 (r / 1.5)^3) cut at the rim (4.2, eq. 12), flat headlight per splat.
+const splatVertex = `
+in vec3 position;
+in vec3 center;
+in vec3 axisU;
+in vec3 axisV;
+in vec3 splatNormal;
+in vec4 splatColor;
+uniform mat4 viewMatrix;
+uniform mat4 projectionMatrix;
+uniform vec3 uEye;
+uniform float uEpsilon;
+uniform int uLit;
+out vec2 vLocal;
+out vec3 vColor;
+void main() {
+  vec2 q = position.xy * 1.05;
+  vec3 p = center + q.x * axisU + q.y * axisV;
+  vec3 ray = p - uEye;
+  if (uEpsilon > 0.0 && dot(ray, ray) > 0.0) p += uEpsilon * length(axisU) * normalize(ray);
+  vLocal = q;
+  vec3 n = mat3(viewMatrix) * splatNormal;
+  float shade = dot(n, n) > 0.0 ? 0.25 + 0.75 * abs(normalize(n).z) : 1.0;
+  vColor = splatColor.rgb * (uLit != 0 ? shade : 1.0);
+  gl_Position = projectionMatrix * (viewMatrix * vec4(p, 1.0));
+}`;
+
+const splatDepthFragment = `
+precision highp float;
+in vec2 vLocal;
+in vec3 vColor;
+out vec4 color;
+void main() {
+  if (dot(vLocal, vLocal) > 1.0) discard;
+  color = vec4(1.0);
+}`;
+
+const splatAccumFragment = `
+precision highp float;
+uniform sampler2D frontDepth;
+in vec2 vLocal;
+in vec3 vColor;
+out vec4 color;
+void main() {
+  if (dot(vLocal, vLocal) > 1.0) discard;
+  // the depth test of pass 2 (LEQUAL against the pushed depth), done by hand
+  float front = texelFetch(frontDepth, ivec2(gl_FragCoord.xy), 0).r;
+  if (gl_FragCoord.z > front) discard;
+  float r = min(length(vLocal), 1.0);
+  float w = exp(-6.0 * pow(r / 1.5, 3.0));
+  color = vec4(w * vColor, w);
+}`;
+
 const resolveVertex = `
 in vec3 position;
 void main() { gl_Position = vec4(position.xy, 0.0, 1.0); }`;
@@ -174,6 +234,7 @@ class Viewer {
     this.scene = new THREE.Scene();
     this.gltf = null;
     this.prims = [];
+    this.splats = [];
     this.frame = null;
     this.resize();
     window.addEventListener('resize', () => {
@@ -253,6 +314,11 @@ class Viewer {
       if (o.isMesh && o.material && o.material.map) this.prims.push(this.primitivePasses(o));
       if (o.isPoints) o.material.size = this.opts.pointSize;
     });
+    this.splats = [];
+    src.traverse((o) => {
+      if (o.isPoints && o.geometry.attributes['khr_gaussian_splatting:rotation']) this.splats.push(this.splatPasses(o));
+    });
+    for (const sp of this.splats) src.add(sp.mesh);
     if (extras.frame && extras.frame.radius > 0) {
       const c = new THREE.Vector3(...extras.frame.center).sub(origin);
       this.frame = { center: c, radius: extras.frame.radius };
@@ -303,6 +369,46 @@ class Viewer {
     return { mesh, gltf: gltfMaterial, depth, accum, count: mesh.geometry.index.count / 6 };
   }
 
+  // The splats of a points node: per point its ellipse axes u a, v b from the Gaussian
+  // (rotation columns x, y; semi-axes 2 sigma, export.md), colour (linear), normal.
+  splatPasses(points) {
+    const g = points.geometry, n = g.attributes.position.count;
+    const rot = g.attributes['khr_gaussian_splatting:rotation'], scale = g.attributes['khr_gaussian_splatting:scale'];
+    const U = new Float32Array(3 * n), V = new Float32Array(3 * n), C = new Float32Array(4 * n);
+    for (let i = 0; i < n; i++) {
+      const x = rot.getX(i), y = rot.getY(i), z = rot.getZ(i), w = rot.getW(i);
+      const a = 2 * Math.exp(scale.getX(i)), b = 2 * Math.exp(scale.getY(i));
+      U.set([(1 - 2 * (y * y + z * z)) * a, 2 * (x * y + w * z) * a, 2 * (x * z - w * y) * a], 3 * i);
+      V.set([2 * (x * y - w * z) * b, (1 - 2 * (x * x + z * z)) * b, 2 * (y * z + w * x) * b], 3 * i);
+      const c = g.attributes.color;
+      C.set(c ? [c.getX(i), c.getY(i), c.getZ(i), 1] : [0.578, 0.578, 0.578, 1], 4 * i);
+    }
+    const geo = new THREE.InstancedBufferGeometry();
+    // the equilateral triangle around the unit circle (splat_renderer.c)
+    geo.setAttribute('position', new THREE.Float32BufferAttribute([-1.7320508, -1, 0, 1.7320508, -1, 0, 0, 2, 0], 3));
+    geo.setAttribute('center', new THREE.InstancedBufferAttribute(g.attributes.position.array.slice(0, 3 * n), 3));
+    geo.setAttribute('axisU', new THREE.InstancedBufferAttribute(U, 3));
+    geo.setAttribute('axisV', new THREE.InstancedBufferAttribute(V, 3));
+    const normals = g.attributes.normal ? g.attributes.normal.array.slice(0, 3 * n) : new Float32Array(3 * n);
+    geo.setAttribute('splatNormal', new THREE.InstancedBufferAttribute(normals, 3));
+    geo.setAttribute('splatColor', new THREE.InstancedBufferAttribute(C, 4));
+    geo.instanceCount = n;
+    const uniforms = { uEye: { value: new THREE.Vector3() }, uEpsilon: { value: 1 }, uLit: { value: 0 },
+      frontDepth: { value: this.front.depthTexture } };
+    const common = { glslVersion: THREE.GLSL3, vertexShader: splatVertex, side: THREE.DoubleSide };
+    const depth = new THREE.RawShaderMaterial({ ...common, fragmentShader: splatDepthFragment, uniforms });
+    const accum = new THREE.RawShaderMaterial({
+      ...common, fragmentShader: splatAccumFragment, uniforms,
+      blending: THREE.CustomBlending, blendEquation: THREE.AddEquation, blendSrc: THREE.OneFactor,
+      blendDst: THREE.OneFactor, blendSrcAlpha: THREE.OneFactor, blendDstAlpha: THREE.OneFactor,
+      depthTest: false, depthWrite: false,
+    });
+    const mesh = new THREE.Mesh(geo, depth);
+    mesh.frustumCulled = false;
+    mesh.position.copy(points.position); // the node's (origin-free) translation
+    return { mesh, points, depth, accum, uniforms };
+  }
+
   // asp_camera_fit + orbit_axes (src/render/camera.c), y up
   fit() {
     const [az, el, dist] = this.opts.view.map((x, i) => (i < 2 ? (x * Math.PI) / 180 : x));
@@ -338,6 +444,34 @@ class Viewer {
     this.clip();
     const r = this.renderer, o = this.opts;
     const bg = new THREE.Color().setRGB(o.bg[0] / 255, o.bg[1] / 255, o.bg[2] / 255, THREE.SRGBColorSpace);
+    const splatting = this.splats.length > 0 && o.points === 'splats';
+    for (const sp of this.splats) {
+      sp.mesh.visible = splatting;
+      sp.points.visible = !splatting;
+    }
+    if (splatting) {
+      this.scene.background = null;
+      for (const sp of this.splats) {
+        sp.uniforms.uEye.value.copy(this.camera.position).sub(sp.mesh.position);
+        sp.uniforms.uLit.value = o.light ? 1 : 0;
+        sp.uniforms.frontDepth.value = this.front.depthTexture;
+        sp.uniforms.uEpsilon.value = 1;
+        sp.mesh.material = sp.depth;
+      }
+      r.setRenderTarget(this.front);
+      r.setClearColor(0x000000, 0);
+      r.clear(true, true, false);
+      r.render(this.scene, this.camera);
+      for (const sp of this.splats) {
+        sp.uniforms.uEpsilon.value = 0;
+        sp.mesh.material = sp.accum;
+      }
+      r.setRenderTarget(this.accum);
+      r.clear(true, false, false);
+      r.render(this.scene, this.camera);
+      this.resolve(true);
+      return;
+    }
     if (this.prims.length === 0 || o.method === 'gltf') {
       for (const p of this.prims) p.mesh.material = p.gltf;
       this.scene.background = bg;
@@ -366,6 +500,12 @@ class Viewer {
     r.setClearColor(0x000000, 0);
     r.clear(true, false, false);
     r.render(this.scene, this.camera);
+    this.resolve(normalized);
+  }
+
+  // the last pass of both: accumulated sums onto the background, in sRGB
+  resolve(normalized) {
+    const r = this.renderer, o = this.opts;
     if (!this.resolveMaterial) {
       this.resolveMaterial = new THREE.RawShaderMaterial({
         glslVersion: THREE.GLSL3,

@@ -1,6 +1,7 @@
 // Screenshot of the web viewer in headless Chromium (docs/web.md):
 //   node web/test/screenshot.mjs FILE.glb OUT.png [--view AZ,EL[,DIST]] [--size WxH] [--bg R,G,B]
-//        [--method normalized|blend-all|gltf] [--light off|head] [--level NAME] [--chromium PATH]
+//        [--method normalized|blend-all|gltf] [--light off|head] [--points splats|points] [--level NAME]
+//        [--chromium PATH]
 // Serves web/ and FILE's directory over a throwaway web/serve.mjs server on 127.0.0.1, opens index.html with the URL
 // parameters, waits until the viewer reports ready, and writes the canvas as PNG. Exit 1 when the
 // page reports an error (printed), 2 on usage errors.
@@ -10,10 +11,10 @@ import puppeteer from 'puppeteer-core';
 import { serve } from '../serve.mjs';
 
 const usage = 'usage: node web/test/screenshot.mjs FILE.glb OUT.png [--view AZ,EL[,DIST]] [--size WxH] ' +
-  '[--bg R,G,B] [--method M] [--light off|head] [--level NAME] [--chromium PATH]';
+  '[--bg R,G,B] [--method M] [--light off|head] [--points splats|points] [--level NAME] [--chromium PATH]';
 
 function parseArgs(argv) {
-  const o = { view: '30,20', size: '256x256', bg: '255,255,255', method: 'normalized', light: 'off', level: null,
+  const o = { view: '30,20', size: '256x256', bg: '255,255,255', method: 'normalized', light: 'off', level: null, points: 'splats',
     chromium: process.env.CHROMIUM || '/usr/bin/chromium', pos: [] };
   for (let i = 0; i < argv.length; i++) {
     const a = argv[i];
@@ -59,7 +60,7 @@ async function main() {
     page.on('pageerror', (e) => logs.push(`pageerror: ${e.message}`));
     await page.setViewport({ width: w, height: h, deviceScaleFactor: 1 });
     const q = new URLSearchParams({ file: `/model/${path.basename(file)}`, view: o.view, size: o.size, bg: o.bg,
-      method: o.method, light: o.light, ui: '0' });
+      method: o.method, light: o.light, points: o.points, ui: '0' });
     if (o.level) q.set('level', o.level);
     const { port } = server.address();
     await page.goto(`http://127.0.0.1:${port}/index.html?${q}`, { waitUntil: 'load' });
