@@ -74,7 +74,7 @@ static void print_result(const struct cli_env *env, const char *in, const char *
         cJSON_AddStringToObject(j, "input", in);
         cJSON_AddStringToObject(j, "output", out);
         cJSON_AddStringToObject(j, "kind", kind);
-        cJSON_AddStringToObject(j, "format", strstr(out, ".gltf") || strstr(out, ".GLTF") ? "gltf" : "glb");
+        cJSON_AddStringToObject(j, "format", asp_file_name_is(out, "gltf") ? "gltf" : "glb");
         cJSON_AddNumberToObject(j, "nodes", (double)st->nodes);
         cJSON_AddNumberToObject(j, "primitives", (double)st->primitives);
         cJSON_AddNumberToObject(j, "points", (double)st->points);
