@@ -4,7 +4,6 @@
  * a BIN chunk padded with zeros, all 4-byte aligned) or a .gltf with a .bin and PNG files.
  */
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include <stb/stb_image_write.h>
@@ -80,7 +79,7 @@ void asp__gltf_release(asp__gltf *g)
     cJSON_Delete(g->root);
     asp_free(g->ctx, g->bin);
     for (size_t i = 0; i < g->png_count; i++)
-        free(g->pngs[i].data);
+        asp_free(g->ctx, g->pngs[i].data);
     asp_free(g->ctx, g->pngs);
     memset(g, 0, sizeof *g);
 }
@@ -181,6 +180,7 @@ int asp__gltf_accessor(asp__gltf *g, int view, int component_type, size_t count,
 }
 
 struct png_sink {
+    const asp_context *ctx;
     unsigned char *data;
     size_t size, capacity;
     int failed;
@@ -195,7 +195,7 @@ static void png_write(void *context, void *data, int size)
         size_t cap = s->capacity ? 2 * s->capacity : 1 << 16;
         while (cap < s->size + (size_t)size)
             cap *= 2;
-        unsigned char *p = realloc(s->data, cap);
+        unsigned char *p = asp_realloc(s->ctx, s->data, s->capacity, cap);
         if (!p) {
             s->failed = 1;
             return;
@@ -209,22 +209,22 @@ static void png_write(void *context, void *data, int size)
 
 int asp__gltf_image(asp__gltf *g, const uint8_t *rgba, uint32_t width, uint32_t height, const char *name)
 {
-    struct png_sink s = {0};
+    struct png_sink s = {.ctx = g->ctx};
     if (!stbi_write_png_to_func(png_write, &s, (int)width, (int)height, 4, rgba, (int)width * 4) || s.failed) {
-        free(s.data);
+        asp_free(g->ctx, s.data);
         g->failed = 1;
         return -1;
     }
     cJSON *img = cJSON_CreateObject();
     if (!img) {
-        free(s.data);
+        asp_free(g->ctx, s.data);
         g->failed = 1;
         return -1;
     }
     cJSON_AddStringToObject(img, "name", name);
     if (g->glb) {
         int view = asp__gltf_view(g, s.data, s.size, 0);
-        free(s.data);
+        asp_free(g->ctx, s.data);
         if (view < 0) {
             cJSON_Delete(img);
             return -1;
@@ -234,7 +234,7 @@ int asp__gltf_image(asp__gltf *g, const uint8_t *rgba, uint32_t width, uint32_t 
     } else {
         asp__gltf_png *p = asp_realloc(g->ctx, g->pngs, g->png_count * sizeof *p, (g->png_count + 1) * sizeof *p);
         if (!p) {
-            free(s.data);
+            asp_free(g->ctx, s.data);
             cJSON_Delete(img);
             g->failed = 1;
             return -1;
@@ -368,27 +368,28 @@ static int write_glb(const char *path, const char *json, const uint8_t *bin, siz
     if (total > UINT32_MAX)
         return asp_error_set(err, ASP_EUNSUPPORTED, "cannot write '%s': %zu bytes exceed the 4 GiB of a GLB file",
                              path, total);
-    uint8_t *head = malloc(12 + 8 + jpad + 8);
-    uint8_t *tail = calloc(1, bpad ? bpad : 1);
-    if (!head || !tail) {
-        free(head);
-        free(tail);
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for the GLB file '%s'", path);
-    }
+    uint8_t head[20], bin_head[8];
     put_u32(head, 0x46546C67u); // "glTF"
     put_u32(head + 4, 2);
     put_u32(head + 8, (uint32_t)total);
     put_u32(head + 12, (uint32_t)jpad);
     put_u32(head + 16, 0x4E4F534Au); // "JSON"
-    memcpy(head + 20, json, jlen);
-    memset(head + 20 + jlen, ' ', jpad - jlen); // the spec pads the JSON chunk with spaces
-    put_u32(head + 20 + jpad, (uint32_t)bpad);
-    put_u32(head + 24 + jpad, 0x004E4942u); // "BIN\0"
-    if (bin_size)
-        memcpy(tail, bin, bin_size);
-    int rc = write_file(path, head, 28 + jpad, tail, bpad, err);
-    free(head);
-    free(tail);
+    put_u32(bin_head, (uint32_t)bpad);
+    put_u32(bin_head + 4, 0x004E4942u); // "BIN\0"
+    static const char spaces[3] = {' ', ' ', ' '}; // the spec pads the JSON chunk with spaces
+    static const uint8_t zeros[3] = {0, 0, 0};      // and the binary chunk with zeros
+    asp__atomic_file f;
+    int rc = asp__atomic_open(&f, path, err);
+    if (rc)
+        return rc;
+    struct { const void *p; size_t n; } parts[] = {{head, 20}, {json, jlen}, {spaces, jpad - jlen}, {bin_head, 8},
+                                                   {bin, bin_size}, {zeros, bpad - bin_size}};
+    for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++)
+        if (parts[i].n && fwrite(parts[i].p, 1, parts[i].n, f.fp) != parts[i].n) {
+            asp__atomic_abort(&f);
+            return asp_error_set(err, ASP_EIO, "cannot write '%s'", path);
+        }
+    rc = asp__atomic_commit(&f, err);
     if (!rc) {
         st->json_bytes = jpad;
         st->bin_bytes = bpad;

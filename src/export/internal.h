@@ -24,7 +24,7 @@ enum {
 };
 
 typedef struct asp__gltf_png {
-    unsigned char *data; /* stbi_write_png_to_mem, freed with free() */
+    unsigned char *data; /* the encoded PNG, through ctx's allocator */
     size_t size;
     char uri[256];       /* file name beside the .gltf */
 } asp__gltf_png;
