@@ -556,6 +556,11 @@ async function main() {
     opts.light = e.target.checked;
     viewer.render();
   };
+  document.getElementById('splats').checked = opts.points === 'splats';
+  document.getElementById('splats').onchange = (e) => {
+    opts.points = e.target.checked ? 'splats' : 'points';
+    viewer.render();
+  };
   document.getElementById('level').onchange = (e) => viewer.gltf && viewer.show(+e.target.value);
   const openFile = (file) =>
     file.arrayBuffer().then((b) => viewer.open(b, file.name)).catch(fail);
