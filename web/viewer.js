@@ -282,10 +282,10 @@ class Viewer {
         throw new Error(`no level '${this.opts.level}' (the file holds ${gltf.scenes.map((s) => s.name).join(', ')})`);
     }
     levels.value = String(Math.max(index, 0));
+    this.name = name;
     this.show(Math.max(index, 0));
+    this.name = name;
     status.info = { file: name, scenes: gltf.scenes.map((s) => s.name), ...this.describe() };
-    document.getElementById('status').textContent =
-      `${name}: ${this.describe().primitives} primitives, ${this.describe().points} points`;
   }
 
   describe() {
@@ -328,6 +328,9 @@ class Viewer {
     }
     this.fit();
     this.render();
+    const d = this.describe();
+    document.getElementById('status').textContent =
+      `${this.name || ''} ${src.name || ''}: ${d.primitives} primitives, ${d.points} points`;
   }
 
   primitivePasses(mesh) {
