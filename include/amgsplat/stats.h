@@ -69,6 +69,12 @@ typedef struct asp_ttest_result {
 int asp_stats_ttest(const asp_stats_summary *a, const asp_stats_summary *b, const asp_ttest_desc *desc,
                     asp_ttest_result *out, asp_error *err);
 
+/**
+ * The level interval of a mean from its summary: mean +- t_{(1+level)/2, n-1}
+ * sd / sqrt(n); *lo = *hi = NaN when n < 2 or level is outside (0, 1). Pure.
+ */
+void asp_stats_mean_interval(const asp_stats_summary *s, double level, double *lo, double *hi);
+
 /* ------------------------------------------------------------------------ */
 /* Navigation grading (src/stats/grade.c; seed 004 2.4, Figs 2.1-2.2)       */
 /* ------------------------------------------------------------------------ */

@@ -17,10 +17,10 @@ static int figures_ok(const asp_stats_summary *s)
     return isfinite(s->mean) && isfinite(s->sd) && s->sd >= 0;
 }
 
-/* Half width of the level interval of a mean: t_{(1+level)/2, n-1} sd / sqrt(n). */
-static void mean_interval(const asp_stats_summary *s, double level, double *lo, double *hi)
+void asp_stats_mean_interval(const asp_stats_summary *s, double level, double *lo, double *hi)
 {
-    if (s->n < 2) {
+    ASP_ASSERT(s && lo && hi);
+    if (s->n < 2 || !(level > 0 && level < 1) || !figures_ok(s)) {
         *lo = *hi = NAN;
         return;
     }
@@ -71,8 +71,8 @@ int asp_stats_ttest(const asp_stats_summary *a, const asp_stats_summary *b, cons
     double h = gsl_cdf_tdist_Pinv(0.5 + 0.5 * d.level, r.df) * r.se;
     r.diff_lo = r.diff - h;
     r.diff_hi = r.diff + h;
-    mean_interval(a, d.level, &r.mean_lo[0], &r.mean_hi[0]);
-    mean_interval(b, d.level, &r.mean_lo[1], &r.mean_hi[1]);
+    asp_stats_mean_interval(a, d.level, &r.mean_lo[0], &r.mean_hi[0]);
+    asp_stats_mean_interval(b, d.level, &r.mean_lo[1], &r.mean_hi[1]);
     *out = r;
     return 0;
 }
