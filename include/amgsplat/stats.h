@@ -167,7 +167,7 @@ typedef struct asp_stats_log {
  * with format "amgsplat-experiment-log 1"; otherwise ASP_EFORMAT naming the
  * file and line 1. A line that is not a complete JSON object (cut off by a
  * crash, or glued to the next by an append after one) counts as a lost frame,
- * never an error. A complete frame or event line missing a required field is
+ * never an error; a complete object glued behind a cut one is still read. A complete frame or event line missing a required field is
  * ASP_EFORMAT naming the file, line and field. Returns 0, ASP_EIO, ASP_EFORMAT
  * or ASP_ENOMEM; on failure log is zeroed. Release with asp_stats_log_release.
  */

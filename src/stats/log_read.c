@@ -171,10 +171,23 @@ static int read_line(asp_stats_log *log, const char *text, size_t line, size_t c
     cJSON *o = cJSON_Parse(text);
     if (!cJSON_IsObject(o)) {
         cJSON_Delete(o);
+        o = NULL;
         if (!log->first_lost_line)
             log->first_lost_line = line;
         log->lost_frames++;
-        return 0;
+        /*
+         * A run resumed after a crash appends to the cut line: the complete object glued
+         * behind the cut one is recovered (the writer prints objects as {"type":...).
+         */
+        const char *glued = NULL;
+        for (const char *q = strstr(text + 1, "{\"type\""); q; q = strstr(q + 1, "{\"type\""))
+            glued = q;
+        if (glued)
+            o = cJSON_Parse(glued);
+        if (!cJSON_IsObject(o)) {
+            cJSON_Delete(o);
+            return 0;
+        }
     }
     const cJSON *type = cJSON_GetObjectItemCaseSensitive(o, "type");
     int rc = 0;
