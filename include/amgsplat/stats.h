@@ -70,6 +70,17 @@ int asp_stats_ttest(const asp_stats_summary *a, const asp_stats_summary *b, cons
                     asp_ttest_result *out, asp_error *err);
 
 /**
+ * One-sample t test of a's mean against mu: t = (mean - mu) / (sd / sqrt(n)),
+ * df = n - 1. On the per-subject differences B - A it is the paired test of
+ * seed 004 2.3 within one group (did run B differ from run A?). out->diff is
+ * mean - mu, the interval is that of mean - mu, mean_lo/hi[0] that of the mean
+ * and [1] NaN; desc->welch is ignored. Returns 0, ASP_EINVAL (n < 2, a
+ * non-finite figure, negative sd) or ASP_EDEGENERATE (sd 0). Thread safe.
+ */
+int asp_stats_ttest_one(const asp_stats_summary *a, double mu, const asp_ttest_desc *desc, asp_ttest_result *out,
+                        asp_error *err);
+
+/**
  * The level interval of a mean from its summary: mean +- t_{(1+level)/2, n-1}
  * sd / sqrt(n); *lo = *hi = NaN when n < 2 or level is outside (0, 1). Pure.
  */

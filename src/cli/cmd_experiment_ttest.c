@@ -16,12 +16,15 @@
 
 static const char usage[] =
     "usage: amgsplat experiment ttest N1,MEAN1,SD1 N2,MEAN2,SD2 [--welch] [--level P] [--json]\n"
+    "       amgsplat experiment ttest N,MEAN,SD [--mu M] [--level P] [--json]\n"
     "\n"
     "Two-sample t test of MEAN1 - MEAN2 from summary figures (SD: sample standard deviations).\n"
     "By default the pooled-variance test of seed 004 section 4.2 (df = N1 + N2 - 2); --welch\n"
     "gives Welch's test (Welch-Satterthwaite df), which does not assume equal variances.\n"
     "Prints t, df, the one-sided p-values of both alternatives and the two-sided one, and\n"
     "P-level confidence intervals (default 0.95) of the difference and of each mean.\n"
+    "With one sample: the one-sample t test of MEAN - M (default M = 0, df = N - 1), which on\n"
+    "per-subject differences B - A is the paired test (did run B differ from run A?).\n"
     "Example (seed 004 Table 4.7): amgsplat experiment ttest 5,7.6,5.0 6,-8.9,23.6";
 
 /* "N,MEAN,SD" with N a whole number >= 1 and SD >= 0 */
@@ -36,12 +39,14 @@ static int parse_sample(struct cli_env *env, const char *s, int which, asp_stats
     return 0;
 }
 
-static void print_json(const asp_stats_summary s[2], const asp_ttest_result *r)
+static void print_json(const asp_stats_summary s[2], int nsamples, double mu, const asp_ttest_result *r)
 {
     cJSON *o = cJSON_CreateObject();
-    cJSON_AddStringToObject(o, "test", r->welch ? "welch" : "pooled");
+    cJSON_AddStringToObject(o, "test", nsamples == 1 ? "one-sample" : r->welch ? "welch" : "pooled");
+    if (nsamples == 1)
+        cJSON_AddNumberToObject(o, "mu", mu);
     cJSON *samples = cJSON_AddArrayToObject(o, "samples");
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < nsamples; k++) {
         cJSON *x = cJSON_CreateObject();
         cJSON_AddNumberToObject(x, "n", (double)s[k].n);
         cJSON_AddNumberToObject(x, "mean", s[k].mean);
@@ -73,30 +78,44 @@ static void print_json(const asp_stats_summary s[2], const asp_ttest_result *r)
 int cmd_experiment_ttest(int argc, char **argv, struct cli_env *env)
 {
     int welch = 0;
-    double level = 0.95;
+    double level = 0.95, mu = 0;
     const struct cli_option opts[] = {
         {"welch", 'w', CLI_FLAG, &welch, NULL, "Welch's test (unequal variances) instead of the pooled one"},
         {"level", 0, CLI_DOUBLE, &level, "P", "confidence level of the intervals, 0 < P < 1 (default 0.95)"},
+        {"mu", 0, CLI_DOUBLE, &mu, "M", "one sample: the mean it is tested against (default 0)"},
         {0},
     };
     int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
     if (rc)
         return rc > 0 ? 0 : 2;
-    if (npos != 2)
-        return cli_usage_error(env, "expected two samples N,MEAN,SD, got %d; see 'amgsplat experiment ttest -h'",
+    if (npos != 1 && npos != 2)
+        return cli_usage_error(env, "expected one or two samples N,MEAN,SD, got %d; see 'amgsplat experiment ttest -h'",
                                npos);
+    if (npos == 1 && welch)
+        return cli_usage_error(env, "--welch compares two samples; one was given");
+    if (!isfinite(mu))
+        return cli_usage_error(env, "--mu expects a finite number");
     if (!(level > 0 && level < 1))
         return cli_usage_error(env, "--level expects a probability between 0 and 1, got %g", level);
     asp_stats_summary s[2];
-    for (int k = 0; k < 2; k++)
+    for (int k = 0; k < npos; k++)
         if ((rc = parse_sample(env, argv[k], k + 1, &s[k])) != 0)
             return rc;
     asp_ttest_result r;
     asp_error err = {0};
-    if (asp_stats_ttest(&s[0], &s[1], &(asp_ttest_desc){.welch = welch, .level = level}, &r, &err))
+    const asp_ttest_desc desc = {.welch = welch, .level = level};
+    if (npos == 1 ? asp_stats_ttest_one(&s[0], mu, &desc, &r, &err) : asp_stats_ttest(&s[0], &s[1], &desc, &r, &err))
         return cli_fail(env, &err);
     if (env->json) {
-        print_json(s, &r);
+        print_json(s, npos, mu, &r);
+        return 0;
+    }
+    if (npos == 1) {
+        printf("one-sample t test: mean - %.6g = %.6g (standard error %.6g)\n", mu, r.diff, r.se);
+        printf("t = %.4f, df = %.0f\n", r.t, r.df);
+        printf("one-sided p = %.4g (alternative mean %s %.6g); two-sided p = %.4g\n", r.p_one,
+               r.p_greater <= r.p_less ? ">" : "<", mu, r.p_two);
+        printf("%g%% interval of the mean: %.6g .. %.6g\n", 100 * level, r.mean_lo[0], r.mean_hi[0]);
         return 0;
     }
     printf("%s: mean1 - mean2 = %.6g (standard error %.6g)\n",

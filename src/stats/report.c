@@ -713,6 +713,26 @@ static void section_navigation_test(struct report *r, const char *test, cJSON *n
             cJSON_AddStringToObject(o, "group", g[k].name);
             cJSON_AddItemToArray(imps, o);
         }
+        // within each group: did run B differ from run A? (one-sample t on the paired differences)
+        fprintf(md, "\nRun B against run A within each group (paired: one-sample t of the improvements against 0; "
+                    "p one-sided in the direction of the change):\n\n| group | n | mean change | t | df | p | %g%% "
+                    "interval |\n|---|---:|---:|---:|---:|---:|---|\n",
+                100 * a->level);
+        cJSON *paired = cJSON_AddArrayToObject(tj, "paired");
+        for (size_t k = 0; k < ng; k++) {
+            asp_ttest_result pr;
+            if (asp_stats_ttest_one(&si[k], 0, &(asp_ttest_desc){.level = a->level}, &pr, NULL)) {
+                fprintf(md, "| %s | %zu | %s | - | - | - | - |\n", g[k].name, si[k].n, cell(b[0], 32, si[k].mean, 1));
+                continue;
+            }
+            fprintf(md, "| %s | %zu | %s | %s | %s | %s | %s .. %s |\n", g[k].name, si[k].n, cell(b[0], 32, pr.diff, 1),
+                    cell(b[1], 32, pr.t, 3), cell(b[2], 32, pr.df, 0), p_cell(b[3], 32, pr.p_one),
+                    cell(b[4], 32, pr.diff_lo, 1), cell(b[5], 32, pr.diff_hi, 1));
+            cJSON *o = json_ttest(&pr);
+            cJSON_ReplaceItemInObject(o, "test", cJSON_CreateString("paired"));
+            cJSON_AddStringToObject(o, "group", g[k].name);
+            cJSON_AddItemToArray(paired, o);
+        }
         if (ng && !strcmp(g[0].name, "control")) {
             fprintf(md, "\nControl against each variable group (alternative of seed 004 4.3: the control group "
                         "improves more; one-sided p = P(T >= t)), and run B alone:\n\n| compared | variable group | "

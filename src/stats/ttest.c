@@ -76,3 +76,32 @@ int asp_stats_ttest(const asp_stats_summary *a, const asp_stats_summary *b, cons
     *out = r;
     return 0;
 }
+
+int asp_stats_ttest_one(const asp_stats_summary *a, double mu, const asp_ttest_desc *desc, asp_ttest_result *out,
+                        asp_error *err)
+{
+    ASP_ASSERT(a && out);
+    double level = desc && desc->level != 0 ? desc->level : 0.95;
+    if (!(level > 0 && level < 1))
+        return asp_error_set(err, ASP_EINVAL, "confidence level %g is outside (0, 1)", level);
+    if (!figures_ok(a) || !isfinite(mu))
+        return asp_error_set(err, ASP_EINVAL, "the sample has a non-finite mean or a negative or non-finite sd");
+    if (a->n < 2)
+        return asp_error_set(err, ASP_EINVAL, "a one-sample t test needs n >= 2, got %zu", a->n);
+    asp_ttest_result r = {.level = level, .diff = a->mean - mu, .df = (double)(a->n - 1)};
+    r.se = a->sd / sqrt((double)a->n);
+    if (!(r.se > 0))
+        return asp_error_set(err, ASP_EDEGENERATE, "standard error is 0: the sample has sd 0");
+    r.t = r.diff / r.se;
+    r.p_greater = gsl_cdf_tdist_Q(r.t, r.df);
+    r.p_less = gsl_cdf_tdist_P(r.t, r.df);
+    r.p_one = r.p_greater < r.p_less ? r.p_greater : r.p_less;
+    r.p_two = 2 * r.p_one > 1 ? 1 : 2 * r.p_one;
+    double h = gsl_cdf_tdist_Pinv(0.5 + 0.5 * level, r.df) * r.se;
+    r.diff_lo = r.diff - h;
+    r.diff_hi = r.diff + h;
+    asp_stats_mean_interval(a, level, &r.mean_lo[0], &r.mean_hi[0]);
+    r.mean_lo[1] = r.mean_hi[1] = NAN;
+    *out = r;
+    return 0;
+}

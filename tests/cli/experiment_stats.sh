@@ -28,6 +28,12 @@ import json,sys; r=json.load(open('$T/out'))
 assert r['test']=='welch' and abs(r['t']-1.6682)<1e-3 and abs(r['df']-5.533)<1e-3, r" || fail "ttest --welch"
 expect_exit 0 "$AMGSPLAT" experiment ttest 10,8.7,8.1 5,-4.3,19.7
 grep -F 't = 1.8487, df = 13' "$T/out" >/dev/null || fail "Table 4.5 text output: $(cat "$T/out")"
+# one sample: the paired test of differences against 0 (t_{0.975,3} = 3.182: p 0.025)
+expect_exit 0 "$AMGSPLAT" experiment ttest 4,3.182,2 --json
+python3 -c "
+import json; r=json.load(open('$T/out'))
+assert r['test']=='one-sample' and r['df']==3 and abs(r['t']-3.182)<1e-9 and abs(r['p_greater']-0.025)<1e-4, r" || fail "one-sample ttest"
+expect_fail 2 "--welch compares two samples" "$AMGSPLAT" experiment ttest 4,3,2 --welch
 expect_fail 2 "expected N,MEAN,SD" "$AMGSPLAT" experiment ttest 5,7.6 6,-8.9,23.6
 expect_fail 2 "expected N,MEAN,SD" "$AMGSPLAT" experiment ttest 2.5,1,1 6,-8.9,23.6
 expect_fail 2 "--level" "$AMGSPLAT" experiment ttest 5,1,1 6,2,1 --level 1.5
@@ -64,6 +70,9 @@ t = [x for x in nav["tests"] if x["compared"] == "improvement"][0]
 assert abs(t["pooled"]["t"] - 40 / math.sqrt(50)) < 1e-9 and t["pooled"]["df"] == 2, t
 assert 0.01 < t["pooled"]["p_greater"] < 0.02, t
 assert t["welch"]["diff_ci"][0] > 0
+paired = {p["group"]: p for p in nav["paired"]}
+# variable: -20, -30: mean -25, se 5, t = -5 with 1 df
+assert abs(paired["variable points"]["t"] + 5) < 1e-9 and paired["variable points"]["df"] == 1, paired
 # recognition, run B: far polygons 1.0 and 1.4 s; points 2.0 s correct, S04 "dog" wrong
 rec = {(x["test"], x["condition"]): x for x in r["recognition"]["rows"]}
 far_poly, far_pts = rec[("far", "polygons")], rec[("far", "points")]

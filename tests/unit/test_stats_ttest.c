@@ -120,6 +120,26 @@ static void test_seed_table_4_5(void)
     CHECK(printed.p_greater > 0.05);
 }
 
+/* One-sample (paired) test: t_{0.975, 3} = 3.182, so mean 3.182 with sd 2 and n 4 (se 1) has p 0.025. */
+static void test_one_sample(void)
+{
+    asp_stats_summary a = fig(4, 3.182 + 1, 2);
+    asp_ttest_result r;
+    asp_error err = {0};
+    CHECK_OK(asp_stats_ttest_one(&a, 1, NULL, &r, &err), &err);
+    CHECK_NEAR(r.diff, 3.182, 1e-12);
+    CHECK_NEAR(r.se, 1, 1e-12);
+    CHECK_NEAR(r.t, 3.182, 1e-12);
+    CHECK_NEAR(r.df, 3, 0);
+    CHECK_NEAR(r.p_greater, 0.025, 5e-5);
+    CHECK_NEAR(r.diff_lo, 0, 1e-3);
+    CHECK_NEAR(r.mean_lo[0], 1, 1e-3);
+    CHECK(isnan(r.mean_lo[1]));
+    asp_stats_summary one = fig(1, 1, 0), flat = fig(3, 1, 0);
+    CHECK(asp_stats_ttest_one(&one, 0, NULL, &r, &err) == ASP_EINVAL);
+    CHECK(asp_stats_ttest_one(&flat, 0, NULL, &r, &err) == ASP_EDEGENERATE);
+}
+
 static void test_bad_input(void)
 {
     asp_stats_summary a = fig(5, 1, 1), b = fig(5, 1, -1), one = fig(1, 0, 0), zero = fig(4, 2, 0);
@@ -141,4 +161,5 @@ static void test_bad_input(void)
 }
 
 TEST_MAIN(TEST_CASE(test_summary), TEST_CASE(test_known_quantiles), TEST_CASE(test_seed_table_4_7),
-          TEST_CASE(test_seed_table_4_3), TEST_CASE(test_seed_table_4_5), TEST_CASE(test_bad_input))
+          TEST_CASE(test_seed_table_4_3), TEST_CASE(test_seed_table_4_5), TEST_CASE(test_one_sample),
+          TEST_CASE(test_bad_input))
