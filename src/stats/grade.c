@@ -58,6 +58,11 @@ double asp_stats_grade_step(const float *path, size_t count, double half_width, 
     // below a millionth of the path width a step is numerical noise, not movement
     if (!(m > 1e-6 * half_width))
         goto done;
+    if (!isfinite(m)) { // coordinates so far apart their difference overflows: nowhere near the path
+        v = ASP_GRADE_OUT;
+        score = 0;
+        goto done;
+    }
     double u[2] = {mx / m, mz / m}, t[2], o[2];
     nearest_segment(path, count, from[0], from[2], t, o);
     if (distance_to_path(path, count, to[0], to[2]) > half_width) {
