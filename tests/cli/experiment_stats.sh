@@ -46,7 +46,9 @@ import json, sys, math
 summary = json.load(open(sys.argv[1]))
 assert summary["logs"] == 24 and summary["subjects"] == 4, summary
 assert summary["lost_frames"] == 2, summary
-r = json.load(open(sys.argv[2] + "/report.json"))
+def strict(c):
+    raise ValueError("report.json holds %s, which JSON does not have" % c)
+r = json.load(open(sys.argv[2] + "/report.json"), parse_constant=strict)
 assert r["format"] == "amgsplat-experiment-report 1"
 assert r["counts"]["lost_frames"] == 2 and r["counts"]["answers"] == 16
 assert r["counts"]["answers_mismatch"] == 0, r["counts"]
