@@ -46,14 +46,14 @@ typedef struct asp_ttest_desc {
 /** Result of a two-sample t test of mean1 - mean2. */
 typedef struct asp_ttest_result {
     int welch;
-    double diff;        /* mean1 - mean2 */
-    double se;          /* standard error of diff */
-    double t, df;       /* df is fractional for Welch */
-    double p_greater;   /* one-sided, alternative mean1 > mean2: P(T >= t) */
-    double p_less;      /* one-sided, alternative mean1 < mean2: P(T <= t) */
-    double p_one;       /* one-sided in the direction of the observed difference: min(p_greater, p_less) */
-    double p_two;       /* two-sided */
-    double level;       /* confidence level of the intervals */
+    double diff;                   /* mean1 - mean2 */
+    double se;                     /* standard error of diff */
+    double t, df;                  /* df is fractional for Welch */
+    double p_greater;              /* one-sided, alternative mean1 > mean2: P(T >= t) */
+    double p_less;                 /* one-sided, alternative mean1 < mean2: P(T <= t) */
+    double p_one;                  /* one-sided in the direction of the observed difference: min(p_greater, p_less) */
+    double p_two;                  /* two-sided */
+    double level;                  /* confidence level of the intervals */
     double diff_lo, diff_hi;       /* interval of mean1 - mean2 (with this test's se and df) */
     double mean_lo[2], mean_hi[2]; /* interval of each mean, t with n - 1 df (NaN when n < 2) */
 } asp_ttest_result;
@@ -117,8 +117,8 @@ double asp_stats_grade_step(const float *path, size_t count, double half_width, 
 
 /** A run's grade (seed 004 2.4: the mean over the samples that show movement). */
 typedef struct asp_grade_result {
-    double grade;  /* mean score of the moving steps, 0..1; NaN when none moved */
-    size_t moving; /* steps graded */
+    double grade;                       /* mean score of the moving steps, 0..1; NaN when none moved */
+    size_t moving;                      /* steps graded */
     size_t along, away, backwards, out; /* steps by verdict */
 } asp_grade_result;
 
@@ -159,18 +159,18 @@ typedef struct asp_stats_log {
     uint64_t seed;
     int observer;
     unsigned screen[2];
-    float *path;       /* 3 * path_count, NULL when the header has none */
+    float *path; /* 3 * path_count, NULL when the header has none */
     size_t path_count;
-    double half_width; /* 0 when the header has none */
+    double half_width;                                      /* 0 when the header has none */
     double drawn_triangles, drawn_points, drawn_primitives; /* header "drawn" */
     asp_stats_frame *frames;
     size_t frame_count;
     asp_stats_event *events;
     size_t event_count;
-    size_t lines;          /* lines read, the header included */
-    size_t lost_frames;    /* lines cut off mid-way or unparsable: frames lost by a crash */
-    size_t first_lost_line;/* 1-based line of the first lost one, 0 if none */
-    size_t ignored_lines;  /* valid JSON objects of a type this reader does not know */
+    size_t lines;           /* lines read, the header included */
+    size_t lost_frames;     /* lines cut off mid-way or unparsable: frames lost by a crash */
+    size_t first_lost_line; /* 1-based line of the first lost one, 0 if none */
+    size_t ignored_lines;   /* valid JSON objects of a type this reader does not know */
 } asp_stats_log;
 
 /**
@@ -178,9 +178,9 @@ typedef struct asp_stats_log {
  * with format "amgsplat-experiment-log 1"; otherwise ASP_EFORMAT naming the
  * file and line 1. A line that is not a complete JSON object (cut off by a
  * crash, or glued to the next by an append after one) counts as a lost frame,
- * never an error; a complete object glued behind a cut one is still read. A complete frame or event line missing a required field is
- * ASP_EFORMAT naming the file, line and field. Returns 0, ASP_EIO, ASP_EFORMAT
- * or ASP_ENOMEM; on failure log is zeroed. Release with asp_stats_log_release.
+ * never an error; a complete object glued behind a cut one is still read. A complete frame or event line missing a
+ * required field is ASP_EFORMAT naming the file, line and field. Returns 0, ASP_EIO, ASP_EFORMAT or ASP_ENOMEM; on
+ * failure log is zeroed. Release with asp_stats_log_release.
  */
 int asp_stats_log_load(asp_stats_log *log, const char *path, asp_error *err);
 /** Frees a log and zeroes it; safe on a zeroed log. */
@@ -188,10 +188,10 @@ void asp_stats_log_release(asp_stats_log *log);
 
 /** Naming of one recognition run from its events (seed 004 2.3). */
 typedef struct asp_stats_naming {
-    int answered;        /* both "recognised" and "answer" events found */
-    double recognition_s;/* t(recognised) */
-    double naming_s;     /* t(answer) - t(recognised) */
-    int correct;         /* answer equals answer_expected, ignoring case and surrounding blanks */
+    int answered;         /* both "recognised" and "answer" events found */
+    double recognition_s; /* t(recognised) */
+    double naming_s;      /* t(answer) - t(recognised) */
+    int correct;          /* answer equals answer_expected, ignoring case and surrounding blanks */
     char answer[64];
 } asp_stats_naming;
 
@@ -218,8 +218,7 @@ typedef struct asp_stats_analyze_desc {
  * ASP_EDEGENERATE (no log found) or ASP_ENOMEM. *out is NULL on failure;
  * destroy with asp_stats_analysis_destroy.
  */
-int asp_stats_analyze(const char *dir, const asp_stats_analyze_desc *desc, asp_stats_analysis **out,
-                      asp_error *err);
+int asp_stats_analyze(const char *dir, const asp_stats_analyze_desc *desc, asp_stats_analysis **out, asp_error *err);
 void asp_stats_analysis_destroy(asp_stats_analysis *a);
 
 /** Counts of an analysis (for a CLI summary line). */

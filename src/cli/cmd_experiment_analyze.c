@@ -40,8 +40,7 @@ int cmd_experiment_analyze(int argc, char **argv, struct cli_env *env)
     if (rc)
         return rc > 0 ? 0 : 2;
     if (npos != 1)
-        return cli_usage_error(env, "expected one study directory, got %d; see 'amgsplat experiment analyze -h'",
-                               npos);
+        return cli_usage_error(env, "expected one study directory, got %d; see 'amgsplat experiment analyze -h'", npos);
     if (!output)
         return cli_usage_error(env, "missing -o REPORT_DIR");
     if (!(level > 0 && level < 1))

@@ -33,8 +33,8 @@ static int parse_sample(struct cli_env *env, const char *s, int which, asp_stats
     double v[3];
     if (cli_parse_doubles(s, v, 3) != 3 || !(v[0] >= 1 && v[0] <= 1e12 && v[0] == floor(v[0])) || !isfinite(v[1]) ||
         !(v[2] >= 0 && isfinite(v[2])))
-        return cli_usage_error(env, "sample %d: expected N,MEAN,SD (N a whole number >= 1, SD >= 0), got '%s'",
-                               which, s);
+        return cli_usage_error(env, "sample %d: expected N,MEAN,SD (N a whole number >= 1, SD >= 0), got '%s'", which,
+                               s);
     *out = (asp_stats_summary){.n = (size_t)v[0], .mean = v[1], .sd = v[2], .median = NAN, .min = NAN, .max = NAN};
     return 0;
 }

@@ -15,8 +15,8 @@
 
 #include "amgsplat/stats.h"
 #include "stats/internal.h"
-#include "util/regular_file.h"
 #include "util/banned.h"
+#include "util/regular_file.h"
 
 const char *const asp__stats_tests[STATS_TESTS] = {"far", "near", "lowspeed", "highspeed"};
 
@@ -135,7 +135,8 @@ static void read_study(asp_stats_analysis *a)
     fclose(fp);
     buf[n] = 0;
     cJSON *s = cJSON_Parse(buf);
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(s, "version"), *seed = cJSON_GetObjectItemCaseSensitive(s, "seed");
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(s, "version"),
+                *seed = cJSON_GetObjectItemCaseSensitive(s, "seed");
     if (cJSON_IsString(v))
         snprintf(a->study_version, sizeof a->study_version, "%s", v->valuestring);
     if (cJSON_IsNumber(seed))
@@ -248,8 +249,7 @@ static int read_subject(asp_stats_analysis *a, const char *subject_dir, asp_erro
     return rc;
 }
 
-int asp_stats_analyze(const char *dir, const asp_stats_analyze_desc *desc, asp_stats_analysis **out,
-                      asp_error *err)
+int asp_stats_analyze(const char *dir, const asp_stats_analyze_desc *desc, asp_stats_analysis **out, asp_error *err)
 {
     ASP_ASSERT(dir && out);
     *out = NULL;

@@ -12,8 +12,7 @@
 #include "util/banned.h"
 
 /* Nearest point of the polyline to (x, z): unit tangent of its segment and the offset to it. */
-static void nearest_segment(const float *path, size_t count, double x, double z, double tangent[2],
-                            double offset[2])
+static void nearest_segment(const float *path, size_t count, double x, double z, double tangent[2], double offset[2])
 {
     double best = INFINITY;
     for (size_t i = 0; i + 1 < count; i++) {
@@ -48,29 +47,13 @@ static double distance_to_path(const float *path, size_t count, double x, double
     return hypot(o[0], o[1]);
 }
 
-double asp_stats_grade_step(const float *path, size_t count, double half_width, const double from[3],
-                            const double to[3], asp_grade_verdict *verdict)
+/* The rules of Fig 2.1 for a step u (unit, ground plane) from `from` (xz) ending inside the bounds. */
+static asp_grade_verdict grade_direction(const float *path, size_t count, double half_width, const double from[2],
+                                         const double u[2], double *score)
 {
-    ASP_ASSERT(path && count >= 2 && half_width > 0 && from && to);
-    asp_grade_verdict v = ASP_GRADE_STILL;
-    double score = -1;
-    double mx = to[0] - from[0], mz = to[2] - from[2], m = hypot(mx, mz);
-    // below a millionth of the path width a step is numerical noise, not movement
-    if (!(m > 1e-6 * half_width))
-        goto done;
-    if (!isfinite(m)) { // coordinates so far apart their difference overflows: nowhere near the path
-        v = ASP_GRADE_OUT;
-        score = 0;
-        goto done;
-    }
-    double u[2] = {mx / m, mz / m}, t[2], o[2];
-    nearest_segment(path, count, from[0], from[2], t, o);
-    if (distance_to_path(path, count, to[0], to[2]) > half_width) {
-        v = ASP_GRADE_OUT;
-        score = 0;
-        goto done;
-    }
-    // c: unit vector toward the centre, without its component along the path (Fig 2.1)
+    double t[2], o[2];
+    nearest_segment(path, count, from[0], from[1], t, o);
+    // c: unit vector toward the centre, without its component along the path
     double along = o[0] * t[0] + o[1] * t[1];
     double c[2] = {o[0] - along * t[0], o[1] - along * t[1]}, cl = hypot(c[0], c[1]);
     double k = 0;
@@ -82,28 +65,42 @@ double asp_stats_grade_step(const float *path, size_t count, double half_width, 
         c[0] = c[1] = 0;
     }
     double g[2] = {t[0] + k * c[0], t[1] + k * c[1]}, gl = hypot(g[0], g[1]);
-    if (!(gl > 0)) { // degenerate path: nothing to compare with
-        v = ASP_GRADE_OUT;
-        score = 0;
-        goto done;
-    }
+    *score = 0;
+    if (!(gl > 0)) // every path vertex the same: no direction to compare with
+        return ASP_GRADE_OUT;
     g[0] /= gl;
     g[1] /= gl;
     double ug = u[0] * g[0] + u[1] * g[1], uc = u[0] * c[0] + u[1] * c[1];
-    if (ug <= 0) {
-        v = ASP_GRADE_BACKWARDS;
-        score = 0;
-    } else if (k > 0 && uc >= 0) {
-        v = ASP_GRADE_ALONG; // toward the centre (or exactly along the path)
-        score = 1;
-    } else {
-        // away from the centre: the cosine to g, scaled so straight along t is still 100%
-        double tg = t[0] * g[0] + t[1] * g[1];
-        score = ug / tg;
-        score = score > 1 ? 1 : score;
-        v = score >= 1 - 1e-12 ? ASP_GRADE_ALONG : ASP_GRADE_AWAY;
+    if (ug <= 0)
+        return ASP_GRADE_BACKWARDS;
+    if (k > 0 && uc >= 0) {
+        *score = 1; // toward the centre, or exactly along the path
+        return ASP_GRADE_ALONG;
     }
-done:
+    // away from the centre: the cosine to g, scaled so straight along t is still 100%
+    double tg = t[0] * g[0] + t[1] * g[1];
+    *score = ug / tg > 1 ? 1 : ug / tg;
+    return *score >= 1 - 1e-12 ? ASP_GRADE_ALONG : ASP_GRADE_AWAY;
+}
+
+double asp_stats_grade_step(const float *path, size_t count, double half_width, const double from[3],
+                            const double to[3], asp_grade_verdict *verdict)
+{
+    ASP_ASSERT(path && count >= 2 && half_width > 0 && from && to);
+    asp_grade_verdict v;
+    double score = 0;
+    double mx = to[0] - from[0], mz = to[2] - from[2], m = hypot(mx, mz);
+    if (!(m > 1e-6 * half_width)) {
+        // below a millionth of the path width a step is numerical noise, not movement
+        v = ASP_GRADE_STILL;
+        score = -1;
+    } else if (!isfinite(m) || distance_to_path(path, count, to[0], to[2]) > half_width) {
+        // out of bounds (or so far apart the difference overflows): 0%
+        v = ASP_GRADE_OUT;
+    } else {
+        v = grade_direction(path, count, half_width, (const double[2]){from[0], from[2]},
+                            (const double[2]){mx / m, mz / m}, &score);
+    }
     if (verdict)
         *verdict = v;
     return score;

@@ -13,7 +13,7 @@ extern const char *const asp__stats_tests[STATS_TESTS];
 
 struct stats_run {
     asp_stats_log log;
-    int navigation;          /* the header has a path: graded */
+    int navigation; /* the header has a path: graded */
     asp_grade_result grade;
     asp_stats_naming naming; /* recognition tests */
 };
@@ -29,7 +29,7 @@ struct asp_stats_analysis {
     size_t answers_lost;     /* answers.jsonl lines cut off */
     size_t answers_mismatch; /* answers whose naming time or correctness differs from the log's events */
     char study_version[64];
-    double study_seed;       /* NaN without study.json */
+    double study_seed; /* NaN without study.json */
 };
 
 #endif

@@ -14,8 +14,8 @@
 #include <cjson/cJSON.h>
 
 #include "amgsplat/stats.h"
-#include "util/regular_file.h"
 #include "util/banned.h"
+#include "util/regular_file.h"
 
 static const char log_format[] = "amgsplat-experiment-log 1";
 
@@ -106,8 +106,7 @@ static int read_header(asp_stats_log *log, const cJSON *h, asp_error *err)
             for (int k = 0; k < 3; k++) {
                 const cJSON *c = cJSON_GetArrayItem(p, k);
                 if (!cJSON_IsNumber(c) || !isfinite(c->valuedouble))
-                    return asp_error_set(err, ASP_EFORMAT, "'%s' line 1: path point %d is not [x,y,z]", log->file,
-                                         i);
+                    return asp_error_set(err, ASP_EFORMAT, "'%s' line 1: path point %d is not [x,y,z]", log->file, i);
                 xyz[k] = c->valuedouble;
             }
             for (int k = 0; k < 3; k++)

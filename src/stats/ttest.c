@@ -47,8 +47,8 @@ int asp_stats_ttest(const asp_stats_summary *a, const asp_stats_summary *b, cons
     asp_ttest_result r = {.welch = d.welch != 0, .level = d.level, .diff = a->mean - b->mean};
     if (r.welch) {
         if (a->n < 2 || b->n < 2)
-            return asp_error_set(err, ASP_EINVAL, "Welch's test needs n >= 2 in both samples, got %zu and %zu",
-                                 a->n, b->n);
+            return asp_error_set(err, ASP_EINVAL, "Welch's test needs n >= 2 in both samples, got %zu and %zu", a->n,
+                                 b->n);
         double q1 = v1 / n1, q2 = v2 / n2;
         r.se = sqrt(q1 + q2);
         // Welch-Satterthwaite; when one sd is 0 the other sample alone carries the variance

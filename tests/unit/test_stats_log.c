@@ -23,20 +23,22 @@ static const char *write_file(const char *name, const char *text)
     return path;
 }
 
-#define HEADER                                                                                                      \
-    "{\"type\":\"header\",\"format\":\"amgsplat-experiment-log 1\",\"subject\":\"S01\",\"group\":\"control\","   \
-    "\"test\":\"lowspeed\",\"run\":\"A\",\"condition\":\"polygons\",\"seed\":3,\"version\":\"0.1.0\","              \
-    "\"observer\":true,\"screen\":[320,240],\"path\":[[0,0,0],[100,0,0]],\"half_width\":5,"                        \
+#define HEADER                                                                                                         \
+    "{\"type\":\"header\",\"format\":\"amgsplat-experiment-log 1\",\"subject\":\"S01\",\"group\":\"control\","         \
+    "\"test\":\"lowspeed\",\"run\":\"A\",\"condition\":\"polygons\",\"seed\":3,\"version\":\"0.1.0\","                 \
+    "\"observer\":true,\"screen\":[320,240],\"path\":[[0,0,0],[100,0,0]],\"half_width\":5,"                            \
     "\"drawn\":{\"triangles\":100,\"points\":0,\"primitives\":0}}\n"
-#define FRAME(i, x)                                                                                                 \
-    "{\"type\":\"frame\",\"i\":" #i ",\"t\":0." #i ",\"frame_ms\":12.5,\"pos\":[" #x ",1.7,0],\"dir\":[1,0,0],"    \
+#define FRAME(i, x)                                                                                                    \
+    "{\"type\":\"frame\",\"i\":" #i ",\"t\":0." #i ",\"frame_ms\":12.5,\"pos\":[" #x ",1.7,0],\"dir\":[1,0,0],"        \
     "\"drawn\":100,\"keys\":\"W\"}\n"
+
+#define OFF_PATH "{\"type\":\"event\",\"t\":0.15,\"what\":\"off_path\",\"text\":\"\"}\n"
+#define CUT_FRAME "{\"type\":\"frame\",\"i\":3,\"t\":0.3,\"fra"
 
 static void test_truncated_log(void)
 {
-    const char *p = write_file("cut.jsonl", HEADER FRAME(0, 10) FRAME(1, 11) "{\"type\":\"event\",\"t\":0.15,"
-                                                                             "\"what\":\"off_path\",\"text\":\"\"}\n"
-                                            FRAME(2, 12) "{\"type\":\"frame\",\"i\":3,\"t\":0.3,\"fra");
+    static const char cut[] = HEADER FRAME(0, 10) FRAME(1, 11) OFF_PATH FRAME(2, 12) CUT_FRAME;
+    const char *p = write_file("cut.jsonl", cut);
     asp_stats_log log;
     asp_error err = {0};
     CHECK_OK(asp_stats_log_load(&log, p, &err), &err);
@@ -98,12 +100,12 @@ static void test_bad_logs(void)
 
 static void test_naming(void)
 {
-    const char *p = write_file(
-        "far.jsonl",
-        "{\"type\":\"header\",\"format\":\"amgsplat-experiment-log 1\",\"subject\":\"S02\",\"test\":\"far\","
-        "\"run\":\"B\",\"condition\":\"points\",\"answer_expected\":\"cat\"}\n" FRAME(0, 0)
-        "{\"type\":\"event\",\"t\":2.5,\"what\":\"recognised\",\"text\":\"\"}\n"
-        "{\"type\":\"event\",\"t\":3.75,\"what\":\"answer\",\"text\":\" CAT \"}\n");
+    const char *p =
+        write_file("far.jsonl",
+                   "{\"type\":\"header\",\"format\":\"amgsplat-experiment-log 1\",\"subject\":\"S02\",\"test\":\"far\","
+                   "\"run\":\"B\",\"condition\":\"points\",\"answer_expected\":\"cat\"}\n" FRAME(
+                       0, 0) "{\"type\":\"event\",\"t\":2.5,\"what\":\"recognised\",\"text\":\"\"}\n"
+                             "{\"type\":\"event\",\"t\":3.75,\"what\":\"answer\",\"text\":\" CAT \"}\n");
     asp_stats_log log;
     asp_error err = {0};
     CHECK_OK(asp_stats_log_load(&log, p, &err), &err);

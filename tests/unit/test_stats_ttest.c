@@ -94,7 +94,7 @@ static void test_seed_table_4_3(void)
     asp_ttest_result nearp = run(7, 2110, 889, 6, 892, 347, 0), farp = run(4, 7157, 2492, 9, 2861, 1987, 0);
     CHECK_NEAR(nearp.df, 11, 0);
     CHECK_NEAR(farp.df, 11, 0);
-    CHECK(fabs(nearp.t - 3.14) < 0.005); // the seed's "far" value
+    CHECK(fabs(nearp.t - 3.14) < 0.005);      // the seed's "far" value
     CHECK(floor(farp.t * 100) / 100 == 3.34); // the seed's "near" value, truncated
     CHECK(nearp.p_greater < 0.005 && farp.p_greater < 0.005);
     asp_ttest_result nearw = run(7, 2110, 889, 6, 892, 347, 1);
