@@ -103,8 +103,9 @@ enum asp_chart_flags {
     ASP_CHART_LOG_X = 1 << 0, /* logarithmic x axis (values <= 0 are skipped) */
     ASP_CHART_LOG_Y = 1 << 1, /* logarithmic y axis (values <= 0 are skipped) */
     ASP_CHART_MARKERS = 1 << 2, /* markers only, no connecting lines (a scatter plot) */
-    ASP_CHART_BARS = 1 << 3     /* vertical bars from y = 0 (a histogram): series side by side in each x slot,
+    ASP_CHART_BARS = 1 << 3,    /* vertical bars from y = 0 (a histogram): series side by side in each x slot,
                                    the slot width the smallest x spacing of any series; not with LOG_Y */
+    ASP_CHART_X_INTEGER = 1 << 4 /* x ticks at whole numbers only (numbered categories); not with LOG_X */
 };
 
 /** Chart layout; the zero value means defaults. */

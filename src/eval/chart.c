@@ -113,6 +113,7 @@ static void text_vertical(const struct canvas *c, long x, long y, const char *s,
 struct axis {
     double lo, hi;
     int log;
+    int integer; /* ticks at whole numbers only */
     double ticks[MAX_TICKS];
     int nticks;
 };
@@ -139,6 +140,8 @@ static void axis_ticks(struct axis *a)
         return;
     }
     double step = nice_step(a->hi - a->lo);
+    if (a->integer && step < 1)
+        step = 1;
     for (double v = ceil(a->lo / step - 1e-9) * step; v <= a->hi + 1e-9 * step && a->nticks < MAX_TICKS; v += step)
         a->ticks[a->nticks++] = fabs(v) < 1e-12 * step ? 0 : v;
 }
@@ -383,6 +386,7 @@ int asp_chart_draw(const asp_chart_series *series, size_t nseries, const asp_cha
     int bars = (d.flags & ASP_CHART_BARS) != 0;
     p.ax.log = (d.flags & ASP_CHART_LOG_X) != 0 && !bars;
     p.ay.log = (d.flags & ASP_CHART_LOG_Y) != 0 && !bars;
+    p.ax.integer = (d.flags & ASP_CHART_X_INTEGER) != 0 && !p.ax.log;
     double slot = bars ? bar_slot_width(series, nseries) : 0;
     axis_range(&p.ax, series, nseries, NULL, 1, 0, 0, bars, slot);
     axis_range(&p.ay, series, nseries, d.y_err, 0, d.y_min, d.y_max, bars, slot);

@@ -237,7 +237,7 @@ static void section_navigation_test(struct report *r, const char *test, cJSON *n
                                                      .title = title,
                                                      .x_label = "group",
                                                      .y_label = "points",
-                                                     .flags = ASP_CHART_MARKERS,
+                                                     .flags = ASP_CHART_MARKERS | ASP_CHART_X_INTEGER,
                                                      .y_err = errs},
                                    name);
         }
