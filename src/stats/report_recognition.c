@@ -25,7 +25,7 @@ void asp__report_recognition(struct report *r)
     cJSON *rec = cJSON_AddObjectToObject(r->root, "recognition");
     cJSON_AddStringToObject(rec, "runs", a->all_runs ? "A and B" : "B");
     cJSON *rows = cJSON_AddArrayToObject(rec, "rows"), *tests = cJSON_AddArrayToObject(rec, "tests");
-    char b[8][32];
+    char b[9][32];
     fprintf(md,
             "## Object recognition (seed 004 Tables 4.2-4.3)\n\nRuns %s (seed 004 4.2 treats run A as practice). "
             "Naming time (seconds from Enter to the typed name) of the correct answers.\n\n"
@@ -127,7 +127,7 @@ void asp__report_recognition(struct report *r)
                 asp__report_cell(b[5], 32, cJSON_GetObjectItem(w, "df")->valuedouble, 1),
                 asp__report_p_cell(b[6], 32, wg < wl ? wg : wl),
                 asp__report_cell(b[7], 32, cJSON_GetArrayItem(ci, 0)->valuedouble, 2),
-                asp__report_cell(b[7] + 16, 16, cJSON_GetArrayItem(ci, 1)->valuedouble, 2));
+                asp__report_cell(b[8], 32, cJSON_GetArrayItem(ci, 1)->valuedouble, 2));
     }
     fputc('\n', md);
 }
