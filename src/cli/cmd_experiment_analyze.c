@@ -45,6 +45,10 @@ int cmd_experiment_analyze(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "missing -o REPORT_DIR");
     if (!(level > 0 && level < 1))
         return cli_usage_error(env, "--level expects a probability between 0 and 1, got %g", level);
+    // the report beside the logs, not over them
+    const char *inputs[1] = {argv[0]};
+    if ((rc = cli_check_output(env, output, NULL, 1, inputs, 1)) != 0)
+        return rc;
     asp_error err = {0};
     asp_stats_analysis *a = NULL;
     if (asp_stats_analyze(argv[0], &(asp_stats_analyze_desc){.level = level, .all_runs = all_runs}, &a, &err))

@@ -109,5 +109,8 @@ expect_fail 1 "expected format 'amgsplat-experiment-log 1'" "$AMGSPLAT" experime
 expect_fail 1 "no experiment log" "$AMGSPLAT" experiment analyze "$T/empty" -o "$T/r4"
 expect_fail 1 "not a directory" "$AMGSPLAT" experiment analyze "$T/nonexistent" -o "$T/r5"
 expect_fail 2 "missing -o" "$AMGSPLAT" experiment analyze "$STUDY"
+expect_fail 2 "is the input" "$AMGSPLAT" experiment analyze "$STUDY" -o "$STUDY/."
+printf 'x' >"$T/afile"
+expect_fail 1 "cannot create report directory" "$AMGSPLAT" experiment analyze "$STUDY" -o "$T/afile"
 [[ ! -e "$T/r2/report.md" ]] || fail "a failed analysis left a report"
 echo "ok"
