@@ -159,7 +159,7 @@ void asp__report_frame_time(struct report *r)
             fprintf(md, "| %s | %s | %zu | %s | %s | %s | %s | %s | %s |\n", test, r->conditions[c], s.n,
                     asp__report_cell(b[0], 32, s.mean, 2), asp__report_cell(b[1], 32, s.median, 2),
                     asp__report_cell(b[2], 32, s.min, 2), asp__report_cell(b[3], 32, s.max, 2),
-                    asp__report_cell(b[4], 32, s.sd, 3), asp__report_cell(b[5], 32, sd.mean, 0));
+                    asp__report_cell(b[4], 32, s.n > 1 ? s.sd : NAN, 3), asp__report_cell(b[5], 32, sd.mean, 0));
             fprintf(csv, "%s,", test);
             asp__report_csv_str(csv, r->conditions[c]);
             fprintf(csv, ",%zu,", s.n);

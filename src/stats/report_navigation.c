@@ -108,7 +108,7 @@ static void summary_row(FILE *md, const char *group, const char *run, const asp_
     fprintf(md, "| %s |%s%s%s %zu | %s | %s | %s | %s | %s |\n", group, run ? " " : "", run ? run : "", run ? " |" : "",
             s->n, asp__report_cell(b[0], 32, s->mean, 1), asp__report_cell(b[1], 32, s->median, 1),
             asp__report_cell(b[2], 32, s->min, 1), asp__report_cell(b[3], 32, s->max, 1),
-            asp__report_cell(b[4], 32, s->sd, 2));
+            asp__report_cell(b[4], 32, s->n > 1 ? s->sd : NAN, 2));
 }
 
 /* Tables 4.4/4.6 (grades by group and run) and 4.5/4.7 (improvement); si receives the improvements' summaries. */

@@ -67,7 +67,7 @@ void asp__report_recognition(struct report *r)
             fprintf(md, "| %s | %s | %zu | %zu | %zu | %s | %s | %s | %s | %s | %s |\n", test, r->conditions[c],
                     correct, wrong, none, asp__report_cell(b[0], 32, pct, 0), asp__report_cell(b[1], 32, s.mean, 2),
                     asp__report_cell(b[2], 32, s.median, 2), asp__report_cell(b[3], 32, s.min, 2),
-                    asp__report_cell(b[4], 32, s.max, 2), asp__report_cell(b[5], 32, s.sd, 2));
+                    asp__report_cell(b[4], 32, s.max, 2), asp__report_cell(b[5], 32, s.n > 1 ? s.sd : NAN, 2));
             fprintf(csv, "%s,", test);
             asp__report_csv_str(csv, r->conditions[c]);
             fprintf(csv, ",%zu,%zu,%zu,", correct, wrong, none);
