@@ -18,7 +18,7 @@
 static const char usage[] =
     "usage: amgsplat render IN.ply -o OUT.png [--size WxH] [--view AZ,EL[,DIST]] [--views N]\n"
     "                      [--renderer disc|splat|square] [--tolerance PX | --budget N] [--kernel A,B,N]\n"
-    "                      [--epsilon X] [--lighting gouraud|pixel|flat] [--opaque] [--point-size PX]\n"
+    "                      [--epsilon X] [--lighting gouraud|pixel|flat] [--opaque] [--unlit] [--point-size PX]\n"
     "                      [--background R,G,B[,A] | --transparent] [--light AZ,EL]\n"
     "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict] [--level L-3] ...\n"
     "       amgsplat render MESH -o OUT.png [--flat] [--texture IMG] [--renderer mesh|disc] ...\n"
@@ -63,6 +63,7 @@ struct render_opts {
     double epsilon;
     double point_size;
     int opaque;
+    int unlit; /* --unlit: the colours as they are, no shading (ASP_RENDER_UNLIT) */
     const char *method;
     double alpha_ref;
     double transparency;
@@ -317,7 +318,8 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
 {
     vs->min_count = SIZE_MAX;
     asp_render_desc desc = {.width = o->width, .height = o->height, .samples = (uint32_t)o->samples,
-                            .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el};
+                            .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el,
+                            .flags = o->unlit ? ASP_RENDER_UNLIT : 0u};
     memcpy(desc.background, o->bg, 4);
     for (size_t i = 0; i < o->views; i++) {
         asp_camera cam;
@@ -389,6 +391,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"epsilon", 0, CLI_DOUBLE, &o.epsilon, "X", "splat: depth offset in splat radii for blending (default 1; 0 = none)"},
         {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
         {"opaque", 0, CLI_FLAG, &o.opaque, NULL, "splat: opaque ellipses, no blending"},
+        {"unlit", 0, CLI_FLAG, &o.unlit, NULL, "colours as they are, no shading (the seeds' flat textured primitives; web viewer's light=off)"},
         {"point-size", 0, CLI_DOUBLE, &o.point_size, "PX", "square: fixed side in pixels (default 0: projected size)"},
         {"color-by", 0, CLI_STRING, &o.color_by, "MODE", ".amg input: classifier, domains or strict; .dps input: domain"},
         {"level", 0, CLI_STRING, &o.level, "L", ".amg: level of the domain colours (default L-3); .dps: level drawn (default the finest in the file)"},

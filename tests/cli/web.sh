@@ -1,9 +1,10 @@
 # The web viewer (web/, issue 16): the bunny's primitives and points exported to GLB, screenshot in headless
 # Chromium (web/test/screenshot.mjs) and compared with `amgsplat render` of the same view, size,
 # background and lighting: SSIM >= 0.9 (the issue's Done-when line). The viewer's "normalized" is the
-# renderer's default method; render's crease clipping is turned off (glTF has no clip planes). Both
-# light with the renderers' headlight, since render has no unlit mode; an unlit pair is compared too
-# when render offers --unlit. Skips (77) without node, web/node_modules or Chromium.
+# renderer's default method; render's crease clipping is turned off (glTF has no clip planes). Lit
+# pairs light with the renderers' headlight on both sides; the unlit pair (lighting off on both: the
+# issue's wording) uses render --unlit and the viewer's light=off. Skips (77) without node,
+# web/node_modules or Chromium.
 source "$(dirname "$0")/common.sh"
 
 web="${ASP_TEST_SRC:-$(dirname "$0")/..}/../web"
@@ -68,12 +69,10 @@ ssim "$T/web_blend.png" "$T/render_blend.png" 0.9
 "$AMGSPLAT" imgdiff "$T/web_30_20.png" "$T/render_200_-35.png" --json >"$T/diff.json"
 python3 -c "import json, sys; d = json.load(open(sys.argv[1])); assert d['ssim'] < 0.9, d" "$T/diff.json" ||
   fail "a different view matched the render: $(cat "$T/diff.json")"
-if "$AMGSPLAT" render -h 2>&1 | grep -e '--unlit' >/dev/null; then
-  shot "$T/b.glb" "$T/web_unlit.png" --view 30,20 --size 256x256 --method normalized --light off
-  "$AMGSPLAT" render "$T/b.dps" -o "$T/render_unlit.png" --view 30,20 --size 256x256 --method normalized \
-    --crease-angle off --unlit -q
-  ssim "$T/web_unlit.png" "$T/render_unlit.png" 0.9
-fi
+shot "$T/b.glb" "$T/web_unlit.png" --view 30,20 --size 256x256 --method normalized --light off
+"$AMGSPLAT" render "$T/b.dps" -o "$T/render_unlit.png" --view 30,20 --size 256x256 --method normalized \
+  --crease-angle off --unlit -q
+ssim "$T/web_unlit.png" "$T/render_unlit.png" 0.9
 
 # colour: Spot's textured surface (sRGB atlas decoded and blended in linear light on both sides)
 if have_data spot_triangulated.obj spot_texture.png; then
