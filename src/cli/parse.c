@@ -306,19 +306,34 @@ int cli_parse_size2(const char *s, unsigned *w, unsigned *h)
     return 0;
 }
 
-void cli_json_string(FILE *fp, const char *s)
+cJSON *cli_json_number(const char *fmt, double v)
 {
-    fputc('"', fp);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            fprintf(fp, "\\%c", c);
-        else if (c < 0x20)
-            fprintf(fp, "\\u%04x", c);
-        else
-            fputc(c, fp);
+    char text[64];
+    if (!isfinite(v))
+        return cJSON_CreateNull(); // JSON has no NaN or infinity; the old writers printed invalid JSON there
+    snprintf(text, sizeof text, fmt, v);
+    return cJSON_CreateNumber(strtod(text, NULL));
+}
+
+cJSON *cli_json_doubles(const double *v, int n)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; a && i < n; i++)
+        cJSON_AddItemToArray(a, cli_json_number("%.17g", v[i]));
+    return a;
+}
+
+int cli_json_print(const struct cli_env *env, cJSON *root)
+{
+    char *text = root ? cJSON_PrintUnformatted(root) : NULL;
+    cJSON_Delete(root);
+    if (!text) {
+        fprintf(stderr, "amgsplat %s: error: out of memory for the JSON output\n", env->cmd);
+        return 1;
     }
-    fputc('"', fp);
+    puts(text);
+    cJSON_free(text);
+    return 0;
 }
 
 int cli_check_output(const struct cli_env *env, const char *output, const char *format, int allow_bare,
@@ -358,4 +373,19 @@ int cli_parse_view(struct cli_env *env, const char *s, double *az, double *el, d
     *el = v[1];
     *dist = n == 3 ? v[2] : 0;
     return 0;
+}
+
+void cli_json_string(FILE *fp, const char *s)
+{
+    fputc('"', fp);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(fp, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(fp, "\\u%04x", c);
+        else
+            fputc(c, fp);
+    }
+    fputc('"', fp);
 }
