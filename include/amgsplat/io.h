@@ -176,7 +176,8 @@ int asp_las_read_memory(const void *data, size_t size, const char *name, const a
  * 4, 5, 9, 10 carry waveforms, which are not written: ASP_EINVAL), else the
  * source's (cloud->las; a waveform format becomes 1, 3, 6 or 8 without the
  * packet), else 8 when there is a "nir" property, 7 with colours, 6 without.
- * Version 1.4 for formats 6-8, else the source's version (at least 1.2).
+ * Version 1.4 for formats 6-8 and when the source has EVLRs, the source's
+ * version when its format is kept, else 1.2 (read by every LAS reader).
  * Scale: desc->las_scale, else the source's, else 0.001 per axis; offset:
  * the source's, else the floor of the bounding-box minimum. Fields are
  * taken from the properties asp_las_read makes (any numeric type, rounded);

@@ -444,7 +444,15 @@ int asp_las_write(const asp_cloud *cloud, const char *path, const asp_save_desc 
     if (w->fmt > 8 || w->fmt == 4 || w->fmt == 5)
         rc = invalid(w, "point format %u: this writer writes formats 0-3 and 6-8 (4, 5, 9 and 10 carry waveforms)",
                      w->fmt);
-    w->minor = w->fmt >= 6 ? 4 : cloud->las && cloud->las->version_minor > 2 ? cloud->las->version_minor : 2;
+    /*
+     * 1.4 for formats 6-8 and for EVLRs; the source's version when its format is kept (LAS -> LAS
+     * reproduces the file); else 1.2, which every LAS reader reads (loaders.gl reads at most 1.3)
+     */
+    int same_format = cloud->las && cloud->las->point_format == w->fmt;
+    w->minor = w->fmt >= 6 ? 4 : same_format && cloud->las->version_minor > 2 ? cloud->las->version_minor : 2;
+    for (size_t i = 0; cloud->las && i < cloud->las->vlr_count; i++)
+        if (cloud->las->vlrs[i].extended)
+            w->minor = 4;
     if (rc == 0) {
         choose_quantisation(w, desc);
         rc = plan(w);
