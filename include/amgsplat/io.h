@@ -197,11 +197,13 @@ int asp_las_write(const asp_cloud *cloud, const char *path, const asp_save_desc 
 /**
  * Loads a point file, its format told by asp_file_recognise (magic bytes, then
  * the extension, case-insensitive: BUNNY.PLY loads): PLY through asp_ply_read
- * (a PLY with faces too: its vertices), .xyz/.pts/.txt through asp_xyz_read. Then rejects non-finite
+ * (a PLY with faces too: its vertices), LAS through asp_las_read (LAZ:
+ * ASP_EUNSUPPORTED, "compressed LAS (LASzip) needs a decompressor ..."),
+ * .xyz/.pts/.txt through asp_xyz_read. Then rejects non-finite
  * values (asp_cloud_validate) and an empty cloud, with ASP_EFORMAT
  * "cannot read 'F': ...". A cloud whose points are all equal loads fine.
  * Unknown extension: ASP_EUNSUPPORTED "cannot read 'f.abc': unknown point
- * format '.abc' (expected .ply, .xyz, .pts, .txt)". A file that is
+ * format '.abc' (expected .ply, .xyz, .pts, .txt, .las)". A file that is
  * something else (a mesh, an image, an .amg ...: by its magic or extension)
  * gives ASP_EUNSUPPORTED "cannot read 'f.obj': a mesh file (obj), not a point
  * file; sample it ...". A directory or FIFO: ASP_EIO at once. On failure
@@ -211,6 +213,7 @@ int asp_cloud_load(const char *path, const asp_context *ctx, asp_cloud **out, as
 
 /**
  * Saves by extension (case-insensitive, asp_file_type_of_name): .ply through asp_ply_write (desc->encoding applies),
+ * .las through asp_las_write (desc->las_format, las_scale apply; .laz is ASP_EUNSUPPORTED),
  * .xyz/.pts/.txt through asp_xyz_write. Unknown extension: ASP_EUNSUPPORTED
  * "cannot write 'f.abc': unknown point format ...". Atomic. Reentrant.
  */
@@ -229,7 +232,7 @@ const char *asp_cloud_format_of(const char *path);
 /** What a file holds, as far as amgsplat is concerned. */
 typedef enum asp_file_kind {
     ASP_FILE_UNKNOWN = 0,
-    ASP_FILE_POINTS = 1, /* PLY without faces, XYZ, PTS, TXT point lists */
+    ASP_FILE_POINTS = 1, /* PLY without faces, LAS/LAZ, XYZ, PTS, TXT point lists */
     ASP_FILE_MESH = 2,   /* OBJ, PLY with faces, OFF, STL, glTF/GLB, 3DS, ... (assimp; asp_mesh_load) */
     ASP_FILE_AMG = 3,    /* AMG decomposition (amgsplat decompose) */
     ASP_FILE_DPS = 4,    /* domain primitives (amgsplat build) */
@@ -247,7 +250,8 @@ typedef struct asp_file_type {
 } asp_file_type;
 
 /**
- * Tells what path holds: magic bytes first (PLY, OFF, GLB, binary 3DS, the
+ * Tells what path holds: magic bytes first (PLY, LAS "LASF" (format "laz"
+ * when LASzip-compressed: format byte bit 7 or 6, or a LASzip VLR), OFF, GLB, binary 3DS, the
  * .amg/.dps/.hier magics, PNG, JPEG ...), then the extension, compared
  * case-insensitively ("BUNNY.PLY", "o.AMG"). A PLY is a mesh when its header
  * declares a non-empty face element (asp_cloud_load still reads its vertices

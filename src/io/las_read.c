@@ -41,6 +41,7 @@ typedef struct reader {
     uint64_t count;
     const uint8_t *extra_vlr; /* Extra Bytes descriptors, or NULL */
     size_t extra_vlr_size;
+    size_t vlr_cap;
     column cols[LAS_MAX_FIELDS + 256 + 32];
     size_t ncols;
 } reader;
@@ -75,10 +76,14 @@ static double get_f64(const uint8_t *p)
 static int keep_vlr(reader *r, const uint8_t *h, size_t size, const uint8_t *data, int extended)
 {
     asp_las_meta *m = r->meta;
-    asp_las_vlr *grown = asp_realloc(r->ctx, m->vlrs, m->vlr_count * sizeof *grown, (m->vlr_count + 1) * sizeof *grown);
-    if (!grown)
-        return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory", r->name);
-    m->vlrs = grown;
+    if (m->vlr_count == r->vlr_cap) {
+        size_t cap = r->vlr_cap ? 2 * r->vlr_cap : 8; // doubling: a file of many small VLRs stays linear
+        asp_las_vlr *grown = asp_realloc(r->ctx, m->vlrs, r->vlr_cap * sizeof *grown, cap * sizeof *grown);
+        if (!grown)
+            return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory", r->name);
+        m->vlrs = grown;
+        r->vlr_cap = cap;
+    }
     asp_las_vlr *v = &m->vlrs[m->vlr_count];
     memset(v, 0, sizeof *v);
     copy_text(v->user_id, h + 2, 16);
