@@ -95,7 +95,7 @@ int cli_parse_view(struct cli_env *env, const char *s, double *az, double *el, d
 int cli_parse_size2(const char *s, unsigned *w, unsigned *h);
 /*
  * --json output: prints root (built with cJSON, the one JSON library) as one
- * line on stdout and frees it. Returns 0, or 1 (the exit status) after
+ * line on stdout, a space after each ':' and ',', and frees it. Returns 0, or 1 (the exit status) after
  * printing an error when root is NULL or printing ran out of memory, so a
  * failed cJSON_Create* anywhere in the tree surfaces here.
  */
@@ -108,6 +108,5 @@ int cli_json_print(const struct cli_env *env, cJSON *root);
 cJSON *cli_json_number(const char *fmt, double v);
 /* A JSON array of n doubles, each to 17 significant digits (round trip exact). */
 cJSON *cli_json_doubles(const double *v, int n);
-void cli_json_string(FILE *fp, const char *s); /* TEMP */
 
 #endif

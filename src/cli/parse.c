@@ -331,7 +331,28 @@ int cli_json_print(const struct cli_env *env, cJSON *root)
         fprintf(stderr, "amgsplat %s: error: out of memory for the JSON output\n", env->cmd);
         return 1;
     }
-    puts(text);
+    /*
+     * cJSON's compact text with a space after each ':' and ',' outside strings: the one-line
+     * layout amgsplat has always printed ({"points": 4, "attributes": ["normals", "colors"]}),
+     * easy to read and to grep, and the same tokens
+     */
+    int in_string = 0, escaped = 0;
+    for (const char *c = text; *c; c++) {
+        putchar(*c);
+        if (in_string) {
+            if (escaped)
+                escaped = 0;
+            else if (*c == '\\')
+                escaped = 1;
+            else if (*c == '"')
+                in_string = 0;
+        } else if (*c == '"') {
+            in_string = 1;
+        } else if (*c == ':' || *c == ',') {
+            putchar(' ');
+        }
+    }
+    putchar('\n');
     cJSON_free(text);
     return 0;
 }
@@ -373,19 +394,4 @@ int cli_parse_view(struct cli_env *env, const char *s, double *az, double *el, d
     *el = v[1];
     *dist = n == 3 ? v[2] : 0;
     return 0;
-}
-
-void cli_json_string(FILE *fp, const char *s)
-{
-    fputc('"', fp);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            fprintf(fp, "\\%c", c);
-        else if (c < 0x20)
-            fprintf(fp, "\\u%04x", c);
-        else
-            fputc(c, fp);
-    }
-    fputc('"', fp);
 }
