@@ -162,8 +162,10 @@ int asp_xyz_write(const asp_cloud *cloud, const char *path, const asp_save_desc 
  * for a bad magic, a truncated header or VLR, a record length below the
  * format's size, counts the file cannot hold (checked before allocating),
  * disagreeing legacy and 64-bit counts, a zero or non-finite scale, a
- * non-finite offset, a bad Extra Bytes descriptor. On failure *out is
- * unchanged. Reentrant; ctx may be NULL.
+ * non-finite offset, a bad Extra Bytes descriptor; ASP_ECANCELED (progress
+ * callback, stage "read LAS"). The file is read a chunk of records at a
+ * time, never held whole. On failure *out is unchanged. Reentrant; ctx may
+ * be NULL.
  */
 int asp_las_read(const char *path, const asp_context *ctx, asp_cloud **out, asp_error *err);
 

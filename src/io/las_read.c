@@ -5,6 +5,7 @@
  * the integer coordinates put back as world = offset + scale * X with the
  * double part in asp_cloud.origin, so UTM-size scans keep every scale step.
  */
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -12,7 +13,7 @@
 
 #include "amgsplat/io.h"
 #include "io/las_internal.h"
-#include "util/byte_io.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 /* One destination of record bytes: a property, or a standard array (normals, radii, labels). */
@@ -30,8 +31,11 @@ typedef struct column {
 } column;
 
 typedef struct reader {
-    const uint8_t *b;
-    size_t size;
+    const uint8_t *b; /* the whole file (asp_las_read_memory), or NULL: */
+    FILE *fp;         /* the file, read a piece at a time (asp_las_read) */
+    uint8_t *scratch; /* what fetch() read from fp */
+    size_t scratch_cap;
+    size_t size;      /* of the file */
     const char *name;
     const asp_context *ctx;
     asp_error *err;
@@ -39,7 +43,7 @@ typedef struct reader {
     unsigned fmt;
     size_t reclen, point_offset;
     uint64_t count;
-    const uint8_t *extra_vlr; /* Extra Bytes descriptors, or NULL */
+    uint8_t *extra_vlr; /* Extra Bytes descriptors (a copy), or NULL */
     size_t extra_vlr_size;
     size_t vlr_cap;
     column cols[LAS_MAX_FIELDS + 256 + 32];
@@ -63,6 +67,32 @@ static void copy_text(char *dst, const uint8_t *src, size_t n)
     for (; k < n && src[k]; k++)
         dst[k] = (src[k] >= 0x20 && src[k] < 0x7f) ? (char)src[k] : '?';
     dst[k] = '\0';
+}
+
+/*
+ * The len bytes at file offset at (the caller has checked that they lie in
+ * the file) in *out: a pointer into the memory image, or into the scratch
+ * buffer, valid until the next fetch. Reading a file a piece at a time keeps
+ * a scan of billions of bytes from being held twice (file and cloud).
+ */
+static int fetch(reader *r, uint64_t at, size_t len, const uint8_t **out)
+{
+    if (r->b) {
+        *out = r->b + at;
+        return 0;
+    }
+    if (len > r->scratch_cap) {
+        uint8_t *grown = asp_realloc(r->ctx, r->scratch, r->scratch_cap, len);
+        if (!grown)
+            return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory for %zu bytes", r->name, len);
+        r->scratch = grown;
+        r->scratch_cap = len;
+    }
+    if (fseeko(r->fp, (off_t)at, SEEK_SET) != 0 || fread(r->scratch, 1, len, r->fp) != len)
+        return asp_error_set(r->err, ferror(r->fp) ? ASP_EIO : ASP_EFORMAT, "cannot read '%s': byte %llu: %s", r->name,
+                             (unsigned long long)at, ferror(r->fp) ? strerror(errno) : "unexpected end of file");
+    *out = r->scratch;
+    return 0;
 }
 
 static double get_f64(const uint8_t *p)
@@ -108,7 +138,12 @@ static int take_vlr(reader *r, const uint8_t *h, size_t size, const uint8_t *dat
     if (strcmp(user, "laszip encoded") == 0)
         return asp__las_laz_error(r->name, r->err);
     if (strcmp(user, "LASF_Spec") == 0 && id == 4) {
-        r->extra_vlr = data;
+        uint8_t *copy = asp_alloc(r->ctx, size ? size : 1);
+        if (!copy)
+            return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory", r->name);
+        memcpy(copy, data, size);
+        asp_free(r->ctx, r->extra_vlr); // a second one replaces the first
+        r->extra_vlr = copy;
         r->extra_vlr_size = size;
         return 0;
     }
@@ -124,11 +159,16 @@ static int read_vlrs(reader *r, size_t header_size, uint32_t nvlr)
         if (end - at < LAS_VLR_HEADER)
             return bad(r, "VLR %u of %u at byte %zu: its 54-byte header runs past the point data offset %zu", i + 1,
                        nvlr, at, end);
-        size_t len = (size_t)las_get(r->b + at + 20, 2);
+        const uint8_t *h;
+        int rc = fetch(r, at, LAS_VLR_HEADER, &h);
+        if (rc)
+            return rc;
+        size_t len = (size_t)las_get(h + 20, 2);
         if (end - at - LAS_VLR_HEADER < len)
             return bad(r, "VLR %u of %u at byte %zu: its %zu data bytes run past the point data offset %zu", i + 1,
                        nvlr, at, len, end);
-        int rc = take_vlr(r, r->b + at, len, r->b + at + LAS_VLR_HEADER, 0);
+        if ((rc = fetch(r, at, LAS_VLR_HEADER + len, &h)) == 0)
+            rc = take_vlr(r, h, len, h + LAS_VLR_HEADER, 0);
         if (rc)
             return rc;
         at += LAS_VLR_HEADER + len;
@@ -150,11 +190,20 @@ static int read_evlrs(reader *r, uint64_t start, uint32_t n)
         if (r->size - at < LAS_EVLR_HEADER)
             return bad(r, "EVLR %u of %u at byte %zu: truncated header (60 bytes needed, %zu left)", i + 1, n, at,
                        r->size - at);
-        uint64_t len = las_get(r->b + at + 20, 8);
+        const uint8_t *h;
+        int rc = fetch(r, at, LAS_EVLR_HEADER, &h);
+        if (rc)
+            return rc;
+        uint64_t len = las_get(h + 20, 8);
         if (len > r->size - at - LAS_EVLR_HEADER)
             return bad(r, "EVLR %u of %u at byte %zu: %llu data bytes, but only %zu are left in the file", i + 1, n,
                        at, (unsigned long long)len, r->size - at - LAS_EVLR_HEADER);
-        int rc = take_vlr(r, r->b + at, (size_t)len, r->b + at + LAS_EVLR_HEADER, 1);
+        if (las_get(h + 18, 2) == 65535 && memcmp(h + 2, "LASF_Spec", 10) == 0) {
+            at += LAS_EVLR_HEADER + (size_t)len; // waveform data, dropped by take_vlr: not worth reading
+            continue;
+        }
+        if ((rc = fetch(r, at, LAS_EVLR_HEADER + (size_t)len, &h)) == 0)
+            rc = take_vlr(r, h, (size_t)len, h + LAS_EVLR_HEADER, 1);
         if (rc)
             return rc;
         at += LAS_EVLR_HEADER + (size_t)len;
@@ -356,6 +405,40 @@ static void store(const column *c, size_t i, double v)
 }
 
 /*
+ * Every record, a chunk at a time: the fields into their columns, the
+ * integer coordinates into the position array as int32 bit patterns (the
+ * same 4 bytes a float takes), for fill_positions to turn into floats once
+ * the range is known.
+ */
+static int decode_records(reader *r, asp_cloud *c)
+{
+    enum { CHUNK_RECORDS = 1 << 14 };
+    for (size_t first = 0; first < c->count; first += CHUNK_RECORDS) {
+        size_t n = c->count - first < CHUNK_RECORDS ? c->count - first : CHUNK_RECORDS;
+        const uint8_t *rec;
+        int rc = fetch(r, r->point_offset + (uint64_t)first * r->reclen, n * r->reclen, &rec);
+        if (rc)
+            return rc;
+        for (size_t j = 0; j < n; j++, rec += r->reclen) {
+            memcpy(&c->positions[3 * (first + j)], rec, 12);
+            for (size_t col = 0; col < r->ncols; col++)
+                store(&r->cols[col], first + j, field_value(&r->cols[col], rec));
+        }
+        if ((rc = asp_progress(r->ctx, "read LAS", (double)(first + n) / (double)c->count)))
+            return asp_error_set(r->err, rc, "cannot read '%s': canceled", r->name);
+    }
+    return 0;
+}
+
+/* The int32 a record's coordinate k of point i is (decode_records left it in the position array). */
+static int64_t stored_int(const asp_cloud *c, size_t i, int k)
+{
+    uint8_t b[4];
+    memcpy(b, &c->positions[3 * i + (size_t)k], 4);
+    return (int32_t)(uint32_t)las_get(b, 4);
+}
+
+/*
  * world = offset + scale * X. Where every |X| < 2^23 the offset is the
  * origin and the float X * scale is within half a scale step (24-bit
  * significand); otherwise the origin moves to the middle integer of the
@@ -367,7 +450,7 @@ static int fill_positions(reader *r, asp_cloud *c)
     for (int k = 0; k < 3; k++) {
         int64_t lo = INT32_MAX, hi = INT32_MIN;
         for (size_t i = 0; i < c->count; i++) {
-            int64_t x = (int32_t)(uint32_t)las_get(r->b + r->point_offset + i * r->reclen + 4 * (size_t)k, 4);
+            int64_t x = stored_int(c, i, k);
             lo = x < lo ? x : lo;
             hi = x > hi ? x : hi;
         }
@@ -379,7 +462,7 @@ static int fill_positions(reader *r, asp_cloud *c)
             return bad(r, "%c offset %g plus the coordinates at scale %g is not a finite number", "XYZ"[k],
                        m->offset[k], m->scale[k]);
         for (size_t i = 0; i < c->count; i++) {
-            int64_t x = (int32_t)(uint32_t)las_get(r->b + r->point_offset + i * r->reclen + 4 * (size_t)k, 4);
+            int64_t x = stored_int(c, i, k);
             double v = (double)(x - mid) * m->scale[k];
             if (!(fabs(v) <= 3.4e38))
                 return bad(r, "point %zu of %zu: %c coordinate %lld at scale %g is outside the float range", i + 1,
@@ -412,7 +495,12 @@ static void fill_colors(asp_cloud *c)
 
 static int read_header(reader *r)
 {
-    const uint8_t *h = r->b;
+    uint8_t h[LAS_HEADER_14] = {0}; // a copy: later fetches reuse the scratch buffer
+    const uint8_t *head;
+    int rc = fetch(r, 0, r->size < LAS_HEADER_14 ? r->size : LAS_HEADER_14, &head);
+    if (rc)
+        return rc;
+    memcpy(h, head, r->size < LAS_HEADER_14 ? r->size : LAS_HEADER_14);
     asp_las_meta *m = r->meta;
     if (r->size < 4 || memcmp(h, "LASF", 4) != 0)
         return bad(r, "not a LAS file (the first 4 bytes are not 'LASF')");
@@ -488,29 +576,20 @@ static int read_header(reader *r)
     if (nvlr > (r->point_offset - header_size) / LAS_VLR_HEADER)
         return bad(r, "%u VLRs do not fit between the header (%zu bytes) and the point data at byte %zu", nvlr,
                    header_size, r->point_offset);
-    int rc = read_vlrs(r, header_size, nvlr);
+    rc = read_vlrs(r, header_size, nvlr);
     if (rc == 0 && minor >= 4)
         rc = read_evlrs(r, las_get(h + LASH_EVLR_START, 8), (uint32_t)las_get(h + LASH_EVLR_COUNT, 4));
     return rc;
 }
 
-int asp_las_read_memory(const void *data, size_t size, const char *name, const asp_context *ctx, asp_cloud **out,
-                        asp_error *err)
+/* Reads from r (its source, size and name set) into *out; frees what r holds. */
+static int read_las(reader *r, asp_cloud **out)
 {
-    ASP_ASSERT(out && (data || size == 0));
-    reader *r = asp_calloc(ctx, 1, sizeof *r);
+    const asp_context *ctx = r->ctx;
+    asp_error *err = r->err;
     asp_las_meta *meta = asp_calloc(ctx, 1, sizeof *meta);
-    const char *nm = name ? name : "<memory>";
-    if (!r || !meta) {
-        asp_free(ctx, r);
-        asp_free(ctx, meta);
-        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory", nm);
-    }
-    r->b = data;
-    r->size = size;
-    r->name = nm;
-    r->ctx = ctx;
-    r->err = err;
+    if (!meta)
+        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory", r->name);
     r->meta = meta;
     asp_cloud *c = NULL;
     int rc = read_header(r);
@@ -527,17 +606,14 @@ int asp_las_read_memory(const void *data, size_t size, const char *name, const a
     asp_error e2;
     if (rc == 0 && (rc = asp_cloud_create((size_t)r->count, asp__las_has_rgb(r->fmt) ? ASP_ATTR_COLORS : 0, ctx, &c,
                                           &e2)))
-        asp_error_set(err, rc, "cannot read '%s': %s", nm, e2.msg);
+        asp_error_set(err, rc, "cannot read '%s': %s", r->name, e2.msg);
     if (rc == 0)
         rc = route_columns(r, c);
     if (rc == 0)
+        rc = decode_records(r, c);
+    if (rc == 0)
         rc = fill_positions(r, c);
     if (rc == 0) {
-        for (size_t i = 0; i < c->count; i++) {
-            const uint8_t *rec = r->b + r->point_offset + i * r->reclen;
-            for (size_t j = 0; j < r->ncols; j++)
-                store(&r->cols[j], i, field_value(&r->cols[j], rec));
-        }
         if (c->colors)
             fill_colors(c);
         c->position_type = ASP_SCALAR_FLOAT64;
@@ -553,18 +629,48 @@ int asp_las_read_memory(const void *data, size_t size, const char *name, const a
         asp_free(ctx, meta);
     }
     asp_cloud_destroy(c);
+    asp_free(ctx, r->extra_vlr);
+    asp_free(ctx, r->scratch);
+    return rc;
+}
+
+int asp_las_read_memory(const void *data, size_t size, const char *name, const asp_context *ctx, asp_cloud **out,
+                        asp_error *err)
+{
+    ASP_ASSERT(out && (data || size == 0));
+    reader *r = asp_calloc(ctx, 1, sizeof *r);
+    const char *nm = name ? name : "<memory>";
+    if (!r)
+        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory", nm);
+    static const uint8_t none[1] = {0};
+    *r = (reader){.b = data ? data : none, .size = size, .name = nm, .ctx = ctx, .err = err};
+    int rc = read_las(r, out);
     asp_free(ctx, r);
     return rc;
 }
 
 int asp_las_read(const char *path, const asp_context *ctx, asp_cloud **out, asp_error *err)
 {
-    uint8_t *buf;
-    size_t size;
-    int rc = asp__byte_slurp(path, ctx, &buf, &size, err);
-    if (rc)
-        return rc;
-    rc = asp_las_read_memory(buf, size, path, ctx, out, err);
-    asp_free(ctx, buf);
+    ASP_ASSERT(path && out);
+    FILE *fp = asp__regular_file_open(path, err);
+    if (!fp)
+        return ASP_EIO;
+    off_t end = -1;
+    if (fseeko(fp, 0, SEEK_END) == 0)
+        end = ftello(fp);
+    if (end < 0) {
+        int e = errno;
+        fclose(fp);
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", path, strerror(e));
+    }
+    reader *r = asp_calloc(ctx, 1, sizeof *r);
+    if (!r) {
+        fclose(fp);
+        return asp_error_set(err, ASP_ENOMEM, "cannot read '%s': out of memory", path);
+    }
+    *r = (reader){.fp = fp, .size = (size_t)end, .name = path, .ctx = ctx, .err = err};
+    int rc = read_las(r, out);
+    asp_free(ctx, r);
+    fclose(fp);
     return rc;
 }
