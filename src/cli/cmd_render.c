@@ -344,33 +344,39 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
     return 0;
 }
 
-static void print_json(const struct render_opts *o, size_t count, const asp_scene *s, asp_gl_context *gl, const char *renderer,
-                       const asp_image *img, const struct view_stats *vs, double seconds)
+static int print_json(const struct cli_env *env, const struct render_opts *o, size_t count, const asp_scene *s,
+                      asp_gl_context *gl, const char *renderer, const asp_image *img, const struct view_stats *vs,
+                      double seconds)
 {
-    printf("{\"output\": ");
-    cli_json_string(stdout, o->output);
-    printf(", \"width\": %u, \"height\": %u, \"tile_width\": %u, \"tile_height\": %u, \"views\": %zu, "
-           "\"points\": %zu, \"renderer\": ",
-           img->width, img->height, o->width, o->height, o->views, count);
-    cli_json_string(stdout, renderer);
+    cJSON *j = cJSON_CreateObject(), *frame = cJSON_CreateArray();
+    cJSON_AddStringToObject(j, "output", o->output);
+    cJSON_AddNumberToObject(j, "width", img->width);
+    cJSON_AddNumberToObject(j, "height", img->height);
+    cJSON_AddNumberToObject(j, "tile_width", o->width);
+    cJSON_AddNumberToObject(j, "tile_height", o->height);
+    cJSON_AddNumberToObject(j, "views", (double)o->views);
+    cJSON_AddNumberToObject(j, "points", (double)count);
+    cJSON_AddStringToObject(j, "renderer", renderer);
     if (o->dps_input) {
-        printf(", \"method\": ");
-        cli_json_string(stdout, asp_prim_render_method_name(o->prim.method));
-        printf(", \"level\": %u", asp_scene_dps_level(s)->level);
+        cJSON_AddStringToObject(j, "method", asp_prim_render_method_name(o->prim.method));
+        cJSON_AddNumberToObject(j, "level", asp_scene_dps_level(s)->level);
     }
-    printf(", \"gl_renderer\": ");
-    cli_json_string(stdout, asp_gl_context_renderer(gl));
-    printf(", \"gl_backend\": ");
-    cli_json_string(stdout, asp_gl_context_backend(gl));
+    cJSON_AddStringToObject(j, "gl_renderer", asp_gl_context_renderer(gl));
+    cJSON_AddStringToObject(j, "gl_backend", asp_gl_context_backend(gl));
     int lod = strcmp(renderer, "disc") && strcmp(renderer, "prim") && strcmp(renderer, "mesh");
-    printf(", \"primitives\": %zu, \"primitives_min\": %zu, \"primitives_max\": %zu, \"tolerance\": %g, "
-           "\"budget\": %zu, \"view_ms\": %.3f",
-           vs->last_count, vs->min_count, vs->max_count, lod && !o->budget ? o->tolerance : 0.0, o->budget,
-           1e3 * vs->seconds / (double)o->views);
+    cJSON_AddNumberToObject(j, "primitives", (double)vs->last_count);
+    cJSON_AddNumberToObject(j, "primitives_min", (double)vs->min_count);
+    cJSON_AddNumberToObject(j, "primitives_max", (double)vs->max_count);
+    cJSON_AddItemToObject(j, "tolerance", cli_json_number("%g", lod && !o->budget ? o->tolerance : 0.0));
+    cJSON_AddNumberToObject(j, "budget", (double)o->budget);
+    cJSON_AddItemToObject(j, "view_ms", cli_json_number("%.3f", 1e3 * vs->seconds / (double)o->views));
     // the camera's sphere, so two inputs of one model can be checked to frame alike
-    printf(", \"frame\": [%.9g, %.9g, %.9g, %.9g]", s->frame.center[0], s->frame.center[1], s->frame.center[2],
-           s->frame.radius);
-    printf(", \"seconds\": %.3f}\n", seconds);
+    for (int k = 0; k < 3; k++)
+        cJSON_AddItemToArray(frame, cli_json_number("%.9g", s->frame.center[k]));
+    cJSON_AddItemToArray(frame, cli_json_number("%.9g", s->frame.radius));
+    cJSON_AddItemToObject(j, "frame", frame);
+    cJSON_AddItemToObject(j, "seconds", cli_json_number("%.3f", seconds));
+    return cli_json_print(env, j);
 }
 
 int cmd_render(int argc, char **argv, struct cli_env *env)
@@ -491,7 +497,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     } else {
         cli_progress_end(env);
         if (env->json)
-            print_json(&o, count, &s, gl, kind->name, result, &vs, seconds);
+            status = print_json(env, &o, count, &s, gl, kind->name, result, &vs, seconds);
         else
             cli_info(env,
                      "rendered %zu view%s of %zu %s (%s, %zu primitives in the last view, %.1f ms per view, %s) "
