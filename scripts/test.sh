@@ -129,6 +129,7 @@ fuzz_smoke() {
       fuzz_image) seed "$corpus" "$seeds"/*.png ;;
       fuzz_mesh) seed "$corpus" "$seeds"/*.ply tests/data/bad/mesh ;;
       fuzz_las) seed "$corpus" "$seeds"/*.las ;;
+      fuzz_stats_log) seed "$corpus" tests/data/experiment ;;
       *) seed "$corpus" "$seeds" tests/data/bad ;; # a new target: every format as a start
     esac
     local nseeds
