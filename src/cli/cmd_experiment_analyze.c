@@ -69,11 +69,8 @@ int cmd_experiment_analyze(int argc, char **argv, struct cli_env *env)
         cJSON_AddNumberToObject(o, "frames", (double)info.frames);
         cJSON_AddNumberToObject(o, "lost_frames", (double)info.lost_frames);
         cJSON_AddNumberToObject(o, "answers", (double)info.answers);
-        char *text = cJSON_Print(o);
-        if (text)
-            printf("%s\n", text);
-        cJSON_free(text);
-        cJSON_Delete(o);
+        if (cli_json_print(env, o))
+            return 1;
     } else if (!env->quiet) {
         printf("%zu logs of %zu subjects, %zu frames, %zu frames lost; report in %s/report.md\n", info.logs,
                info.subjects, info.frames, info.lost_frames, output);

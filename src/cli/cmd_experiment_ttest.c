@@ -39,7 +39,8 @@ static int parse_sample(struct cli_env *env, const char *s, int which, asp_stats
     return 0;
 }
 
-static void print_json(const asp_stats_summary s[2], int nsamples, double mu, const asp_ttest_result *r)
+static int print_json(const struct cli_env *env, const asp_stats_summary s[2], int nsamples, double mu,
+                      const asp_ttest_result *r)
 {
     cJSON *o = cJSON_CreateObject();
     cJSON_AddStringToObject(o, "test", nsamples == 1 ? "one-sample" : r->welch ? "welch" : "pooled");
@@ -68,11 +69,7 @@ static void print_json(const asp_stats_summary s[2], int nsamples, double mu, co
     cJSON *ci = cJSON_AddArrayToObject(o, "diff_ci");
     cJSON_AddItemToArray(ci, cJSON_CreateNumber(r->diff_lo));
     cJSON_AddItemToArray(ci, cJSON_CreateNumber(r->diff_hi));
-    char *text = cJSON_Print(o);
-    if (text)
-        printf("%s\n", text);
-    cJSON_free(text);
-    cJSON_Delete(o);
+    return cli_json_print(env, o);
 }
 
 int cmd_experiment_ttest(int argc, char **argv, struct cli_env *env)
@@ -106,10 +103,8 @@ int cmd_experiment_ttest(int argc, char **argv, struct cli_env *env)
     const asp_ttest_desc desc = {.welch = welch, .level = level};
     if (npos == 1 ? asp_stats_ttest_one(&s[0], mu, &desc, &r, &err) : asp_stats_ttest(&s[0], &s[1], &desc, &r, &err))
         return cli_fail(env, &err);
-    if (env->json) {
-        print_json(s, npos, mu, &r);
-        return 0;
-    }
+    if (env->json)
+        return print_json(env, s, npos, mu, &r);
     if (npos == 1) {
         printf("one-sample t test: mean - %.6g = %.6g (standard error %.6g)\n", mu, r.diff, r.se);
         printf("t = %.4f, df = %.0f\n", r.t, r.df);

@@ -66,7 +66,7 @@ static int parse_levels(struct cli_env *env, const asp_dps *dps, const char *pat
     return 0;
 }
 
-static void print_result(const struct cli_env *env, const char *in, const char *out, const char *kind,
+static int print_result(const struct cli_env *env, const char *in, const char *out, const char *kind,
                          const asp_gltf_stats *st, const asp_gltf_desc *d)
 {
     if (env->json) {
@@ -92,12 +92,9 @@ static void print_result(const struct cli_env *env, const char *in, const char *
         } else {
             cJSON_AddBoolToObject(j, "gaussian_splats", !(d->flags & ASP_GLTF_NO_SPLATS));
         }
-        char *text = cJSON_Print(j);
-        if (text)
-            printf("%s\n", text);
-        cJSON_free(text);
-        cJSON_Delete(j);
-    } else if (!env->quiet) {
+        return cli_json_print(env, j);
+    }
+    if (!env->quiet) {
         if (st->primitives)
             printf("exported '%s' -> '%s': %zu level%s, %zu primitives, %zu images, %zu bytes in %zu file%s\n", in, out,
                    st->nodes, st->nodes == 1 ? "" : "s", st->primitives, st->images, st->file_bytes, st->files,
@@ -108,6 +105,7 @@ static void print_result(const struct cli_env *env, const char *in, const char *
                    st->files == 1 ? "" : "s");
         printf("origin %.17g %.17g %.17g (the node translation)\n", st->origin[0], st->origin[1], st->origin[2]);
     }
+    return 0;
 }
 
 static int check_options(struct cli_env *env, const struct export_opts *o, asp_gltf_desc *d)
@@ -158,8 +156,7 @@ static int export_dps(struct cli_env *env, const char *in, const struct export_o
     }
     asp_dps_destroy(dps);
     cli_progress_end(env);
-    print_result(env, in, o->output, "primitives", &st, d);
-    return 0;
+    return print_result(env, in, o->output, "primitives", &st, d);
 }
 
 static int export_points(struct cli_env *env, const char *in, int hier_file, const struct export_opts *o,
@@ -184,8 +181,7 @@ static int export_points(struct cli_env *env, const char *in, int hier_file, con
     if (rc)
         return cli_fail(env, &err);
     cli_progress_end(env);
-    print_result(env, in, o->output, "points", &st, d);
-    return 0;
+    return print_result(env, in, o->output, "points", &st, d);
 }
 
 int cmd_export(int argc, char **argv, struct cli_env *env)
