@@ -3,8 +3,18 @@
 // colours as 8-bit RGBA, the first and last intensity and classification, the version and format.
 // usage: node web/test/las_check.mjs FILE.las     (exit 3 when loaders.gl cannot read the file)
 import { readFile } from 'node:fs/promises';
+import { dirname, join } from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
 import { parse } from '@loaders.gl/core';
-import { LASLoader } from '@loaders.gl/las';
+import { LAZRsLoader } from '@loaders.gl/las';
+
+// The laz-rs (Rust, WebAssembly) loader of @loaders.gl/las 4.5 reads LAS 1.0-1.4 and formats 0-10;
+// the default laz-perf one stops at 1.3. Its wasm is fetched by URL, which Node's fetch cannot do for
+// file: URLs, so it is initialised here from the file's bytes.
+const lasDir = dirname(fileURLToPath(import.meta.resolve('@loaders.gl/las')));
+const wasmDir = join(lasDir, 'libs', 'laz-rs-wasm');
+const initWasm = (await import(pathToFileURL(join(wasmDir, 'laz_rs_wasm.js')).href)).default;
+await initWasm({ module_or_path: await readFile(join(wasmDir, 'laz_rs_wasm_bg.wasm')) });
 
 const path = process.argv[2];
 if (!path) {
@@ -16,7 +26,7 @@ let mesh;
 try {
   // fp64: world coordinates in double, as amgsplat's origin + offset; colorDepth 'auto': the high byte
   // when a value exceeds 255, as amgsplat's reader does (docs/las.md)
-  mesh = await parse(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength), LASLoader, {
+  mesh = await parse(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength), LAZRsLoader, {
     worker: false,
     las: { fp64: true, colorDepth: 'auto', shape: 'mesh' },
   });
