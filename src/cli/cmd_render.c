@@ -278,8 +278,10 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
         memset(o->bg, 0, 4);
     if (o->light) {
         double v[2] = {0, 0};
-        if (cli_parse_doubles(o->light, v, 2) != 2 || !(v[1] >= -90 && v[1] <= 90) || !isfinite(v[0]))
-            return cli_usage_error(env, "--light expects AZ,EL in degrees with EL in -90..90, got '%s'", o->light);
+        // AZ bounded as --view's (cli_parse_view): 1e300 degrees is no direction
+        if (cli_parse_doubles(o->light, v, 2) != 2 || !(v[1] >= -90 && v[1] <= 90) || !(fabs(v[0]) <= 36000))
+            return cli_usage_error(env, "--light expects AZ,EL in degrees with AZ in -36000..36000 and EL in -90..90, "
+                                   "got '%s'", o->light);
         o->light_az = v[0];
         o->light_el = v[1];
     }
