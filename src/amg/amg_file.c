@@ -163,8 +163,15 @@ static int read_options(asp__byte_reader *r, asp_amg_desc *d)
     if (u32[0] > ASP_AMG_CLASSIFIER_MOMENT || u32[1] > ASP_AMG_COARSEN_HMIS || u32[2] > ASP_AMG_INTERP_EXTENDED_I)
         return asp__byte_bad(r, "unknown classifier, coarsening or interpolation code");
     /* drop_tol drives every product P^l (journal 2.3): a NaN would silently empty the basis */
-    if (!isfinite(d->epsilon) || !(f[4] < 0.01))
-        return asp__byte_bad(r, "options: non-finite epsilon or drop tolerance not below 0.01");
+    char msg[120];
+    if (!isfinite(d->epsilon) || !(f[4] < 0.01)) {
+        r->at -= AMG_OPTIONS; // the start of the options block
+        if (!isfinite(d->epsilon))
+            snprintf(msg, sizeof msg, "options: epsilon %g, expected a finite neighbourhood radius", d->epsilon);
+        else
+            snprintf(msg, sizeof msg, "options: drop tolerance %.17g, expected one below 0.01", f[4]);
+        return asp__byte_bad(r, msg);
+    }
     d->k_min = (size_t)u64[0];
     d->k_max = (size_t)u64[1];
     d->fan_k = (size_t)u64[2];

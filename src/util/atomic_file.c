@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "amgsplat/output.h"
@@ -170,6 +171,10 @@ int asp__atomic_open(asp__atomic_file *f, const char *path, asp_error *err)
         return asp_error_set(err, ASP_EINVAL, "empty output path");
     if (strlen(path) >= sizeof f->path)
         return asp_error_set(err, ASP_EINVAL, "output path too long: '%.64s...'", path);
+    // refused now, not at the rename: inside an output batch the renames come after every file is written
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return asp_error_set(err, ASP_EIO, "cannot write '%s': is a directory", path);
     snprintf(f->path, sizeof f->path, "%s", path);
     snprintf(f->tmp, sizeof f->tmp, "%s.tmp.%ld", path, (long)getpid());
     install_handlers();
