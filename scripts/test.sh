@@ -89,8 +89,10 @@ build_d() {
   run_ctest build-nohypre
 }
 
-# Seeds: small valid files of every format the fuzzers read, made fresh by build a's tools, plus
-# the malformed inputs of tests/data/bad. No corpus is kept in the repository.
+# Seeds: the committed corpus of each target (tools/corpus/<target>/, remade by
+# tools/corpus/make_seeds.py or replaced by the minimized corpora of longer runs), small valid files
+# of every format the fuzzers read made fresh by build a's tools (the current format versions), and
+# the malformed inputs of tests/data/bad.
 fuzz_smoke() {
   local seeds=build-fuzz/seeds
   rm -rf "$seeds" build-fuzz/corpus
@@ -126,6 +128,9 @@ fuzz_smoke() {
       fuzz_mesh) seed "$corpus" "$seeds"/*.ply tests/data/bad/mesh ;;
       *) seed "$corpus" "$seeds" tests/data/bad ;; # a new target: every format as a start
     esac
+    if [[ -d tools/corpus/$name ]]; then
+      seed "$corpus" "tools/corpus/$name"
+    fi
     local nseeds
     nseeds=$(ls "$corpus" | wc -l)
     echo "--- $name: $fuzz_seconds s" >&2
