@@ -9,7 +9,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -53,12 +55,20 @@ static int hypre_started;
  * (OMPI_MCA_*, the issue's case) or a memory limit (RLIMIT_AS, RLIMIT_DATA).
  */
 static char mpi_log[4096];
+extern char **environ;
 
 /* The reason in Open MPI's report: the missing component, else the failed call and its code, else the first line. */
 static void mpi_reason(const char *log, char *out, size_t cap)
 {
     char buf[16384];
-    snprintf(out, cap, "no report from Open MPI");
+    // Open MPI's helper sometimes loses part or all of the report under load (ORTE_ERROR_LOG in
+    // show_help.c): then name the settings that are the likely cause
+    const char *setting = NULL;
+    for (char **e = environ; e && *e && !setting; e++)
+        if (strncmp(*e, "OMPI_MCA_", 9) == 0)
+            setting = *e;
+    snprintf(out, cap, "MPI_Init_thread failed (Open MPI gave no reason%s%.80s)", setting ? "; set: " : "",
+             setting ? setting : "");
     FILE *fp = fopen(log, "r");
     if (!fp)
         return;
@@ -78,8 +88,9 @@ static void mpi_reason(const char *log, char *out, size_t cap)
             snprintf(ret, sizeof ret, "%.120s", line + 13);
         else if (strstr(line, "() failed"))
             snprintf(call, sizeof call, "%.120s", line);
-        else if (!first[0] && line[0] && line[0] != '-' && line[0] != '[')
+        else if (!first[0] && line[0] && line[0] != '-' && line[0] != '[' && line[0] != '*')
             snprintf(first, sizeof first, "%.150s", line);
+
     }
     if (fw[0] && comp[0])
         snprintf(out, cap, "component '%s' of framework '%s' not found (an OMPI_MCA_%s setting?)", comp, fw, fw);
@@ -88,8 +99,6 @@ static void mpi_reason(const char *log, char *out, size_t cap)
     else if (first[0])
         snprintf(out, cap, "%s", first);
 }
-
-extern char **environ;
 
 /* Whether MPI_Init_thread can plausibly fail here (see above). */
 static int mpi_start_at_risk(void)
@@ -135,6 +144,16 @@ static int mpi_probe(asp_error *err)
     if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
         unlink(mpi_log);
         return 0;
+    }
+    // Open MPI's helper (orted) prints part of the report for the child, after the child has gone: wait
+    // until the log has not grown for 0.3 s, at most 3 s
+    off_t last = -1;
+    for (int i = 0, still = 0; i < 60 && still < 6; i++) {
+        struct stat st;
+        off_t now = stat(mpi_log, &st) == 0 ? st.st_size : -1;
+        still = now > 0 && now == last ? still + 1 : 0;
+        last = now;
+        nanosleep(&(struct timespec){0, 50 * 1000 * 1000}, NULL);
     }
     char reason[512];
     mpi_reason(mpi_log, reason, sizeof reason);
