@@ -258,3 +258,10 @@ expect_fail 1 "cannot write '$T/simp/g.mtl': is a directory" "$A" simplify "$T/g
 rmdir "$T/simp/g.mtl"
 "$A" simplify "$T/grid.obj" -o "$T/simp/g.obj" --triangles 8 >/dev/null
 [[ -s "$T/simp/g.png" && -s "$T/simp/g.mtl" ]] && grep -q "^f " "$T/simp/g.obj" || fail "simplify did not write OBJ+MTL+PNG: $(ls "$T/simp")"
+# decompose -o with --colors-out: a level that does not exist leaves the old .amg, and no colours file
+printf 'old amg\n' >"$T/keep.amg"
+expect_fail 1 "no level 'L-99': the decomposition has levels 0.." "$A" decompose "$T/pts.xyz" -o "$T/keep.amg" \
+  --export-colors domains --level L-99 --colors-out "$T/colours.ply"
+[[ "$(cat "$T/keep.amg")" == "old amg" && ! -e "$T/colours.ply" ]] || fail "decompose wrote half of -o and --colors-out"
+"$A" decompose "$T/pts.xyz" -o "$T/keep.amg" --export-colors domains --level L-1 --colors-out "$T/colours.ply" -q
+"$A" info "$T/keep.amg" >/dev/null && "$A" info "$T/colours.ply" >/dev/null || fail "decompose -o with --colors-out"
