@@ -263,5 +263,7 @@ printf 'old amg\n' >"$T/keep.amg"
 expect_fail 1 "no level 'L-99': the decomposition has levels 0.." "$A" decompose "$T/pts.xyz" -o "$T/keep.amg" \
   --export-colors domains --level L-99 --colors-out "$T/colours.ply"
 [[ "$(cat "$T/keep.amg")" == "old amg" && ! -e "$T/colours.ply" ]] || fail "decompose wrote half of -o and --colors-out"
-"$A" decompose "$T/pts.xyz" -o "$T/keep.amg" --export-colors domains --level L-1 --colors-out "$T/colours.ply" -q
+# (Open MPI leaks by design: in the ASan build this successful run is not leak-checked, CMakeLists.txt)
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+  "$A" decompose "$T/pts.xyz" -o "$T/keep.amg" --export-colors domains --level L-1 --colors-out "$T/colours.ply" -q
 "$A" info "$T/keep.amg" >/dev/null && "$A" info "$T/colours.ply" >/dev/null || fail "decompose -o with --colors-out"

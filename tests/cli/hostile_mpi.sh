@@ -25,6 +25,7 @@ for cmd in decompose build; do
   rm -f "$log"
 done
 # without the setting: the same command works, and no report file is left
-"$A" decompose "$T/pts.xyz" -o "$T/o.amg" --quiet
+# (Open MPI leaks by design: in the ASan build this successful start is not leak-checked, CMakeLists.txt)
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" "$A" decompose "$T/pts.xyz" -o "$T/o.amg" --quiet
 [[ -s "$T/o.amg" ]] || fail "decompose without the setting wrote nothing"
 ! ls "$T"/amgsplat-mpi-* >/dev/null 2>&1 || fail "a report file was left after a good start"
