@@ -124,7 +124,7 @@ fuzz_smoke() {
       fuzz_amg) seed "$corpus" "$seeds"/*.amg ;;
       fuzz_dps) seed "$corpus" "$seeds"/*.dps ;;
       fuzz_hier) seed "$corpus" "$seeds"/*.hier ;;
-      fuzz_image) seed "$corpus" "$seeds"/*.png ;;
+      fuzz_image) seed "$corpus" "$seeds"/*.png tests/data/bad/image ;;
       fuzz_mesh) seed "$corpus" "$seeds"/*.ply tests/data/bad/mesh ;;
       *) seed "$corpus" "$seeds" tests/data/bad ;; # a new target: every format as a start
     esac

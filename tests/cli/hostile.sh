@@ -191,7 +191,7 @@ open(d + '/empty.png', 'w').write('')
 PY
 expect_fail 1 "cannot read image '$T/huge.png': PNG header says 100000x100000, outside the 1..16384 pixels a side" "$A" imgdiff "$T/huge.png" "$T/img.png"
 expect_fail 1 "cannot read '$T/huge.png': PNG of 100000x100000 that stb_image refuses" "$A" info "$T/huge.png"
-expect_fail 1 "cannot decode image '$T/noidat.png': PNG of 4x4: damaged image data" "$A" imgdiff "$T/noidat.png" "$T/img.png"
+expect_fail 1 "cannot decode image '$T/noidat.png': cut off at byte 33: no image data (IDAT) and no IEND chunk" "$A" imgdiff "$T/noidat.png" "$T/img.png"
 expect_fail 1 "'$T/text.png': not an image: no PNG, JPEG, GIF, BMP or PSD signature" "$A" imgdiff "$T/img.png" "$T/text.png"
 expect_fail 1 "cannot read image '$T/empty.png': empty file" "$A" sample "$T/tri.obj" -o "$T/o.ply" --texture "$T/empty.png"
 
@@ -267,3 +267,14 @@ expect_fail 1 "no level 'L-99': the decomposition has levels 0.." "$A" decompose
 ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
   "$A" decompose "$T/pts.xyz" -o "$T/keep.amg" --export-colors domains --level L-1 --colors-out "$T/colours.ply" -q
 "$A" info "$T/keep.amg" >/dev/null && "$A" info "$T/colours.ply" >/dev/null || fail "decompose -o with --colors-out"
+
+# damaged images (tests/data/bad/image/expected.txt): each described by what is wrong with it
+BADIMG="${ASP_TEST_SRC:-$(dirname "$0")/..}/data/bad/image"
+n=0
+while IFS=$'\t' read -r file want; do
+  [[ -z "$file" || "$file" == \#* ]] && continue
+  expect_fail 1 "image '$BADIMG/$file': $want" "$A" imgdiff "$BADIMG/$file" "$T/img.png"
+  expect_fail 1 "'$BADIMG/$file': $want" "$A" sample "$T/tri.obj" -o "$T/o.ply" --points 10 --texture "$BADIMG/$file"
+  n=$((n + 1))
+done <"$BADIMG/expected.txt"
+((n >= 9)) || fail "only $n damaged images tried"
