@@ -278,3 +278,12 @@ while IFS=$'\t' read -r file want; do
   n=$((n + 1))
 done <"$BADIMG/expected.txt"
 ((n >= 9)) || fail "only $n damaged images tried"
+
+# options that end up in floats are bounded and refused by name (1e300 became inf below them)
+expect_fail 2 "--radius-scale expects a value in (0, 1e6], got 1e+300" "$A" render "$T/pts.xyz" -o "$T/r.png" --size 16x16 --radius-scale 1e300
+expect_fail 2 "--tolerance expects pixels in 0..1e6, got 1e+300" "$A" render "$T/pts.xyz" -o "$T/r.png" --size 16x16 --tolerance 1e300
+expect_fail 2 "--epsilon expects splat radii in 0..1e6, got 1e+300" "$A" render "$T/pts.xyz" -o "$T/r.png" --size 16x16 --epsilon 1e300
+expect_fail 2 "--tau expects pixels in 0..1e6, got 1e+300" "$A" view "$T/pts.xyz" --frames 1 --tau 1e300
+expect_fail 2 "--view expects AZ,EL[,DIST] with AZ in -36000..36000, EL in -90..90 and DIST in (0, 1e6] radii, got '1e300,0'" \
+  "$A" render "$T/pts.xyz" -o "$T/r.png" --size 16x16 --view 1e300,0
+[[ ! -e "$T/r.png" ]] || fail "a refused render wrote '$T/r.png'"
