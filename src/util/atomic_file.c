@@ -114,7 +114,7 @@ static int claim_slot(const char *tmp, size_t path_len)
 
 static void release_slot(int i)
 {
-    if (i >= 0)
+    if (i >= 0 && i < LIVE_MAX)
         atomic_store_explicit(&live[i].state, SLOT_FREE, memory_order_release);
 }
 
@@ -262,10 +262,12 @@ void asp__atomic_abort(asp__atomic_file *f)
         fclose(f->fp);
         f->fp = NULL;
     }
-    if (f->tmp[0])
+    // a zeroed, never opened file has no temporary and no slot of its own (slot 0 may be another's)
+    if (f->tmp[0]) {
         remove(f->tmp);
+        release_slot(f->slot);
+    }
     f->tmp[0] = '\0';
-    release_slot(f->slot);
     f->slot = -1;
 }
 
