@@ -67,37 +67,60 @@ static void mpi_reason(const char *log, char *out, size_t cap)
     for (char **e = environ; e && *e && !setting; e++)
         if (strncmp(*e, "OMPI_MCA_", 9) == 0)
             setting = *e;
-    snprintf(out, cap, "MPI_Init_thread failed (Open MPI gave no reason%s%.80s)", setting ? "; set: " : "",
-             setting ? setting : "");
+    char limit[64] = "";
+    struct rlimit as;
+    if (getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY)
+        snprintf(limit, sizeof limit, "; memory limit (ulimit -v) %llu MB", (unsigned long long)(as.rlim_cur >> 20));
+    snprintf(out, cap, "MPI_Init_thread failed (Open MPI gave no reason%s%.80s)%s", setting ? "; set: " : "",
+             setting ? setting : "", limit);
     FILE *fp = fopen(log, "r");
     if (!fp)
         return;
     size_t n = fread(buf, 1, sizeof buf - 1, fp);
     fclose(fp);
     buf[n] = '\0';
-    char fw[64] = "", comp[64] = "", call[128] = "", ret[128] = "", first[160] = "";
+    // first: the first paragraph of Open MPI's help text (between its dashed lines), joined into one line
+    char fw[64] = "", comp[64] = "", call[128] = "", ret[128] = "", first[200] = "";
+    int in_first = 0, resources = 0;
     for (char *line = buf, *next; line && *line; line = next) {
         next = strchr(line, '\n');
         if (next)
             *next++ = '\0';
         while (*line == ' ')
             line++;
+        resources |= strstr(line, "OUT-OF-RESOURCE") != NULL || strstr(line, "Out of resource") != NULL;
         if (sscanf(line, "Framework: %63s", fw) == 1 || sscanf(line, "Component: %63s", comp) == 1)
             continue;
+        int text = line[0] && line[0] != '-' && line[0] != '[' && line[0] != '*';
+        if (in_first && text) {
+            size_t used = strlen(first);
+            snprintf(first + used, sizeof first - used, " %.190s", line);
+            continue;
+        }
+        in_first = 0;
         if (strncmp(line, "--> Returned ", 13) == 0)
             snprintf(ret, sizeof ret, "%.120s", line + 13);
         else if (strstr(line, "() failed"))
             snprintf(call, sizeof call, "%.120s", line);
-        else if (!first[0] && line[0] && line[0] != '-' && line[0] != '[' && line[0] != '*')
-            snprintf(first, sizeof first, "%.150s", line);
-
+        else if (!first[0] && text) {
+            snprintf(first, sizeof first, "%.190s", line);
+            in_first = 1;
+        }
     }
+    char *stop = strstr(first, ". "); // its first sentence, without the full stop
+    if (stop)
+        *stop = '\0';
+    else if (first[0] && first[strlen(first) - 1] == '.')
+        first[strlen(first) - 1] = '\0';
     if (fw[0] && comp[0])
         snprintf(out, cap, "component '%s' of framework '%s' not found (an OMPI_MCA_%s setting?)", comp, fw, fw);
     else if (call[0])
-        snprintf(out, cap, "%s, returned %s", call, ret[0] ? ret : "an error");
+        snprintf(out, cap, "%s, returned %s%s", call, ret[0] ? ret : "an error", limit);
     else if (first[0])
-        snprintf(out, cap, "%s", first);
+        snprintf(out, cap, "%s%s", first, limit);
+    else if (resources)
+        snprintf(out, cap, "Open MPI ran out of resources%s%.80s%s", setting ? "; set: " : "", setting ? setting : "",
+                 limit);
 }
 
 /* Whether MPI_Init_thread can plausibly fail here (see above). */
