@@ -21,5 +21,6 @@
 #include "render.h"
 #include "scene.h"
 #include "viewer.h"
+#include "output.h"
 
 #endif

@@ -232,13 +232,19 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     asp_dps *dps = NULL;
     if (!rc)
         rc = asp_prim_build(amg, cloud, levels, nlevels, &desc, argv[0], &env->ctx, &dps, &err);
+    // the .dps and its atlases appear all or none (issue #13): a failed atlas leaves the old .dps as it was
+    asp_output_batch_begin(NULL);
     if (!rc)
         rc = asp_dps_save(dps, output, &err);
     asp_dps_summary rows[64];
     if (!rc)
         asp_dps_summarize(dps, rows, 64);
-    if (!rc && atlas && (rc = save_atlases(atlas, dps, rows, &err)) != 0)
-        remove(output); // all outputs or none (issue #13): the .dps just written goes with the failed atlas
+    if (!rc && atlas)
+        rc = save_atlases(atlas, dps, rows, &err);
+    if (rc)
+        asp_output_batch_abort();
+    else
+        rc = asp_output_batch_commit(&err);
     double t_total = asp_time_now() - t0;
     asp_amg_destroy(amg);
     asp_cloud_destroy(cloud);

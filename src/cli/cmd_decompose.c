@@ -261,6 +261,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     asp_error err = {0};
     asp_amg *amg = NULL;
     double t0 = asp_time_now();
+    asp_output_batch_begin(NULL); // -o and --colors-out: committed after both are written
     if (from_amg) {
         if (asp_amg_load(input, &env->ctx, &amg, &err))
             return cli_fail(env, &err);
@@ -275,6 +276,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
             return cli_fail(env, &err);
         }
         if (output && asp_amg_save(amg, output, &err)) {
+            asp_output_batch_abort();
             asp_amg_destroy(amg);
             asp_amg_shutdown();
             return cli_fail(env, &err);
@@ -284,6 +286,10 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     rc = 0;
     if (export_mode)
         rc = export_colors(env, amg, color_mode, level_name, colors_out, &err);
+    if (rc) // both appear or neither (issue #13)
+        asp_output_batch_abort();
+    else
+        rc = asp_output_batch_commit(&err);
     cli_progress_end(env);
     int json_status = 0;
     if (!rc && env->json) {

@@ -321,8 +321,14 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
     double t0 = asp_time_now();
     asp_eval_result *res = NULL;
     rc = asp_eval_run(cloud, &desc, &env->ctx, &res, &err);
-    if (!rc)
+    if (!rc) { // the report's files appear all or none (issue #13): a failed chart keeps the old report whole
+        asp_output_batch_begin(NULL);
         rc = save_outputs(res, argv[0], dir, sizes, nsizes, &err);
+        if (rc)
+            asp_output_batch_abort();
+        else
+            rc = asp_output_batch_commit(&err);
+    }
     double seconds = asp_time_now() - t0;
     asp_cloud_destroy(cloud);
     asp_mesh_destroy(mesh);

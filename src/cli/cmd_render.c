@@ -153,10 +153,11 @@ static int parse_colour(struct cli_env *env, const char *s, uint8_t out[4])
 /* Options of the hierarchy renderers and of .amg inputs. */
 static int parse_splat_options(struct cli_env *env, struct render_opts *o)
 {
-    if (!(o->tolerance >= 0) || !isfinite(o->tolerance))
-        return cli_usage_error(env, "--tolerance expects pixels >= 0, got %g", o->tolerance);
-    if (!(o->epsilon >= 0) || !isfinite(o->epsilon))
-        return cli_usage_error(env, "--epsilon expects a number >= 0 (splat radii), got %g", o->epsilon);
+    // bounded: the renderers take floats, and 1e300 became inf there (issue #13)
+    if (!(o->tolerance >= 0 && o->tolerance <= 1e6))
+        return cli_usage_error(env, "--tolerance expects pixels in 0..1e6, got %g", o->tolerance);
+    if (!(o->epsilon >= 0 && o->epsilon <= 1e6))
+        return cli_usage_error(env, "--epsilon expects splat radii in 0..1e6, got %g", o->epsilon);
     if (!(o->point_size >= 0) || !(o->point_size <= 256))
         return cli_usage_error(env, "--point-size expects pixels in 0..256 (0 = projected size), got %g",
                                o->point_size);
@@ -292,15 +293,17 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
         memset(o->bg, 0, 4);
     if (o->light) {
         double v[2] = {0, 0};
-        if (cli_parse_doubles(o->light, v, 2) != 2 || !(v[1] >= -90 && v[1] <= 90) || !isfinite(v[0]))
-            return cli_usage_error(env, "--light expects AZ,EL in degrees with EL in -90..90, got '%s'", o->light);
+        // AZ bounded as --view's (cli_parse_view): 1e300 degrees is no direction
+        if (cli_parse_doubles(o->light, v, 2) != 2 || !(v[1] >= -90 && v[1] <= 90) || !(fabs(v[0]) <= 36000))
+            return cli_usage_error(env, "--light expects AZ,EL in degrees with AZ in -36000..36000 and EL in -90..90, "
+                                   "got '%s'", o->light);
         o->light_az = v[0];
         o->light_el = v[1];
     }
     if (!(o->fov > 0 && o->fov < 180))
         return cli_usage_error(env, "--fov expects degrees in (0, 180), got %g", o->fov);
-    if (!(o->radius_scale > 0) || !isfinite(o->radius_scale))
-        return cli_usage_error(env, "--radius-scale expects a positive number, got %g", o->radius_scale);
+    if (!(o->radius_scale > 0 && o->radius_scale <= 1e6))
+        return cli_usage_error(env, "--radius-scale expects a value in (0, 1e6], got %g", o->radius_scale);
     if (parse_splat_options(env, o))
         return 2;
     return parse_prim_options(env, o);

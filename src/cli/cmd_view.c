@@ -69,8 +69,8 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
     }
     if (o->up && cli_parse_up(o->up, &d->up) != 0)
         return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
-    if (!(o->tau >= 0) || !isfinite(o->tau))
-        return cli_usage_error(env, "--tau expects pixels >= 0, got %g", o->tau);
+    if (!(o->tau >= 0 && o->tau <= 1e6)) // a float below: 1e300 became "tolerance inf" (issue #13)
+        return cli_usage_error(env, "--tau expects pixels in 0..1e6, got %g", o->tau);
     d->tolerance = (float)o->tau;
     if (o->color) {
         size_t m = sizeof color_modes / sizeof color_modes[0];
