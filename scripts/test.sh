@@ -89,8 +89,10 @@ build_d() {
   run_ctest build-nohypre
 }
 
-# Seeds: small valid files of every format the fuzzers read, made fresh by build a's tools, plus
-# the malformed inputs of tests/data/bad. No corpus is kept in the repository.
+# Seeds: the committed corpus of each target (tools/corpus/<target>/, remade by
+# tools/corpus/make_seeds.py or replaced by the minimized corpora of longer runs), small valid files
+# of every format the fuzzers read made fresh by build a's tools (the current format versions), and
+# the malformed inputs of tests/data/bad.
 fuzz_smoke() {
   local seeds=build-fuzz/seeds
   rm -rf "$seeds" build-fuzz/corpus
@@ -104,6 +106,10 @@ fuzz_smoke() {
   "$A" build "$seeds/oct.amg" -o "$seeds/oct.dps" --primitives 8 -q >/dev/null
   build/seed_hier "$seeds/oct.ply" "$seeds/oct.hier"
   "$A" render "$seeds/oct.ply" -o "$seeds/oct.png" --size 32x32 -q
+  "$A" convert "$seeds/oct.ply" "$seeds/oct.las" -q
+  "$A" convert --las-format 3 "$seeds/oct.ply" "$seeds/oct3.las" -q
+  python3 tests/cli/las_handmade.py "$seeds/hand14.las" 4 8 20 --extra >/dev/null
+  python3 tests/cli/las_handmade.py "$seeds/hand12.las" 2 1 20 >/dev/null
   # seeds: regular files only, from files and folders (tests/data/bad has subfolders per kind)
   seed() {
     local dst=$1
@@ -122,16 +128,26 @@ fuzz_smoke() {
       fuzz_amg) seed "$corpus" "$seeds"/*.amg ;;
       fuzz_dps) seed "$corpus" "$seeds"/*.dps ;;
       fuzz_hier) seed "$corpus" "$seeds"/*.hier ;;
-      fuzz_image) seed "$corpus" "$seeds"/*.png ;;
+      fuzz_image) seed "$corpus" "$seeds"/*.png tests/data/bad/image ;;
       fuzz_mesh) seed "$corpus" "$seeds"/*.ply tests/data/bad/mesh ;;
+      fuzz_las) seed "$corpus" "$seeds"/*.las ;;
+      fuzz_stats_log) seed "$corpus" tests/data/experiment ;;
       *) seed "$corpus" "$seeds" tests/data/bad ;; # a new target: every format as a start
     esac
+    if [[ -d tools/corpus/$name ]]; then
+      seed "$corpus" "tools/corpus/$name"
+    fi
     local nseeds
     nseeds=$(ls "$corpus" | wc -l)
     echo "--- $name: $fuzz_seconds s" >&2
     # leaks are checked: the readers start no MPI. -max_len keeps mutations near the seeds' sizes.
     local log=build-fuzz/$name.log st=0
-    ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+    local asan="detect_leaks=1:strict_string_checks=1" lsan=""
+    if [[ $name == fuzz_mesh ]]; then # assimp's own leaks on damaged files: tools/fuzz_mesh.supp says why
+      asan+=":fast_unwind_on_malloc=0"
+      lsan="suppressions=$PWD/tools/fuzz_mesh.supp:print_suppressions=0"
+    fi
+    ASAN_OPTIONS="$asan" LSAN_OPTIONS="$lsan" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
       "$f" -max_total_time="$fuzz_seconds" -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
       -artifact_prefix=build-fuzz/"$name"- "$corpus" >"$log" 2>&1 || st=$?
     if ((st != 0)); then

@@ -17,8 +17,10 @@
 #include "hier.h"
 #include "amg.h"
 #include "prim.h"
+#include "export.h"
 #include "render.h"
 #include "scene.h"
 #include "viewer.h"
+#include "output.h"
 
 #endif

@@ -542,8 +542,10 @@ typedef enum asp_prim_render_method {
     /* Thesis appendix C "No Blend": opaque, depth-tested texels where
      * alpha > alpha_ref, for strict (non-overlapping) domains. */
     ASP_PRIM_RENDER_NO_BLEND = 7,
-    /* Journal Fig. 12b: the support rectangles drawn opaque (texture colour,
-     * alpha ignored), a flat-shaded polygon soup. */
+    /* Journal Fig. 12b: the support polygons drawn opaque and unblended
+     * (texture colour), each trimmed to its domain's footprint (texels of
+     * alpha > 0: the convex hull of the domain's points, journal 3.1), a
+     * flat polygon soup. --outline shows the whole rectangles. */
     ASP_PRIM_RENDER_POLYGONS = 8
 } asp_prim_render_method;
 

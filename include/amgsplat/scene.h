@@ -38,6 +38,8 @@ typedef struct asp_scene_desc {
                             .dps: level drawn (asp_dps_level_parse; NULL = the finest in the file) */
     float crease_angle;  /* point and .amg inputs: degrees in (0, 90): clip planes at sharper creases
                             (asp_crease_clip_planes; needs normals); 0 = none */
+    int crease_if_normals; /* 1: crease_angle is a default, not a request: points without normals are
+                              drawn unclipped instead of refused */
     const char *texture; /* meshes: image used as the texture of every material that names none or whose
                             file is missing (asp_mesh_load_desc.texture_override); NULL = none */
 } asp_scene_desc;

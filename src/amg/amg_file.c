@@ -59,6 +59,21 @@ static uint64_t payload_size(const asp_amg *amg)
     return s;
 }
 
+/*
+ * No command writes what its own reader refuses (issue #13): the whole file
+ * is parsed back before it replaces the target. A full read, not a header
+ * check, because what went wrong before was in the payload (an epsilon of
+ * inf in the options block); it costs about what the write does.
+ */
+static int amg_reads_back(const char *tmp, void *user, asp_error *err)
+{
+    const asp_amg *amg = user;
+    asp_amg *back = NULL;
+    int rc = asp_amg_load(tmp, &amg->ctx, &back, err);
+    asp_amg_destroy(back);
+    return rc;
+}
+
 int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err)
 {
     if (!host_is_little_endian())
@@ -130,7 +145,7 @@ int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err)
         asp__crc_put(&w, p->col, nnz * sizeof *p->col);
         asp__crc_put(&w, p->val, nnz * sizeof *p->val);
     }
-    return asp__byte_commit(&w, &f, path, err);
+    return asp__byte_commit(&w, &f, path, amg_reads_back, (void *)amg, err);
 }
 
 /* The options block (128 bytes): what produced the hierarchy (docs/cli/decompose.md). */
@@ -148,8 +163,15 @@ static int read_options(asp__byte_reader *r, asp_amg_desc *d)
     if (u32[0] > ASP_AMG_CLASSIFIER_MOMENT || u32[1] > ASP_AMG_COARSEN_HMIS || u32[2] > ASP_AMG_INTERP_EXTENDED_I)
         return asp__byte_bad(r, "unknown classifier, coarsening or interpolation code");
     /* drop_tol drives every product P^l (journal 2.3): a NaN would silently empty the basis */
-    if (!isfinite(d->epsilon) || !(f[4] < 0.01))
-        return asp__byte_bad(r, "options: non-finite epsilon or drop tolerance not below 0.01");
+    char msg[120];
+    if (!isfinite(d->epsilon) || !(f[4] < 0.01)) {
+        r->at -= AMG_OPTIONS; // the start of the options block
+        if (!isfinite(d->epsilon))
+            snprintf(msg, sizeof msg, "options: epsilon %g, expected a finite neighbourhood radius", d->epsilon);
+        else
+            snprintf(msg, sizeof msg, "options: drop tolerance %.17g, expected one below 0.01", f[4]);
+        return asp__byte_bad(r, msg);
+    }
     d->k_min = (size_t)u64[0];
     d->k_max = (size_t)u64[1];
     d->fan_k = (size_t)u64[2];
@@ -218,9 +240,11 @@ static int read_prolongation(asp__byte_reader *r, size_t l, size_t rows, size_t 
                                        "cannot read '%s': level %zu: row %zu of P has column %u, expected increasing "
                                        "columns below %zu", r->path, l, q, (unsigned)p->col[k], cols);
                 else
+                    // %.17g: 1.0000000000000566 printed with %g read "weight 1, expected one in [0,1]" (issue #13)
                     rc = asp_error_set(r->err, ASP_EFORMAT,
-                                       "cannot read '%s': level %zu: row %zu of P has weight %g, expected one in [0,1]",
-                                       r->path, l, q, p->val[k]);
+                                       "cannot read '%s': level %zu: row %zu of P has weight %.17g, %s (weights are "
+                                       "in [0,1])", r->path, l, q, p->val[k],
+                                       p->val[k] > 1 ? "above 1" : p->val[k] < 0 ? "below 0" : "not a number");
                 asp_amg_csr_destroy(p);
                 return rc;
             }
@@ -229,7 +253,8 @@ static int read_prolongation(asp__byte_reader *r, size_t l, size_t rows, size_t 
         if (fabs(sum - 1) > 1e-6) {
             asp_amg_csr_destroy(p);
             return asp_error_set(r->err, ASP_EFORMAT,
-                                 "cannot read '%s': level %zu: row %zu of P sums to %g, expected 1", r->path, l, q, sum);
+                                 "cannot read '%s': level %zu: row %zu of P sums to %.17g, expected 1 within 1e-6",
+                                 r->path, l, q, sum);
         }
     }
     *out = p;

@@ -5,6 +5,7 @@
  * Table 2).
  */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -109,6 +110,18 @@ static int check_cloud(const asp_cloud *cloud, asp_error *err)
         return rc;
     if (lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2])
         return asp_error_set(err, ASP_EDEGENERATE, "cannot decompose: all %zu points are equal", cloud->count);
+    /*
+     * Neighbour search (knn.c) and the neighbourhood radius compare float squared distances: past
+     * sqrt(FLT_MAX) they overflow to inf, epsilon becomes inf and the file is unreadable (issue #13).
+     */
+    double diag2 = 0;
+    for (int k = 0; k < 3; k++)
+        diag2 += ((double)hi[k] - lo[k]) * ((double)hi[k] - lo[k]);
+    if (!(diag2 < FLT_MAX))
+        return asp_error_set(err, ASP_EUNSUPPORTED,
+                             "cannot decompose: the coordinate extent %.3g (bounding-box diagonal) overflows float: "
+                             "squared distances need an extent below %.3g; scale the points down", sqrt(diag2),
+                             sqrt(FLT_MAX));
     return 0;
 }
 

@@ -3,9 +3,18 @@
  * the stiffness matrix and copies the prolongations P^l out into our own CSR
  * matrices (journal 2.3: A^l = (P^l)^T A^(l-1) P^l). No solve is ever done.
  */
+#include <errno.h>
 #include <limits.h>
 #include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 /*
  * hypre's internal header (needed for the P matrices, journal 2.3) is not
@@ -32,6 +41,151 @@ int ffs(int i);
 static int mpi_started_here;
 static int hypre_started;
 
+/*
+ * MPI start-up failure as one line (issue #13). Open MPI reports a failed
+ * MPI_Init_thread as 25 lines on fd 2 (its own and its orted helper's) and
+ * then calls _exit(1) from inside the call (ess singleton abort): no error
+ * code comes back, no atexit handler runs, and MPI_ERRORS_RETURN cannot be
+ * set before MPI exists. So a forked child tries MPI_Init_thread first, its
+ * fds 1 and 2 going to a log file: when it fails, this process has not
+ * started MPI and returns an error naming the reason and the log; when it
+ * works, this process starts MPI itself. The probe doubles MPI's start-up
+ * (0.4-0.5 s measured on the 2-core CI machine), so it runs only where
+ * start-up can be made to fail: Open MPI settings in the environment
+ * (OMPI_MCA_*, the issue's case) or a memory limit (RLIMIT_AS, RLIMIT_DATA).
+ */
+static char mpi_log[4096];
+extern char **environ;
+
+/* The reason in Open MPI's report: the missing component, else the failed call and its code, else the first line. */
+static void mpi_reason(const char *log, char *out, size_t cap)
+{
+    char buf[16384];
+    // Open MPI's helper sometimes loses part or all of the report under load (ORTE_ERROR_LOG in
+    // show_help.c): then name the settings that are the likely cause
+    const char *setting = NULL;
+    for (char **e = environ; e && *e && !setting; e++)
+        if (strncmp(*e, "OMPI_MCA_", 9) == 0)
+            setting = *e;
+    char limit[64] = "";
+    struct rlimit as;
+    if (getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY)
+        snprintf(limit, sizeof limit, "; memory limit (ulimit -v) %llu MB", (unsigned long long)(as.rlim_cur >> 20));
+    snprintf(out, cap, "MPI_Init_thread failed (Open MPI gave no reason%s%.80s)%s", setting ? "; set: " : "",
+             setting ? setting : "", limit);
+    FILE *fp = fopen(log, "r");
+    if (!fp)
+        return;
+    size_t n = fread(buf, 1, sizeof buf - 1, fp);
+    fclose(fp);
+    buf[n] = '\0';
+    // first: the first paragraph of Open MPI's help text (between its dashed lines), joined into one line
+    char fw[64] = "", comp[64] = "", call[128] = "", ret[128] = "", first[200] = "";
+    int in_first = 0, resources = 0;
+    for (char *line = buf, *next; line && *line; line = next) {
+        next = strchr(line, '\n');
+        if (next)
+            *next++ = '\0';
+        while (*line == ' ')
+            line++;
+        resources |= strstr(line, "OUT-OF-RESOURCE") != NULL || strstr(line, "Out of resource") != NULL;
+        if (sscanf(line, "Framework: %63s", fw) == 1 || sscanf(line, "Component: %63s", comp) == 1)
+            continue;
+        int text = line[0] && line[0] != '-' && line[0] != '[' && line[0] != '*';
+        if (in_first && text) {
+            size_t used = strlen(first);
+            snprintf(first + used, sizeof first - used, " %.190s", line);
+            continue;
+        }
+        in_first = 0;
+        if (strncmp(line, "--> Returned ", 13) == 0)
+            snprintf(ret, sizeof ret, "%.120s", line + 13);
+        else if (strstr(line, "() failed"))
+            snprintf(call, sizeof call, "%.120s", line);
+        else if (!first[0] && text) {
+            snprintf(first, sizeof first, "%.190s", line);
+            in_first = 1;
+        }
+    }
+    char *stop = strstr(first, ". "); // its first sentence, without the full stop
+    if (stop)
+        *stop = '\0';
+    else if (first[0] && first[strlen(first) - 1] == '.')
+        first[strlen(first) - 1] = '\0';
+    if (fw[0] && comp[0])
+        snprintf(out, cap, "component '%s' of framework '%s' not found (an OMPI_MCA_%s setting?)", comp, fw, fw);
+    else if (call[0])
+        snprintf(out, cap, "%s, returned %s%s", call, ret[0] ? ret : "an error", limit);
+    else if (first[0])
+        snprintf(out, cap, "%s%s", first, limit);
+    else if (resources)
+        snprintf(out, cap, "Open MPI ran out of resources%s%.80s%s", setting ? "; set: " : "", setting ? setting : "",
+                 limit);
+}
+
+/* Whether MPI_Init_thread can plausibly fail here (see above). */
+static int mpi_start_at_risk(void)
+{
+    for (char **e = environ; e && *e; e++)
+        if (strncmp(*e, "OMPI_", 5) == 0 || strncmp(*e, "PMIX_", 5) == 0)
+            return 1;
+    struct rlimit as, data;
+    return (getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY) ||
+           (getrlimit(RLIMIT_DATA, &data) == 0 && data.rlim_cur != RLIM_INFINITY);
+}
+
+/* 0 when a child process could start MPI (or no probe is needed); otherwise the reason, with the log kept. */
+static int mpi_probe(asp_error *err)
+{
+    if (!mpi_start_at_risk())
+        return 0;
+    const char *dir = getenv("TMPDIR");
+    snprintf(mpi_log, sizeof mpi_log, "%s/amgsplat-mpi-XXXXXX", dir && *dir ? dir : "/tmp");
+    int fd = mkstemp(mpi_log);
+    if (fd < 0)
+        return 0; // no log to read: the real start-up speaks for itself
+    fflush(stdout);
+    fflush(stderr);
+    pid_t pid = fork();
+    if (pid < 0) {
+        close(fd);
+        unlink(mpi_log);
+        return 0;
+    }
+    if (pid == 0) {
+        dup2(fd, 1);
+        dup2(fd, 2);
+        int provided = 0;
+        if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
+            _exit(2);
+        _exit(0); // no MPI_Finalize: the helper it waits for costs more than the probe itself
+    }
+    close(fd);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
+        ;
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+        unlink(mpi_log);
+        return 0;
+    }
+    // Open MPI's helper (orted) prints part of the report for the child, after the child has gone: wait
+    // until the log has not grown for 0.3 s, at most 3 s
+    off_t last = -1;
+    for (int i = 0, still = 0; i < 60 && still < 6; i++) {
+        struct stat st;
+        off_t now = stat(mpi_log, &st) == 0 ? st.st_size : -1;
+        still = now > 0 && now == last ? still + 1 : 0;
+        last = now;
+        nanosleep(&(struct timespec){0, 50 * 1000 * 1000}, NULL);
+    }
+    char reason[512];
+    mpi_reason(mpi_log, reason, sizeof reason);
+    if (WIFSIGNALED(status))
+        snprintf(reason + strlen(reason), sizeof reason - strlen(reason), " (killed by signal %d)", WTERMSIG(status));
+    return asp_error_set(err, ASP_ESOLVER, "cannot start MPI for the AMG solver: %s; Open MPI's report is in '%s'",
+                         reason, mpi_log);
+}
+
 static int ensure_mpi(asp_error *err)
 {
     int flag = 0, done = 0;
@@ -41,9 +195,12 @@ static int ensure_mpi(asp_error *err)
     MPI_Initialized(&flag);
     if (!flag) {
         int provided = 0;
+        int rc = mpi_probe(err);
+        if (rc)
+            return rc;
         /* a singleton run: no mpirun needed, no argc/argv */
         if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
-            return asp_error_set(err, ASP_ESOLVER, "cannot initialise MPI for hypre");
+            return asp_error_set(err, ASP_ESOLVER, "cannot start MPI for the AMG solver: MPI_Init_thread failed");
         mpi_started_here = 1;
     }
     if (!hypre_started) {

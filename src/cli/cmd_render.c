@@ -18,7 +18,7 @@
 static const char usage[] =
     "usage: amgsplat render IN.ply -o OUT.png [--size WxH] [--view AZ,EL[,DIST]] [--views N]\n"
     "                      [--renderer disc|splat|square] [--tolerance PX | --budget N] [--kernel A,B,N]\n"
-    "                      [--epsilon X] [--lighting gouraud|pixel|flat] [--opaque] [--point-size PX]\n"
+    "                      [--epsilon X] [--lighting gouraud|pixel|flat] [--opaque] [--unlit] [--point-size PX]\n"
     "                      [--background R,G,B[,A] | --transparent] [--light AZ,EL]\n"
     "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict] [--level L-3] ...\n"
     "       amgsplat render MESH -o OUT.png [--flat] [--texture IMG] [--renderer mesh|disc] ...\n"
@@ -63,6 +63,7 @@ struct render_opts {
     double epsilon;
     double point_size;
     int opaque;
+    int unlit; /* --unlit: the colours as they are, no shading (ASP_RENDER_UNLIT) */
     const char *method;
     double alpha_ref;
     double transparency;
@@ -87,6 +88,7 @@ struct render_opts {
     asp_prim_render_options prim;
     asp_up_axis up_axis;
     double point_crease; /* point inputs: crease angle of the clip planes, degrees; 0 = no clipping */
+    int point_crease_default; /* point_crease is the default (points without normals: no clipping) */
     const asp_context *ctx;
 };
 
@@ -95,7 +97,8 @@ struct render_opts {
 static int load_scene(const char *path, const struct render_opts *o, const struct cli_env *env, asp_scene *s,
                       asp_error *err)
 {
-    asp_scene_desc d = {.level = o->level, .crease_angle = (float)o->point_crease, .texture = o->texture};
+    asp_scene_desc d = {.level = o->level, .crease_angle = (float)o->point_crease,
+                        .crease_if_normals = o->point_crease_default, .texture = o->texture};
     if (o->amg_input && o->color_by) {
         d.amg_color = (asp_scene_amg_color)(o->color_mode + 1);
         if (o->color_mode != ASP_AMG_COLOR_CLASSIFIER && !o->level)
@@ -150,10 +153,11 @@ static int parse_colour(struct cli_env *env, const char *s, uint8_t out[4])
 /* Options of the hierarchy renderers and of .amg inputs. */
 static int parse_splat_options(struct cli_env *env, struct render_opts *o)
 {
-    if (!(o->tolerance >= 0) || !isfinite(o->tolerance))
-        return cli_usage_error(env, "--tolerance expects pixels >= 0, got %g", o->tolerance);
-    if (!(o->epsilon >= 0) || !isfinite(o->epsilon))
-        return cli_usage_error(env, "--epsilon expects a number >= 0 (splat radii), got %g", o->epsilon);
+    // bounded: the renderers take floats, and 1e300 became inf there (issue #13)
+    if (!(o->tolerance >= 0 && o->tolerance <= 1e6))
+        return cli_usage_error(env, "--tolerance expects pixels in 0..1e6, got %g", o->tolerance);
+    if (!(o->epsilon >= 0 && o->epsilon <= 1e6))
+        return cli_usage_error(env, "--epsilon expects splat radii in 0..1e6, got %g", o->epsilon);
     if (!(o->point_size >= 0) || !(o->point_size <= 256))
         return cli_usage_error(env, "--point-size expects pixels in 0..256 (0 = projected size), got %g",
                                o->point_size);
@@ -209,7 +213,18 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
             return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline and "
                                         "--no-normal-map need a .dps input (amgsplat build makes one)");
         double deg = 0;
-        if (!o->crease_angle || strcmp(o->crease_angle, "off") == 0)
+        if (!o->crease_angle) {
+            // the default: discs and splats cut at creases sharper than 60 degrees, as the primitives
+            // and eval's reference are, so one --view gives one silhouette whatever the file (issue 12:
+            // octahedron points vs primitives IoU 0.936 unclipped, 0.981 clipped); points without
+            // normals stay unclipped. The square renderer does not clip.
+            if (!(o->renderer && strcmp(o->renderer, "square") == 0)) {
+                o->point_crease = ASP_PRIM_CREASE_ANGLE_DEFAULT;
+                o->point_crease_default = 1;
+            }
+            return 0;
+        }
+        if (strcmp(o->crease_angle, "off") == 0)
             return 0;
         if (cli_parse_doubles(o->crease_angle, &deg, 1) != 1 || !(deg > 0 && deg < 90))
             return cli_usage_error(env, "--crease-angle expects degrees in (0, 90) or 'off' for points, got '%s'",
@@ -278,15 +293,17 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
         memset(o->bg, 0, 4);
     if (o->light) {
         double v[2] = {0, 0};
-        if (cli_parse_doubles(o->light, v, 2) != 2 || !(v[1] >= -90 && v[1] <= 90) || !isfinite(v[0]))
-            return cli_usage_error(env, "--light expects AZ,EL in degrees with EL in -90..90, got '%s'", o->light);
+        // AZ bounded as --view's (cli_parse_view): 1e300 degrees is no direction
+        if (cli_parse_doubles(o->light, v, 2) != 2 || !(v[1] >= -90 && v[1] <= 90) || !(fabs(v[0]) <= 36000))
+            return cli_usage_error(env, "--light expects AZ,EL in degrees with AZ in -36000..36000 and EL in -90..90, "
+                                   "got '%s'", o->light);
         o->light_az = v[0];
         o->light_el = v[1];
     }
     if (!(o->fov > 0 && o->fov < 180))
         return cli_usage_error(env, "--fov expects degrees in (0, 180), got %g", o->fov);
-    if (!(o->radius_scale > 0) || !isfinite(o->radius_scale))
-        return cli_usage_error(env, "--radius-scale expects a positive number, got %g", o->radius_scale);
+    if (!(o->radius_scale > 0 && o->radius_scale <= 1e6))
+        return cli_usage_error(env, "--radius-scale expects a value in (0, 1e6], got %g", o->radius_scale);
     if (parse_splat_options(env, o))
         return 2;
     return parse_prim_options(env, o);
@@ -304,7 +321,8 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
 {
     vs->min_count = SIZE_MAX;
     asp_render_desc desc = {.width = o->width, .height = o->height, .samples = (uint32_t)o->samples,
-                            .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el};
+                            .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el,
+                            .flags = o->unlit ? ASP_RENDER_UNLIT : 0u};
     memcpy(desc.background, o->bg, 4);
     for (size_t i = 0; i < o->views; i++) {
         asp_camera cam;
@@ -329,33 +347,39 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
     return 0;
 }
 
-static void print_json(const struct render_opts *o, size_t count, const asp_scene *s, asp_gl_context *gl, const char *renderer,
-                       const asp_image *img, const struct view_stats *vs, double seconds)
+static int print_json(const struct cli_env *env, const struct render_opts *o, size_t count, const asp_scene *s,
+                      asp_gl_context *gl, const char *renderer, const asp_image *img, const struct view_stats *vs,
+                      double seconds)
 {
-    printf("{\"output\": ");
-    cli_json_string(stdout, o->output);
-    printf(", \"width\": %u, \"height\": %u, \"tile_width\": %u, \"tile_height\": %u, \"views\": %zu, "
-           "\"points\": %zu, \"renderer\": ",
-           img->width, img->height, o->width, o->height, o->views, count);
-    cli_json_string(stdout, renderer);
+    cJSON *j = cJSON_CreateObject(), *frame = cJSON_CreateArray();
+    cJSON_AddStringToObject(j, "output", o->output);
+    cJSON_AddNumberToObject(j, "width", img->width);
+    cJSON_AddNumberToObject(j, "height", img->height);
+    cJSON_AddNumberToObject(j, "tile_width", o->width);
+    cJSON_AddNumberToObject(j, "tile_height", o->height);
+    cJSON_AddNumberToObject(j, "views", (double)o->views);
+    cJSON_AddNumberToObject(j, "points", (double)count);
+    cJSON_AddStringToObject(j, "renderer", renderer);
     if (o->dps_input) {
-        printf(", \"method\": ");
-        cli_json_string(stdout, asp_prim_render_method_name(o->prim.method));
-        printf(", \"level\": %u", asp_scene_dps_level(s)->level);
+        cJSON_AddStringToObject(j, "method", asp_prim_render_method_name(o->prim.method));
+        cJSON_AddNumberToObject(j, "level", asp_scene_dps_level(s)->level);
     }
-    printf(", \"gl_renderer\": ");
-    cli_json_string(stdout, asp_gl_context_renderer(gl));
-    printf(", \"gl_backend\": ");
-    cli_json_string(stdout, asp_gl_context_backend(gl));
+    cJSON_AddStringToObject(j, "gl_renderer", asp_gl_context_renderer(gl));
+    cJSON_AddStringToObject(j, "gl_backend", asp_gl_context_backend(gl));
     int lod = strcmp(renderer, "disc") && strcmp(renderer, "prim") && strcmp(renderer, "mesh");
-    printf(", \"primitives\": %zu, \"primitives_min\": %zu, \"primitives_max\": %zu, \"tolerance\": %g, "
-           "\"budget\": %zu, \"view_ms\": %.3f",
-           vs->last_count, vs->min_count, vs->max_count, lod && !o->budget ? o->tolerance : 0.0, o->budget,
-           1e3 * vs->seconds / (double)o->views);
+    cJSON_AddNumberToObject(j, "primitives", (double)vs->last_count);
+    cJSON_AddNumberToObject(j, "primitives_min", (double)vs->min_count);
+    cJSON_AddNumberToObject(j, "primitives_max", (double)vs->max_count);
+    cJSON_AddItemToObject(j, "tolerance", cli_json_number("%g", lod && !o->budget ? o->tolerance : 0.0));
+    cJSON_AddNumberToObject(j, "budget", (double)o->budget);
+    cJSON_AddItemToObject(j, "view_ms", cli_json_number("%.3f", 1e3 * vs->seconds / (double)o->views));
     // the camera's sphere, so two inputs of one model can be checked to frame alike
-    printf(", \"frame\": [%.9g, %.9g, %.9g, %.9g]", s->frame.center[0], s->frame.center[1], s->frame.center[2],
-           s->frame.radius);
-    printf(", \"seconds\": %.3f}\n", seconds);
+    for (int k = 0; k < 3; k++)
+        cJSON_AddItemToArray(frame, cli_json_number("%.9g", s->frame.center[k]));
+    cJSON_AddItemToArray(frame, cli_json_number("%.9g", s->frame.radius));
+    cJSON_AddItemToObject(j, "frame", frame);
+    cJSON_AddItemToObject(j, "seconds", cli_json_number("%.3f", seconds));
+    return cli_json_print(env, j);
 }
 
 int cmd_render(int argc, char **argv, struct cli_env *env)
@@ -376,6 +400,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"epsilon", 0, CLI_DOUBLE, &o.epsilon, "X", "splat: depth offset in splat radii for blending (default 1; 0 = none)"},
         {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
         {"opaque", 0, CLI_FLAG, &o.opaque, NULL, "splat: opaque ellipses, no blending"},
+        {"unlit", 0, CLI_FLAG, &o.unlit, NULL, "colours as they are, no shading (the seeds' flat textured primitives; web viewer's light=off)"},
         {"point-size", 0, CLI_DOUBLE, &o.point_size, "PX", "square: fixed side in pixels (default 0: projected size)"},
         {"color-by", 0, CLI_STRING, &o.color_by, "MODE", ".amg input: classifier, domains or strict; .dps input: domain"},
         {"level", 0, CLI_STRING, &o.level, "L", ".amg: level of the domain colours (default L-3); .dps: level drawn (default the finest in the file)"},
@@ -383,7 +408,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"alpha-ref", 0, CLI_DOUBLE, &o.alpha_ref, "X", ".dps: alpha test of the locks and the front layer, 0..1 (default 0.1)"},
         {"transparency", 0, CLI_DOUBLE, &o.transparency, "X", ".dps: global opacity scaling alpha, (0, 1] (default 1)"},
         {"depth-window", 0, CLI_DOUBLE, &o.depth_window, "X", ".dps: depth offset / window in world units (default: half the mean primitive radius)"},
-        {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", "cut at creases sharper than DEG: .dps primitives (default 60; off = as the seeds); points: discs, splats (default off)"},
+        {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", "cut at creases sharper than DEG (default 60; off = as the seeds): .dps primitives; points with normals: discs, splats"},
         {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
@@ -475,7 +500,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     } else {
         cli_progress_end(env);
         if (env->json)
-            print_json(&o, count, &s, gl, kind->name, result, &vs, seconds);
+            status = print_json(env, &o, count, &s, gl, kind->name, result, &vs, seconds);
         else
             cli_info(env,
                      "rendered %zu view%s of %zu %s (%s, %zu primitives in the last view, %.1f ms per view, %s) "

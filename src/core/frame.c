@@ -5,6 +5,7 @@
  * bounding sphere of the drawn discs that render, view and eval fit the
  * camera to, recorded in .amg, .dps and .hier so their pictures match.
  */
+#include <float.h>
 #include <math.h>
 
 #include "amgsplat/cloud.h"
@@ -55,7 +56,18 @@ int asp_positions_frame(const float *positions, size_t count, const double origi
         max_d2 = d2 > max_d2 ? d2 : max_d2;
     }
     double r = sqrt(max_d2) + radius;
-    if (!(r > 0) || !isfinite(r))
+    /*
+     * Cameras are float (render/camera.c) and place the eye up to 1e6 radii away (--view DIST), with
+     * a far plane beyond it: a larger sphere turns the camera into inf and NaN. An overflow is not
+     * "all at the same position" (issue #13: points at +-3e38 were described so).
+     */
+    const double frame_max = FLT_MAX / 1e7;
+    if (!(r <= frame_max))
+        return asp_error_set(err, ASP_EUNSUPPORTED,
+                             "cannot frame %zu points: bounding sphere radius %.3g (extent %.3g, disc radius %.3g) is "
+                             "beyond the %.3g a float camera can place; scale the points down",
+                             count, r, sqrt(max_d2), radius, frame_max);
+    if (!(r > 0))
         return asp_error_set(err, ASP_EDEGENERATE,
                              "cannot frame %zu points: they are all at the same position and have no radius", count);
     for (int k = 0; k < 3; k++)

@@ -69,6 +69,11 @@ int asp_image_load(asp_image *img, const char *path, asp_error *err)
         return asp_error_set(err, ASP_EFORMAT, "image '%s' is %dx%d, outside 1..%d per side", path, w, h,
                              ASP_IMAGE_MAX_SIDE);
     }
+    char bomb[200];
+    if (asp__png_precheck(fp, ASP_IMAGE_MAX_SIDE, bomb, sizeof bomb)) {
+        fclose(fp);
+        return asp_error_set(err, ASP_EFORMAT, "cannot decode image '%s': %s", path, bomb);
+    }
     unsigned char *data = stbi_load_from_file(fp, &w, &h, &comp, 4);
     if (!data) {
         char why[160];

@@ -29,6 +29,8 @@ static int load_clip_planes(asp_scene *s, const asp_scene_desc *d, asp_error *er
         return 0;
     if (!(d->crease_angle < 90))
         return asp_error_set(err, ASP_EINVAL, "crease angle %g is outside (0, 90) degrees", (double)d->crease_angle);
+    if (d->crease_if_normals && !s->cloud->normals)
+        return 0; // a default: nothing to clip by (asp_crease_clip_planes would refuse)
     s->clip_planes = asp_alloc(&s->ctx, 8 * s->cloud->count * sizeof(float));
     if (!s->clip_planes)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the crease planes of %zu points", s->cloud->count);

@@ -129,6 +129,16 @@ static uint64_t payload_size(uint64_t nodes, uint64_t points)
     return nodes * (NODE_REC + COV_REC) + (nodes + points) * SPLAT_REC;
 }
 
+/* The whole file parsed and its tree validated before it replaces the target (issue #13). */
+static int hier_reads_back(const char *tmp, void *user, asp_error *err)
+{
+    const asp_hier *hier = user;
+    asp_hier *back = NULL;
+    int rc = asp_hier_load(tmp, &hier->ctx, &back, err);
+    asp_hier_destroy(back);
+    return rc;
+}
+
 int asp_hier_save(const asp_hier *hier, const char *path, asp_error *err)
 {
     asp__atomic_file f;
@@ -161,7 +171,7 @@ int asp_hier_save(const asp_hier *hier, const char *path, asp_error *err)
         asp__atomic_abort(&f);
         return asp_error_set(err, ASP_EIO, "cannot write '%s': %s", path, strerror(e ? e : EIO));
     }
-    return asp__atomic_commit(&f, err);
+    return asp__atomic_commit_checked(&f, hier_reads_back, (void *)hier, err);
 }
 
 /* ---- loading ---- */

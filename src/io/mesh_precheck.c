@@ -2,7 +2,7 @@
  * Mesh pre-checks (see mesh_precheck.h). OFF is read line by line (Geomview's
  * OFF: keyword, "nv nf ne", nv vertex lines, nf face lines "k i1 .. ik [colour]",
  * '#' comments); binary STL's triangle count must fit its size (80-byte
- * header, count, 50 bytes a triangle); an OBJ must not end inside a face or
+ * header, count, 50 bytes a triangle), ASCII STL follows its grammar; an OBJ must not end inside a face or
  * vertex line, the mark of a file cut off.
  */
 #include <errno.h>
@@ -138,6 +138,101 @@ static int check_off(const char *b, size_t size, const char *name, asp_error *er
     return 0;
 }
 
+/* The next blank-separated word of [*s, e) in w (cut at cap - 1 bytes); 0 when there is none. */
+static size_t take_word(const char **s, const char *e, char *w, size_t cap)
+{
+    const char *p = *s;
+    while (p < e && (*p == ' ' || *p == '\t'))
+        p++;
+    const char *b = p;
+    while (p < e && *p != ' ' && *p != '\t')
+        p++;
+    size_t n = (size_t)(p - b);
+    snprintf(w, cap, "%.*s", (int)(n < cap ? n : cap - 1), b);
+    *s = p;
+    return n;
+}
+
+/* Three finite numbers after a keyword ("facet normal", "vertex"); 0, or the word that is not one. */
+static int take_three(const char **s, const char *e, char *bad, size_t cap)
+{
+    for (int k = 0; k < 3; k++) {
+        char w[64];
+        size_t n = take_word(s, e, w, sizeof w);
+        char *end = NULL;
+        double v = n && n < sizeof w ? strtod(w, &end) : 0;
+        if (!n || n >= sizeof w || !end || *end || !(v - v == 0)) {
+            snprintf(bad, cap, "%s", n ? w : "nothing");
+            return -1;
+        }
+    }
+    char w[64];
+    if (take_word(s, e, w, sizeof w)) {
+        snprintf(bad, cap, "a fourth value '%.60s'", w);
+        return -1;
+    }
+    return 0;
+}
+
+/*
+ * ASCII STL: "solid", then facets of "facet normal n n n", "outer loop", three "vertex x y z",
+ * "endloop", "endfacet", then "endsolid". assimp reads anything else into a message quoting the
+ * rest of the file and leaks the mesh it was building (fuzz_mesh, issue #13), so the grammar is
+ * checked here, naming the line.
+ */
+static int check_stl_ascii(const char *b, size_t size, const char *name, asp_error *err)
+{
+    static const char *const want[] = {"facet", "outer", "vertex", "vertex", "vertex", "endloop", "endfacet"};
+    cursor c = {b, b + size, 0};
+    const char *s, *e;
+    int state = -1; // -1: outside a solid; 0: between facets; 1..7: the next line is want[state - 1]
+    char w[64], bad[96];
+    while (1) {
+        // next_line cuts '#': an STL has no comments, but a solid's name may hold one, which is harmless
+        if (!next_line(&c, &s, &e))
+            break;
+        size_t n = take_word(&s, e, w, sizeof w);
+        for (char *q = w; *q; q++)
+            *q = (char)(*q >= 'A' && *q <= 'Z' ? *q - 'A' + 'a' : *q);
+        (void)n;
+        if (state == -1) {
+            if (strcmp(w, "solid") != 0)
+                return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu: ASCII STL: expected 'solid', got "
+                                     "'%.40s'", name, c.line, w);
+            state = 0;
+            continue;
+        }
+        if (state == 0 && strcmp(w, "endsolid") == 0) {
+            state = -1;
+            continue;
+        }
+        const char *expect = want[state == 0 ? 0 : state - 1];
+        if (state == 0)
+            state = 1;
+        if (strcmp(w, expect) != 0)
+            return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu: ASCII STL: expected '%s'%s, got "
+                                 "'%.40s'", name, c.line, expect, state == 1 ? " or 'endsolid'" : "", w);
+        if (state == 1) {
+            if (take_word(&s, e, w, sizeof w) == 0 || strcmp(w, "normal") != 0 || take_three(&s, e, bad, sizeof bad))
+                return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu: ASCII STL: expected 'facet normal "
+                                     "NX NY NZ' with three finite numbers", name, c.line);
+        } else if (state == 2) {
+            if (take_word(&s, e, w, sizeof w) == 0 || strcmp(w, "loop") != 0)
+                return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu: ASCII STL: expected 'outer loop'",
+                                     name, c.line);
+        } else if (state <= 5) {
+            if (take_three(&s, e, bad, sizeof bad))
+                return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu: ASCII STL: vertex %d of a facet: "
+                                     "expected three finite numbers, got %s", name, c.line, state - 2, bad);
+        }
+        state = state == 7 ? 0 : state + 1;
+    }
+    if (state > 0)
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu: ASCII STL: the file ends inside a facet "
+                             "(expected '%s'): it is cut off", name, c.line, want[state - 1]);
+    return 0;
+}
+
 static int check_stl(const unsigned char *b, size_t size, const char *name, asp_error *err)
 {
     if (size >= 5 && memcmp(b, "solid", 5) == 0) {
@@ -145,7 +240,7 @@ static int check_stl(const unsigned char *b, size_t size, const char *name, asp_
         size_t look = size < 1024 ? size : 1024;
         for (size_t i = 0; i + 5 <= look; i++)
             if (memcmp(b + i, "facet", 5) == 0)
-                return 0;
+                return check_stl_ascii((const char *)b, size, name, err);
     }
     if (size < 84)
         return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': %zu bytes, too short for binary STL (84 at least)",

@@ -10,6 +10,7 @@
 
 #include "amgsplat/io.h"
 #include "amgsplat/mesh.h"
+#include "amgsplat/output.h"
 #include "util/atomic_file.h"
 #include "util/banned.h"
 
@@ -259,10 +260,16 @@ int asp_mesh_save(const asp_mesh *mesh, const char *path, const asp_mesh_save_de
     int rc = asp_file_type_of_name(path, &type, err);
     if (rc)
         return rc;
-    if (strcmp(type.format, "obj") == 0)
-        return save_obj(mesh, path, err);
-    if (strcmp(type.format, "ply") == 0)
-        return save_ply(mesh, path, desc, err);
+    // OBJ, MTL and textures (PLY and texture) appear all or none (issue #13)
+    if (strcmp(type.format, "obj") == 0 || strcmp(type.format, "ply") == 0) {
+        asp_output_batch_begin(NULL);
+        rc = type.format[0] == 'o' ? save_obj(mesh, path, err) : save_ply(mesh, path, desc, err);
+        if (rc) {
+            asp_output_batch_abort();
+            return rc;
+        }
+        return asp_output_batch_commit(err);
+    }
     return asp_error_set(err, ASP_EUNSUPPORTED, "cannot write '%s': mesh output is .obj or .ply, not .%s", path,
                          type.format);
 }

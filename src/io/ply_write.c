@@ -338,6 +338,21 @@ static int write_faces(writer *w, int index_uint)
 
 /* ---------- driver ---------- */
 
+/*
+ * No command writes a PLY that asp_ply_read refuses (issue #13): the file is
+ * read back whole before it replaces the target. The reader's checks are
+ * per value (finite coordinates, list counts, face indices), so a header
+ * check would miss what can actually be wrong.
+ */
+static int ply_reads_back(const char *tmp, void *user, asp_error *err)
+{
+    const asp_cloud *c = user;
+    asp_cloud *back = NULL;
+    int rc = asp_ply_read(tmp, &c->ctx, &back, err);
+    asp_cloud_destroy(back);
+    return rc;
+}
+
 static int write_all(writer *w)
 {
     const asp_cloud *c = w->cloud;
@@ -364,7 +379,7 @@ static int write_all(writer *w)
     if (rc == 0)
         rc = write_faces(w, index_uint);
     if (rc == 0)
-        return asp__atomic_commit(&w->file, w->err);
+        return asp__atomic_commit_checked(&w->file, ply_reads_back, (void *)c, w->err);
     asp__atomic_abort(&w->file);
     return rc;
 }

@@ -51,6 +51,16 @@ static void put_prim(asp__crc_writer *w, const asp_prim *p)
         asp__put_u32(w, u[k]);
 }
 
+/* The whole file parsed back before it replaces the target (issue #13): no command writes what build, render and info refuse. */
+static int dps_reads_back(const char *tmp, void *user, asp_error *err)
+{
+    const asp_dps *dps = user;
+    asp_dps *back = NULL;
+    int rc = asp_dps_load(tmp, &dps->ctx, &back, err);
+    asp_dps_destroy(back);
+    return rc;
+}
+
 int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
 {
     if (!dps || !path)
@@ -123,7 +133,7 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
         if (lv->normal_atlas.width)
             asp__crc_put(&w, lv->normal_atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
     }
-    return asp__byte_commit(&w, &f, path, err);
+    return asp__byte_commit(&w, &f, path, dps_reads_back, (void *)dps, err);
 }
 
 /* ---- reading ---- */

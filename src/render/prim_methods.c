@@ -12,6 +12,22 @@
 #include "render/prim_internal.h"
 #include "util/banned.h"
 
+/*
+ * The polygons method draws each support rectangle where its domain lies:
+ * where the basis function (texture alpha) exceeds the domain threshold tau
+ * (journal eq. 8, thesis 2.5: the domain is the points with Psi > tau). With
+ * affine textures (thesis 3.2.2) that is a polygon inside the convex hull of
+ * the domain's projected points, the "tighter fitting n-sided bounding
+ * polygon" the journal (3.1) and the thesis (3.1) name as the alternative to
+ * the rectangle. The rectangle's empty corners widen the silhouette: bunny,
+ * 354 primitives, view 30,20, 128 px, IoU against the points 0.873 with whole
+ * rectangles, 0.948 at alpha > 0, 0.955 at alpha > tau. The renderer sees one
+ * level, not the build options, so this is the default tau (0.05, the one
+ * `amgsplat build` uses); a set built through the library with another tau is
+ * trimmed at 0.05 all the same. --outline still draws the whole rectangles.
+ */
+#define POLYGON_ALPHA_REF 0.05f
+
 void asp__prim_targets_release(asp__prim_targets *t)
 {
     GLuint fbos[3] = {t->seed_fbo.id, t->front_fbo.id, t->accum_fbo.id};
@@ -322,7 +338,8 @@ static void draw_seed(asp__prim_renderer *r, const asp__frame *f)
         glDepthMask(GL_TRUE);
         main_pass(r, ASP__PASS_OPAQUE);
         if (o->method == ASP_PRIM_RENDER_POLYGONS)
-            glProgramUniform1f(r->programs[ASP__PROG_MAIN].id, r->uniforms[ASP__PROG_MAIN][PU_ALPHA_REF], -1.0f);
+            glProgramUniform1f(r->programs[ASP__PROG_MAIN].id, r->uniforms[ASP__PROG_MAIN][PU_ALPHA_REF],
+                               POLYGON_ALPHA_REF);
         draw_all(r);
         break;
     default:
@@ -406,7 +423,7 @@ static void resolve(asp__prim_renderer *r, GLuint caller_fbo, int normalize)
  */
 static void outlines(asp__prim_renderer *r)
 {
-    float ref = r->opt.method == ASP_PRIM_RENDER_POLYGONS ? -1.0f : r->opt.alpha_ref;
+    float ref = r->opt.method == ASP_PRIM_RENDER_POLYGONS ? POLYGON_ALPHA_REF : r->opt.alpha_ref;
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);

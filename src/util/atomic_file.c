@@ -1,17 +1,130 @@
 /*
  * Atomic output files (see atomic_file.h): temporary name in the same
- * directory, then rename(2), which replaces the target in one step.
+ * directory, then rename(2), which replaces the target in one step. The
+ * temporaries being written are kept in a fixed table that a signal handler
+ * can walk without locks or allocation, and that an output batch uses to
+ * find the renames it deferred (issue #13).
  */
 #include <dirent.h>
 #include <errno.h>
 #include <signal.h>
+#include <stdint.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include "amgsplat/output.h"
 #include "util/atomic_file.h"
 #include "util/banned.h"
+
+/*
+ * The table of live temporaries. A signal may arrive on any thread at any
+ * moment, so the handler may only read what a slot's state publishes: the
+ * writer fills tmp first, then stores LIVE with release order; the handler
+ * loads the state with acquire order and calls unlink(2), which is
+ * async-signal-safe (POSIX.1-2008 2.4.3). This is process-wide state by
+ * nature (signals are), the one exception to STYLE.md 7.
+ */
+enum { LIVE_MAX = 128, SLOT_FREE = 0, SLOT_CLAIMED = 1, SLOT_LIVE = 2 };
+typedef struct live_slot {
+    atomic_int state;
+    unsigned batch;   /* the output batch that owns the rename, 0 for none */
+    size_t path_len;  /* tmp is path + ".tmp.<pid>": the target is its first path_len bytes */
+    char tmp[4096 + 32];
+} live_slot;
+static live_slot live[LIVE_MAX];
+
+static const int caught[] = {SIGINT, SIGTERM, SIGHUP};
+static struct sigaction previous[3];
+static atomic_int handlers_installed;
+
+static void remove_live_temporaries(void)
+{
+    for (int i = 0; i < LIVE_MAX; i++)
+        if (atomic_load_explicit(&live[i].state, memory_order_acquire) == SLOT_LIVE)
+            unlink(live[i].tmp);
+}
+
+/* Removes every live temporary, then lets the signal do what it would have done without us. */
+static void on_signal(int sig, siginfo_t *info, void *uctx)
+{
+    int saved = errno;
+    remove_live_temporaries();
+    for (int k = 0; k < 3; k++) {
+        if (caught[k] != sig)
+            continue;
+        const struct sigaction *old = &previous[k];
+        if (old->sa_flags & SA_SIGINFO) {
+            old->sa_sigaction(sig, info, uctx);
+        } else if (old->sa_handler != SIG_DFL && old->sa_handler != SIG_IGN) {
+            old->sa_handler(sig);
+        } else {
+            // the default action (terminate) once this handler returns: the signal is blocked until then
+            signal(sig, SIG_DFL);
+            raise(sig);
+        }
+    }
+    errno = saved;
+}
+
+/*
+ * Installed once, on the first output. A signal the program ignores (nohup's
+ * SIGHUP) stays ignored; a handler the program set is called after ours.
+ */
+static void install_handlers(void)
+{
+    int expected = 0;
+    if (!atomic_compare_exchange_strong(&handlers_installed, &expected, 1))
+        return;
+    for (int k = 0; k < 3; k++) {
+        struct sigaction old;
+        if (sigaction(caught[k], NULL, &old) != 0 || (!(old.sa_flags & SA_SIGINFO) && old.sa_handler == SIG_IGN))
+            continue;
+        previous[k] = old;
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_sigaction = on_signal;
+        sa.sa_flags = SA_SIGINFO | SA_RESTART;
+        sigfillset(&sa.sa_mask); // no second signal runs the handler while it walks the table
+        sigaction(caught[k], &sa, NULL);
+    }
+}
+
+/* The output batch open on this thread (its id), 0 for none; ids never repeat. */
+static _Thread_local unsigned thread_batch;
+static atomic_uint next_batch = 1;
+
+static int claim_slot(const char *tmp, size_t path_len)
+{
+    for (int i = 0; i < LIVE_MAX; i++) {
+        int expected = SLOT_FREE;
+        if (atomic_compare_exchange_strong(&live[i].state, &expected, SLOT_CLAIMED)) {
+            snprintf(live[i].tmp, sizeof live[i].tmp, "%s", tmp);
+            live[i].path_len = path_len;
+            live[i].batch = thread_batch;
+            atomic_store_explicit(&live[i].state, SLOT_LIVE, memory_order_release);
+            return i;
+        }
+    }
+    return -1;
+}
+
+static void release_slot(int i)
+{
+    if (i >= 0 && i < LIVE_MAX)
+        atomic_store_explicit(&live[i].state, SLOT_FREE, memory_order_release);
+}
+
+size_t asp__atomic_live_count(void)
+{
+    size_t n = 0;
+    for (int i = 0; i < LIVE_MAX; i++)
+        n += atomic_load(&live[i].state) == SLOT_LIVE;
+    return n;
+}
 
 /*
  * Removes "<path>.tmp.<pid>" files that a killed run left (issue #13: 2-15 MB
@@ -53,20 +166,37 @@ static void remove_stale(const char *path)
 int asp__atomic_open(asp__atomic_file *f, const char *path, asp_error *err)
 {
     memset(f, 0, sizeof *f);
+    f->slot = -1;
     if (!path || !*path)
         return asp_error_set(err, ASP_EINVAL, "empty output path");
     if (strlen(path) >= sizeof f->path)
         return asp_error_set(err, ASP_EINVAL, "output path too long: '%.64s...'", path);
+    // refused now, not at the rename: inside an output batch the renames come after every file is written
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return asp_error_set(err, ASP_EIO, "cannot write '%s': is a directory", path);
     snprintf(f->path, sizeof f->path, "%s", path);
     snprintf(f->tmp, sizeof f->tmp, "%s.tmp.%ld", path, (long)getpid());
+    install_handlers();
     remove_stale(path);
+    // registered before it exists: a signal between fopen and registration would leave it behind
+    f->slot = claim_slot(f->tmp, strlen(path));
+    if (f->slot < 0) {
+        f->tmp[0] = '\0';
+        return asp_error_set(err, ASP_EIO, "cannot write '%s': %d outputs are already being written", path, LIVE_MAX);
+    }
     f->fp = fopen(f->tmp, "wb");
-    if (!f->fp)
-        return asp_error_set(err, ASP_EIO, "cannot create '%s': %s", f->tmp, strerror(errno));
+    if (!f->fp) {
+        int e = errno;
+        release_slot(f->slot);
+        f->slot = -1;
+        return asp_error_set(err, ASP_EIO, "cannot create '%s': %s", f->tmp, strerror(e));
+    }
     return 0;
 }
 
-int asp__atomic_commit(asp__atomic_file *f, asp_error *err)
+/* Flushes, syncs and closes the temporary; on failure removes it. */
+static int finish_temporary(asp__atomic_file *f, asp_error *err)
 {
     if (!f->fp)
         return asp_error_set(err, ASP_EIO, "cannot write '%s': file not open", f->path);
@@ -80,16 +210,50 @@ int asp__atomic_commit(asp__atomic_file *f, asp_error *err)
     if (fclose(f->fp) != 0) {
         int e = errno;
         f->fp = NULL;
-        remove(f->tmp);
+        asp__atomic_abort(f);
         return asp_error_set(err, ASP_EIO, "cannot write '%s': %s", f->path, strerror(e));
     }
     f->fp = NULL;
+    return 0;
+}
+
+static int publish(asp__atomic_file *f, asp_error *err)
+{
+    // inside an output batch the rename waits for asp_output_batch_commit; the slot keeps the temporary
+    if (f->slot >= 0 && live[f->slot].batch && live[f->slot].batch == thread_batch) {
+        f->slot = -1;
+        f->tmp[0] = '\0';
+        return 0;
+    }
     if (rename(f->tmp, f->path) != 0) {
         int e = errno;
-        remove(f->tmp);
-        return asp_error_set(err, ASP_EIO, "cannot rename '%s' to '%s': %s", f->tmp, f->path, strerror(e));
+        asp__atomic_abort(f);
+        return asp_error_set(err, ASP_EIO, "cannot rename '%s.tmp.%ld' to '%s': %s", f->path, (long)getpid(),
+                             f->path, strerror(e));
     }
+    release_slot(f->slot);
+    f->slot = -1;
+    f->tmp[0] = '\0';
     return 0;
+}
+
+int asp__atomic_commit(asp__atomic_file *f, asp_error *err)
+{
+    int rc = finish_temporary(f, err);
+    return rc ? rc : publish(f, err);
+}
+
+int asp__atomic_commit_checked(asp__atomic_file *f, asp__atomic_check check, void *user, asp_error *err)
+{
+    int rc = finish_temporary(f, err);
+    if (rc)
+        return rc;
+    asp_error why = {0};
+    if (check && (rc = check(f->tmp, user, &why)) != 0) {
+        asp__atomic_abort(f);
+        return asp_error_set(err, rc, "internal error: the written '%s' does not read back: %s", f->path, why.msg);
+    }
+    return publish(f, err);
 }
 
 void asp__atomic_abort(asp__atomic_file *f)
@@ -98,7 +262,83 @@ void asp__atomic_abort(asp__atomic_file *f)
         fclose(f->fp);
         f->fp = NULL;
     }
-    if (f->tmp[0])
+    // a zeroed, never opened file has no temporary and no slot of its own (slot 0 may be another's)
+    if (f->tmp[0]) {
         remove(f->tmp);
+        release_slot(f->slot);
+    }
     f->tmp[0] = '\0';
+    f->slot = -1;
+}
+
+/* ---- output batches (amgsplat/output.h) ---- */
+
+/*
+ * Batches nest (a command's batch holds asp_mesh_save's OBJ+MTL+PNG batch):
+ * only the outermost commit renames. An inner abort removes the files of the
+ * whole batch and marks it failed, so the outer commit cannot publish half.
+ */
+static _Thread_local unsigned thread_depth;
+static _Thread_local int thread_failed;
+
+int asp_output_batch_begin(asp_error *err)
+{
+    if (thread_depth == UINT32_MAX)
+        return asp_error_set(err, ASP_EINVAL, "output batches nested too deeply");
+    if (thread_depth++ == 0) {
+        thread_failed = 0;
+        thread_batch = atomic_fetch_add(&next_batch, 1);
+        if (!thread_batch) // after 2^32 batches: 0 means "none"
+            thread_batch = atomic_fetch_add(&next_batch, 1);
+    }
+    return 0;
+}
+
+static void drop_batch(unsigned id)
+{
+    for (int i = 0; i < LIVE_MAX; i++)
+        if (atomic_load(&live[i].state) == SLOT_LIVE && live[i].batch == id) {
+            unlink(live[i].tmp);
+            release_slot(i);
+        }
+}
+
+int asp_output_batch_commit(asp_error *err)
+{
+    if (!thread_depth)
+        return asp_error_set(err, ASP_EINVAL, "no output batch is open on this thread");
+    if (--thread_depth)
+        return thread_failed ? asp_error_set(err, ASP_ECANCELED, "the output batch was aborted") : 0;
+    const unsigned id = thread_batch;
+    thread_batch = 0;
+    if (thread_failed)
+        return asp_error_set(err, ASP_ECANCELED, "the output batch was aborted: no output written");
+    size_t done = 0;
+    for (int i = 0; i < LIVE_MAX; i++) {
+        live_slot *s = &live[i];
+        if (atomic_load(&s->state) != SLOT_LIVE || s->batch != id)
+            continue;
+        char path[sizeof s->tmp];
+        snprintf(path, sizeof path, "%.*s", (int)s->path_len, s->tmp);
+        if (rename(s->tmp, path) != 0) {
+            int e = errno;
+            drop_batch(id);
+            // renames cannot be undone: say how many outputs did appear
+            return asp_error_set(err, ASP_EIO, "cannot rename '%s' to '%s': %s (%zu other outputs were already in "
+                                 "place, the rest removed)", s->tmp, path, strerror(e), done);
+        }
+        release_slot(i);
+        done++;
+    }
+    return 0;
+}
+
+void asp_output_batch_abort(void)
+{
+    if (!thread_depth)
+        return;
+    drop_batch(thread_batch);
+    thread_failed = 1;
+    if (--thread_depth == 0)
+        thread_batch = 0;
 }

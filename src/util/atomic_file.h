@@ -2,6 +2,13 @@
  * Atomic output files: write to "<path>.tmp.<pid>" and rename over path on
  * commit, so a failure or crash never leaves a partial output (DEVELOPERS.md
  * "Errors"). Shared by every module that writes files; not public API.
+ *
+ * Issue #13 adds three guarantees: SIGINT, SIGTERM and SIGHUP remove the
+ * temporary files that are being written (a fixed table of live temporaries
+ * and an async-signal-safe handler); a writer can have its file read back
+ * and validated before it replaces the target (asp__atomic_commit_checked);
+ * and the outputs of one command appear all or none (asp_output_batch, which
+ * defers every rename of the calling thread to the batch's commit).
  */
 #ifndef ASP_UTIL_ATOMIC_FILE_H
 #define ASP_UTIL_ATOMIC_FILE_H
@@ -13,13 +20,32 @@ typedef struct asp__atomic_file {
     FILE *fp;
     char path[4096];
     char tmp[4096 + 32];
+    int slot; /* index in the table of live temporaries, -1 when none */
 } asp__atomic_file;
 
-/** Opens the temporary file for binary writing. */
+/**
+ * Opens the temporary file for binary writing and registers it for removal
+ * on SIGINT/SIGTERM/SIGHUP; removes stale temporaries of dead processes.
+ */
 int asp__atomic_open(asp__atomic_file *f, const char *path, asp_error *err);
 /** Flushes, fsyncs and renames into place; on any failure removes the temporary and reports. */
 int asp__atomic_commit(asp__atomic_file *f, asp_error *err);
+
+/**
+ * Reads back what was written: check(tmp, user, err) runs on the closed
+ * temporary file and returns 0 when the format's own reader accepts it.
+ */
+typedef int (*asp__atomic_check)(const char *tmp, void *user, asp_error *err);
+/**
+ * As asp__atomic_commit, but check runs on the closed temporary before the
+ * rename. When it fails the temporary is removed, the target is untouched,
+ * and err says "internal error: the written 'PATH' does not read back: ...".
+ */
+int asp__atomic_commit_checked(asp__atomic_file *f, asp__atomic_check check, void *user, asp_error *err);
 /** Closes and removes the temporary file (after a failure). Safe to call twice. */
 void asp__atomic_abort(asp__atomic_file *f);
+
+/** The number of temporaries registered for removal on a signal (tests). */
+size_t asp__atomic_live_count(void);
 
 #endif

@@ -41,7 +41,8 @@ void asp__put_f64(asp__crc_writer *w, double v)
     asp__put_u64(w, u);
 }
 
-int asp__byte_commit(asp__crc_writer *w, asp__atomic_file *f, const char *path, asp_error *err)
+int asp__byte_commit(asp__crc_writer *w, asp__atomic_file *f, const char *path, asp__atomic_check check, void *user,
+                     asp_error *err)
 {
     asp__put_u32(w, w->crc);
     if (w->failed) {
@@ -49,7 +50,7 @@ int asp__byte_commit(asp__crc_writer *w, asp__atomic_file *f, const char *path, 
         asp__atomic_abort(f);
         return asp_error_set(err, ASP_EIO, "cannot write '%s': %s", path, strerror(e));
     }
-    return asp__atomic_commit(f, err);
+    return asp__atomic_commit_checked(f, check, user, err);
 }
 
 size_t asp__byte_left(const asp__byte_reader *r)

@@ -22,11 +22,13 @@ void asp__put_f32(asp__crc_writer *w, float v);
 void asp__put_f64(asp__crc_writer *w, double v);
 
 /*
- * Appends the CRC-32 trailer (of everything written before it) and renames f
- * into place. After any write failure removes the temporary instead and
- * reports "cannot write '<path>': <strerror>" (ASP_EIO).
+ * Appends the CRC-32 trailer (of everything written before it), reads the
+ * file back with check (asp__atomic_commit_checked; NULL: no check) and
+ * renames f into place. After any write failure removes the temporary
+ * instead and reports "cannot write '<path>': <strerror>" (ASP_EIO).
  */
-int asp__byte_commit(asp__crc_writer *w, asp__atomic_file *f, const char *path, asp_error *err);
+int asp__byte_commit(asp__crc_writer *w, asp__atomic_file *f, const char *path, asp__atomic_check check, void *user,
+                     asp_error *err);
 
 /* ---- reading ---- */
 

@@ -19,4 +19,14 @@
  */
 void asp__image_problem(FILE *fp, const char *stb_reason, unsigned max_side, char *out, size_t cap);
 
+/*
+ * Checks before stb_image decodes a PNG, which allocates what the file
+ * declares (fuzz_image: 115 bytes whose IDAT chunk declared 1.7 GB made it
+ * allocate 2 GB): every chunk must fit the file, and the image data must not
+ * inflate past what the header's size needs (a decompression bomb). Returns
+ * 1 with out filled when either fails; 0 otherwise, also for what is not a
+ * PNG. fp is rewound.
+ */
+int asp__png_precheck(FILE *fp, unsigned max_side, char *out, size_t cap);
+
 #endif

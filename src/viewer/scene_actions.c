@@ -55,7 +55,9 @@ int asp__viewer_scene_check_desc(const asp_viewer_desc *desc, asp_error *err)
 int asp__viewer_scene_load(asp_scene *s, const char *path, const asp_viewer_desc *desc, const asp_context *ctx,
                            asp_error *err)
 {
+    // points cut at creases as `render` and the primitives do (one picture per --view, issue 12)
     asp_scene_desc d = {.amg_color = scene_color(desc->amg_color), .level = desc->amg_level,
+                        .crease_angle = ASP_PRIM_CREASE_ANGLE_DEFAULT, .crease_if_normals = 1,
                         .texture = desc->texture};
     asp_scene t;
     memset(&t, 0, sizeof t);

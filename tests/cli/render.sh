@@ -104,9 +104,12 @@ check "$T/square3.png" "px(32, 32)[3] == 255 and px(0, 0)[3] == 0"
 # low (blue) on the creases and high (red) on the faces (Fig. 1b)
 "$AMGSPLAT" synth octahedron -o "$T/o.ply" -q
 # crease clipping: discs cut at the octahedron's edges no longer stick out of its silhouette, so the
-# clipped render covers fewer pixels (about 5% at this size) and keeps the faces
+# clipped render covers fewer pixels (about 5% at this size) and keeps the faces; 60 degrees is the
+# default for points with normals (as for primitives), 'off' draws the seeds' unclipped discs
 "$AMGSPLAT" render "$T/o.ply" -o "$T/oc.png" --crease-angle 60 --size 128x128 -q
-"$AMGSPLAT" render "$T/o.ply" -o "$T/ou.png" --size 128x128 -q
+"$AMGSPLAT" render "$T/o.ply" -o "$T/od.png" --size 128x128 -q
+cmp -s "$T/oc.png" "$T/od.png" || fail "the default render of points with normals is not the 60-degree clipped one"
+"$AMGSPLAT" render "$T/o.ply" -o "$T/ou.png" --crease-angle off --size 128x128 -q
 "$AMGSPLAT" render "$T/o.ply" -o "$T/os.png" --renderer splat --tolerance 0 --crease-angle 60 --size 128x128 -q
 python3 "$(dirname "$0")/png_check.py" "$T/oc.png" "0.3 < fg < 0.5" || fail "clipped discs"
 iou=$("$AMGSPLAT" imgdiff "$T/oc.png" "$T/ou.png" --background 255,255,255 --json | python3 -c "import json,sys; print(json.load(sys.stdin)['iou'])")
