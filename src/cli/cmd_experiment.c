@@ -31,6 +31,7 @@ static const char usage[] =
 struct run_table {
     struct cli_env *env;
     size_t rows;
+    cJSON *rows_json; /* --json: one object per run */
 };
 
 static void on_log(void *user, const char *line)
@@ -44,19 +45,31 @@ static void on_run(void *user, const asp_experiment_run_result *r)
     struct run_table *t = user;
     int recog = r->test <= ASP_EXPERIMENT_NEAR;
     if (t->env->json) {
-        printf("%s{\"subject\": ", t->rows ? ",\n " : "[");
-        cli_json_string(stdout, r->subject);
-        printf(", \"test\": \"%s\", \"run\": \"%c\", \"condition\": \"%s\", \"group\": \"%s\", \"frames\": %zu, "
-               "\"mean_frame_ms\": %.4f, \"drawn\": %zu",
-               asp_experiment_test_name(r->test), r->run, asp_experiment_condition_name(r->condition),
-               r->variable ? "variable" : "control", r->frames, r->mean_frame_ms, r->drawn);
-        if (recog) {
-            printf(", \"answer\": ");
-            cli_json_string(stdout, r->answer);
-            printf(", \"correct\": %s, \"recognition_s\": %.4f, \"naming_s\": %.4f}", r->correct ? "true" : "false",
-                   r->recognition_s, r->naming_s);
-        } else {
-            printf(", \"progress\": %.4f, \"off_path\": %zu}", r->progress, r->off_path);
+        /* one array printed at the end (cli_json_print); a row that cannot be built makes it NULL */
+        cJSON *o = cJSON_CreateObject();
+        if (o) {
+            cJSON_AddStringToObject(o, "subject", r->subject);
+            cJSON_AddStringToObject(o, "test", asp_experiment_test_name(r->test));
+            cJSON_AddStringToObject(o, "run", r->run == 'A' ? "A" : "B");
+            cJSON_AddStringToObject(o, "condition", asp_experiment_condition_name(r->condition));
+            cJSON_AddStringToObject(o, "group", r->variable ? "variable" : "control");
+            cJSON_AddNumberToObject(o, "frames", (double)r->frames);
+            cJSON_AddItemToObject(o, "mean_frame_ms", cli_json_number("%.4f", r->mean_frame_ms));
+            cJSON_AddNumberToObject(o, "drawn", (double)r->drawn);
+            if (recog) {
+                cJSON_AddStringToObject(o, "answer", r->answer);
+                cJSON_AddBoolToObject(o, "correct", r->correct);
+                cJSON_AddItemToObject(o, "recognition_s", cli_json_number("%.4f", r->recognition_s));
+                cJSON_AddItemToObject(o, "naming_s", cli_json_number("%.4f", r->naming_s));
+            } else {
+                cJSON_AddItemToObject(o, "progress", cli_json_number("%.4f", r->progress));
+                cJSON_AddNumberToObject(o, "off_path", (double)r->off_path);
+            }
+        }
+        if (!o || !t->rows_json || !cJSON_AddItemToArray(t->rows_json, o)) {
+            cJSON_Delete(o);
+            cJSON_Delete(t->rows_json);
+            t->rows_json = NULL;
         }
     } else {
         if (!t->rows)
@@ -70,7 +83,8 @@ static void on_run(void *user, const asp_experiment_run_result *r)
             printf("progress %.1f%%, %zu %s\n", 100.0 * r->progress, r->off_path,
                    r->test == ASP_EXPERIMENT_HIGHSPEED ? "collisions" : "off path");
     }
-    fflush(stdout);
+    if (!t->env->json)
+        fflush(stdout);
     t->rows++;
 }
 
@@ -172,18 +186,18 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
         d.width = w;
         d.height = h;
     }
-    struct run_table table = {.env = env};
+    struct run_table table = {.env = env, .rows_json = env->json ? cJSON_CreateArray() : NULL};
     d.on_run = on_run;
     d.log = on_log;
     d.user = &table;
     asp_error err = {0};
     rc = asp_experiment_run(&d, &env->ctx, &err);
     asp_amg_shutdown(); // the primitives' decomposition may have started MPI (once per process)
-    if (env->json && table.rows)
-        printf("]\n");
-    if (rc)
+    if (rc) {
+        cJSON_Delete(table.rows_json);
         return cli_fail(env, &err);
-    return 0;
+    }
+    return env->json ? cli_json_print(env, table.rows_json) : 0;
 }
 
 int cmd_experiment(int argc, char **argv, struct cli_env *env)

@@ -124,6 +124,11 @@ rows = json.load(open(T + "/a.json"))
 assert len(rows) == 16 and all(r["frames"] > 0 and r["mean_frame_ms"] > 0 for r in rows), rows
 PY
 
+# the reader of the same contract (experiment analyze) takes the logs whole
+expect_exit 0 "$AMGSPLAT" experiment analyze "$T/a" -o "$T/report"
+grep -F "0 frames lost" "$T/report/report.md" >/dev/null || fail "analyze lost frames of a whole study"
+grep -E "^lowspeed,.*,A," "$T/report/navigation.csv" >/dev/null || fail "no lowspeed grades: $(cat "$T/report/navigation.csv")"
+
 # screenshots: every test in every condition, the blank ones a single colour
 for t in far near lowspeed highspeed; do
   for c in polygons points primitives blank; do
