@@ -117,7 +117,8 @@ double asp_stats_grade_step(const float *path, size_t count, double half_width, 
 
 /** A run's grade (seed 004 2.4: the mean over the samples that show movement). */
 typedef struct asp_grade_result {
-    double grade;                       /* mean score of the moving steps, 0..1; NaN when none moved */
+    double grade;                       /* mean score of the moving steps, 0..1; 0 when the track has
+                                           frames but never moved; NaN for fewer than 2 frames */
     size_t moving;                      /* steps graded */
     size_t along, away, backwards, out; /* steps by verdict */
 } asp_grade_result;

@@ -136,6 +136,10 @@ int asp_stats_grade_track(const float *path, size_t count, double half_width, co
     }
     if (r.moving)
         r.grade = sum / (double)r.moving;
+    else if (n >= 2)
+        r.grade = 0; // frames were recorded and the subject never moved: it did not navigate (issue 15:
+                     // a blank frame grades near 0); the seed (2.4) grades moving samples only and
+                     // had no subject who stood still for a whole run
     *out = r;
     return 0;
 }

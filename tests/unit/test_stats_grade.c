@@ -95,7 +95,11 @@ static void test_track(void)
     CHECK_OK(asp_stats_grade_track(straight, 2, 5, pos, 12, &r, &err), &err);
     CHECK(r.moving == 10 && r.along == 8 && r.backwards == 2 && r.out == 0);
     CHECK_NEAR(r.grade, 0.8, 1e-12);
-    // a track that never moves has no grade (NaN), not 0
+    // a track that never moves did not navigate: grade 0 (a blank frame grades near 0, issue 15);
+    // a single frame has no step at all: no grade
+    const double still[9] = {3, 0, 1, 3, 0, 1, 3, 0, 1};
+    CHECK_OK(asp_stats_grade_track(straight, 2, 5, still, 3, &r, &err), &err);
+    CHECK(r.moving == 0 && r.grade == 0);
     CHECK_OK(asp_stats_grade_track(straight, 2, 5, pos, 1, &r, &err), &err);
     CHECK(r.moving == 0 && isnan(r.grade));
     CHECK(asp_stats_grade_track(straight, 1, 5, pos, 12, &r, &err) == ASP_EINVAL);
