@@ -12,6 +12,7 @@
 
 #include "amgsplat/eval.h"
 #include "util/atomic_file.h"
+#include "util/json_file.h"
 #include "util/banned.h"
 
 /*
@@ -105,19 +106,7 @@ int asp_eval_save_json(const asp_eval_result *res, const char *model, const char
     for (size_t i = 0; i < res->row_count; i++)
         cJSON_AddItemToArray(rows, row_json(res, i));
     cJSON_AddItemToObject(o, "rows", rows);
-    char *text = o ? cJSON_Print(o) : NULL; // indented: eval.json is read by people as well as by scripts
-    cJSON_Delete(o);
-    if (!text)
-        return asp_error_set(err, ASP_ENOMEM, "cannot write '%s': out of memory", path);
-    asp__atomic_file f;
-    int rc = asp__atomic_open(&f, path, err);
-    if (rc == 0) {
-        fputs(text, f.fp);
-        fputc('\n', f.fp);
-        rc = asp__atomic_commit(&f, err);
-    }
-    cJSON_free(text);
-    return rc;
+    return asp__json_save(o, path, err); // indented: eval.json is read by people as well as by scripts
 }
 
 enum { MAX_SERIES = 16 };

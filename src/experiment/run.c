@@ -17,6 +17,7 @@
 
 #include "experiment/internal.h"
 #include "util/atomic_file.h"
+#include "util/json_file.h"
 #include "util/banned.h"
 
 
@@ -607,19 +608,7 @@ static int write_study(exp_study *st, char subjects[][32], size_t nsubjects, con
         cJSON_AddStringToObject(o, "points_file", p->points_file);
         cJSON_AddStringToObject(o, "primitives_file", p->dps_file);
     }
-    char *text = cJSON_Print(root);
-    cJSON_Delete(root);
-    if (!text)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory writing '%s'", path);
-    asp__atomic_file f;
-    int rc = asp__atomic_open(&f, path, err);
-    if (!rc) {
-        fputs(text, f.fp);
-        fputc('\n', f.fp);
-        rc = asp__atomic_commit(&f, err);
-    }
-    cJSON_free(text);
-    return rc;
+    return asp__json_save(root, path, err);
 }
 
 /* PNGs of every test in every condition from its start view, for the docs and for checking a lab's scenes */

@@ -11,6 +11,7 @@
 
 #include "experiment/internal.h"
 #include "util/atomic_file.h"
+#include "util/json_file.h"
 #include "util/regular_file.h"
 #include "util/banned.h"
 
@@ -244,17 +245,9 @@ int asp_experiment_scenes_save(const asp_experiment_scenes *sc, const char *path
              cJSON_AddNumberToObject(o, "points", (double)s->points) &&
              cJSON_AddNumberToObject(o, "primitives", (double)s->primitives);
     }
-    char *text = ok ? cJSON_Print(root) : NULL;
-    cJSON_Delete(root);
-    if (!text)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory writing '%s'", path);
-    asp__atomic_file f;
-    int rc = asp__atomic_open(&f, path, err);
-    if (!rc) {
-        fputs(text, f.fp);
-        fputc('\n', f.fp);
-        rc = asp__atomic_commit(&f, err);
+    if (!ok) {
+        cJSON_Delete(root);
+        root = NULL; // reported as out of memory
     }
-    cJSON_free(text);
-    return rc;
+    return asp__json_save(root, path, err);
 }

@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 
 #include "stats/report_internal.h"
+#include "util/json_file.h"
 #include "util/banned.h"
 
 static const char *const file_names[F_COUNT] = {"report.md",       "logs.csv",       "frame_time.csv",
@@ -222,25 +223,13 @@ int asp_stats_report_write(const asp_stats_analysis *a, const char *report_dir, 
         if (!r.rc)
             asp__report_navigation(&r);
     }
-    char *json = NULL;
-    if (!r.rc) {
-        json = cJSON_Print(r.root);
-        if (!json)
-            r.rc = asp_error_set(err, ASP_ENOMEM, "out of memory printing the JSON report");
-    }
     if (!r.rc) {
         char path[4096];
-        asp__atomic_file jf;
         snprintf(path, sizeof path, "%s/report.json", report_dir);
-        r.rc = asp__atomic_open(&jf, path, err);
-        if (!r.rc) {
-            fputs(json, jf.fp);
-            fputc('\n', jf.fp);
-            r.rc = asp__atomic_commit(&jf, err);
-        }
+        r.rc = asp__json_save(r.root, path, err);
+    } else {
+        cJSON_Delete(r.root);
     }
-    cJSON_free(json);
-    cJSON_Delete(r.root);
     for (size_t i = 0; i < opened && i < F_COUNT; i++) {
         if (r.rc)
             asp__atomic_abort(&r.f[i]);
