@@ -123,6 +123,18 @@ typedef enum asp_amg_interp {
 } asp_amg_interp;
 
 /**
+ * Positive off-diagonal entries of A = (A~ + A~^T) / 2 (journal eq. 5-7, thesis 2.4). They come from
+ * obtuse angles of the lifted 3D fans (a fan Delaunay in the tangent plane need not be Delaunay on the
+ * surface). The seeds keep them; amgsplat clamps them to 0 by default because classical AMG
+ * interpolation is built for M-matrices: a positive coupling gives negative interpolation weights, and
+ * then basis functions outside [0, 1] (docs/seeds.md has the measurement).
+ */
+typedef enum asp_amg_stiffness {
+    ASP_AMG_STIFFNESS_CLAMPED = 0,  /* positive A_ij set to 0 (diagonal = -sum of the rest), counted in info */
+    ASP_AMG_STIFFNESS_UNCLAMPED = 1 /* the seeds' matrix as assembled; still counted in info */
+} asp_amg_stiffness;
+
+/**
  * Options; the zero value means the documented defaults, so
  * `&(asp_amg_desc){ .k_min = 40 }` works.
  */
@@ -143,6 +155,7 @@ typedef struct asp_amg_desc {
     double drop_tol;         /* basis entries below this are dropped and rows renormalised (0 = 1e-4, < 0 keeps all) */
     double crease_cut;       /* cut coarse couplings whose interface classifier is below this times the smaller
                                 interior classifier of the two unknowns (0 = 0.25, < 0 = off; hierarchy.c) */
+    asp_amg_stiffness stiffness; /* 0 = CLAMPED */
 } asp_amg_desc;
 
 /** Opaque decomposition: points, classifier and the AMG hierarchy. */
@@ -155,7 +168,7 @@ typedef struct asp_amg_info {
     double mean_neighbourhood;  /* mean |N(x)| */
     double mean_fan;            /* mean fan size */
     size_t matrix_nnz;          /* non-zeros of A^0 */
-    size_t positive_offdiag;    /* positive A_ij clamped to 0 (obtuse 3D fans) */
+    size_t positive_offdiag;    /* positive A_ij (obtuse 3D fans): clamped to 0 unless desc.stiffness is UNCLAMPED */
     size_t isolated_points;     /* points without any fan neighbour */
     size_t repaired_rows;       /* P rows hypre left empty, filled to keep the partition of unity */
     double t_neighbours, t_classifier, t_fans, t_assembly, t_amg, t_basis;

@@ -230,7 +230,7 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
     if ((rc = stage(ctx, "assembly", 0, err)) != 0)
         goto fail;
     /* with the crease test, also the same fans with C = 1: its reference (hierarchy.c) */
-    rc = asp__amg_assemble(pos, a->classifier, &fans, ctx, &a->matrix, d.crease_cut > 0 ? &flat : NULL,
+    rc = asp__amg_assemble(pos, a->classifier, &fans, d.stiffness, ctx, &a->matrix, d.crease_cut > 0 ? &flat : NULL,
                            &a->info.positive_offdiag, err);
     if (rc)
         goto fail;
