@@ -20,5 +20,6 @@
 #include "render.h"
 #include "scene.h"
 #include "viewer.h"
+#include "preset.h"
 
 #endif

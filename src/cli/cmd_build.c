@@ -134,6 +134,7 @@ static int save_atlases(const char *path, const asp_dps *dps, const asp_dps_summ
 
 int cmd_build(int argc, char **argv, struct cli_env *env)
 {
+    const char *preset = NULL; /* applied by cli_parse */
     const char *output = NULL, *level_text = NULL, *method = "affine", *shape = "linear", *norm = "positive";
     const char *atlas = NULL;
     size_t budget = SIZE_MAX, max_texture = 0, padding = 0; // SIZE_MAX: not given, so a given 0 is refused
@@ -141,6 +142,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     int unweighted = 0, project = 0, no_extend = 0, normals = 0, merge = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output primitives (.dps)"},
+        {"preset", 0, CLI_STRING, &preset, "SEED", "the seed's options: thesis, journal (docs/seeds.md)"},
         {"level", 'l', CLI_STRING, &level_text, "L", "level(s): L, L-5, 3, 'L-5,L-3' or 'L-6..L' (default L-3)"},
         {"primitives", 'p', CLI_SIZE, &budget, "N", "the finest level with at most N domains"},
         {"texel-size", 0, CLI_DOUBLE, &texel, "X", "texel edge in mean point radii (default 1)"},
@@ -169,6 +171,8 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat build -h'", npos);
     if (!output)
         return cli_usage_error(env, "missing -o OUT.dps");
+    if (level_text && budget != SIZE_MAX && cli_from_preset(env, &level_text))
+        level_text = NULL; /* --primitives given by hand wins over the preset's level */
     if (level_text && budget != SIZE_MAX)
         return cli_usage_error(env, "--level and --primitives exclude each other");
     if (budget == 0 || (budget != SIZE_MAX && budget > UINT32_MAX))

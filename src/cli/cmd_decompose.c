@@ -11,7 +11,8 @@
 #include "util/banned.h"
 
 static const char usage[] =
-    "usage: amgsplat decompose IN.ply -o OUT.amg [--k N] [--k-max N] [--epsilon X] [--fan-k N]\n"
+    "usage: amgsplat decompose IN.ply -o OUT.amg [--preset thesis|journal] [--k N] [--k-max N] [--epsilon X]\n"
+    "                          [--fan-k N] [--stiffness clamped|unclamped]\n"
     "                          [--classifier variation|moment] [--alpha X] [--beta X]\n"
     "                          [--coarsen rs|falgout|cljp|pmis|hmis] [--interp classical|direct|standard|ext+i]\n"
     "                          [--strong X] [--trunc X] [--max-levels N] [--max-coarse N] [--crease-cut X]\n"
@@ -43,6 +44,8 @@ static const struct name_code interps[] = {{"classical", ASP_AMG_INTERP_CLASSICA
                                            {"standard", ASP_AMG_INTERP_STANDARD},
                                            {"ext+i", ASP_AMG_INTERP_EXTENDED_I},
                                            {0, 0}};
+static const struct name_code stiffness_forms[] = {
+    {"clamped", ASP_AMG_STIFFNESS_CLAMPED}, {"unclamped", ASP_AMG_STIFFNESS_UNCLAMPED}, {0, 0}};
 static const struct name_code color_modes[] = {
     {"classifier", ASP_AMG_COLOR_CLASSIFIER}, {"domains", ASP_AMG_COLOR_DOMAINS}, {"strict", ASP_AMG_COLOR_STRICT}, {0, 0}};
 
@@ -162,6 +165,7 @@ static int check_output_name(const struct cli_env *env, const char *input, const
 int cmd_decompose(int argc, char **argv, struct cli_env *env)
 {
     const char *output = NULL, *classifier = "variation", *coarsen = "rs", *interp = "classical";
+    const char *preset = NULL, *stiffness = "clamped"; /* --preset is applied by cli_parse */
     const char *export_mode = NULL, *level_name = "L-3", *colors_out = NULL;
     /* UNSET, not 0: 0 means "default" to the library, so a given 0 would pass silently */
     size_t k = UNSET, k_max = UNSET, fan_k = UNSET, max_levels = UNSET, max_coarse = UNSET;
@@ -169,10 +173,13 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     int stats = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output decomposition (.amg)"},
+        {"preset", 0, CLI_STRING, &preset, "SEED", "the seed's options: thesis, journal (docs/seeds.md)"},
         {"k", 'k', CLI_SIZE, &k, "N", "minimum neighbourhood size k_min (default 24)"},
         {"k-max", 0, CLI_SIZE, &k_max, "N", "cap with the epsilon-ball extension (default 2 k_min)"},
         {"epsilon", 0, CLI_DOUBLE, &epsilon, "X", "neighbourhood radius (default: median k_min-th distance)"},
         {"fan-k", 0, CLI_SIZE, &fan_k, "N", "nearest neighbours projected for the fan (default 16)"},
+        {"stiffness", 0, CLI_STRING, &stiffness, "F",
+         "positive off-diagonals: clamped (default, an M-matrix for AMG) or unclamped (the seeds)"},
         {"classifier", 0, CLI_STRING, &classifier, "C", "variation (default, thesis 2.3) or moment (journal eq. 3)"},
         {"alpha", 0, CLI_DOUBLE, &alpha, "X", "G(s) = 1/(alpha + beta s^2): alpha (default 0.01)"},
         {"beta", 0, CLI_DOUBLE, &beta, "X", "beta (default 100)"},
@@ -223,6 +230,9 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     if (lookup(interps, interp, &code))
         return cli_usage_error(env, "--interp must be classical, direct, standard or ext+i, got '%s'", interp);
     desc.interp = (asp_amg_interp)code;
+    if (lookup(stiffness_forms, stiffness, &code))
+        return cli_usage_error(env, "--stiffness must be clamped or unclamped, got '%s'", stiffness);
+    desc.stiffness = (asp_amg_stiffness)code;
     if (export_mode && lookup(color_modes, export_mode, &color_mode))
         return cli_usage_error(env, "--export-colors must be classifier, domains or strict, got '%s'", export_mode);
     if (export_mode && !colors_out)
@@ -281,8 +291,8 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
             printf("%s: %zu points, %zu levels (L = %zu, coarsest %zu unknowns)", output ? output : input,
                    asp_amg_cloud(amg)->count, nl, nl - 1, asp_amg_level_size(amg, nl - 1));
             if (!from_amg)
-                printf(", epsilon %.4g, %zu positive couplings clamped, %.2f s", in->epsilon, in->positive_offdiag,
-                       t_total);
+                printf(", epsilon %.4g, %zu positive couplings %s, %.2f s", in->epsilon, in->positive_offdiag,
+                       desc.stiffness == ASP_AMG_STIFFNESS_UNCLAMPED ? "kept" : "clamped", t_total);
             printf("\n");
         }
         if (stats)

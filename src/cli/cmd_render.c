@@ -64,6 +64,7 @@ struct render_opts {
     double point_size;
     int opaque;
     const char *method;
+    const char *preset; /* --preset: applied by cli_parse (docs/seeds.md) */
     double alpha_ref;
     double transparency;
     double depth_window;
@@ -379,6 +380,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                             .transparency = NAN, .depth_window = NAN, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
+        {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
         {"size", 0, CLI_STRING, &o.size, "WxH", "image size of one view (default 512x512)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "camera azimuth, elevation (degrees), distance in radii (default 30,20)"},
         {"views", 0, CLI_SIZE, &o.views, "N", "N views around the object in a contact sheet (default 1)"},
@@ -422,6 +424,11 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         asp_file_type_of_name(argv[0], &type, NULL);
     o.amg_input = type.kind == ASP_FILE_AMG;
     o.dps_input = type.kind == ASP_FILE_DPS;
+    // a preset names the options of every input kind; those that do not fit this input are dropped
+    if (!o.dps_input && cli_from_preset(env, &o.method))
+        o.method = NULL;
+    if ((o.dps_input || type.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.renderer))
+        o.renderer = NULL;
     if (parse_options(env, &o))
         return 2;
     if (o.dps_input && o.renderer)

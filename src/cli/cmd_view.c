@@ -39,6 +39,7 @@ struct view_opts {
     const char *screenshot;
     const char *keys;
     const char *method;
+    const char *preset; /* --preset: applied by cli_parse (docs/seeds.md) */
     double alpha_ref;
     size_t frames;
     double tau;
@@ -158,6 +159,7 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
     struct view_opts o = {.alpha_ref = NAN}; // NaN: not given (the parser refuses non-finite values)
     const struct cli_option opts[] = {
         {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
+        {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "first view as in 'amgsplat render' (default 30,20)"},
         {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y (default), z (scans, CAD), x, -y, -z or -x"},
         {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "first renderer (default disc, mesh for meshes; 'h' in the window lists them)"},
@@ -181,6 +183,14 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         return prc > 0 ? 0 : 2;
     if (npos != 1)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat view -h'", npos);
+    // a preset names the options of every input kind; those that do not fit this input are dropped
+    asp_file_type ft = {ASP_FILE_UNKNOWN, "", 0};
+    if (asp_file_recognise(argv[0], &ft, NULL) != 0)
+        asp_file_type_of_name(argv[0], &ft, NULL);
+    if (ft.kind != ASP_FILE_DPS && cli_from_preset(env, &o.method))
+        o.method = NULL;
+    if ((ft.kind == ASP_FILE_DPS || ft.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.renderer))
+        o.renderer = NULL;
     asp_viewer_desc desc = {.log = log_line, .log_user = env};
     if (parse_into(env, argv[0], &o, &desc))
         return 2;

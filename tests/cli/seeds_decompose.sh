@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Seed presets and options of decompose and build (issue 17, docs/seeds.md): --preset sets the seed's
+# values, an option given by hand wins wherever it stands, a wrong name is a usage error; the
+# unclamped stiffness matrix keeps the positive couplings the default clamps.
+source "$(dirname "$0")/common.sh"
+A="$AMGSPLAT"
+jget() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
+
+"$A" decompose -h | grep -- "--preset" >/dev/null || fail "decompose -h lacks --preset"
+"$A" build -h | grep -- "--preset" >/dev/null || fail "build -h lacks --preset"
+"$A" synth octahedron --points 4000 -o "$T/o.ply" -q >/dev/null
+
+# journal 2.1-2.3: moment classifier, k_min 50 with the whole epsilon-ball, fans from the k-closest set
+"$A" decompose "$T/o.ply" -o "$T/j.amg" --preset journal --json >"$T/j.json" 2>"$T/j.err"
+[[ $(jget "$T/j.json" "d['k_min'], d['k_max'], d['fan_k']") == "(50, 1024, 50)" ]] || fail "journal sizes: $(cat "$T/j.json")"
+grep -F "preset journal: --classifier moment --alpha 0.01 --beta 100" "$T/j.err" >/dev/null || fail "preset line: $(cat "$T/j.err")"
+# the journal keeps its positive couplings: the mean neighbourhood is larger than k_min (epsilon-ball)
+jget "$T/j.json" "d['mean_neighbourhood'] >= 50 and d['positive_offdiag_clamped'] > 0" | grep True >/dev/null \
+  || fail "journal neighbourhood: $(cat "$T/j.json")"
+# explicit options win, before or after --preset
+"$A" decompose "$T/o.ply" --k 30 --preset journal --fan-k 20 --stats --json -q >"$T/k.json"
+[[ $(jget "$T/k.json" "d['k_min'], d['fan_k']") == "(30, 20)" ]] || fail "explicit --k/--fan-k lost: $(cat "$T/k.json")"
+"$A" decompose "$T/o.ply" --preset=thesis --stats --json -q >"$T/t.json"
+[[ $(jget "$T/t.json" "d['tau'], d['k_min']") == "(0.01, 24)" ]] || fail "thesis tau: $(cat "$T/t.json")"
+expect_fail 2 "unknown preset 'seed'" "$A" decompose "$T/o.ply" --stats --preset seed
+expect_fail 2 "--stiffness must be clamped or unclamped" "$A" decompose "$T/o.ply" --stats --stiffness maybe
+
+# the stiffness forms: equal counts of positive couplings, reported as clamped or kept
+"$A" decompose "$T/o.ply" -o "$T/c.amg" >"$T/c.txt"
+"$A" decompose "$T/o.ply" -o "$T/u.amg" --stiffness unclamped >"$T/u.txt"
+nc=$(sed -n 's/.* \([0-9]*\) positive couplings clamped.*/\1/p' "$T/c.txt")
+nu=$(sed -n 's/.* \([0-9]*\) positive couplings kept.*/\1/p' "$T/u.txt")
+[[ -n "$nc" && "$nc" -gt 0 && "$nc" == "$nu" ]] || fail "positive couplings: '$(cat "$T/c.txt")' vs '$(cat "$T/u.txt")'"
+"$A" decompose "$T/u.amg" --stats -q >/dev/null || fail "the unclamped .amg does not load"
+
+# build: the journal's level L-5 (2.3); --primitives by hand replaces the preset's level
+"$A" build "$T/j.amg" -o "$T/j.dps" --preset journal -q >/dev/null
+"$A" info "$T/j.dps" --json >"$T/ji.json"
+[[ $(jget "$T/ji.json" "[l['name'] for l in d['levels']]") == "['L-5']" ]] || fail "journal level: $(cat "$T/ji.json")"
+"$A" build "$T/j.amg" -o "$T/p.dps" --preset journal --primitives 30 -q >/dev/null || fail "--primitives with --preset journal"
+"$A" info "$T/p.dps" --json >"$T/pi.json"
+jget "$T/pi.json" "d['levels'][0]['primitives'] <= 30" | grep True >/dev/null || fail "budget lost: $(cat "$T/pi.json")"
+"$A" build "$T/c.amg" -o "$T/t.dps" --preset thesis -q >/dev/null
+"$A" info "$T/t.dps" --json >"$T/ti.json"
+[[ $(jget "$T/ti.json" "d['method']") == "radial" ]] || fail "thesis method: $(cat "$T/ti.json")"
+expect_fail 2 "unknown preset" "$A" build "$T/c.amg" -o "$T/x.dps" --preset Journal
+exit 0

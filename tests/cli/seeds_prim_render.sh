@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Seed presets of render and view (issue 17, docs/seeds.md): a preset draws exactly what its options
+# given by hand draw, options by hand win, and settings for another input kind (a .dps method for
+# points, a point renderer for a .dps) are dropped rather than refused.
+source "$(dirname "$0")/common.sh"
+A="$AMGSPLAT"
+jget() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
+
+"$A" render -h | grep -- "--preset SEED" >/dev/null || fail "render -h lacks --preset"
+"$A" view -h | grep -- "--preset SEED" >/dev/null || fail "view -h lacks --preset"
+"$A" synth octahedron --points 3000 -o "$T/o.ply" -q
+R=(--size 64x64 --view 30,20 -q)
+
+# pajarola (seed 001): splats with psi_E a=6 b=1.5 n=3, tau 0, uncut; the same pixels as by hand
+"$A" render "$T/o.ply" -o "$T/p.png" --preset pajarola "${R[@]}" --json >"$T/p.json"
+[[ $(jget "$T/p.json" "d['renderer'], d['tolerance']") == "('splat', 0)" ]] || fail "pajarola: $(cat "$T/p.json")"
+"$A" render "$T/o.ply" -o "$T/h.png" --renderer splat --kernel 6,1.5,3 --tolerance 0 --crease-angle off "${R[@]}"
+cmp -s "$T/p.png" "$T/h.png" || fail "--preset pajarola draws other pixels than its options by hand"
+# ... and differs from the default, which cuts at creases: the preset did something
+"$A" render "$T/o.ply" -o "$T/d.png" --renderer splat "${R[@]}"
+! cmp -s "$T/p.png" "$T/d.png" || fail "--preset pajarola draws the default's pixels"
+# explicit wins
+"$A" render "$T/o.ply" -o "$T/x.png" --renderer disc --preset pajarola "${R[@]}" --json >"$T/x.json"
+[[ $(jget "$T/x.json" "d['renderer']") == "disc" ]] || fail "explicit --renderer lost: $(cat "$T/x.json")"
+# schwarz (seed 004): square points
+"$A" render "$T/o.ply" -o "$T/s.png" --preset schwarz "${R[@]}" --json >"$T/s.json"
+[[ $(jget "$T/s.json" "d['renderer']") == "square" ]] || fail "schwarz: $(cat "$T/s.json")"
+# journal on points: its .dps method does not apply and is dropped; the seeds' uncut discs remain
+"$A" render "$T/o.ply" -o "$T/j.png" --preset journal "${R[@]}"
+"$A" render "$T/o.ply" -o "$T/jh.png" --crease-angle off "${R[@]}"
+cmp -s "$T/j.png" "$T/jh.png" || fail "--preset journal on points is not the uncut discs"
+# ... but a --method given by hand to points is still refused
+expect_fail 2 "need a .dps input" "$A" render "$T/o.ply" -o "$T/e.png" --preset journal --method overlap
+expect_fail 2 "unknown preset 'qsplat'" "$A" render "$T/o.ply" -o "$T/e.png" --preset qsplat
+expect_fail 2 "unknown preset 'qsplat'" "$A" view "$T/o.ply" --preset qsplat
+
+# journal on a .dps: the overlap method of journal Fig. 10; pajarola's point renderer is dropped there
+"$A" decompose "$T/o.ply" -o "$T/o.amg" -q
+"$A" build "$T/o.amg" -o "$T/o.dps" --primitives 8 -q >/dev/null
+"$A" render "$T/o.dps" -o "$T/jd.png" --preset journal "${R[@]}" --json >"$T/jd.json"
+[[ $(jget "$T/jd.json" "d['method']") == "overlap" ]] || fail "journal .dps method: $(cat "$T/jd.json")"
+"$A" render "$T/o.dps" -o "$T/jt.png" --preset thesis --method prefix "${R[@]}" --json >"$T/jt.json"
+[[ $(jget "$T/jt.json" "d['method']") == "prefix" ]] || fail "explicit --method lost: $(cat "$T/jt.json")"
+"$A" render "$T/o.dps" -o "$T/pd.png" --preset pajarola "${R[@]}" || fail "--preset pajarola on a .dps"
+exit 0
