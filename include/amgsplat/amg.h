@@ -126,8 +126,9 @@ typedef enum asp_amg_interp {
  * Positive off-diagonal entries of A = (A~ + A~^T) / 2 (journal eq. 5-7, thesis 2.4). They come from
  * obtuse angles of the lifted 3D fans (a fan Delaunay in the tangent plane need not be Delaunay on the
  * surface). The seeds keep them; amgsplat clamps them to 0 by default because classical AMG
- * interpolation is built for M-matrices: a positive coupling gives negative interpolation weights, and
- * then basis functions outside [0, 1] (docs/seeds.md has the measurement).
+ * interpolation is built for M-matrices: a positive coupling can give negative interpolation weights,
+ * which the hierarchy drops before renormalising the row (asp_amg_info.repaired_rows), so P stays a
+ * partition of unity with values in [0, 1] either way (docs/seeds.md has the measurement).
  */
 typedef enum asp_amg_stiffness {
     ASP_AMG_STIFFNESS_CLAMPED = 0,  /* positive A_ij set to 0 (diagonal = -sum of the rest), counted in info */
