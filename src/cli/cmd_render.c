@@ -65,6 +65,10 @@ struct render_opts {
     int opaque;
     const char *method;
     const char *preset; /* --preset: applied by cli_parse (docs/seeds.md) */
+    const char *kernel_shape, *kernel_rim, *axes; /* seed 001 eq. 11-12, eq. 5-6 (docs/seeds.md) */
+    double sigma, epsilon_uniform, tolerance_area; /* NaN: not given */
+    unsigned splat_flags, hier_flags;
+    asp_splat_kernel kernel_kind;
     double alpha_ref;
     double transparency;
     double depth_window;
@@ -116,9 +120,16 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
                                          .epsilon = o->epsilon > 0 ? (float)o->epsilon : -1.0f, // 0 = no offset
                                          .tolerance = (float)o->tolerance, .radius_scale = (float)o->radius_scale,
                                          .lighting = o->light_mode,
-                                         .mode = o->opaque ? ASP_SPLAT_OPAQUE : ASP_SPLAT_BLEND};
+                                         .mode = o->opaque ? ASP_SPLAT_OPAQUE : ASP_SPLAT_BLEND,
+                                         .flags = o->splat_flags, .kernel = o->kernel_kind,
+                                         .kernel_sigma = isnan(o->sigma) ? 0.0f : (float)o->sigma,
+                                         .hier = {.flags = o->hier_flags}};
+    if (!isnan(o->epsilon_uniform))
+        r->splat.epsilon = (float)o->epsilon_uniform; // world units; 0 = the mean point splat
     r->square = (asp_square_renderer_desc){.point_size = (float)o->point_size, .tolerance = (float)o->tolerance,
-                                           .radius_scale = (float)o->radius_scale};
+                                           .radius_scale = (float)o->radius_scale, .hier = {.flags = o->hier_flags}};
+    if (!isnan(o->tolerance_area)) // seed 001 5.1: tau in percent of the window (one view's) area
+        r->splat.tolerance = r->square.tolerance = asp_render_tolerance_from_area(o->tolerance_area, o->width, o->height);
     r->prim = o->prim;
     r->mesh.flags = o->flat ? ASP_MESH_RENDER_FLAT : 0u;
 }
@@ -169,6 +180,27 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
         for (int i = 0; i < 3; i++)
             o->kernel_abn[i] = (float)v[i];
     }
+    if (o->kernel_shape && strcmp(o->kernel_shape, "psi-e") != 0 && strcmp(o->kernel_shape, "psi-g") != 0)
+        return cli_usage_error(env, "--kernel-shape expects psi-e or psi-g, got '%s'", o->kernel_shape);
+    o->kernel_kind = o->kernel_shape && strcmp(o->kernel_shape, "psi-g") == 0 ? ASP_SPLAT_KERNEL_PSI_G
+                                                                              : ASP_SPLAT_KERNEL_PSI_E;
+    if (!isnan(o->sigma) && !(o->sigma > 0))
+        return cli_usage_error(env, "--sigma expects a number > 0, got %g", o->sigma);
+    if (o->kernel_rim && strcmp(o->kernel_rim, "1") != 0 && strcmp(o->kernel_rim, "b") != 0)
+        return cli_usage_error(env, "--kernel-rim expects 1 or b, got '%s'", o->kernel_rim);
+    if (o->kernel_rim && strcmp(o->kernel_rim, "b") == 0)
+        o->splat_flags |= ASP_SPLAT_KERNEL_RIM_AT_B;
+    if (!isnan(o->epsilon_uniform) && !(o->epsilon_uniform >= 0))
+        return cli_usage_error(env, "--epsilon-uniform expects world units >= 0 (0 = the mean splat), got %g",
+                               o->epsilon_uniform);
+    if (!isnan(o->epsilon_uniform))
+        o->splat_flags |= ASP_SPLAT_EPSILON_UNIFORM;
+    if (!isnan(o->tolerance_area) && !(o->tolerance_area >= 0 && o->tolerance_area <= 100))
+        return cli_usage_error(env, "--tolerance-area expects a percentage in 0..100, got %g", o->tolerance_area);
+    if (o->axes && strcmp(o->axes, "sqrt") != 0 && strcmp(o->axes, "lambda") != 0)
+        return cli_usage_error(env, "--axes expects sqrt or lambda, got '%s'", o->axes);
+    if (o->axes && strcmp(o->axes, "lambda") == 0)
+        o->hier_flags |= ASP_HIER_BUILD_LAMBDA_AXES;
     static const char *const modes[] = {"gouraud", "pixel", "flat"};
     if (o->lighting) {
         int found = -1;
@@ -377,6 +409,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     // NaN marks the .dps numbers as not given
     struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .width = 512, .height = 512,
                             .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0, .alpha_ref = NAN,
+                            .sigma = NAN, .epsilon_uniform = NAN, .tolerance_area = NAN,
                             .transparency = NAN, .depth_window = NAN, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
@@ -389,6 +422,12 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"budget", 0, CLI_SIZE, &o.budget, "N", "splat, square: cut the hierarchy to N splats per view instead of a tolerance"},
         {"kernel", 0, CLI_STRING, &o.kernel, "A,B,N", "splat: kernel exp(-A (r/B)^N) (default 6,1.5,3)"},
         {"epsilon", 0, CLI_DOUBLE, &o.epsilon, "X", "splat: depth offset in splat radii for blending (default 1; 0 = none)"},
+        {"epsilon-uniform", 0, CLI_DOUBLE, &o.epsilon_uniform, "X", "splat: one depth offset for all splats in world units, seed 001 5.3 (0 = the mean splat)"},
+        {"kernel-shape", 0, CLI_STRING, &o.kernel_shape, "K", "splat: psi-e (default, seed 001 eq. 12) or psi-g (eq. 11, --sigma)"},
+        {"sigma", 0, CLI_DOUBLE, &o.sigma, "X", "splat: psi-g's sigma in kernel radii (default 0.5)"},
+        {"kernel-rim", 0, CLI_STRING, &o.kernel_rim, "1|b", "splat: the ellipse rim is the kernel's r = 1 (default) or r = b (seed 001 Fig. 11)"},
+        {"tolerance-area", 0, CLI_DOUBLE, &o.tolerance_area, "PCT", "splat, square: tau in percent of the view's area (seed 001 5.1); replaces --tolerance"},
+        {"axes", 0, CLI_STRING, &o.axes, "A", "splat, square: ellipse axis ratio sqrt (default) or lambda (seed 001 eq. 5-6)"},
         {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
         {"opaque", 0, CLI_FLAG, &o.opaque, NULL, "splat: opaque ellipses, no blending"},
         {"point-size", 0, CLI_DOUBLE, &o.point_size, "PX", "square: fixed side in pixels (default 0: projected size)"},

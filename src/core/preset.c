@@ -52,10 +52,17 @@ static const asp_preset_setting thesis[] = {
     S("view", "method", "overlap", "thesis 4.4.4"),
 };
 
-/* Pajarola, Sainz, Guidotti 2003: psi_E with a = 6, b = 1.5, n = 3 (6, Fig. 20), tau = 0 (Table 2). */
+/*
+ * Pajarola, Sainz, Guidotti 2003: psi_E with a = 6, b = 1.5, n = 3 (6, Fig. 20) whose support r = b is the
+ * ellipse rim (Fig. 11), tau = 0 (Table 2), one epsilon for all splats (5.3), axes a' = lambda_1, b' =
+ * lambda_2 (eq. 5-6).
+ */
 static const asp_preset_setting pajarola[] = {
     S("render", "renderer", "splat", "seed 001 5"),
     S("render", "kernel", "6,1.5,3", "seed 001 6, Fig. 20"),
+    S("render", "kernel-rim", "b", "seed 001 4.2 eq. 12, Fig. 11"),
+    S("render", "epsilon-uniform", "0", "seed 001 5.3"),
+    S("render", "axes", "lambda", "seed 001 3.4 eq. 5-6"),
     S("render", "tolerance", "0", "seed 001 Table 2"),
     S("render", "crease-angle", "off", "seed 001 (none)"),
     S("view", "renderer", "splat", "seed 001 5"),

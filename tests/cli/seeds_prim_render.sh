@@ -11,10 +11,12 @@ jget() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval
 "$A" synth octahedron --points 3000 -o "$T/o.ply" -q
 R=(--size 64x64 --view 30,20 -q)
 
-# pajarola (seed 001): splats with psi_E a=6 b=1.5 n=3, tau 0, uncut; the same pixels as by hand
+# pajarola (seed 001): splats with psi_E a=6 b=1.5 n=3 (rim at b), tau 0, one epsilon, lambda axes, uncut;
+# the same pixels as by hand
 "$A" render "$T/o.ply" -o "$T/p.png" --preset pajarola "${R[@]}" --json >"$T/p.json"
 [[ $(jget "$T/p.json" "d['renderer'], d['tolerance']") == "('splat', 0)" ]] || fail "pajarola: $(cat "$T/p.json")"
-"$A" render "$T/o.ply" -o "$T/h.png" --renderer splat --kernel 6,1.5,3 --tolerance 0 --crease-angle off "${R[@]}"
+"$A" render "$T/o.ply" -o "$T/h.png" --renderer splat --kernel 6,1.5,3 --kernel-rim b --epsilon-uniform 0 --axes lambda \
+  --tolerance 0 --crease-angle off "${R[@]}"
 cmp -s "$T/p.png" "$T/h.png" || fail "--preset pajarola draws other pixels than its options by hand"
 # ... and differs from the default, which cuts at creases: the preset did something
 "$A" render "$T/o.ply" -o "$T/d.png" --renderer splat "${R[@]}"
@@ -42,4 +44,21 @@ expect_fail 2 "unknown preset 'qsplat'" "$A" view "$T/o.ply" --preset qsplat
 "$A" render "$T/o.dps" -o "$T/jt.png" --preset thesis --method prefix "${R[@]}" --json >"$T/jt.json"
 [[ $(jget "$T/jt.json" "d['method']") == "prefix" ]] || fail "explicit --method lost: $(cat "$T/jt.json")"
 "$A" render "$T/o.dps" -o "$T/pd.png" --preset pajarola "${R[@]}" || fail "--preset pajarola on a .dps"
+
+# seed 001 options one by one: each changes the blended image, none the silhouette; bad values are refused
+for opt in "--kernel-rim b" "--kernel-shape psi-g" "--epsilon-uniform 0.3"; do
+  "$A" render "$T/o.ply" -o "$T/opt.png" --renderer splat --tolerance 0 $opt "${R[@]}"
+  "$A" render "$T/o.ply" -o "$T/base.png" --renderer splat --tolerance 0 "${R[@]}"
+  ! cmp -s "$T/opt.png" "$T/base.png" || fail "$opt leaves the image unchanged"
+  "$A" imgdiff "$T/opt.png" "$T/base.png" --json | python3 -c "import json,sys; d=json.load(sys.stdin); assert d['iou'] > 0.99, d" \
+    || fail "$opt changes the silhouette"
+done
+# tau as 5% of the window area: a coarser cut than every point
+"$A" render "$T/o.ply" -o "$T/ta.png" --renderer splat --tolerance-area 5 "${R[@]}" --json >"$T/ta.json"
+jget "$T/ta.json" "d['primitives'] < 3000" | grep True >/dev/null || fail "--tolerance-area 5: $(cat "$T/ta.json")"
+expect_fail 2 "--kernel-shape expects psi-e or psi-g" "$A" render "$T/o.ply" -o "$T/e.png" --kernel-shape gauss
+expect_fail 2 "--kernel-rim expects 1 or b" "$A" render "$T/o.ply" -o "$T/e.png" --kernel-rim 2
+expect_fail 2 "--axes expects sqrt or lambda" "$A" render "$T/o.ply" -o "$T/e.png" --axes pca
+expect_fail 2 "--tolerance-area expects a percentage" "$A" render "$T/o.ply" -o "$T/e.png" --tolerance-area 101
+expect_fail 2 "--sigma expects a number > 0" "$A" render "$T/o.ply" -o "$T/e.png" --sigma 0
 exit 0
