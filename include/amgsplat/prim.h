@@ -59,6 +59,9 @@ typedef struct asp_prim_desc {
     double merge_flatness;   /* merge while l_min / sum l of both and the union is below this (0 = 0.01) */
     double merge_angle;      /* and their normals differ by less than this, degrees (0 = 15) */
     uint32_t padding;        /* atlas padding around each texture, texels (0 = 2) */
+    double enlarge;          /* thesis appendix C "Enlarge Bounding Rectangle": > 0 grows the sides of the
+                                points' bounding rectangle by this percentage (at most 1000) instead of the
+                                default margin of one point footprint on every side (0) */
 } asp_prim_desc;
 
 /* ---- one primitive ---- */

@@ -138,7 +138,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     const char *output = NULL, *level_text = NULL, *method = "affine", *shape = "linear", *norm = "positive";
     const char *atlas = NULL;
     size_t budget = SIZE_MAX, max_texture = 0, padding = 0; // SIZE_MAX: not given, so a given 0 is refused
-    double texel = 0, width = 0, tau = 0, fraction = 0, flat = 0, angle = 0;
+    double texel = 0, width = 0, tau = 0, fraction = 0, flat = 0, angle = 0, enlarge = 0;
     int unweighted = 0, project = 0, no_extend = 0, normals = 0, merge = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output primitives (.dps)"},
@@ -161,6 +161,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         {"merge-flatness", 0, CLI_DOUBLE, &flat, "X", "merge while l_min/sum l < X (default 0.01)"},
         {"merge-angle", 0, CLI_DOUBLE, &angle, "DEG", "and normals within DEG degrees (default 15)"},
         {"padding", 0, CLI_SIZE, &padding, "N", "atlas padding in texels (default 2)"},
+        {"enlarge", 0, CLI_DOUBLE, &enlarge, "PCT", "grow the points' rectangle by PCT % (thesis app. C; default: one footprint margin)"},
         {"atlas", 0, CLI_STRING, &atlas, "X.png", "also write each level's atlas as PNG"},
         {0},
     };
@@ -184,11 +185,14 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     }
     if (max_texture > 8192 || padding > 64)
         return cli_usage_error(env, "--max-texture must be at most 8192 and --padding at most 64");
+    if (!(enlarge >= 0 && enlarge <= 1000))
+        return cli_usage_error(env, "--enlarge expects a percentage in 0..1000, got %g", enlarge);
     asp_error err = {0};
     asp_prim_desc desc = {.tau = tau, .texel_size = texel, .max_texture = (uint32_t)max_texture, .width = width,
                           .unweighted = unweighted, .project_radii = project, .no_extend_color = no_extend,
                           .normal_map = normals, .neighbour_fraction = fraction, .merge = merge,
-                          .merge_flatness = flat, .merge_angle = angle, .padding = (uint32_t)padding};
+                          .merge_flatness = flat, .merge_angle = angle, .padding = (uint32_t)padding,
+                          .enlarge = enlarge};
     if (asp_prim_method_parse(method, &desc.method, &err) || asp_prim_shape_parse(shape, &desc.shape, &err) ||
         asp_prim_normalise_parse(norm, &desc.normalise, &err))
         return cli_usage_error(env, "%s", err.msg);

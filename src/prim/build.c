@@ -74,6 +74,9 @@ static int check_desc(const asp_prim_desc *d, asp_error *err)
         return asp_error_set(err, ASP_EINVAL, "merge flatness must be in (0, 1/3], got %g", d->merge_flatness);
     if (!(d->merge_angle > 0 && d->merge_angle <= 180))
         return asp_error_set(err, ASP_EINVAL, "merge angle must be in (0, 180] degrees, got %g", d->merge_angle);
+    if (!(d->enlarge >= 0 && d->enlarge <= 1000))
+        return asp_error_set(err, ASP_EINVAL, "rectangle enlargement must be in [0, 1000] percent, got %g",
+                             d->enlarge);
     if (d->padding > 64)
         return asp_error_set(err, ASP_EINVAL, "atlas padding must be at most 64 texels, got %u", d->padding);
     if ((unsigned)d->method > ASP_PRIM_RADIAL || (unsigned)d->shape > ASP_PRIM_GAUSSIAN ||
@@ -109,6 +112,11 @@ static void plan_one(const build_src *src, const asp_amg_csr *dom, const asp_pri
     /* margin: the largest footprint, but at most 3x the domain's mean, so one outlier radius cannot bloat it */
     double margin = L->foot * fmin(rmax, 3 * rsum / (double)n);
     double ew = L->pl.smax - L->pl.smin + 2 * margin, eh = L->pl.tmax - L->pl.tmin + 2 * margin;
+    if (d->enlarge > 0) {
+        /* thesis appendix C: the sides grown by a percentage so the point samples fall inside */
+        ew = (L->pl.smax - L->pl.smin) * (1 + d->enlarge / 100);
+        eh = (L->pl.tmax - L->pl.tmin) * (1 + d->enlarge / 100);
+    }
     double T = d->texel_size * src->mean_radius;
     double wf = ceil(ew / T), hf = ceil(eh / T);
     L->capped = 0;
