@@ -590,7 +590,11 @@ typedef enum asp_prim_render_method {
 enum asp_prim_render_flags {
     ASP_PRIM_RENDER_OUTLINE = 1 << 0,       /* draw each support rectangle's edges (journal Fig. 12b) */
     ASP_PRIM_RENDER_COLOR_BY_DOMAIN = 1 << 1, /* one colour per primitive, neighbours distinct (journal Fig. 5d) */
-    ASP_PRIM_RENDER_NO_NORMAL_MAP = 1 << 2  /* light with the primitive normal even when the level has a normal map */
+    ASP_PRIM_RENDER_NO_NORMAL_MAP = 1 << 2, /* light with the primitive normal even when the level has a normal map */
+    /* overlap method as the pseudocode of journal Fig. 10 / thesis 4.4.4 reads: the neighbours a
+     * front-facing primitive adds are drawn even when they face away (default: back faces culled,
+     * thesis 5.3.1) */
+    ASP_PRIM_RENDER_OVERLAP_BACKFACES = 1 << 3
 };
 
 /**

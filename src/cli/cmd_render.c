@@ -78,6 +78,7 @@ struct render_opts {
     int flat;
     int outline;
     int no_normal_map;
+    int overlap_backfaces;
     /* parsed */
     unsigned width, height;
     double az, el, dist; /* dist 0 = fit */
@@ -238,10 +239,10 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
 {
     // NaN marks "not given": the option parser refuses non-finite values, so no user value collides with it
     int given = o->method || !isnan(o->alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
-                o->no_normal_map;
+                o->no_normal_map || o->overlap_backfaces;
     if (!o->dps_input) {
         if (given)
-            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline and "
+            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline, --overlap-backfaces and "
                                         "--no-normal-map need a .dps input (amgsplat build makes one)");
         double deg = 0;
         if (!o->crease_angle) {
@@ -295,7 +296,8 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
                                    o->crease_angle);
     }
     p->flags = (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
-               (o->no_normal_map ? ASP_PRIM_RENDER_NO_NORMAL_MAP : 0u);
+               (o->no_normal_map ? ASP_PRIM_RENDER_NO_NORMAL_MAP : 0u) |
+               (o->overlap_backfaces ? ASP_PRIM_RENDER_OVERLAP_BACKFACES : 0u);
     return 0;
 }
 
@@ -440,6 +442,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", "cut at creases sharper than DEG (default 60; off = as the seeds): .dps primitives; points with normals: discs, splats"},
         {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
+        {"overlap-backfaces", 0, CLI_FLAG, &o.overlap_backfaces, NULL, ".dps, overlap: also draw back-facing neighbours, as journal Fig. 10's pseudocode"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
         {"transparent", 0, CLI_FLAG, &o.transparent, NULL, "transparent background"},
         {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
@@ -466,6 +469,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     // a preset names the options of every input kind; those that do not fit this input are dropped
     if (!o.dps_input && cli_from_preset(env, &o.method))
         o.method = NULL;
+    if (!o.dps_input && cli_from_preset(env, &o.overlap_backfaces))
+        o.overlap_backfaces = 0;
     if ((o.dps_input || type.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.renderer))
         o.renderer = NULL;
     if (parse_options(env, &o))

@@ -30,6 +30,7 @@ static const asp_preset_setting journal[] = {
     S("build", "tau", "0.05", "journal 2.3 eq. 8"),
     S("build", "method", "affine", "journal 3.2"),
     S("render", "method", "overlap", "journal 4, Fig. 10"),
+    S("render", "overlap-backfaces", NULL, "journal Fig. 10 (pseudocode)"),
     S("render", "crease-angle", "off", "journal 4 (none)"),
     S("view", "method", "overlap", "journal 4, Fig. 10"),
 };
@@ -48,6 +49,7 @@ static const asp_preset_setting thesis[] = {
     S("build", "shape", "linear", "thesis 3.3.2"),
     S("build", "normalise", "ge1", "thesis 3.3.2 eq. 3.3"),
     S("render", "method", "overlap", "thesis 4.4.4"),
+    S("render", "overlap-backfaces", NULL, "thesis 4.4.4 (pseudocode)"),
     S("render", "crease-angle", "off", "thesis 4.4 (none)"),
     S("view", "method", "overlap", "thesis 4.4.4"),
 };

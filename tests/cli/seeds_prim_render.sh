@@ -45,6 +45,33 @@ expect_fail 2 "unknown preset 'qsplat'" "$A" view "$T/o.ply" --preset qsplat
 [[ $(jget "$T/jt.json" "d['method']") == "prefix" ]] || fail "explicit --method lost: $(cat "$T/jt.json")"
 "$A" render "$T/o.dps" -o "$T/pd.png" --preset pajarola "${R[@]}" || fail "--preset pajarola on a .dps"
 
+# overlap with back-facing neighbours (journal Fig. 10's pseudocode): an open sheet folded at x = 0
+# (a face z = 0 and a face z = 2x rising towards the eye) seen from azimuth 40: the fold's second face
+# turns its back, is culled by default and drawn as the pseudocode's neighbour of the first
+python3 - "$T/fold.ply" <<'PY'
+import math, sys
+rows = []
+for j in range(51):
+    y = -0.5 + 0.02 * j
+    rows += ["%g %g 0 0 0 1" % (-1 + 0.02 * i, y) for i in range(51)]
+    rows += ["%g %g %g %g 0 %g" % (0.02 * i, y, 0.04 * i, -2 / math.sqrt(5), 1 / math.sqrt(5)) for i in range(1, 31)]
+open(sys.argv[1], "w").write("ply\nformat ascii 1.0\nelement vertex %d\n" % len(rows) + "".join(
+    "property float %s\n" % n for n in ("x", "y", "z", "nx", "ny", "nz")) + "end_header\n" + "\n".join(rows) + "\n")
+PY
+"$A" decompose "$T/fold.ply" -o "$T/fold.amg" --crease-cut -1 -q
+"$A" build "$T/fold.amg" -o "$T/fold.dps" --primitives 4 --neighbours 0.001 -q >/dev/null
+"$A" render "$T/fold.dps" -o "$T/fa.png" --method overlap --view 40,0 --size 128x128 --transparent -q
+"$A" render "$T/fold.dps" -o "$T/fb.png" --method overlap --view 40,0 --size 128x128 --transparent -q --overlap-backfaces
+"$A" imgdiff "$T/fa.png" "$T/fb.png" --json >"$T/fold.json"
+python3 - "$T/fold.json" <<'PY' || fail "--overlap-backfaces: $(cat "$T/fold.json")"
+import json, sys
+d = json.load(open(sys.argv[1]))
+a, b = d["silhouette"][0]["pixels"], d["silhouette"][1]["pixels"]
+# every culled pixel is drawn too, and the back face adds at least 5% more
+assert b > 1.05 * a and abs(d["iou"] - a / b) < 0.01, (a, b, d["iou"])
+PY
+expect_fail 2 "--overlap-backfaces" "$A" render "$T/o.ply" -o "$T/e.png" --overlap-backfaces
+
 # seed 001 options one by one: each changes the blended image, none the silhouette; bad values are refused
 for opt in "--kernel-rim b" "--kernel-shape psi-g" "--epsilon-uniform 0.3"; do
   "$A" render "$T/o.ply" -o "$T/opt.png" --renderer splat --tolerance 0 $opt "${R[@]}"
