@@ -59,6 +59,9 @@ typedef struct asp_prim_desc {
     double merge_flatness;   /* merge while l_min / sum l of both and the union is below this (0 = 0.01) */
     double merge_angle;      /* and their normals differ by less than this, degrees (0 = 15) */
     uint32_t padding;        /* atlas padding around each texture, texels (0 = 2) */
+    int normalise_color;     /* 1: the radial criterion decides for colour too, as eq. 3.3 reads (colour not
+                                divided where f < 1, so it darkens with alpha at a domain's border); 0:
+                                colour, stored straight, is always divided by f (an interpolation) */
     double enlarge;          /* thesis appendix C "Enlarge Bounding Rectangle": > 0 grows the sides of the
                                 points' bounding rectangle by this percentage (at most 1000) instead of the
                                 default margin of one point footprint on every side (0) */

@@ -135,6 +135,7 @@ static int save_atlases(const char *path, const asp_dps *dps, const asp_dps_summ
 int cmd_build(int argc, char **argv, struct cli_env *env)
 {
     const char *preset = NULL; /* applied by cli_parse */
+    int norm_color = 0;
     const char *output = NULL, *level_text = NULL, *method = "affine", *shape = "linear", *norm = "positive";
     const char *atlas = NULL;
     size_t budget = SIZE_MAX, max_texture = 0, padding = 0; // SIZE_MAX: not given, so a given 0 is refused
@@ -161,6 +162,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         {"merge-flatness", 0, CLI_DOUBLE, &flat, "X", "merge while l_min/sum l < X (default 0.01)"},
         {"merge-angle", 0, CLI_DOUBLE, &angle, "DEG", "and normals within DEG degrees (default 15)"},
         {"padding", 0, CLI_SIZE, &padding, "N", "atlas padding in texels (default 2)"},
+        {"normalise-color", 0, CLI_FLAG, &norm_color, NULL, "radial: the --normalise criterion for colour too (thesis eq. 3.3 as written)"},
         {"enlarge", 0, CLI_DOUBLE, &enlarge, "PCT", "grow the points' rectangle by PCT % (thesis app. C; default: one footprint margin)"},
         {"atlas", 0, CLI_STRING, &atlas, "X.png", "also write each level's atlas as PNG"},
         {0},
@@ -192,7 +194,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
                           .unweighted = unweighted, .project_radii = project, .no_extend_color = no_extend,
                           .normal_map = normals, .neighbour_fraction = fraction, .merge = merge,
                           .merge_flatness = flat, .merge_angle = angle, .padding = (uint32_t)padding,
-                          .enlarge = enlarge};
+                          .enlarge = enlarge, .normalise_color = norm_color};
     if (asp_prim_method_parse(method, &desc.method, &err) || asp_prim_shape_parse(shape, &desc.shape, &err) ||
         asp_prim_normalise_parse(norm, &desc.normalise, &err))
         return cli_usage_error(env, "%s", err.msg);

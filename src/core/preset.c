@@ -48,6 +48,7 @@ static const asp_preset_setting thesis[] = {
     S("build", "method", "radial", "thesis 3.3.2"),
     S("build", "shape", "linear", "thesis 3.3.2"),
     S("build", "normalise", "ge1", "thesis 3.3.2 eq. 3.3"),
+    S("build", "normalise-color", NULL, "thesis 3.3.2 eq. 3.3"),
     S("render", "method", "overlap", "thesis 4.4.4"),
     S("render", "overlap-backfaces", NULL, "thesis 4.4.4 (pseudocode)"),
     S("render", "crease-angle", "off", "thesis 4.4 (none)"),

@@ -161,6 +161,7 @@ static void texture_one(const build_src *src, const asp_amg_csr *dom, const asp_
     }
     asp__tex_input in = {.n = n, .x = x, .y = y, .r = r, .attr = attr, .channels = C, .w = L->w, .h = L->h,
                          .method = d->method, .shape = d->shape, .normalise = d->normalise,
+                         .normalise_color = d->normalise_color,
                          .extend_color = !d->no_extend_color};
     size_t off = 4 * ((size_t)P->tex_y * atlas->width + P->tex_x);
     asp__prim_texture(&in, (uint8_t *)scratch + head, atlas->pixels + off, natlas ? natlas->pixels + off : NULL,
