@@ -68,6 +68,8 @@ struct render_opts {
     const char *kernel_shape, *kernel_rim, *axes; /* seed 001 eq. 11-12, eq. 5-6 (docs/seeds.md) */
     double sigma, epsilon_uniform, tolerance_area; /* NaN: not given */
     unsigned splat_flags, hier_flags;
+    int cull_backfaces;  /* seed 004 3.2.2: normal-cone culling of hierarchy nodes */
+    size_t depth_limit;  /* seed 004 3.2.5: traversal depth limit (0 = none) */
     asp_splat_kernel kernel_kind;
     double alpha_ref;
     double transparency;
@@ -128,7 +130,10 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
     if (!isnan(o->epsilon_uniform))
         r->splat.epsilon = (float)o->epsilon_uniform; // world units; 0 = the mean point splat
     r->square = (asp_square_renderer_desc){.point_size = (float)o->point_size, .tolerance = (float)o->tolerance,
-                                           .radius_scale = (float)o->radius_scale, .hier = {.flags = o->hier_flags}};
+                                           .radius_scale = (float)o->radius_scale, .hier = {.flags = o->hier_flags},
+                                           .flags = o->cull_backfaces ? ASP_SPLAT_CULL_BACKFACES : 0u};
+    if (o->cull_backfaces)
+        r->splat.flags |= ASP_SPLAT_CULL_BACKFACES;
     if (!isnan(o->tolerance_area)) // seed 001 5.1: tau in percent of the window (one view's) area
         r->splat.tolerance = r->square.tolerance = asp_render_tolerance_from_area(o->tolerance_area, o->width, o->height);
     r->prim = o->prim;
@@ -429,6 +434,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"sigma", 0, CLI_DOUBLE, &o.sigma, "X", "splat: psi-g's sigma in kernel radii (default 0.5)"},
         {"kernel-rim", 0, CLI_STRING, &o.kernel_rim, "1|b", "splat: the ellipse rim is the kernel's r = 1 (default) or r = b (seed 001 Fig. 11)"},
         {"tolerance-area", 0, CLI_DOUBLE, &o.tolerance_area, "PCT", "splat, square: tau in percent of the view's area (seed 001 5.1); replaces --tolerance"},
+        {"cull-backfaces", 0, CLI_FLAG, &o.cull_backfaces, NULL, "splat, square: drop subtrees whose normal cone faces away (seed 004 3.2.2)"},
+        {"depth-limit", 0, CLI_SIZE, &o.depth_limit, "N", "splat, square: traverse the hierarchy to depth N at most (seed 004 3.2.5; default 0: none)"},
         {"axes", 0, CLI_STRING, &o.axes, "A", "splat, square: ellipse axis ratio sqrt (default) or lambda (seed 001 eq. 5-6)"},
         {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
         {"opaque", 0, CLI_FLAG, &o.opaque, NULL, "splat: opaque ellipses, no blending"},
@@ -494,6 +501,10 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "renderer '%s' draws points; sample the mesh to points first (amgsplat sample "
                                     "'%s' -o points.ply) or draw it with --renderer mesh",
                                kind->name, argv[0]);
+    if ((o.depth_limit || o.cull_backfaces) && !kind->has_lod)
+        return cli_usage_error(env, "--depth-limit and --cull-backfaces need --renderer splat or square");
+    if (o.depth_limit > 64)
+        return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o.depth_limit);
     if (o.budget && !kind->has_lod)
         return cli_usage_error(env, "--budget needs --renderer splat or square (the %s renderer draws every %s)",
                                kind->name, o.dps_input ? "primitive" : "point");
@@ -521,6 +532,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     }
     if (!rc && o.budget)
         rc = asp_renderer_set_budget(r, o.budget, &err);
+    if (!rc && o.depth_limit)
+        rc = asp_renderer_set_lod(r, kind->has_lod ? ropts.splat.tolerance : 0.0f, (uint32_t)o.depth_limit, &err);
     if (!rc)
         rc = render_views(gl, r, &s, &o, env, tiles, &vs, &err);
     if (!rc && o.views > 1)

@@ -83,6 +83,19 @@ done
 # tau as 5% of the window area: a coarser cut than every point
 "$A" render "$T/o.ply" -o "$T/ta.png" --renderer splat --tolerance-area 5 "${R[@]}" --json >"$T/ta.json"
 jget "$T/ta.json" "d['primitives'] < 3000" | grep True >/dev/null || fail "--tolerance-area 5: $(cat "$T/ta.json")"
+# seed 004: normal-cone culling (3.2.2) and the traversal depth limit (3.2.5)
+"$A" synth sphere --points 6000 -o "$T/sp.ply" -q
+"$A" render "$T/sp.ply" -o "$T/c0.png" --renderer splat --tolerance 0 "${R[@]}" --json >"$T/c0.json"
+"$A" render "$T/sp.ply" -o "$T/c1.png" --renderer splat --tolerance 0 --cull-backfaces "${R[@]}" --json >"$T/c1.json"
+"$A" render "$T/sp.ply" -o "$T/c2.png" --renderer square --tolerance 0 --depth-limit 3 "${R[@]}" --json >"$T/c2.json"
+python3 - "$T" <<'PY' || fail "culling / depth limit: $(cat "$T"/c?.json)"
+import json, sys
+n = [json.load(open("%s/c%d.json" % (sys.argv[1], i)))["primitives"] for i in range(3)]
+assert n[0] == 6000 and n[1] < 0.7 * n[0] and n[2] <= 8 ** 3, n   # about half of a sphere faces away
+PY
+"$A" imgdiff "$T/c0.png" "$T/c1.png" --json | python3 -c "import json,sys; d=json.load(sys.stdin); assert d['ssim'] > 0.98, d" \
+  || fail "--cull-backfaces changed what is seen"
+expect_fail 2 "--depth-limit and --cull-backfaces need" "$A" render "$T/sp.ply" -o "$T/e.png" --cull-backfaces
 expect_fail 2 "--kernel-shape expects psi-e or psi-g" "$A" render "$T/o.ply" -o "$T/e.png" --kernel-shape gauss
 expect_fail 2 "--kernel-rim expects 1 or b" "$A" render "$T/o.ply" -o "$T/e.png" --kernel-rim 2
 expect_fail 2 "--axes expects sqrt or lambda" "$A" render "$T/o.ply" -o "$T/e.png" --axes pca
