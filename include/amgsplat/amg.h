@@ -264,6 +264,16 @@ int asp_amg_domains(const asp_amg_csr *psi, double tau, const asp_context *ctx, 
  */
 void asp_amg_strict_domains(const asp_amg_csr *psi, asp_index *label);
 
+/**
+ * The strict domains (thesis eq. 2.5) as domain rows, in the layout of
+ * asp_amg_domains: one row per basis function listing, in increasing order,
+ * the points whose largest Psi is that function's (ties: the smaller index),
+ * each with value 1 (hard membership: strict domains do not overlap, thesis
+ * 2.5, so they are drawn without blending). Every point is in exactly one
+ * row. The caller frees *out. Returns 0 or ASP_ENOMEM.
+ */
+int asp_amg_strict_domain_rows(const asp_amg_csr *psi, const asp_context *ctx, asp_amg_csr **out, asp_error *err);
+
 /** Per-level figures for decompose --stats. */
 typedef struct asp_amg_level_stats {
     size_t level;

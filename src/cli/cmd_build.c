@@ -136,6 +136,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
 {
     const char *preset = NULL; /* applied by cli_parse */
     int norm_color = 0;
+    const char *domain_set = "thresholded";
     const char *output = NULL, *level_text = NULL, *method = "affine", *shape = "linear", *norm = "positive";
     const char *atlas = NULL;
     size_t budget = SIZE_MAX, max_texture = 0, padding = 0; // SIZE_MAX: not given, so a given 0 is refused
@@ -163,6 +164,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         {"merge-angle", 0, CLI_DOUBLE, &angle, "DEG", "and normals within DEG degrees (default 15)"},
         {"padding", 0, CLI_SIZE, &padding, "N", "atlas padding in texels (default 2)"},
         {"normalise-color", 0, CLI_FLAG, &norm_color, NULL, "radial: the --normalise criterion for colour too (thesis eq. 3.3 as written)"},
+        {"domains", 0, CLI_STRING, &domain_set, "SET", "thresholded (default, Psi > tau) or strict (thesis eq. 2.5; draw with --method no-blend)"},
         {"enlarge", 0, CLI_DOUBLE, &enlarge, "PCT", "grow the points' rectangle by PCT % (thesis app. C; default: one footprint margin)"},
         {"atlas", 0, CLI_STRING, &atlas, "X.png", "also write each level's atlas as PNG"},
         {0},
@@ -187,6 +189,8 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     }
     if (max_texture > 8192 || padding > 64)
         return cli_usage_error(env, "--max-texture must be at most 8192 and --padding at most 64");
+    if (strcmp(domain_set, "thresholded") != 0 && strcmp(domain_set, "strict") != 0)
+        return cli_usage_error(env, "--domains expects thresholded or strict, got '%s'", domain_set);
     if (!(enlarge >= 0 && enlarge <= 1000))
         return cli_usage_error(env, "--enlarge expects a percentage in 0..1000, got %g", enlarge);
     asp_error err = {0};
@@ -194,7 +198,8 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
                           .unweighted = unweighted, .project_radii = project, .no_extend_color = no_extend,
                           .normal_map = normals, .neighbour_fraction = fraction, .merge = merge,
                           .merge_flatness = flat, .merge_angle = angle, .padding = (uint32_t)padding,
-                          .enlarge = enlarge, .normalise_color = norm_color};
+                          .enlarge = enlarge, .normalise_color = norm_color,
+                          .strict = strcmp(domain_set, "strict") == 0};
     if (asp_prim_method_parse(method, &desc.method, &err) || asp_prim_shape_parse(shape, &desc.shape, &err) ||
         asp_prim_normalise_parse(norm, &desc.normalise, &err))
         return cli_usage_error(env, "%s", err.msg);

@@ -341,7 +341,7 @@ static int build_level(const asp_amg *amg, const build_src *src, size_t level, c
     uint32_t *bfirst = NULL, *bcount = NULL;
     int rc = asp_amg_basis(amg, level, ctx, &psi, err);
     if (!rc)
-        rc = asp_amg_domains(psi, d->tau, ctx, &dom, err);
+        rc = d->strict ? asp_amg_strict_domain_rows(psi, ctx, &dom, err) : asp_amg_domains(psi, d->tau, ctx, &dom, err);
     asp_amg_csr_destroy(psi);
     if (rc)
         return rc;

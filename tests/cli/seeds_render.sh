@@ -45,6 +45,16 @@ expect_fail 2 "unknown preset 'qsplat'" "$A" view "$T/o.ply" --preset qsplat
 [[ $(jget "$T/jt.json" "d['method']") == "prefix" ]] || fail "explicit --method lost: $(cat "$T/jt.json")"
 "$A" render "$T/o.dps" -o "$T/pd.png" --preset pajarola "${R[@]}" || fail "--preset pajarola on a .dps"
 
+# strict domains as primitives (thesis eq. 2.5), drawn without blending: one silhouette with the points
+"$A" build "$T/o.amg" -o "$T/s.dps" --level L-2 --domains strict -q >/dev/null
+"$A" info "$T/s.dps" --json | python3 -c "import json,sys; d=json.load(sys.stdin); assert d['levels'][0]['neighbour_pairs'] == 0, d" \
+  || fail "strict domains have neighbours"
+"$A" render "$T/s.dps" -o "$T/sd.png" --method no-blend "${R[@]}"
+"$A" render "$T/o.ply" -o "$T/sp.png" --renderer splat --tolerance 0 "${R[@]}"
+"$A" imgdiff "$T/sd.png" "$T/sp.png" --json | python3 -c "import json,sys; d=json.load(sys.stdin); assert d['iou'] > 0.9, d" \
+  || fail "strict primitives do not cover the points' silhouette"
+expect_fail 2 "--domains expects thresholded or strict" "$A" build "$T/o.amg" -o "$T/x.dps" --domains fuzzy
+
 # overlap with back-facing neighbours (journal Fig. 10's pseudocode): an open sheet folded at x = 0
 # (a face z = 0 and a face z = 2x rising towards the eye) seen from azimuth 40: the fold's second face
 # turns its back, is culled by default and drawn as the pseudocode's neighbour of the first
