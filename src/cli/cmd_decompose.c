@@ -4,6 +4,7 @@
  */
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli/cli.h"
@@ -127,6 +128,36 @@ static int export_colors(struct cli_env *env, const asp_amg *amg, int mode, cons
     return rc;
 }
 
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* --critical-k: the distribution of the per-point critical size, a guide for --k (thesis 2.3) */
+static int print_critical(struct cli_env *env, const asp_cloud *cloud, asp_error *err)
+{
+    const asp_critical_desc cd = {0};
+    uint32_t *k = asp_calloc(&env->ctx, cloud->count, sizeof *k);
+    if (!k)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu critical sizes", cloud->count);
+    int rc = asp_critical_neighbourhood(cloud->positions, cloud->count, &cd, &env->ctx, k, err);
+    cli_progress_end(env);
+    if (!rc) {
+        qsort(k, cloud->count, sizeof *k, cmp_u32);
+        size_t n = cloud->count, jumped = 0;
+        for (size_t i = 0; i < n; i++)
+            jumped += k[i] < 96;
+        // stderr with --json: stdout holds the one JSON document
+        fprintf(env->json ? stderr : stdout,
+                "critical neighbourhood size (thesis 2.3, k 8..96 step 4): 10%% %u, median %u, 90%% %u; "
+                "%.1f%% of the points see a jump in the surface variation\n",
+                k[n / 10], k[n / 2], k[n - 1 - n / 10], 100.0 * (double)jumped / (double)n);
+    }
+    asp_free(&env->ctx, k);
+    return rc;
+}
+
 #define UNSET SIZE_MAX
 
 /* The library's ranges (src/amg/neighbourhood.c), checked here so the message names the option. */
@@ -170,7 +201,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     /* UNSET, not 0: 0 means "default" to the library, so a given 0 would pass silently */
     size_t k = UNSET, k_max = UNSET, fan_k = UNSET, max_levels = UNSET, max_coarse = UNSET;
     double epsilon = 0, alpha = 0, beta = 0, strong = 0, trunc = 0, weak = 0, drop = 0, tau = 0.05, crease = 0;
-    int stats = 0;
+    int stats = 0, critical = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output decomposition (.amg)"},
         {"preset", 0, CLI_STRING, &preset, "SEED", "the seed's options: thesis, journal (docs/seeds.md)"},
@@ -194,6 +225,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         {"weak-cut", 0, CLI_DOUBLE, &weak, "X", "cut coarse couplings below X times the median (default 0: off)"},
         {"drop", 0, CLI_DOUBLE, &drop, "X", "drop basis values below X, renormalised (default 1e-4)"},
         {"stats", 0, CLI_FLAG, &stats, NULL, "print per-level statistics"},
+        {"critical-k", 0, CLI_FLAG, &critical, NULL, "print the points' critical neighbourhood sizes (thesis 2.3), to choose --k"},
         {"tau", 0, CLI_DOUBLE, &tau, "X", "domain threshold for --stats (default 0.05; thesis K = 0.01)"},
         {"export-colors", 0, CLI_STRING, &export_mode, "M", "write a coloured point file: classifier, domains, strict"},
         {"level", 'l', CLI_STRING, &level_name, "L", "level for --export-colors domains|strict (default L-3)"},
@@ -239,7 +271,9 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--export-colors needs --colors-out FILE.ply");
     if (!(tau >= 0 && tau < 1))
         return cli_usage_error(env, "--tau must be in [0, 1), got %g", tau);
-    if (!from_amg && !output && !stats && !export_mode)
+    if (critical && from_amg)
+        return cli_usage_error(env, "--critical-k needs a point input");
+    if (!from_amg && !output && !stats && !export_mode && !critical)
         return cli_usage_error(env, "missing -o OUT.amg (or --stats / --export-colors)");
     if (from_amg && output)
         return cli_usage_error(env, "'%s' is already a decomposition; -o applies to point input", input);
@@ -254,6 +288,14 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         asp_cloud *cloud = NULL;
         if (asp_cloud_load(input, &env->ctx, &cloud, &err))
             return cli_fail(env, &err);
+        if (critical && print_critical(env, cloud, &err)) {
+            asp_cloud_destroy(cloud);
+            return cli_fail(env, &err);
+        }
+        if (!output && !stats && !export_mode) {
+            asp_cloud_destroy(cloud);
+            return 0;
+        }
         rc = asp_amg_decompose(cloud, &desc, &env->ctx, &amg, &err);
         asp_cloud_destroy(cloud);
         if (rc) {

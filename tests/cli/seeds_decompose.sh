@@ -25,6 +25,12 @@ jget "$T/j.json" "d['mean_neighbourhood'] >= 50 and d['positive_offdiag_clamped'
 expect_fail 2 "unknown preset 'seed'" "$A" decompose "$T/o.ply" --stats --preset seed
 expect_fail 2 "--stiffness must be clamped or unclamped" "$A" decompose "$T/o.ply" --stats --stiffness maybe
 
+# critical neighbourhood size (thesis 2.3): a flat octahedron face far from its edges sees no jump
+"$A" decompose "$T/o.ply" --critical-k >"$T/crit.txt"
+grep -E "critical neighbourhood size .*median [0-9]+, 90% 96; [0-9.]+% of the points" "$T/crit.txt" >/dev/null \
+  || fail "--critical-k: $(cat "$T/crit.txt")"
+expect_fail 2 "--critical-k needs a point input" "$A" decompose "$T/j.amg" --critical-k
+
 # the stiffness forms: equal counts of positive couplings, reported as clamped or kept
 "$A" decompose "$T/o.ply" -o "$T/c.amg" >"$T/c.txt"
 "$A" decompose "$T/o.ply" -o "$T/u.amg" --stiffness unclamped >"$T/u.txt"
