@@ -15,6 +15,8 @@ static const char usage[] =
     "usage: amgsplat build IN.amg|IN.ply -o OUT.dps [--level L-5 | --level L-6..L | --primitives 400]\n"
     "                      [--texel-size X] [--method affine|radial] [--shape linear|constant|gaussian]\n"
     "                      [--width W] [--normalise positive|ge1] [--merge] [--normals] [--atlas X.png]\n"
+    "                      [--preset thesis|journal] [--domains thresholded|strict] [--enlarge PCT]\n"
+    "                      [--normalise-color]\n"
     "\n"
     "Turns every domain of the chosen AMG level(s) into one planar rectangle (weighted PCA of\n"
     "its points) with a texture: colour = the points' colours, alpha = the domain's basis\n"

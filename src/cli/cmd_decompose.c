@@ -18,7 +18,7 @@ static const char usage[] =
     "                          [--coarsen rs|falgout|cljp|pmis|hmis] [--interp classical|direct|standard|ext+i]\n"
     "                          [--strong X] [--trunc X] [--max-levels N] [--max-coarse N] [--crease-cut X]\n"
     "                          [--weak-cut X]\n"
-    "                          [--drop X] [--stats] [--tau X] [--json]\n"
+    "                          [--drop X] [--stats] [--tau X] [--critical-k] [--json]\n"
     "                          [--export-colors classifier|domains|strict --level L-3 --colors-out X.ply]\n"
     "       amgsplat decompose IN.amg --stats | --export-colors ...\n"
     "\n"

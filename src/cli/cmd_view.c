@@ -15,6 +15,7 @@ static const char usage[] =
     "usage: amgsplat view FILE [--size WxH] [--view AZ,EL[,DIST]] [--renderer NAME] [--tau PX]\n"
     "                     [--color MODE] [--level L] [--method NAME] [--alpha-ref X] [--unlit]\n"
     "                     [--background R,G,B] [--texture IMG] [--verbose]\n"
+    "                     [--preset thesis|journal|pajarola|schwarz]\n"
     "       amgsplat view FILE --frames N [--screenshot OUT.png] [--keys KEYS] [options above]\n"
     "\n"
     "Opens a window on a point file (.ply, .xyz, .pts, .txt), an AMG decomposition (.amg,\n"
