@@ -41,6 +41,8 @@ struct view_opts {
     const char *keys;
     const char *method;
     const char *preset; /* --preset: applied by cli_parse (docs/seeds.md) */
+    int cull_backfaces; /* seed 004 3.2.2 */
+    size_t depth_limit; /* seed 004 3.2.5 */
     double alpha_ref;
     size_t frames;
     double tau;
@@ -112,6 +114,10 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
             return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
         d->prim_alpha_ref = o->alpha_ref > 0 ? (float)o->alpha_ref : -1.0f; // the library's "exactly 0"
     }
+    if (o->depth_limit > 64)
+        return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o->depth_limit);
+    d->lod_flags = o->cull_backfaces ? ASP_SPLAT_CULL_BACKFACES : 0u;
+    d->depth_limit = (uint32_t)o->depth_limit;
     d->renderer = o->renderer;
     d->amg_level = o->level;
     d->texture = o->texture;
@@ -164,6 +170,8 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "first view as in 'amgsplat render' (default 30,20)"},
         {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y (default), z (scans, CAD), x, -y, -z or -x"},
         {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "first renderer (default disc, mesh for meshes; 'h' in the window lists them)"},
+        {"cull-backfaces", 0, CLI_FLAG, &o.cull_backfaces, NULL, "splat, square: drop subtrees whose normal cone faces away (seed 004 3.2.2)"},
+        {"depth-limit", 0, CLI_SIZE, &o.depth_limit, "N", "splat, square: traverse the hierarchy to depth N at most (seed 004 3.2.5; 0 = none)"},
         {"tau", 0, CLI_DOUBLE, &o.tau, "PX", "screen tolerance of the hierarchy renderers in pixels (default 0)"},
         {"color", 0, CLI_STRING, &o.color, "MODE", ".amg: classifier (default), domains, strict or input"},
         {"level", 0, CLI_STRING, &o.level, "L", ".amg: level for domain colours: L, L-2 or an index (default L); .dps: level drawn (default the finest in the file)"},
