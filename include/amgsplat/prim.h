@@ -62,6 +62,9 @@ typedef struct asp_prim_desc {
     int normalise_color;     /* 1: the radial criterion decides for colour too, as eq. 3.3 reads (colour not
                                 divided where f < 1, so it darkens with alpha at a domain's border); 0:
                                 colour, stored straight, is always divided by f (an interpolation) */
+    int no_model_colors;     /* 1: every point light grey 200 (thesis appendix C "Use Model Colors" unchecked) */
+    double brightness;       /* thesis appendix C "Adjust Brightness": added to each point colour's HSV value,
+                                in [-1, 1] (1 = full scale); hue and saturation kept; 0 = unchanged */
     int strict;              /* 1: primitives of the strict domains (thesis eq. 2.5, asp_amg_strict_domain_rows),
                                 alpha 1 inside, for the no-blend method; 0: thresholded domains Psi > tau */
     double enlarge;          /* thesis appendix C "Enlarge Bounding Rectangle": > 0 grows the sides of the

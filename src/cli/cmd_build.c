@@ -16,7 +16,7 @@ static const char usage[] =
     "                      [--texel-size X] [--method affine|radial] [--shape linear|constant|gaussian]\n"
     "                      [--width W] [--normalise positive|ge1] [--merge] [--normals] [--atlas X.png]\n"
     "                      [--preset thesis|journal] [--domains thresholded|strict] [--enlarge PCT]\n"
-    "                      [--normalise-color]\n"
+    "                      [--normalise-color] [--no-model-colors] [--brightness X]\n"
     "\n"
     "Turns every domain of the chosen AMG level(s) into one planar rectangle (weighted PCA of\n"
     "its points) with a texture: colour = the points' colours, alpha = the domain's basis\n"
@@ -137,7 +137,8 @@ static int save_atlases(const char *path, const asp_dps *dps, const asp_dps_summ
 int cmd_build(int argc, char **argv, struct cli_env *env)
 {
     const char *preset = NULL; /* applied by cli_parse */
-    int norm_color = 0;
+    int norm_color = 0, no_colors = 0;
+    double brightness = 0;
     const char *domain_set = "thresholded";
     const char *output = NULL, *level_text = NULL, *method = "affine", *shape = "linear", *norm = "positive";
     const char *atlas = NULL;
@@ -166,6 +167,8 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         {"merge-angle", 0, CLI_DOUBLE, &angle, "DEG", "and normals within DEG degrees (default 15)"},
         {"padding", 0, CLI_SIZE, &padding, "N", "atlas padding in texels (default 2)"},
         {"normalise-color", 0, CLI_FLAG, &norm_color, NULL, "radial: the --normalise criterion for colour too (thesis eq. 3.3 as written)"},
+        {"no-model-colors", 0, CLI_FLAG, &no_colors, NULL, "grey points instead of the model's colours (thesis app. C)"},
+        {"brightness", 0, CLI_DOUBLE, &brightness, "X", "add X (-1..1) to each point colour's HSV value (thesis app. C)"},
         {"domains", 0, CLI_STRING, &domain_set, "SET", "thresholded (default, Psi > tau) or strict (thesis eq. 2.5; draw with --method no-blend)"},
         {"enlarge", 0, CLI_DOUBLE, &enlarge, "PCT", "grow the points' rectangle by PCT % (thesis app. C; default: one footprint margin)"},
         {"atlas", 0, CLI_STRING, &atlas, "X.png", "also write each level's atlas as PNG"},
@@ -191,6 +194,8 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     }
     if (max_texture > 8192 || padding > 64)
         return cli_usage_error(env, "--max-texture must be at most 8192 and --padding at most 64");
+    if (!(brightness >= -1 && brightness <= 1))
+        return cli_usage_error(env, "--brightness expects -1..1, got %g", brightness);
     if (strcmp(domain_set, "thresholded") != 0 && strcmp(domain_set, "strict") != 0)
         return cli_usage_error(env, "--domains expects thresholded or strict, got '%s'", domain_set);
     if (!(enlarge >= 0 && enlarge <= 1000))
@@ -201,7 +206,8 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
                           .normal_map = normals, .neighbour_fraction = fraction, .merge = merge,
                           .merge_flatness = flat, .merge_angle = angle, .padding = (uint32_t)padding,
                           .enlarge = enlarge, .normalise_color = norm_color,
-                          .strict = strcmp(domain_set, "strict") == 0};
+                          .strict = strcmp(domain_set, "strict") == 0, .no_model_colors = no_colors,
+                          .brightness = brightness};
     if (asp_prim_method_parse(method, &desc.method, &err) || asp_prim_shape_parse(shape, &desc.shape, &err) ||
         asp_prim_normalise_parse(norm, &desc.normalise, &err))
         return cli_usage_error(env, "%s", err.msg);

@@ -74,6 +74,8 @@ static int check_desc(const asp_prim_desc *d, asp_error *err)
         return asp_error_set(err, ASP_EINVAL, "merge flatness must be in (0, 1/3], got %g", d->merge_flatness);
     if (!(d->merge_angle > 0 && d->merge_angle <= 180))
         return asp_error_set(err, ASP_EINVAL, "merge angle must be in (0, 180] degrees, got %g", d->merge_angle);
+    if (!(d->brightness >= -1 && d->brightness <= 1))
+        return asp_error_set(err, ASP_EINVAL, "brightness must be in [-1, 1], got %g", d->brightness);
     if (!(d->enlarge >= 0 && d->enlarge <= 1000))
         return asp_error_set(err, ASP_EINVAL, "rectangle enlargement must be in [0, 1000] percent, got %g",
                              d->enlarge);
@@ -94,6 +96,23 @@ static double point_radius(const build_src *src, const asp__plane *pl, const asp
         r *= fmax(fabs(n[0] * pl->n[0] + n[1] * pl->n[1] + n[2] * pl->n[2]), 0.05);
     }
     return r;
+}
+
+/*
+ * The colour a point gives the texture: the model's or grey (thesis appendix C "Use Model Colors"),
+ * its HSV value shifted by desc->brightness ("Adjust Brightness"): scaling RGB by V' / V keeps hue
+ * and saturation.
+ */
+static void point_color(const build_src *src, const asp_prim_desc *d, size_t p, float out[3])
+{
+    for (int j = 0; j < 3; j++)
+        out[j] = src->colors && !d->no_model_colors ? src->colors[4 * p + (size_t)j] : 200.0f;
+    if (d->brightness == 0)
+        return;
+    float v = fmaxf(out[0], fmaxf(out[1], out[2]));
+    float nv = fminf(255.0f, fmaxf(0.0f, v + (float)d->brightness * 255.0f));
+    for (int j = 0; j < 3; j++)
+        out[j] = v > 0 ? out[j] * (nv / v) : nv;
 }
 
 /* Pass 1 for one domain: plane, rectangle with margin, texel grid. */
@@ -152,8 +171,7 @@ static void texture_one(const build_src *src, const asp_amg_csr *dom, const asp_
         y[k] = (float)((t - L->t0) / L->texel);
         r[k] = (float)(L->foot * point_radius(src, &L->pl, d, p) / L->texel);
         float *o = &attr[(size_t)C * k];
-        for (int j = 0; j < 3; j++)
-            o[j] = src->colors ? src->colors[4 * p + (size_t)j] : 200.0f;
+        point_color(src, d, p, o);
         o[3] = (float)dom->val[a + k];
         if (C == 7)
             for (int j = 0; j < 3; j++)
