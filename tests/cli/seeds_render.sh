@@ -82,6 +82,13 @@ assert b > 1.05 * a and abs(d["iou"] - a / b) < 0.01, (a, b, d["iou"])
 PY
 expect_fail 2 "--overlap-backfaces" "$A" render "$T/o.ply" -o "$T/e.png" --overlap-backfaces
 
+# bench-paper: thesis Table 5.1 with its columns tc, AMG and cb
+"$A" bench-paper octahedron --sizes 64 --frames 1 --no-texture-methods >"$T/bp.txt"
+grep -F "Thesis Table 5.1" "$T/bp.txt" >/dev/null || fail "no Table 5.1: $(cat "$T/bp.txt")"
+grep -E "^model +#points +level +#poly +# tex +tc +AMG +cb +dpc$" "$T/bp.txt" >/dev/null || fail "Table 5.1 header"
+grep -E "^octahedron +16000 +L-[0-9]+ +[0-9]+ +[0-9]+ +la +[0-9.]+ +[0-9.]+ +[0-9.]+$" "$T/bp.txt" >/dev/null \
+  || fail "Table 5.1 row: $(cat "$T/bp.txt")"
+
 # seed 001 options one by one: each changes the blended image, none the silhouette; bad values are refused
 for opt in "--kernel-rim b" "--kernel-shape psi-g" "--epsilon-uniform 0.3"; do
   "$A" render "$T/o.ply" -o "$T/opt.png" --renderer splat --tolerance 0 $opt "${R[@]}"
