@@ -18,11 +18,12 @@ static const char usage[] =
     "                            [--markdown]\n"
     "\n"
     "Measures and prints, in the layouts of the seeds: journal Table 1 (points, level, polygons,\n"
-    "texels, decomposition and construction time), journal Table 2 / thesis Table 5.2 (per level:\n"
+    "texels, decomposition and construction time), thesis Table 5.1 (the same level with texture\n"
+    "method tc, AMG and basis time cb), journal Table 2 / thesis Table 5.2 (per level:\n"
     "polygons, texels, error, normalised error, basis and construction times, frame rate at each\n"
     "screen size), thesis Table 5.3 (frame rate of the point set against domain primitives, speed-up)\n"
     "and thesis Table 5.4 (construction time per texture method at texel sizes 2, 1 and 0.5). The\n"
-    "Table 1 / 5.3 / 5.4 level is the finest with at most --budget primitives. MODEL as for\n"
+    "Table 1 / 5.1 / 5.3 / 5.4 level is the finest with at most --budget primitives. MODEL as for\n"
     "'amgsplat eval'. --markdown prints the tables as Markdown (docs/results.md uses it).";
 
 enum { MAX_SIZES = 8 };

@@ -28,7 +28,7 @@ static const struct cli_command commands[] = {
     {"build", cmd_build, "domain primitives (textured polygons) of AMG levels into a .dps file"},
     {"view", cmd_view, "open a window on points or an .amg decomposition (interactive viewer)"},
     {"eval", cmd_eval, "measure every representation against the reference: PSNR, SSIM, IoU, frame time"},
-    {"bench-paper", cmd_bench_paper, "print the seeds' tables (journal Tables 1-2, thesis Tables 5.2-5.4)"},
+    {"bench-paper", cmd_bench_paper, "print the seeds' tables (journal Tables 1-2, thesis Tables 5.1-5.4)"},
 };
 enum { N_COMMANDS = sizeof commands / sizeof commands[0] };
 
