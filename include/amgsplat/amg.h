@@ -187,6 +187,19 @@ typedef struct asp_amg_info {
 int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out,
                       asp_error *err);
 
+/**
+ * Decomposes a triangle mesh through its own connectivity (journal eq. 4):
+ * as asp_amg_decompose on the mesh's vertices (the classifier still comes
+ * from each vertex's neighbourhood, journal 2.1), but the stiffness matrix is
+ * assembled on the mesh triangles incident to each vertex instead of the
+ * local Delaunay fans of journal 2.2 (desc->fan_k is unused). triangles holds
+ * 3 * triangle_count vertex indices, counter-clockwise; degenerate triangles
+ * are skipped. Errors as asp_amg_decompose, and ASP_EINVAL (no triangles, an
+ * index not below vertices->count).
+ */
+int asp_amg_decompose_mesh(const asp_cloud *vertices, const uint32_t *triangles, size_t triangle_count,
+                           const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out, asp_error *err);
+
 /** Frees a decomposition; NULL is accepted. */
 void asp_amg_destroy(asp_amg *amg);
 

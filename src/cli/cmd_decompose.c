@@ -19,6 +19,7 @@ static const char usage[] =
     "                          [--strong X] [--trunc X] [--max-levels N] [--max-coarse N] [--crease-cut X]\n"
     "                          [--weak-cut X]\n"
     "                          [--drop X] [--stats] [--tau X] [--critical-k] [--json]\n"
+    "                          [--mesh-stiffness (MESH input)]\n"
     "                          [--export-colors classifier|domains|strict --level L-3 --colors-out X.ply]\n"
     "       amgsplat decompose IN.amg --stats | --export-colors ...\n"
     "\n"
@@ -158,6 +159,30 @@ static int print_critical(struct cli_env *env, const asp_cloud *cloud, asp_error
     return rc;
 }
 
+/* --mesh-stiffness: the mesh and its vertices as the point set, index for index (journal eq. 4) */
+static int load_mesh_vertices(struct cli_env *env, const char *path, asp_mesh **mesh, asp_cloud **cloud,
+                              asp_error *err)
+{
+    int rc = asp_mesh_load(path, NULL, &env->ctx, mesh, err);
+    if (rc)
+        return rc;
+    const asp_mesh *m = *mesh;
+    rc = asp_cloud_create(m->vertex_count, ASP_ATTR_NORMALS | (m->colors ? ASP_ATTR_COLORS : 0u), &env->ctx, cloud,
+                          err);
+    if (rc) {
+        asp_mesh_destroy(*mesh);
+        *mesh = NULL;
+        return rc;
+    }
+    asp_cloud *c = *cloud;
+    memcpy(c->origin, m->origin, sizeof c->origin);
+    memcpy(c->positions, m->positions, 3 * m->vertex_count * sizeof *c->positions);
+    memcpy(c->normals, m->normals, 3 * m->vertex_count * sizeof *c->normals);
+    if (m->colors)
+        memcpy(c->colors, m->colors, 4 * m->vertex_count * sizeof *c->colors);
+    return 0;
+}
+
 #define UNSET SIZE_MAX
 
 /* The library's ranges (src/amg/neighbourhood.c), checked here so the message names the option. */
@@ -201,7 +226,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     /* UNSET, not 0: 0 means "default" to the library, so a given 0 would pass silently */
     size_t k = UNSET, k_max = UNSET, fan_k = UNSET, max_levels = UNSET, max_coarse = UNSET;
     double epsilon = 0, alpha = 0, beta = 0, strong = 0, trunc = 0, weak = 0, drop = 0, tau = 0.05, crease = 0;
-    int stats = 0, critical = 0;
+    int stats = 0, critical = 0, mesh_stiffness = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output decomposition (.amg)"},
         {"preset", 0, CLI_STRING, &preset, "SEED", "the seed's options: thesis, journal (docs/seeds.md)"},
@@ -225,6 +250,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         {"weak-cut", 0, CLI_DOUBLE, &weak, "X", "cut coarse couplings below X times the median (default 0: off)"},
         {"drop", 0, CLI_DOUBLE, &drop, "X", "drop basis values below X, renormalised (default 1e-4)"},
         {"stats", 0, CLI_FLAG, &stats, NULL, "print per-level statistics"},
+        {"mesh-stiffness", 0, CLI_FLAG, &mesh_stiffness, NULL, "MESH input: the stiffness matrix on the mesh's own triangles (journal eq. 4)"},
         {"critical-k", 0, CLI_FLAG, &critical, NULL, "print the points' critical neighbourhood sizes (thesis 2.3), to choose --k"},
         {"tau", 0, CLI_DOUBLE, &tau, "X", "domain threshold for --stats (default 0.05; thesis K = 0.01)"},
         {"export-colors", 0, CLI_STRING, &export_mode, "M", "write a coloured point file: classifier, domains, strict"},
@@ -239,7 +265,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat decompose -h'", npos);
     const char *input = argv[0];
     /* the recogniser (magic, then extension in any case: O.AMG); a failure here resurfaces in the loader */
-    asp_file_type type;
+    asp_file_type type = {ASP_FILE_UNKNOWN, "", 0};
     int from_amg = asp_file_recognise(input, &type, NULL) == 0 && type.kind == ASP_FILE_AMG;
     int color_mode = 0;
     if (check_counts(env, k, k_max, fan_k, max_levels, max_coarse))
@@ -271,6 +297,8 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--export-colors needs --colors-out FILE.ply");
     if (!(tau >= 0 && tau < 1))
         return cli_usage_error(env, "--tau must be in [0, 1), got %g", tau);
+    if (mesh_stiffness && type.kind != ASP_FILE_MESH)
+        return cli_usage_error(env, "--mesh-stiffness needs a mesh input (OBJ, PLY with faces, OFF, STL, glTF, 3DS)");
     if (critical && from_amg)
         return cli_usage_error(env, "--critical-k needs a point input");
     if (!from_amg && !output && !stats && !export_mode && !critical)
@@ -286,7 +314,9 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
             return cli_fail(env, &err);
     } else {
         asp_cloud *cloud = NULL;
-        if (asp_cloud_load(input, &env->ctx, &cloud, &err))
+        asp_mesh *mesh = NULL;
+        if (mesh_stiffness ? load_mesh_vertices(env, input, &mesh, &cloud, &err)
+                           : asp_cloud_load(input, &env->ctx, &cloud, &err))
             return cli_fail(env, &err);
         if (critical && print_critical(env, cloud, &err)) {
             asp_cloud_destroy(cloud);
@@ -294,10 +324,13 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         }
         if (!output && !stats && !export_mode) {
             asp_cloud_destroy(cloud);
+            asp_mesh_destroy(mesh);
             return 0;
         }
-        rc = asp_amg_decompose(cloud, &desc, &env->ctx, &amg, &err);
+        rc = mesh ? asp_amg_decompose_mesh(cloud, mesh->triangles, mesh->triangle_count, &desc, &env->ctx, &amg, &err)
+                  : asp_amg_decompose(cloud, &desc, &env->ctx, &amg, &err);
         asp_cloud_destroy(cloud);
+        asp_mesh_destroy(mesh);
         if (rc) {
             asp_amg_shutdown();
             return cli_fail(env, &err);

@@ -31,6 +31,26 @@ grep -E "critical neighbourhood size .*median [0-9]+, 90% 96; [0-9.]+% of the po
   || fail "--critical-k: $(cat "$T/crit.txt")"
 expect_fail 2 "--critical-k needs a point input" "$A" decompose "$T/j.amg" --critical-k
 
+# the mesh stiffness matrix (journal eq. 4): a 30 x 30 grid mesh, each cell split in two triangles;
+# its vertices are the points, index for index, and an inner vertex's fan is its 6 mesh triangles
+python3 - "$T/grid.obj" <<'PY'
+import sys
+N = 30
+with open(sys.argv[1], "w") as f:
+    for j in range(N):
+        for i in range(N):
+            f.write("v %g %g %g\n" % (i / (N - 1), j / (N - 1), 0.3 * abs(i / (N - 1) - 0.5)))
+    for j in range(N - 1):
+        for i in range(N - 1):
+            a = j * N + i + 1
+            f.write("f %d %d %d\nf %d %d %d\n" % (a, a + 1, a + N + 1, a, a + N + 1, a + N))
+PY
+"$A" decompose "$T/grid.obj" --mesh-stiffness -o "$T/grid.amg" --json -q >"$T/grid.json"
+jget "$T/grid.json" "d['points'] == 900 and 5.5 < d['mean_fan'] <= 6 and d['levels'] >= 3" | grep True >/dev/null \
+  || fail "--mesh-stiffness: $(cat "$T/grid.json")"
+"$A" build "$T/grid.amg" -o "$T/grid.dps" --primitives 4 -q >/dev/null || fail "build of a mesh decomposition"
+expect_fail 2 "--mesh-stiffness needs a mesh input" "$A" decompose "$T/o.ply" --stats --mesh-stiffness
+
 # the stiffness forms: equal counts of positive couplings, reported as clamped or kept
 "$A" decompose "$T/o.ply" -o "$T/c.amg" >"$T/c.txt"
 "$A" decompose "$T/o.ply" -o "$T/u.amg" --stiffness unclamped >"$T/u.txt"
