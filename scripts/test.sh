@@ -104,6 +104,10 @@ fuzz_smoke() {
   "$A" build "$seeds/oct.amg" -o "$seeds/oct.dps" --primitives 8 -q >/dev/null
   build/seed_hier "$seeds/oct.ply" "$seeds/oct.hier"
   "$A" render "$seeds/oct.ply" -o "$seeds/oct.png" --size 32x32 -q
+  "$A" convert "$seeds/oct.ply" "$seeds/oct.las" -q
+  "$A" convert --las-format 3 "$seeds/oct.ply" "$seeds/oct3.las" -q
+  python3 tests/cli/las_handmade.py "$seeds/hand14.las" 4 8 20 --extra >/dev/null
+  python3 tests/cli/las_handmade.py "$seeds/hand12.las" 2 1 20 >/dev/null
   # seeds: regular files only, from files and folders (tests/data/bad has subfolders per kind)
   seed() {
     local dst=$1
@@ -124,6 +128,8 @@ fuzz_smoke() {
       fuzz_hier) seed "$corpus" "$seeds"/*.hier ;;
       fuzz_image) seed "$corpus" "$seeds"/*.png ;;
       fuzz_mesh) seed "$corpus" "$seeds"/*.ply tests/data/bad/mesh ;;
+      fuzz_las) seed "$corpus" "$seeds"/*.las ;;
+      fuzz_stats_log) seed "$corpus" tests/data/experiment ;;
       *) seed "$corpus" "$seeds" tests/data/bad ;; # a new target: every format as a start
     esac
     local nseeds

@@ -17,6 +17,7 @@
 #include "hier.h"
 #include "amg.h"
 #include "prim.h"
+#include "export.h"
 #include "render.h"
 #include "scene.h"
 #include "viewer.h"

@@ -35,6 +35,37 @@ typedef struct asp_property {
     void *data; /* count * asp_scalar_size(type) bytes, owned by the cloud */
 } asp_property;
 
+/** A LAS variable-length record (VLR or, in LAS 1.4, extended EVLR) kept as bytes: GeoTIFF keys, WKT, ... */
+typedef struct asp_las_vlr {
+    char user_id[17];     /* NUL-terminated */
+    uint16_t record_id;
+    char description[33]; /* NUL-terminated */
+    int extended;         /* 1: an EVLR (after the points, 64-bit length) */
+    size_t size;
+    uint8_t *data;        /* size bytes, owned by the cloud */
+} asp_las_vlr;
+
+/**
+ * What a LAS file says beyond its points, kept so that LAS in, LAS out
+ * reproduces it (asp_las_read fills it, asp_las_write reuses it). The Extra
+ * Bytes VLR is not among vlrs: the writer makes it from the properties.
+ */
+typedef struct asp_las_meta {
+    uint8_t version_minor;   /* 1.version_minor: 0 to 4 */
+    uint8_t point_format;    /* point data record format, 0 to 10 */
+    uint16_t record_length;  /* bytes per point record in the file */
+    uint16_t file_source_id, global_encoding;
+    uint8_t guid[16];
+    char system_id[33], software[33]; /* NUL-terminated */
+    uint16_t creation_day, creation_year;
+    double scale[3], offset[3];       /* world = offset + scale * integer coordinate */
+    double min[3], max[3];            /* bounds as the header states them */
+    uint64_t point_count;             /* as the header states it */
+    uint64_t points_by_return[15];
+    size_t vlr_count;
+    asp_las_vlr *vlrs;
+} asp_las_meta;
+
 /** Which optional attributes a cloud holds (bit set). */
 enum asp_cloud_attr {
     ASP_ATTR_NORMALS = 1 << 0,
@@ -75,6 +106,8 @@ typedef struct asp_cloud {
     /* How standard attributes were typed in the source file, so a writer can reproduce them. */
     asp_scalar_type position_type; /* FLOAT32 or FLOAT64 (NONE = float) */
     asp_scalar_type color_type;    /* UINT8 or FLOAT32 (NONE = uchar) */
+
+    asp_las_meta *las; /* the LAS header and VLRs when read from LAS, else NULL; owned, copied by asp_cloud_clone */
 
     asp_context ctx; /* copy of the context that allocated the arrays */
 } asp_cloud;

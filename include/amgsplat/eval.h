@@ -101,7 +101,11 @@ typedef struct asp_chart_series {
 /** Flags for asp_chart_desc.flags. */
 enum asp_chart_flags {
     ASP_CHART_LOG_X = 1 << 0, /* logarithmic x axis (values <= 0 are skipped) */
-    ASP_CHART_LOG_Y = 1 << 1  /* logarithmic y axis (values <= 0 are skipped) */
+    ASP_CHART_LOG_Y = 1 << 1, /* logarithmic y axis (values <= 0 are skipped) */
+    ASP_CHART_MARKERS = 1 << 2, /* markers only, no connecting lines (a scatter plot) */
+    ASP_CHART_BARS = 1 << 3,    /* vertical bars from y = 0 (a histogram): series side by side in each x slot,
+                                   the slot width the smallest x spacing of any series; not with LOG_Y */
+    ASP_CHART_X_INTEGER = 1 << 4 /* x ticks at whole numbers only (numbered categories); not with LOG_X */
 };
 
 /** Chart layout; the zero value means defaults. */
@@ -111,6 +115,11 @@ typedef struct asp_chart_desc {
     const char *x_label, *y_label;
     double y_min, y_max;     /* fixed y range when y_min < y_max; else from the data */
     unsigned flags;          /* asp_chart_flags */
+    /*
+     * NULL, or nseries pointers, each NULL or the series' count half lengths of
+     * vertical error bars (y +- y_err[s][i]), e.g. standard deviations
+     */
+    const double *const *y_err;
 } asp_chart_desc;
 
 /**
@@ -120,7 +129,8 @@ typedef struct asp_chart_desc {
  * series (series i gets palette colour i mod 12), a legend right of the plot
  * area, the title and axis labels in stb_easy_font's bitmap font. Axis
  * ranges cover every finite point (padded by 5%); a single value gets a unit
- * range around it. nseries may be 0 (axes only, range 0..1). Deterministic.
+ * range around it. nseries may be 0 (axes only, range 0..1). Error bars
+ * (desc->y_err) widen the y range to hold them. Deterministic.
  * Returns 0, ASP_EINVAL (size out of range, a series with count > 0 and NULL
  * x or y) or ASP_ENOMEM; dst is unchanged on failure. Thread safe.
  */

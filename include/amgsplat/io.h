@@ -23,9 +23,14 @@ typedef enum asp_ply_encoding {
     ASP_PLY_ASCII = 3
 } asp_ply_encoding;
 
+/** LAS point data record format n for asp_save_desc.las_format (0 there means "choose"). */
+#define ASP_LAS_FORMAT(n) ((unsigned)(n) + 1u)
+
 /** Options for writing point files; the zero value means defaults. */
 typedef struct asp_save_desc {
     asp_ply_encoding encoding; /* PLY only; ignored by the text formats */
+    unsigned las_format;       /* LAS only: ASP_LAS_FORMAT(0..3, 6..8), or 0 to choose (asp_las_write) */
+    double las_scale;          /* LAS only: coordinate step in world units; 0 keeps the source's, else 0.001 */
 } asp_save_desc;
 
 /**
@@ -125,13 +130,82 @@ int asp_xyz_read_memory(const void *data, size_t size, const char *name, const a
 int asp_xyz_write(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err);
 
 /**
+ * Reads an ASPRS LAS file, versions 1.0 to 1.4, point data record formats 0
+ * to 10 (LAS 1.4 R15), into a new cloud (*out; free with asp_cloud_destroy).
+ *  - World coordinates are offset + scale * X (X the int32 of the record).
+ *    origin is the header's offset, or, when some |X| >= 2^23, the offset
+ *    plus the middle of the data's X range times the scale; positions are
+ *    the float rest, within half a scale step of the true value for spans up
+ *    to 2^24 scale steps. position_type is FLOAT64.
+ *  - Record fields become properties with the same names in every format:
+ *    intensity (uint16), return_number, number_of_returns,
+ *    scan_direction_flag, edge_of_flight_line, classification,
+ *    classification_flags (bit 0 synthetic, 1 key-point, 2 withheld, 3
+ *    overlap), scanner_channel (formats 6-10), user_data (uint8),
+ *    scan_angle_rank (int8 degrees, formats 0-5) or scan_angle (int16 steps
+ *    of 0.006 degrees, 6-10), point_source_id (uint16), gps_time (double),
+ *    red16/green16/blue16 and nir (uint16), the wave packet fields
+ *    (wave_packet_index, wave_packet_offset, wave_packet_size,
+ *    wave_return_location, wave_dx/dy/dz; the waveforms are not read).
+ *  - RGB also becomes colors (alpha 255): the high byte when any value of
+ *    the file exceeds 255, else the values as they are.
+ *  - Extra bytes become properties named and typed by the Extra Bytes VLR
+ *    (scaled ones as double, 64-bit integers as double), bytes nothing
+ *    describes as uint8 "extra_byte_K"; extra bytes nx/ny/nz (float) become
+ *    normals, radius (float) radii, label (uint32) labels.
+ *  - The header and every VLR and EVLR but Extra Bytes and waveform data
+ *    are kept in cloud->las for asp_las_write.
+ * Errors: ASP_EIO (open, read), ASP_ENOMEM, ASP_EUNSUPPORTED (LAS 2.x;
+ * LASzip-compressed data, by the format byte or the LASzip VLR: "cannot read
+ * 'F': compressed LAS (LASzip) needs a decompressor this build does not
+ * have; ..."; more than 2^32-1 points), ASP_EFORMAT "cannot read 'F': ..."
+ * for a bad magic, a truncated header or VLR, a record length below the
+ * format's size, counts the file cannot hold (checked before allocating),
+ * disagreeing legacy and 64-bit counts, a zero or non-finite scale, a
+ * non-finite offset, a bad Extra Bytes descriptor; ASP_ECANCELED (progress
+ * callback, stage "read LAS"). The file is read a chunk of records at a
+ * time, never held whole. On failure *out is unchanged. Reentrant; ctx may
+ * be NULL.
+ */
+int asp_las_read(const char *path, const asp_context *ctx, asp_cloud **out, asp_error *err);
+
+/** As asp_las_read from size bytes at data (borrowed); name for messages (NULL: "<memory>"). Fuzzed. */
+int asp_las_read_memory(const void *data, size_t size, const char *name, const asp_context *ctx, asp_cloud **out,
+                        asp_error *err);
+
+/**
+ * Writes cloud as LAS. Point format: desc->las_format when set (0-3 or 6-8;
+ * 4, 5, 9, 10 carry waveforms, which are not written: ASP_EINVAL), else the
+ * source's (cloud->las; a waveform format becomes 1, 3, 6 or 8 without the
+ * packet), else 8 when there is a "nir" property, 7 with colours, 6 without.
+ * Version 1.4 for formats 6-8 and when the source has EVLRs, the source's
+ * version when its format is kept, else 1.2 (read by every LAS reader).
+ * Scale: desc->las_scale, else the source's, else 0.001 per axis; offset:
+ * the source's, else the floor of the bounding-box minimum. Fields are
+ * taken from the properties asp_las_read makes (any numeric type, rounded);
+ * missing ones are 0, return_number and number_of_returns 1; RGB is
+ * red16/green16/blue16 when they give the colours by the read rule, else
+ * colour * 257. Other properties, normals (nx, ny, nz), radii (radius) and
+ * labels (label) are written as extra bytes with an Extra Bytes VLR; uvs and
+ * alpha are not written. The source's VLRs and EVLRs are written back.
+ * Errors: ASP_EINVAL (a coordinate outside int32 at the scale, naming the
+ * point: choose a larger scale; a value outside its field in the format,
+ * e.g. classification 40 in format 3; a name longer than 32 bytes for an
+ * extra byte; records over 65535 bytes), ASP_EIO, ASP_ENOMEM. Atomic.
+ * Reentrant; the cloud is only read.
+ */
+int asp_las_write(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err);
+
+/**
  * Loads a point file, its format told by asp_file_recognise (magic bytes, then
  * the extension, case-insensitive: BUNNY.PLY loads): PLY through asp_ply_read
- * (a PLY with faces too: its vertices), .xyz/.pts/.txt through asp_xyz_read. Then rejects non-finite
+ * (a PLY with faces too: its vertices), LAS through asp_las_read (LAZ:
+ * ASP_EUNSUPPORTED, "compressed LAS (LASzip) needs a decompressor ..."),
+ * .xyz/.pts/.txt through asp_xyz_read. Then rejects non-finite
  * values (asp_cloud_validate) and an empty cloud, with ASP_EFORMAT
  * "cannot read 'F': ...". A cloud whose points are all equal loads fine.
  * Unknown extension: ASP_EUNSUPPORTED "cannot read 'f.abc': unknown point
- * format '.abc' (expected .ply, .xyz, .pts, .txt)". A file that is
+ * format '.abc' (expected .ply, .xyz, .pts, .txt, .las)". A file that is
  * something else (a mesh, an image, an .amg ...: by its magic or extension)
  * gives ASP_EUNSUPPORTED "cannot read 'f.obj': a mesh file (obj), not a point
  * file; sample it ...". A directory or FIFO: ASP_EIO at once. On failure
@@ -141,6 +215,7 @@ int asp_cloud_load(const char *path, const asp_context *ctx, asp_cloud **out, as
 
 /**
  * Saves by extension (case-insensitive, asp_file_type_of_name): .ply through asp_ply_write (desc->encoding applies),
+ * .las through asp_las_write (desc->las_format, las_scale apply; .laz is ASP_EUNSUPPORTED),
  * .xyz/.pts/.txt through asp_xyz_write. Unknown extension: ASP_EUNSUPPORTED
  * "cannot write 'f.abc': unknown point format ...". Atomic. Reentrant.
  */
@@ -159,7 +234,7 @@ const char *asp_cloud_format_of(const char *path);
 /** What a file holds, as far as amgsplat is concerned. */
 typedef enum asp_file_kind {
     ASP_FILE_UNKNOWN = 0,
-    ASP_FILE_POINTS = 1, /* PLY without faces, XYZ, PTS, TXT point lists */
+    ASP_FILE_POINTS = 1, /* PLY without faces, LAS/LAZ, XYZ, PTS, TXT point lists */
     ASP_FILE_MESH = 2,   /* OBJ, PLY with faces, OFF, STL, glTF/GLB, 3DS, ... (assimp; asp_mesh_load) */
     ASP_FILE_AMG = 3,    /* AMG decomposition (amgsplat decompose) */
     ASP_FILE_DPS = 4,    /* domain primitives (amgsplat build) */
@@ -170,14 +245,15 @@ typedef enum asp_file_kind {
 /** What asp_file_recognise found. */
 typedef struct asp_file_type {
     asp_file_kind kind;
-    char format[16]; /* lower-case short name: "ply", "xyz", "pts", "txt", "obj", "off", "stl", "gltf",
+    char format[16]; /* lower-case short name: "ply", "xyz", "pts", "txt", "las", "laz", "obj", "off", "stl", "gltf",
                         "glb", "3ds", "fbx", "dae", "amg", "dps", "hier", "png", "jpeg", "bmp", "tga",
                         "gif"; "" when unknown */
     int by_magic;    /* 1: told by the first bytes of the file, 0: by its extension */
 } asp_file_type;
 
 /**
- * Tells what path holds: magic bytes first (PLY, OFF, GLB, binary 3DS, the
+ * Tells what path holds: magic bytes first (PLY, LAS "LASF" (format "laz"
+ * when LASzip-compressed: format byte bit 7 or 6, or a LASzip VLR), OFF, GLB, binary 3DS, the
  * .amg/.dps/.hier magics, PNG, JPEG ...), then the extension, compared
  * case-insensitively ("BUNNY.PLY", "o.AMG"). A PLY is a mesh when its header
  * declares a non-empty face element (asp_cloud_load still reads its vertices

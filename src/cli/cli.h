@@ -8,6 +8,8 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include <cjson/cJSON.h>
+
 #include "amgsplat/amgsplat.h"
 
 struct cli_progress_state {
@@ -100,7 +102,20 @@ int cli_parse_up(const char *s, asp_up_axis *out);
 int cli_parse_view(struct cli_env *env, const char *s, double *az, double *el, double *dist);
 /* Parses "WxH"; returns 0 or -1. */
 int cli_parse_size2(const char *s, unsigned *w, unsigned *h);
-/* Writes s as a JSON string literal (quotes and escapes). */
-void cli_json_string(FILE *fp, const char *s);
+/*
+ * --json output: prints root (built with cJSON, the one JSON library) as one
+ * line on stdout, a space after each ':' and ',', and frees it. Returns 0, or 1 (the exit status) after
+ * printing an error when root is NULL or printing ran out of memory, so a
+ * failed cJSON_Create* anywhere in the tree surfaces here.
+ */
+int cli_json_print(const struct cli_env *env, cJSON *root);
+/*
+ * A JSON number holding v as printf(fmt, v) writes it (fmt such as "%.9g",
+ * "%.4f"), so --json keeps the digits the text output shows; null for NaN
+ * and infinities, which JSON cannot hold. NULL when out of memory.
+ */
+cJSON *cli_json_number(const char *fmt, double v);
+/* A JSON array of n doubles, each to 17 significant digits (round trip exact). */
+cJSON *cli_json_doubles(const double *v, int n);
 
 #endif

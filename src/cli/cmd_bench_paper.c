@@ -195,46 +195,55 @@ static void table54(const asp_eval_paper *p, int md)
     }
 }
 
-static void print_json(const asp_eval_paper *p, const char *model, int texture_methods)
+static int print_json(const struct cli_env *env, const asp_eval_paper *p, const char *model, int texture_methods)
 {
-    printf("{\"model\": ");
-    cli_json_string(stdout, model);
-    printf(", \"points\": %zu, \"decompose_seconds\": %.4f, \"gl_renderer\": ", p->points, p->t_decompose);
-    cli_json_string(stdout, p->gl_renderer);
-    printf(", \"fps_method\": ");
-    cli_json_string(stdout, p->fps_method);
-    printf(", \"sizes\": [");
-    for (size_t i = 0; i < p->size_count; i++)
-        printf("%s%u", i ? ", " : "", p->sizes[i]);
-    printf("], \"fps_points\": [");
-    for (size_t i = 0; i < p->size_count; i++)
-        printf(isfinite(p->fps_points[i]) ? "%s%.2f" : "%snull", i ? ", " : "", p->fps_points[i]);
-    printf("], \"budget_level\": \"%s\", \"levels\": [", p->levels[p->budget_level].name);
+    cJSON *o = cJSON_CreateObject(), *sizes = cJSON_CreateArray(), *fps = cJSON_CreateArray(),
+          *levels = cJSON_CreateArray();
+    cJSON_AddStringToObject(o, "model", model);
+    cJSON_AddNumberToObject(o, "points", (double)p->points);
+    cJSON_AddItemToObject(o, "decompose_seconds", cli_json_number("%.4f", p->t_decompose));
+    cJSON_AddStringToObject(o, "gl_renderer", p->gl_renderer);
+    cJSON_AddStringToObject(o, "fps_method", p->fps_method);
+    for (size_t i = 0; i < p->size_count; i++) {
+        cJSON_AddItemToArray(sizes, cJSON_CreateNumber(p->sizes[i]));
+        cJSON_AddItemToArray(fps, cli_json_number("%.2f", p->fps_points[i]));
+    }
+    cJSON_AddItemToObject(o, "sizes", sizes);
+    cJSON_AddItemToObject(o, "fps_points", fps);
+    cJSON_AddStringToObject(o, "budget_level", p->levels[p->budget_level].name);
     for (size_t l = 0; l < p->level_count; l++) {
         const asp_eval_paper_level *lv = &p->levels[l];
-        printf("%s{\"level\": %u, \"name\": \"%s\", \"primitives\": %zu, \"texels\": %llu, \"error\": %.9g, "
-               "\"normalised_error\": %.6g, \"cb_seconds\": %.4f, \"dpc_seconds\": %.4f, \"fps\": [",
-               l ? ", " : "", lv->level, lv->name, lv->primitives, (unsigned long long)lv->texels, lv->error,
-               lv->error_norm, lv->t_basis, lv->t_construct);
+        cJSON *j = cJSON_CreateObject(), *lfps = cJSON_CreateArray();
+        cJSON_AddNumberToObject(j, "level", lv->level);
+        cJSON_AddStringToObject(j, "name", lv->name);
+        cJSON_AddNumberToObject(j, "primitives", (double)lv->primitives);
+        cJSON_AddNumberToObject(j, "texels", (double)lv->texels);
+        cJSON_AddItemToObject(j, "error", cli_json_number("%.9g", lv->error));
+        cJSON_AddItemToObject(j, "normalised_error", cli_json_number("%.6g", lv->error_norm));
+        cJSON_AddItemToObject(j, "cb_seconds", cli_json_number("%.4f", lv->t_basis));
+        cJSON_AddItemToObject(j, "dpc_seconds", cli_json_number("%.4f", lv->t_construct));
         for (size_t i = 0; i < p->size_count; i++)
-            printf(isfinite(lv->fps[i]) ? "%s%.2f" : "%snull", i ? ", " : "", lv->fps[i]);
-        printf("]}");
+            cJSON_AddItemToArray(lfps, cli_json_number("%.2f", lv->fps[i]));
+        cJSON_AddItemToObject(j, "fps", lfps);
+        cJSON_AddItemToArray(levels, j);
     }
-    printf("], \"texture_methods\": ");
+    cJSON_AddItemToObject(o, "levels", levels);
     if (!texture_methods) {
-        printf("null}\n");
-        return;
+        cJSON_AddNullToObject(o, "texture_methods");
+        return cli_json_print(env, o);
     }
-    printf("[");
+    cJSON *tm = cJSON_CreateArray();
     static const char *names[4] = {"constant", "linear", "gaussian", "linear_affine"};
     for (int k = 0; k < 3; k++) {
-        printf("%s{\"texel_size\": %g, \"texels\": %llu", k ? ", " : "", p->t54_texel_size[k],
-               (unsigned long long)p->t54_texels[k]);
+        cJSON *j = cJSON_CreateObject();
+        cJSON_AddItemToObject(j, "texel_size", cli_json_number("%g", p->t54_texel_size[k]));
+        cJSON_AddNumberToObject(j, "texels", (double)p->t54_texels[k]);
         for (int m = 0; m < 4; m++)
-            printf(", \"%s\": %.4f", names[m], p->t54_seconds[k][m]);
-        printf("}");
+            cJSON_AddItemToObject(j, names[m], cli_json_number("%.4f", p->t54_seconds[k][m]));
+        cJSON_AddItemToArray(tm, j);
     }
-    printf("]}\n");
+    cJSON_AddItemToObject(o, "texture_methods", tm);
+    return cli_json_print(env, o);
 }
 
 int cmd_bench_paper(int argc, char **argv, struct cli_env *env)
@@ -291,8 +300,9 @@ int cmd_bench_paper(int argc, char **argv, struct cli_env *env)
     cli_progress_end(env);
     if (rc)
         return cli_fail(env, &err);
+    int status = 0;
     if (env->json) {
-        print_json(p, argv[0], !no_t54);
+        status = print_json(env, p, argv[0], !no_t54);
     } else {
         if (!env->quiet)
             printf("%s: %zu points; frame rates on %s\n", argv[0], p->points, p->gl_renderer);
@@ -304,5 +314,5 @@ int cmd_bench_paper(int argc, char **argv, struct cli_env *env)
             table54(p, markdown);
     }
     asp_eval_paper_destroy(p);
-    return 0;
+    return status;
 }

@@ -90,27 +90,39 @@ static void print_table(const asp_dps *dps, const asp_dps_summary *rows)
     }
 }
 
-static void print_json(const char *input, const char *output, const asp_dps *dps, const asp_dps_summary *rows,
-                       double t_decompose, double t_total)
+static int print_json(const struct cli_env *env, const char *input, const char *output, const asp_dps *dps,
+                      const asp_dps_summary *rows, double t_decompose, double t_total)
 {
-    printf("{\"input\": ");
-    cli_json_string(stdout, input);
-    printf(", \"output\": ");
-    cli_json_string(stdout, output);
-    printf(", \"points\": %llu, \"mean_radius\": %.9g, \"method\": \"%s\", \"texel_size\": %g, "
-           "\"decompose_seconds\": %.4f, \"total_seconds\": %.4f, \"levels\": [",
-           (unsigned long long)dps->source_points, dps->mean_radius, asp_prim_method_name(dps->desc.method),
-           dps->desc.texel_size, t_decompose, t_total);
+    cJSON *o = cJSON_CreateObject(), *levels = cJSON_CreateArray();
+    cJSON_AddStringToObject(o, "input", input);
+    cJSON_AddStringToObject(o, "output", output);
+    cJSON_AddNumberToObject(o, "points", (double)dps->source_points);
+    cJSON_AddItemToObject(o, "mean_radius", cli_json_number("%.9g", dps->mean_radius));
+    cJSON_AddStringToObject(o, "method", asp_prim_method_name(dps->desc.method));
+    cJSON_AddItemToObject(o, "texel_size", cli_json_number("%g", dps->desc.texel_size));
+    cJSON_AddItemToObject(o, "decompose_seconds", cli_json_number("%.4f", t_decompose));
+    cJSON_AddItemToObject(o, "total_seconds", cli_json_number("%.4f", t_total));
     for (size_t i = 0; i < dps->level_count; i++) {
         const asp_dps_summary *s = &rows[i];
-        printf("%s{\"level\": %u, \"name\": \"%s\", \"primitives\": %zu, \"texels\": %llu, \"error\": %.9g, "
-               "\"normalised_error\": %.6g, \"cb_seconds\": %.4f, \"dpc_seconds\": %.4f, \"skipped\": %u, "
-               "\"degenerate\": %u, \"capped\": %u, \"merges\": %u, \"atlas\": [%u, %u], \"neighbour_pairs\": %zu}",
-               i ? ", " : "", s->level, s->name, s->primitives, (unsigned long long)s->texels, s->error,
-               s->error_norm, s->t_basis, s->t_construct, s->skipped, s->degenerate, s->capped, s->merges,
-               s->atlas_width, s->atlas_height, s->neighbour_pairs);
+        cJSON *l = cJSON_CreateObject();
+        cJSON_AddNumberToObject(l, "level", s->level);
+        cJSON_AddStringToObject(l, "name", s->name);
+        cJSON_AddNumberToObject(l, "primitives", (double)s->primitives);
+        cJSON_AddNumberToObject(l, "texels", (double)s->texels);
+        cJSON_AddItemToObject(l, "error", cli_json_number("%.9g", s->error));
+        cJSON_AddItemToObject(l, "normalised_error", cli_json_number("%.6g", s->error_norm));
+        cJSON_AddItemToObject(l, "cb_seconds", cli_json_number("%.4f", s->t_basis));
+        cJSON_AddItemToObject(l, "dpc_seconds", cli_json_number("%.4f", s->t_construct));
+        cJSON_AddNumberToObject(l, "skipped", s->skipped);
+        cJSON_AddNumberToObject(l, "degenerate", s->degenerate);
+        cJSON_AddNumberToObject(l, "capped", s->capped);
+        cJSON_AddNumberToObject(l, "merges", s->merges);
+        cJSON_AddItemToObject(l, "atlas", cJSON_CreateIntArray((const int[]){(int)s->atlas_width, (int)s->atlas_height}, 2));
+        cJSON_AddNumberToObject(l, "neighbour_pairs", (double)s->neighbour_pairs);
+        cJSON_AddItemToArray(levels, l);
     }
-    printf("]}\n");
+    cJSON_AddItemToObject(o, "levels", levels);
+    return cli_json_print(env, o);
 }
 
 /* Atlas PNGs: X.png for one level, X-L-3.png for each of several. */
@@ -263,8 +275,9 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         if (rows[i].capped)
             cli_info(env, "warning: level %s: %u of %zu textures reached --max-texture %u; their texels are larger",
                      rows[i].name, rows[i].capped, rows[i].primitives, dps->desc.max_texture);
+    int status = 0;
     if (env->json) {
-        print_json(argv[0], output, dps, rows, t_dec, t_total);
+        status = print_json(env, argv[0], output, dps, rows, t_dec, t_total);
     } else {
         if (!env->quiet)
             printf("%s: %llu points, %zu level(s), mean radius %.4g, %s textures, texel size %g%s, %.2f s\n", output,
@@ -274,5 +287,5 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         print_table(dps, rows);
     }
     asp_dps_destroy(dps);
-    return 0;
+    return status;
 }

@@ -1,12 +1,16 @@
 /*
  * amgsplat convert: point files between PLY (binary little/big endian,
- * ascii) and text XYZ/PTS/TXT, through asp_cloud_load / asp_cloud_save.
+ * ascii), LAS (1.0-1.4 in, 1.2/1.4 out) and text XYZ/PTS/TXT, through
+ * asp_cloud_load / asp_cloud_save.
  */
 static const char usage[] =
-    "usage: amgsplat convert [--ascii | --big-endian] IN OUT\n"
+    "usage: amgsplat convert [--ascii | --big-endian] [--las-format N] [--las-scale S] IN OUT\n"
     "\n"
-    "Converts a point file; formats follow the extensions (.ply, .xyz, .pts, .txt).\n"
+    "Converts a point file; formats follow the extensions (.ply, .xyz, .pts, .txt, .las).\n"
     "PLY output is binary little endian unless --ascii or --big-endian is given.\n"
+    "LAS output keeps the source's point format, scale, offset and VLRs when it was LAS;\n"
+    "otherwise it is LAS 1.4 format 7 with colours, 6 without (8 with a 'nir' property), at\n"
+    "a 0.001 scale. --las-format 0-3 (LAS 1.2) or 6-8 (LAS 1.4) and --las-scale override.\n"
     "Text output keeps positions, normals and colours only.";
 
 #include <stdio.h>
@@ -16,22 +20,40 @@ static const char usage[] =
 #include "cli/commands.h"
 #include "util/banned.h"
 
-static void attr_list(const asp_cloud *c, char *out, size_t cap, int json)
+static const struct {
+    unsigned bit;
+    const char *name;
+} attr_names[] = {{ASP_ATTR_NORMALS, "normals"}, {ASP_ATTR_COLORS, "colors"}, {ASP_ATTR_RADII, "radii"},
+                  {ASP_ATTR_UVS, "uvs"},         {ASP_ATTR_LABELS, "labels"}};
+
+static void attr_list(const asp_cloud *c, char *out, size_t cap)
 {
-    static const struct {
-        unsigned bit;
-        const char *name;
-    } names[] = {{ASP_ATTR_NORMALS, "normals"}, {ASP_ATTR_COLORS, "colors"}, {ASP_ATTR_RADII, "radii"},
-                 {ASP_ATTR_UVS, "uvs"},         {ASP_ATTR_LABELS, "labels"}};
     unsigned attrs = asp_cloud_attrs(c);
     size_t len = 0;
     out[0] = '\0';
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
-        if (attrs & names[i].bit) {
-            int n = snprintf(out + len, cap - len, json ? "%s\"%s\"" : "%s%s", len ? ", " : "", names[i].name);
+    for (size_t i = 0; i < sizeof attr_names / sizeof attr_names[0]; i++)
+        if (attrs & attr_names[i].bit) {
+            int n = snprintf(out + len, cap - len, "%s%s", len ? ", " : "", attr_names[i].name);
             if (n > 0 && (size_t)n < cap - len)
                 len += (size_t)n;
         }
+}
+
+static int print_json(const struct cli_env *env, const asp_cloud *c, const char *in, const char *out,
+                      const char *enc)
+{
+    cJSON *root = cJSON_CreateObject(), *attrs = cJSON_CreateArray();
+    cJSON_AddStringToObject(root, "input", in);
+    cJSON_AddStringToObject(root, "output", out);
+    cJSON_AddStringToObject(root, "encoding", enc);
+    cJSON_AddNumberToObject(root, "points", (double)c->count);
+    cJSON_AddNumberToObject(root, "faces", (double)c->face_count);
+    for (size_t i = 0; i < sizeof attr_names / sizeof attr_names[0]; i++)
+        if (asp_cloud_attrs(c) & attr_names[i].bit)
+            cJSON_AddItemToArray(attrs, cJSON_CreateString(attr_names[i].name));
+    cJSON_AddItemToObject(root, "attributes", attrs);
+    cJSON_AddNumberToObject(root, "properties", (double)c->property_count);
+    return cli_json_print(env, root);
 }
 
 /* What a text file cannot hold, so the user is told instead of surprised. */
@@ -59,10 +81,13 @@ static void note_dropped(const struct cli_env *env, const asp_cloud *c, const ch
 
 int cmd_convert(int argc, char **argv, struct cli_env *env)
 {
-    int ascii = 0, big_endian = 0, npos = 0;
+    int ascii = 0, big_endian = 0, npos = 0, las_format = -1;
+    double las_scale = 0;
     const struct cli_option opts[] = {
         {"ascii", 0, CLI_FLAG, &ascii, NULL, "write PLY as ascii text"},
         {"big-endian", 0, CLI_FLAG, &big_endian, NULL, "write PLY as binary big endian"},
+        {"las-format", 0, CLI_INT, &las_format, "N", "LAS point data record format: 0-3 or 6-8"},
+        {"las-scale", 0, CLI_DOUBLE, &las_scale, "S", "LAS coordinate step (default: the source's, else 0.001)"},
         {0},
     };
     int rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -80,38 +105,47 @@ int cmd_convert(int argc, char **argv, struct cli_env *env)
     const char *out_fmt = asp_file_type_of_name(out, &out_type, NULL) == 0 ? out_type.format : NULL;
     if ((ascii || big_endian) && out_fmt && strcmp(out_fmt, "ply") != 0)
         return cli_usage_error(env, "--%s applies to .ply output only, not '%s'", ascii ? "ascii" : "big-endian", out);
+    int las_out = out_fmt && strcmp(out_fmt, "las") == 0;
+    if ((las_format != -1 || las_scale != 0) && !las_out)
+        return cli_usage_error(env, "--%s applies to .las output only, not '%s'",
+                               las_format != -1 ? "las-format" : "las-scale", out);
+    if (las_format != -1 && (las_format < 0 || las_format > 8 || las_format == 4 || las_format == 5))
+        return cli_usage_error(env, "--las-format %d: expected 0, 1, 2, 3, 6, 7 or 8 (waveform formats are not written)",
+                               las_format);
+    if (las_scale < 0 || !(las_scale <= 1e6))
+        return cli_usage_error(env, "--las-scale %g: expected a positive step up to 1e6", las_scale);
 
     asp_error err = {0};
     asp_cloud *cloud = NULL;
     if (asp_cloud_load(in, &env->ctx, &cloud, &err))
         return cli_fail(env, &err);
-    asp_save_desc desc = {.encoding = ascii ? ASP_PLY_ASCII : big_endian ? ASP_PLY_BINARY_BE : ASP_PLY_BINARY_LE};
+    asp_save_desc desc = {.encoding = ascii ? ASP_PLY_ASCII : big_endian ? ASP_PLY_BINARY_BE : ASP_PLY_BINARY_LE,
+                          .las_format = las_format >= 0 ? ASP_LAS_FORMAT(las_format) : 0,
+                          .las_scale = las_scale};
     if (asp_cloud_save(cloud, out, &desc, &err)) {
         asp_cloud_destroy(cloud);
         return cli_fail(env, &err);
     }
     cli_progress_end(env);
-    const char *enc = !out_fmt || strcmp(out_fmt, "ply") != 0 ? "text"
+    const char *enc = las_out                                 ? "las"
+                      : !out_fmt || strcmp(out_fmt, "ply") != 0 ? "text"
                       : ascii                                 ? "ascii"
                       : big_endian                            ? "binary_big_endian"
                                                               : "binary_little_endian";
     char attrs[128];
     if (strcmp(enc, "text") == 0)
         note_dropped(env, cloud, out);
+    else if (las_out && (cloud->uvs || cloud->face_count || cloud->comment_count || cloud->obj_info_count))
+        cli_info(env, "amgsplat convert: note: '%s' (LAS) does not keep%s%s%s", out, cloud->uvs ? " uvs" : "",
+                 cloud->face_count ? " faces" : "", cloud->comment_count || cloud->obj_info_count ? " comments" : "");
     if (env->json) {
-        attr_list(cloud, attrs, sizeof attrs, 1);
-        printf("{\"input\": ");
-        cli_json_string(stdout, in);
-        printf(", \"output\": ");
-        cli_json_string(stdout, out);
-        printf(", \"encoding\": \"%s\", \"points\": %zu, \"faces\": %zu, \"attributes\": [%s], \"properties\": %zu}\n",
-               enc, cloud->count, cloud->face_count, attrs, cloud->property_count);
+        rc = print_json(env, cloud, in, out, enc);
     } else if (!env->quiet) {
-        attr_list(cloud, attrs, sizeof attrs, 0);
+        attr_list(cloud, attrs, sizeof attrs);
         printf("converted '%s' -> '%s' (%s): %zu points%s%s%s, %zu faces, %zu extra properties\n", in, out, enc,
                cloud->count, attrs[0] ? " (" : "", attrs, attrs[0] ? ")" : "", cloud->face_count,
                cloud->property_count);
     }
     asp_cloud_destroy(cloud);
-    return 0;
+    return rc;
 }

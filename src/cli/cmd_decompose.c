@@ -61,22 +61,35 @@ static int lookup(const struct name_code *t, const char *name, int *out)
     return -1;
 }
 
-static void print_info_json(const asp_amg *amg)
+static void add_info_json(cJSON *o, const asp_amg *amg)
 {
     const asp_amg_info *in = asp_amg_get_info(amg);
-    printf("\"points\": %zu, \"levels\": %zu, \"level_sizes\": [", asp_amg_cloud(amg)->count, asp_amg_level_count(amg));
+    cJSON *sizes = cJSON_CreateArray(), *sec = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "points", (double)asp_amg_cloud(amg)->count);
+    cJSON_AddNumberToObject(o, "levels", (double)asp_amg_level_count(amg));
     for (size_t l = 0; l < asp_amg_level_count(amg); l++)
-        printf("%s%zu", l ? ", " : "", asp_amg_level_size(amg, l));
-    printf("], \"epsilon\": %.9g, \"k_min\": %zu, \"k_max\": %zu, \"fan_k\": %zu, \"mean_neighbourhood\": %.4g, "
-           "\"mean_fan\": %.4g, \"matrix_nnz\": %zu, \"positive_offdiag_clamped\": %zu, \"isolated_points\": %zu, "
-           "\"repaired_rows\": %zu, \"seconds\": {\"neighbours\": %.4f, \"classifier\": %.4f, \"fans\": %.4f, "
-           "\"assembly\": %.4f, \"amg\": %.4f}",
-           in->epsilon, in->k_min, in->k_max, in->fan_k, in->mean_neighbourhood, in->mean_fan, in->matrix_nnz,
-           in->positive_offdiag, in->isolated_points, in->repaired_rows, in->t_neighbours, in->t_classifier, in->t_fans,
-           in->t_assembly, in->t_amg);
+        cJSON_AddItemToArray(sizes, cJSON_CreateNumber((double)asp_amg_level_size(amg, l)));
+    cJSON_AddItemToObject(o, "level_sizes", sizes);
+    cJSON_AddItemToObject(o, "epsilon", cli_json_number("%.9g", in->epsilon));
+    cJSON_AddNumberToObject(o, "k_min", (double)in->k_min);
+    cJSON_AddNumberToObject(o, "k_max", (double)in->k_max);
+    cJSON_AddNumberToObject(o, "fan_k", (double)in->fan_k);
+    cJSON_AddItemToObject(o, "mean_neighbourhood", cli_json_number("%.4g", in->mean_neighbourhood));
+    cJSON_AddItemToObject(o, "mean_fan", cli_json_number("%.4g", in->mean_fan));
+    cJSON_AddNumberToObject(o, "matrix_nnz", (double)in->matrix_nnz);
+    cJSON_AddNumberToObject(o, "positive_offdiag_clamped", (double)in->positive_offdiag);
+    cJSON_AddNumberToObject(o, "isolated_points", (double)in->isolated_points);
+    cJSON_AddNumberToObject(o, "repaired_rows", (double)in->repaired_rows);
+    cJSON_AddItemToObject(sec, "neighbours", cli_json_number("%.4f", in->t_neighbours));
+    cJSON_AddItemToObject(sec, "classifier", cli_json_number("%.4f", in->t_classifier));
+    cJSON_AddItemToObject(sec, "fans", cli_json_number("%.4f", in->t_fans));
+    cJSON_AddItemToObject(sec, "assembly", cli_json_number("%.4f", in->t_assembly));
+    cJSON_AddItemToObject(sec, "amg", cli_json_number("%.4f", in->t_amg));
+    cJSON_AddItemToObject(o, "seconds", sec);
 }
 
-static int print_stats(struct cli_env *env, const asp_amg *amg, double tau, asp_error *err)
+/* The per-level statistics: into json (tau, level_stats) when it is given, else as a table on stdout. */
+static int print_stats(struct cli_env *env, const asp_amg *amg, double tau, cJSON *json, asp_error *err)
 {
     size_t nl = asp_amg_level_count(amg);
     asp_amg_level_stats *st = asp_calloc(&env->ctx, nl, sizeof *st);
@@ -84,16 +97,27 @@ static int print_stats(struct cli_env *env, const asp_amg *amg, double tau, asp_
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the level statistics");
     int rc = asp_amg_level_stats_all(amg, tau, &env->ctx, st, err);
     cli_progress_end(env);
-    if (!rc && env->json) {
-        printf(", \"tau\": %g, \"level_stats\": [", tau);
-        for (size_t l = 0; l < nl; l++)
-            printf("%s{\"level\": %zu, \"name\": \"L-%zu\", \"unknowns\": %zu, \"domains\": %zu, "
-                   "\"mean_domain_size\": %.6g, \"max_domain_size\": %zu, \"mean_domains_per_point\": %.6g, "
-                   "\"reduction\": %.4g, \"max_pou_error\": %.3g, \"seconds\": %.4f}",
-                   l ? ", " : "", l, nl - 1 - l, st[l].unknowns, st[l].domains, st[l].mean_domain_size,
-                   st[l].max_domain_size, st[l].mean_domains_per_point,
-                   l ? (double)st[l - 1].unknowns / (double)st[l].unknowns : 1.0, st[l].max_pou_error, st[l].seconds);
-        printf("]");
+    if (!rc && json) {
+        cJSON *levels = cJSON_CreateArray();
+        cJSON_AddItemToObject(json, "tau", cli_json_number("%g", tau));
+        for (size_t l = 0; l < nl; l++) {
+            char name[32];
+            snprintf(name, sizeof name, "L-%zu", nl - 1 - l);
+            cJSON *j = cJSON_CreateObject();
+            cJSON_AddNumberToObject(j, "level", (double)l);
+            cJSON_AddStringToObject(j, "name", name);
+            cJSON_AddNumberToObject(j, "unknowns", (double)st[l].unknowns);
+            cJSON_AddNumberToObject(j, "domains", (double)st[l].domains);
+            cJSON_AddItemToObject(j, "mean_domain_size", cli_json_number("%.6g", st[l].mean_domain_size));
+            cJSON_AddNumberToObject(j, "max_domain_size", (double)st[l].max_domain_size);
+            cJSON_AddItemToObject(j, "mean_domains_per_point", cli_json_number("%.6g", st[l].mean_domains_per_point));
+            cJSON_AddItemToObject(j, "reduction",
+                                  cli_json_number("%.4g", l ? (double)st[l - 1].unknowns / (double)st[l].unknowns : 1.0));
+            cJSON_AddItemToObject(j, "max_pou_error", cli_json_number("%.3g", st[l].max_pou_error));
+            cJSON_AddItemToObject(j, "seconds", cli_json_number("%.4f", st[l].seconds));
+            cJSON_AddItemToArray(levels, j);
+        }
+        cJSON_AddItemToObject(json, "level_stats", levels);
     } else if (!rc) {
         printf("level  name   unknowns  reduction   domains  mean size   max size  domains/pt   seconds\n");
         for (size_t l = 0; l < nl; l++) {
@@ -346,19 +370,22 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     if (export_mode)
         rc = export_colors(env, amg, color_mode, level_name, colors_out, &err);
     cli_progress_end(env);
+    int json_status = 0;
     if (!rc && env->json) {
-        printf("{\"input\": ");
-        cli_json_string(stdout, input);
-        printf(", \"output\": ");
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "input", input);
         if (output)
-            cli_json_string(stdout, output);
+            cJSON_AddStringToObject(o, "output", output);
         else
-            printf("null");
-        printf(", ");
-        print_info_json(amg);
+            cJSON_AddNullToObject(o, "output");
+        add_info_json(o, amg);
         if (stats)
-            rc = print_stats(env, amg, tau, &err);
-        printf(", \"total_seconds\": %.4f}\n", t_total);
+            rc = print_stats(env, amg, tau, o, &err);
+        cJSON_AddItemToObject(o, "total_seconds", cli_json_number("%.4f", t_total));
+        if (rc)
+            cJSON_Delete(o);
+        else
+            json_status = cli_json_print(env, o);
     } else if (!rc) {
         size_t nl = asp_amg_level_count(amg);
         if (!env->quiet) {
@@ -371,11 +398,11 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
             printf("\n");
         }
         if (stats)
-            rc = print_stats(env, amg, tau, &err);
+            rc = print_stats(env, amg, tau, NULL, &err);
     }
     asp_amg_destroy(amg);
     asp_amg_shutdown();
     if (rc)
         return cli_fail(env, &err);
-    return 0;
+    return json_status;
 }

@@ -96,14 +96,16 @@ int cmd_estimate(int argc, char **argv, struct cli_env *env)
     int did_radii = radii && (force || !had_radii);
     cli_progress_end(env);
     if (env->json) {
-        printf("{\"input\": ");
-        cli_json_string(stdout, input);
-        printf(", \"output\": ");
-        cli_json_string(stdout, output);
-        printf(", \"points\": %zu, \"normals\": \"%s\", \"radii\": \"%s\", \"k\": %zu, \"radius_k\": %zu, "
-               "\"seconds\": %.4f}\n",
-               count, did_normals ? "estimated" : had_normals ? "kept" : "none",
-               did_radii ? "estimated" : had_radii ? "kept" : "none", k, radius_k, asp_time_now() - t0);
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "input", input);
+        cJSON_AddStringToObject(o, "output", output);
+        cJSON_AddNumberToObject(o, "points", (double)count);
+        cJSON_AddStringToObject(o, "normals", did_normals ? "estimated" : had_normals ? "kept" : "none");
+        cJSON_AddStringToObject(o, "radii", did_radii ? "estimated" : had_radii ? "kept" : "none");
+        cJSON_AddNumberToObject(o, "k", (double)k);
+        cJSON_AddNumberToObject(o, "radius_k", (double)radius_k);
+        cJSON_AddItemToObject(o, "seconds", cli_json_number("%.4f", asp_time_now() - t0));
+        return cli_json_print(env, o);
     } else if (!env->quiet) {
         printf("%s: %zu points, normals %s, radii %s\n", output, count,
                did_normals ? "estimated" : had_normals ? "kept" : "none",

@@ -125,57 +125,81 @@ static size_t find_row(const asp_eval_result *res, const asp_eval_row *at, const
  * how many views it wins; with a mesh also against the mesh simplified to the
  * same count and to the same bytes (issue 14); as text lines or JSON objects.
  */
-static void print_claim(const asp_eval_result *res, FILE *fp, int json)
+/* 1 when rows[i] is a point cut with a domain-primitive row at its size and level: the best in *best, the mesh rows. */
+static int claim_row(const asp_eval_result *res, size_t i, size_t *best, size_t *mt, size_t *mb)
+{
+    const asp_eval_row *pt = &res->rows[i];
+    if (strcmp(pt->representation, "points") != 0)
+        return 0;
+    *best = SIZE_MAX;
+    for (size_t j = 0; j < res->row_count; j++) {
+        const asp_eval_row *r = &res->rows[j];
+        if (r->size == pt->size && r->level == pt->level && strncmp(r->representation, "dp-", 3) == 0 &&
+            (*best == SIZE_MAX || r->ssim_mean > res->rows[*best].ssim_mean))
+            *best = j;
+    }
+    int mesh = res->mesh_triangles > 0;
+    *mt = mesh ? find_row(res, pt, "mesh-tris") : SIZE_MAX;
+    *mb = mesh ? find_row(res, pt, "mesh-bytes") : SIZE_MAX;
+    return *best != SIZE_MAX;
+}
+
+static cJSON *claim_json(const asp_eval_result *res)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (size_t i = 0; i < res->row_count; i++) {
+        size_t best, mt, mb;
+        if (!claim_row(res, i, &best, &mt, &mb))
+            continue;
+        const asp_eval_row *pt = &res->rows[i], *b = &res->rows[best];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "size", pt->size);
+        cJSON_AddStringToObject(o, "level_name", pt->level_name);
+        cJSON_AddNumberToObject(o, "primitives", (double)pt->primitives);
+        cJSON_AddStringToObject(o, "best", b->representation);
+        cJSON_AddItemToObject(o, "best_ssim", cli_json_number("%.6f", b->ssim_mean));
+        cJSON_AddItemToObject(o, "points_ssim", cli_json_number("%.6f", pt->ssim_mean));
+        cJSON_AddNumberToObject(o, "wins", (double)asp_eval_ssim_wins(res, best, i));
+        cJSON_AddNumberToObject(o, "views", (double)res->views);
+        if (mt != SIZE_MAX) {
+            cJSON_AddItemToObject(o, "mesh_tris_ssim", cli_json_number("%.6f", res->rows[mt].ssim_mean));
+            cJSON_AddNumberToObject(o, "wins_mesh_tris", (double)asp_eval_ssim_wins(res, best, mt));
+        }
+        if (mb != SIZE_MAX) {
+            cJSON_AddItemToObject(o, "mesh_bytes_ssim", cli_json_number("%.6f", res->rows[mb].ssim_mean));
+            cJSON_AddNumberToObject(o, "wins_mesh_bytes", (double)asp_eval_ssim_wins(res, best, mb));
+        }
+        cJSON_AddItemToArray(a, o);
+    }
+    return a;
+}
+
+static void print_claim(const asp_eval_result *res, FILE *fp)
 {
     int first = 1, mesh = res->mesh_triangles > 0;
     for (size_t i = 0; i < res->row_count; i++) {
-        const asp_eval_row *pt = &res->rows[i];
-        if (strcmp(pt->representation, "points") != 0)
+        size_t best, mt, mb;
+        if (!claim_row(res, i, &best, &mt, &mb))
             continue;
-        size_t best = SIZE_MAX;
-        for (size_t j = 0; j < res->row_count; j++) {
-            const asp_eval_row *r = &res->rows[j];
-            if (r->size == pt->size && r->level == pt->level && strncmp(r->representation, "dp-", 3) == 0 &&
-                (best == SIZE_MAX || r->ssim_mean > res->rows[best].ssim_mean))
-                best = j;
-        }
-        if (best == SIZE_MAX)
-            continue;
-        const asp_eval_row *b = &res->rows[best];
+        const asp_eval_row *pt = &res->rows[i], *b = &res->rows[best];
         size_t wins = asp_eval_ssim_wins(res, best, i);
-        size_t mt = mesh ? find_row(res, pt, "mesh-tris") : SIZE_MAX;
-        size_t mb = mesh ? find_row(res, pt, "mesh-bytes") : SIZE_MAX;
-        if (json) {
-            fprintf(fp, "%s{\"size\": %u, \"level_name\": \"%s\", \"primitives\": %zu, \"best\": \"%s\", "
-                        "\"best_ssim\": %.6f, \"points_ssim\": %.6f, \"wins\": %zu, \"views\": %zu",
-                    first ? "" : ", ", pt->size, pt->level_name, pt->primitives, b->representation, b->ssim_mean,
-                    pt->ssim_mean, wins, res->views);
-            if (mt != SIZE_MAX)
-                fprintf(fp, ", \"mesh_tris_ssim\": %.6f, \"wins_mesh_tris\": %zu", res->rows[mt].ssim_mean,
-                        asp_eval_ssim_wins(res, best, mt));
-            if (mb != SIZE_MAX)
-                fprintf(fp, ", \"mesh_bytes_ssim\": %.6f, \"wins_mesh_bytes\": %zu", res->rows[mb].ssim_mean,
-                        asp_eval_ssim_wins(res, best, mb));
-            fputc('}', fp);
-        } else {
-            if (first)
-                fprintf(fp, "\nbest domain-primitive method against the point cut (thesis Fig. 1.1)%s:\n"
-                            "%5s %-6s %10s %-18s %9s %9s %9s%s\n",
-                        mesh ? " and the simplified mesh at equal triangles and equal bytes" : "", "size", "level",
-                        "primitives", "best method", "SSIM", "points", "wins",
-                        mesh ? "  mesh-tris      wins mesh-bytes      wins" : "");
-            fprintf(fp, "%5u %-6s %10zu %-18s %9.4f %9.4f %5zu/%zu", pt->size, pt->level_name, pt->primitives,
-                    b->representation, b->ssim_mean, pt->ssim_mean, wins, res->views);
-            const size_t other[2] = {mt, mb};
-            for (int k = 0; k < 2 && mesh; k++) {
-                if (other[k] == SIZE_MAX)
-                    fprintf(fp, " %10s %9s", "-", "-");
-                else
-                    fprintf(fp, " %10.4f %5zu/%zu", res->rows[other[k]].ssim_mean,
-                            asp_eval_ssim_wins(res, best, other[k]), res->views);
-            }
-            fputc('\n', fp);
+        if (first)
+            fprintf(fp, "\nbest domain-primitive method against the point cut (thesis Fig. 1.1)%s:\n"
+                        "%5s %-6s %10s %-18s %9s %9s %9s%s\n",
+                    mesh ? " and the simplified mesh at equal triangles and equal bytes" : "", "size", "level",
+                    "primitives", "best method", "SSIM", "points", "wins",
+                    mesh ? "  mesh-tris      wins mesh-bytes      wins" : "");
+        fprintf(fp, "%5u %-6s %10zu %-18s %9.4f %9.4f %5zu/%zu", pt->size, pt->level_name, pt->primitives,
+                b->representation, b->ssim_mean, pt->ssim_mean, wins, res->views);
+        const size_t other[2] = {mt, mb};
+        for (int k = 0; k < 2 && mesh; k++) {
+            if (other[k] == SIZE_MAX)
+                fprintf(fp, " %10s %9s", "-", "-");
+            else
+                fprintf(fp, " %10.4f %5zu/%zu", res->rows[other[k]].ssim_mean,
+                        asp_eval_ssim_wins(res, best, other[k]), res->views);
         }
+        fputc('\n', fp);
         first = 0;
     }
 }
@@ -310,18 +334,19 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
             remove_directory(dir);
         return cli_fail(env, &err);
     }
+    int status = 0;
     if (env->json) {
-        printf("{\"model\": ");
-        cli_json_string(stdout, argv[0]);
-        printf(", \"output\": ");
-        cli_json_string(stdout, dir);
-        printf(", \"points\": %zu, \"mesh_triangles\": %zu, \"views\": %zu, \"rows\": %zu, \"seconds\": %.2f, "
-               "\"gl_renderer\": ",
-               res->points, res->mesh_triangles, res->views, res->row_count, seconds);
-        cli_json_string(stdout, res->gl_renderer);
-        printf(", \"claim\": [");
-        print_claim(res, stdout, 1);
-        printf("]}\n");
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "model", argv[0]);
+        cJSON_AddStringToObject(o, "output", dir);
+        cJSON_AddNumberToObject(o, "points", (double)res->points);
+        cJSON_AddNumberToObject(o, "mesh_triangles", (double)res->mesh_triangles);
+        cJSON_AddNumberToObject(o, "views", (double)res->views);
+        cJSON_AddNumberToObject(o, "rows", (double)res->row_count);
+        cJSON_AddItemToObject(o, "seconds", cli_json_number("%.2f", seconds));
+        cJSON_AddStringToObject(o, "gl_renderer", res->gl_renderer);
+        cJSON_AddItemToObject(o, "claim", claim_json(res));
+        status = cli_json_print(env, o);
     } else {
         if (!env->quiet)
             printf("%s: %zu points%s, %zu levels, %zu views, %s; decomposition %.2f s, primitives %.2f s, "
@@ -330,8 +355,8 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
                    res->level_count, res->views, res->gl_renderer, res->t_decompose, res->t_build, res->t_simplify,
                    res->t_render, dir);
         print_table(res);
-        print_claim(res, stdout, 0);
+        print_claim(res, stdout);
     }
     asp_eval_result_destroy(res);
-    return 0;
+    return status;
 }

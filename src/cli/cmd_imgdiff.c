@@ -18,17 +18,21 @@ static const char usage[] =
     "corner pixels share. A pixel is background when each channel is within --tolerance\n"
     "(default 8) of that colour.";
 
-static void print_source(const asp_silhouette_info *s, int json)
+static cJSON *source_json(const asp_silhouette_info *s)
 {
-    if (json) {
-        printf("{\"source\": \"%s\"", asp_silhouette_source_name(s->source));
-        if (s->source != ASP_SILHOUETTE_ALPHA)
-            printf(", \"background\": [%u, %u, %u]", s->background[0], s->background[1], s->background[2]);
-        if (s->source == ASP_SILHOUETTE_CORNERS)
-            printf(", \"corners_agreeing\": %d", s->corners_agreeing);
-        printf(", \"pixels\": %zu}", s->foreground);
-        return;
-    }
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "source", asp_silhouette_source_name(s->source));
+    if (s->source != ASP_SILHOUETTE_ALPHA)
+        cJSON_AddItemToObject(o, "background",
+                              cJSON_CreateIntArray((const int[]){s->background[0], s->background[1], s->background[2]}, 3));
+    if (s->source == ASP_SILHOUETTE_CORNERS)
+        cJSON_AddNumberToObject(o, "corners_agreeing", s->corners_agreeing);
+    cJSON_AddNumberToObject(o, "pixels", (double)s->foreground);
+    return o;
+}
+
+static void print_source(const asp_silhouette_info *s)
+{
     printf("%s", asp_silhouette_source_name(s->source));
     if (s->source != ASP_SILHOUETTE_ALPHA)
         printf(" %u,%u,%u", s->background[0], s->background[1], s->background[2]);
@@ -73,17 +77,18 @@ int cmd_imgdiff(int argc, char **argv, struct cli_env *env)
         asp_image_silhouettes(&a, &b, &sdesc, &iou, sil, &err)) {
         status = cli_fail(env, &err);
     } else if (env->json) {
-        printf("{\"width\": %u, \"height\": %u, \"psnr\": ", a.width, a.height);
-        if (isinf(psnr))
-            printf("null");
-        else
-            printf("%.4f", psnr);
-        printf(", \"identical\": %s, \"ssim\": %.6f, \"iou\": %.6f, \"tolerance\": %d, \"silhouette\": [",
-               isinf(psnr) ? "true" : "false", ssim, iou, tolerance);
-        print_source(&sil[0], 1);
-        printf(", ");
-        print_source(&sil[1], 1);
-        printf("]}\n");
+        cJSON *o = cJSON_CreateObject(), *sils = cJSON_CreateArray();
+        cJSON_AddNumberToObject(o, "width", a.width);
+        cJSON_AddNumberToObject(o, "height", a.height);
+        cJSON_AddItemToObject(o, "psnr", cli_json_number("%.4f", psnr)); // null when identical (infinite)
+        cJSON_AddBoolToObject(o, "identical", isinf(psnr));
+        cJSON_AddItemToObject(o, "ssim", cli_json_number("%.6f", ssim));
+        cJSON_AddItemToObject(o, "iou", cli_json_number("%.6f", iou));
+        cJSON_AddNumberToObject(o, "tolerance", tolerance);
+        cJSON_AddItemToArray(sils, source_json(&sil[0]));
+        cJSON_AddItemToArray(sils, source_json(&sil[1]));
+        cJSON_AddItemToObject(o, "silhouette", sils);
+        status = cli_json_print(env, o);
     } else {
         printf("size %ux%u\n", a.width, a.height);
         if (isinf(psnr))
@@ -93,7 +98,7 @@ int cmd_imgdiff(int argc, char **argv, struct cli_env *env)
         printf("ssim %.6f\niou  %.6f\n", ssim, iou);
         for (int k = 0; k < 2; k++) {
             printf("silhouette %c: ", k ? 'B' : 'A');
-            print_source(&sil[k], 0);
+            print_source(&sil[k]);
             printf("\n");
         }
     }

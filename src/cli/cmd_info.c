@@ -20,9 +20,10 @@ static const char usage[] =
     "usage: amgsplat info FILE [--json]\n"
     "\n"
     "Tells what FILE is (by its first bytes, else its extension in any case) and describes it.\n"
-    "Point file (.ply, .xyz, .pts, .txt): points and faces, the attributes present (normals,\n"
+    "Point file (.ply, .xyz, .pts, .txt, .las): points and faces, the attributes present (normals,\n"
     "colours, radii, texture coordinates, labels and extra properties with their types), the\n"
-    "bounding box in world coordinates and the radius statistics. Mesh (OBJ, PLY with faces,\n"
+    "bounding box in world coordinates and the radius statistics; for LAS also the version,\n"
+    "point format, header counts, scale, offset, header bounds and VLRs. Mesh (OBJ, PLY with faces,\n"
     "OFF, STL, glTF, 3DS ...): vertices, triangles, UV sets, vertex colours, materials with\n"
     "their colour and texture (a texture file that cannot be found is named as MISSING; info\n"
     "still succeeds), the bounds as 'sample' will see them and the up axis assumed. Primitive\n"
@@ -53,6 +54,22 @@ static struct radius_stats radius_stats(const asp_cloud *c)
     return s;
 }
 
+/* The LAS header of a cloud read from LAS: version, format, counts, scale and offset, the header's bounds. */
+static void print_las_text(const asp_las_meta *m)
+{
+    printf("las         version 1.%u, point format %u, %u-byte records, %llu points in the header\n",
+           m->version_minor, m->point_format, m->record_length, (unsigned long long)m->point_count);
+    printf("las scale   %.15g %.15g %.15g\n", m->scale[0], m->scale[1], m->scale[2]);
+    printf("las offset  %.15g %.15g %.15g\n", m->offset[0], m->offset[1], m->offset[2]);
+    printf("las bounds  %.15g %.15g %.15g  to  %.15g %.15g %.15g (header)\n", m->min[0], m->min[1], m->min[2],
+           m->max[0], m->max[1], m->max[2]);
+    printf("las system  '%s', software '%s', created day %u of %u\n", m->system_id, m->software, m->creation_day,
+           m->creation_year);
+    for (size_t i = 0; i < m->vlr_count; i++)
+        printf("las %s '%s' %u: %zu bytes, '%s'\n", m->vlrs[i].extended ? "evlr" : "vlr ", m->vlrs[i].user_id,
+               m->vlrs[i].record_id, m->vlrs[i].size, m->vlrs[i].description);
+}
+
 static void print_text(const char *path, const asp_cloud *c, const double lo[3], const double hi[3],
                        struct radius_stats r)
 {
@@ -71,6 +88,8 @@ static void print_text(const char *path, const asp_cloud *c, const double lo[3],
     double d = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
     printf("diagonal    %.9g\n", d);
+    if (c->las)
+        print_las_text(c->las);
     if (c->radii)
         printf("radius      mean %.6g min %.6g max %.6g\n", r.mean, r.min, r.max);
     for (size_t i = 0; i < c->comment_count; i++)
@@ -79,33 +98,73 @@ static void print_text(const char *path, const asp_cloud *c, const double lo[3],
         printf("obj_info    %s\n", c->obj_info[i]);
 }
 
-static void print_json(const char *path, const asp_cloud *c, const double lo[3], const double hi[3],
-                       struct radius_stats r)
+static cJSON *las_json(const asp_las_meta *m)
 {
-    printf("{\"file\": ");
-    cli_json_string(stdout, path);
-    printf(", \"points\": %zu, \"faces\": %zu, \"position_type\": \"%s\"", c->count, c->face_count,
-           asp_scalar_name(c->position_type));
-    printf(", \"normals\": %s, \"colors\": %s, \"radii\": %s, \"uvs\": %s, \"labels\": %s",
-           c->normals ? "true" : "false", c->colors ? "true" : "false", c->radii ? "true" : "false",
-           c->uvs ? "true" : "false", c->labels ? "true" : "false");
-    printf(", \"properties\": [");
+    cJSON *o = cJSON_CreateObject(), *v = cJSON_CreateArray(), *br = cJSON_CreateArray();
+    char version[8];
+    snprintf(version, sizeof version, "1.%u", m->version_minor);
+    cJSON_AddStringToObject(o, "version", version);
+    cJSON_AddNumberToObject(o, "point_format", m->point_format);
+    cJSON_AddNumberToObject(o, "record_length", m->record_length);
+    cJSON_AddNumberToObject(o, "point_count", (double)m->point_count);
+    for (int k = 0; k < 15; k++)
+        cJSON_AddItemToArray(br, cJSON_CreateNumber((double)m->points_by_return[k]));
+    cJSON_AddItemToObject(o, "points_by_return", br);
+    cJSON_AddItemToObject(o, "scale", cli_json_doubles(m->scale, 3));
+    cJSON_AddItemToObject(o, "offset", cli_json_doubles(m->offset, 3));
+    cJSON_AddItemToObject(o, "min", cli_json_doubles(m->min, 3));
+    cJSON_AddItemToObject(o, "max", cli_json_doubles(m->max, 3));
+    cJSON_AddStringToObject(o, "system_id", m->system_id);
+    cJSON_AddStringToObject(o, "software", m->software);
+    cJSON_AddNumberToObject(o, "creation_day", m->creation_day);
+    cJSON_AddNumberToObject(o, "creation_year", m->creation_year);
+    for (size_t i = 0; i < m->vlr_count; i++) {
+        cJSON *r = cJSON_CreateObject();
+        cJSON_AddStringToObject(r, "user_id", m->vlrs[i].user_id);
+        cJSON_AddNumberToObject(r, "record_id", m->vlrs[i].record_id);
+        cJSON_AddStringToObject(r, "description", m->vlrs[i].description);
+        cJSON_AddBoolToObject(r, "extended", m->vlrs[i].extended);
+        cJSON_AddNumberToObject(r, "bytes", (double)m->vlrs[i].size);
+        cJSON_AddItemToArray(v, r);
+    }
+    cJSON_AddItemToObject(o, "vlrs", v);
+    return o;
+}
+
+static int print_json(const struct cli_env *env, const char *path, const asp_cloud *c, const double lo[3],
+                      const double hi[3], struct radius_stats r)
+{
+    cJSON *o = cJSON_CreateObject(), *props = cJSON_CreateArray(), *comments = cJSON_CreateArray();
+    cJSON_AddStringToObject(o, "file", path);
+    cJSON_AddNumberToObject(o, "points", (double)c->count);
+    cJSON_AddNumberToObject(o, "faces", (double)c->face_count);
+    cJSON_AddStringToObject(o, "position_type", asp_scalar_name(c->position_type));
+    cJSON_AddBoolToObject(o, "normals", c->normals != NULL);
+    cJSON_AddBoolToObject(o, "colors", c->colors != NULL);
+    cJSON_AddBoolToObject(o, "radii", c->radii != NULL);
+    cJSON_AddBoolToObject(o, "uvs", c->uvs != NULL);
+    cJSON_AddBoolToObject(o, "labels", c->labels != NULL);
     for (size_t i = 0; i < c->property_count; i++) {
-        printf("%s{\"name\": ", i ? ", " : "");
-        cli_json_string(stdout, c->properties[i].name);
-        printf(", \"type\": \"%s\"}", asp_scalar_name(c->properties[i].type));
+        cJSON *p = cJSON_CreateObject();
+        cJSON_AddStringToObject(p, "name", c->properties[i].name);
+        cJSON_AddStringToObject(p, "type", asp_scalar_name(c->properties[i].type));
+        cJSON_AddItemToArray(props, p);
     }
-    printf("], \"origin\": [%.17g, %.17g, %.17g]", c->origin[0], c->origin[1], c->origin[2]);
-    printf(", \"bbox_min\": [%.17g, %.17g, %.17g], \"bbox_max\": [%.17g, %.17g, %.17g]", lo[0], lo[1], lo[2], hi[0],
-           hi[1], hi[2]);
-    if (c->radii)
-        printf(", \"radius_mean\": %.9g, \"radius_min\": %.9g, \"radius_max\": %.9g", r.mean, r.min, r.max);
-    printf(", \"comments\": [");
-    for (size_t i = 0; i < c->comment_count; i++) {
-        printf("%s", i ? ", " : "");
-        cli_json_string(stdout, c->comments[i]);
+    cJSON_AddItemToObject(o, "properties", props);
+    cJSON_AddItemToObject(o, "origin", cli_json_doubles(c->origin, 3));
+    cJSON_AddItemToObject(o, "bbox_min", cli_json_doubles(lo, 3));
+    cJSON_AddItemToObject(o, "bbox_max", cli_json_doubles(hi, 3));
+    if (c->radii) {
+        cJSON_AddItemToObject(o, "radius_mean", cli_json_number("%.9g", r.mean));
+        cJSON_AddItemToObject(o, "radius_min", cli_json_number("%.9g", r.min));
+        cJSON_AddItemToObject(o, "radius_max", cli_json_number("%.9g", r.max));
     }
-    printf("]}\n");
+    for (size_t i = 0; i < c->comment_count; i++)
+        cJSON_AddItemToArray(comments, cJSON_CreateString(c->comments[i]));
+    cJSON_AddItemToObject(o, "comments", comments);
+    if (c->las)
+        cJSON_AddItemToObject(o, "las", las_json(c->las));
+    return cli_json_print(env, o);
 }
 
 /* The framing sphere recorded with a representation (asp_frame); radius 0 means the file predates it. */
@@ -118,13 +177,16 @@ static void print_frame_text(const asp_frame *f)
         printf("frame       not recorded\n");
 }
 
-static void print_frame_json(const asp_frame *f)
+static void add_frame_json(cJSON *o, const asp_frame *f)
 {
-    if (f && f->radius > 0)
-        printf(", \"frame\": {\"center\": [%.17g, %.17g, %.17g], \"radius\": %.17g}", f->center[0], f->center[1],
-               f->center[2], f->radius);
-    else
-        printf(", \"frame\": null");
+    if (f && f->radius > 0) {
+        cJSON *fr = cJSON_CreateObject();
+        cJSON_AddItemToObject(fr, "center", cli_json_doubles(f->center, 3));
+        cJSON_AddItemToObject(fr, "radius", cli_json_number("%.17g", f->radius));
+        cJSON_AddItemToObject(o, "frame", fr);
+    } else {
+        cJSON_AddNullToObject(o, "frame");
+    }
 }
 
 /* A .dps file (amgsplat build): the thesis Table 5.2 columns per stored level. */
@@ -138,26 +200,39 @@ static int info_dps(const char *path, struct cli_env *env)
     size_t nl = dps->level_count < 64 ? dps->level_count : 64;
     asp_dps_summarize(dps, rows, 64);
     cli_progress_end(env);
+    int rc = 0;
     if (env->json) {
-        printf("{\"file\": ");
-        cli_json_string(stdout, path);
-        printf(", \"source\": ");
-        cli_json_string(stdout, dps->source);
-        printf(", \"points\": %llu, \"mean_radius\": %.9g, \"method\": \"%s\", \"texel_size\": %g",
-               (unsigned long long)dps->source_points, dps->mean_radius, asp_prim_method_name(dps->desc.method),
-               dps->desc.texel_size);
-        print_frame_json(&dps->frame);
-        printf(", \"levels\": [");
-        for (size_t i = 0; i < nl; i++)
-            printf("%s{\"level\": %u, \"name\": \"%s\", \"primitives\": %zu, \"texels\": %llu, \"error\": %.9g, "
-                   "\"normalised_error\": %.6g, \"cb_seconds\": %.4f, \"dpc_seconds\": %.4f, \"skipped\": %u, "
-                   "\"degenerate\": %u, \"capped\": %u, \"merges\": %u, \"atlas\": [%u, %u], "
-                   "\"neighbour_pairs\": %zu, \"normal_map\": %s}",
-                   i ? ", " : "", rows[i].level, rows[i].name, rows[i].primitives, (unsigned long long)rows[i].texels,
-                   rows[i].error, rows[i].error_norm, rows[i].t_basis, rows[i].t_construct, rows[i].skipped,
-                   rows[i].degenerate, rows[i].capped, rows[i].merges, rows[i].atlas_width, rows[i].atlas_height,
-                   rows[i].neighbour_pairs, rows[i].normal_map ? "true" : "false");
-        printf("]}\n");
+        cJSON *o = cJSON_CreateObject(), *levels = cJSON_CreateArray();
+        cJSON_AddStringToObject(o, "file", path);
+        cJSON_AddStringToObject(o, "source", dps->source);
+        cJSON_AddNumberToObject(o, "points", (double)dps->source_points);
+        cJSON_AddItemToObject(o, "mean_radius", cli_json_number("%.9g", dps->mean_radius));
+        cJSON_AddStringToObject(o, "method", asp_prim_method_name(dps->desc.method));
+        cJSON_AddItemToObject(o, "texel_size", cli_json_number("%g", dps->desc.texel_size));
+        add_frame_json(o, &dps->frame);
+        for (size_t i = 0; i < nl; i++) {
+            cJSON *l = cJSON_CreateObject();
+            cJSON_AddNumberToObject(l, "level", rows[i].level);
+            cJSON_AddStringToObject(l, "name", rows[i].name);
+            cJSON_AddNumberToObject(l, "primitives", (double)rows[i].primitives);
+            cJSON_AddNumberToObject(l, "texels", (double)rows[i].texels);
+            cJSON_AddItemToObject(l, "error", cli_json_number("%.9g", rows[i].error));
+            cJSON_AddItemToObject(l, "normalised_error", cli_json_number("%.6g", rows[i].error_norm));
+            cJSON_AddItemToObject(l, "cb_seconds", cli_json_number("%.4f", rows[i].t_basis));
+            cJSON_AddItemToObject(l, "dpc_seconds", cli_json_number("%.4f", rows[i].t_construct));
+            cJSON_AddNumberToObject(l, "skipped", rows[i].skipped);
+            cJSON_AddNumberToObject(l, "degenerate", rows[i].degenerate);
+            cJSON_AddNumberToObject(l, "capped", rows[i].capped);
+            cJSON_AddNumberToObject(l, "merges", rows[i].merges);
+            cJSON_AddItemToObject(l, "atlas",
+                                  cJSON_CreateIntArray((const int[]){(int)rows[i].atlas_width, (int)rows[i].atlas_height},
+                                                       2));
+            cJSON_AddNumberToObject(l, "neighbour_pairs", (double)rows[i].neighbour_pairs);
+            cJSON_AddBoolToObject(l, "normal_map", rows[i].normal_map);
+            cJSON_AddItemToArray(levels, l);
+        }
+        cJSON_AddItemToObject(o, "levels", levels);
+        rc = cli_json_print(env, o);
     } else {
         printf("file        %s\nsource      %s (%llu points, mean radius %.6g)\n", path, dps->source,
                (unsigned long long)dps->source_points, dps->mean_radius);
@@ -170,7 +245,7 @@ static int info_dps(const char *path, struct cli_env *env)
                    rows[i].t_basis, rows[i].t_construct, rows[i].atlas_width, rows[i].atlas_height);
     }
     asp_dps_destroy(dps);
-    return 0;
+    return rc;
 }
 
 /* An .amg file (amgsplat decompose): the stored points and the size of every level (journal section 2). */
@@ -184,22 +259,28 @@ static int info_amg(const char *path, struct cli_env *env)
     const size_t nl = asp_amg_level_count(amg);
     const char *normals = asp_amg_has_input_normals(amg) ? "input" : "tangent planes (unoriented)";
     cli_progress_end(env);
+    int rc = 0;
     if (env->json) {
-        printf("{\"file\": ");
-        cli_json_string(stdout, path);
-        printf(", \"points\": %zu, \"normals\": \"%s\", \"colors\": %s, \"radii\": %s, \"uvs\": %s, "
-               "\"labels\": %s",
-               c->count, asp_amg_has_input_normals(amg) ? "input" : "tangent", c->colors ? "true" : "false",
-               c->radii ? "true" : "false", c->uvs ? "true" : "false", c->labels ? "true" : "false");
-        print_frame_json(asp_amg_frame(amg));
-        printf(", \"levels\": [");
+        cJSON *o = cJSON_CreateObject(), *levels = cJSON_CreateArray();
+        cJSON_AddStringToObject(o, "file", path);
+        cJSON_AddNumberToObject(o, "points", (double)c->count);
+        cJSON_AddStringToObject(o, "normals", asp_amg_has_input_normals(amg) ? "input" : "tangent");
+        cJSON_AddBoolToObject(o, "colors", c->colors != NULL);
+        cJSON_AddBoolToObject(o, "radii", c->radii != NULL);
+        cJSON_AddBoolToObject(o, "uvs", c->uvs != NULL);
+        cJSON_AddBoolToObject(o, "labels", c->labels != NULL);
+        add_frame_json(o, asp_amg_frame(amg));
         for (size_t l = 0; l < nl; l++) {
             char name[32];
             snprintf(name, sizeof name, l == nl - 1 ? "L" : "L-%zu", nl - 1 - l);
-            printf("%s{\"level\": %zu, \"name\": \"%s\", \"unknowns\": %zu}", l ? ", " : "", l, name,
-                   asp_amg_level_size(amg, l));
+            cJSON *lv = cJSON_CreateObject();
+            cJSON_AddNumberToObject(lv, "level", (double)l);
+            cJSON_AddStringToObject(lv, "name", name);
+            cJSON_AddNumberToObject(lv, "unknowns", (double)asp_amg_level_size(amg, l));
+            cJSON_AddItemToArray(levels, lv);
         }
-        printf("]}\n");
+        cJSON_AddItemToObject(o, "levels", levels);
+        rc = cli_json_print(env, o);
     } else {
         printf("file        %s\npoints      %zu\nnormals     %s\nattributes ", path, c->count, normals);
         printf("%s%s%s%s\n", c->colors ? " colours" : "", c->radii ? " radii" : "", c->uvs ? " uvs" : "",
@@ -215,7 +296,7 @@ static int info_amg(const char *path, struct cli_env *env)
         }
     }
     asp_amg_destroy(amg);
-    return 0;
+    return rc;
 }
 
 /* A .hier file (asp_hier_save): the point hierarchy's shape (thesis chapter 4). */
@@ -226,13 +307,17 @@ static int info_hier(const char *path, struct cli_env *env)
     if (asp_hier_load(path, &env->ctx, &h, &err))
         return cli_fail(env, &err);
     cli_progress_end(env);
+    int rc = 0;
     if (env->json) {
-        printf("{\"file\": ");
-        cli_json_string(stdout, path);
-        printf(", \"kind\": \"hier\", \"nodes\": %zu, \"points\": %zu, \"depth\": %u, \"leaf_size\": %zu",
-               asp_hier_node_count(h), asp_hier_point_count(h), asp_hier_depth(h), asp_hier_leaf_size(h));
-        print_frame_json(asp_hier_frame(h));
-        printf("}\n");
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "file", path);
+        cJSON_AddStringToObject(o, "kind", "hier");
+        cJSON_AddNumberToObject(o, "nodes", (double)asp_hier_node_count(h));
+        cJSON_AddNumberToObject(o, "points", (double)asp_hier_point_count(h));
+        cJSON_AddNumberToObject(o, "depth", asp_hier_depth(h));
+        cJSON_AddNumberToObject(o, "leaf_size", (double)asp_hier_leaf_size(h));
+        add_frame_json(o, asp_hier_frame(h));
+        rc = cli_json_print(env, o);
     } else {
         printf("file        %s\nkind        point hierarchy (.hier)\nnodes       %zu\npoints      %zu\n"
                "depth       %u\nleaf size   %zu\n",
@@ -240,7 +325,7 @@ static int info_hier(const char *path, struct cli_env *env)
         print_frame_text(asp_hier_frame(h));
     }
     asp_hier_destroy(h);
-    return 0;
+    return rc;
 }
 
 static int info_image(const char *path, const asp_file_type *type, struct cli_env *env)
@@ -252,10 +337,14 @@ static int info_image(const char *path, const asp_file_type *type, struct cli_en
     static const char *const layout[] = {"", "grey", "grey+alpha", "RGB", "RGBA"};
     cli_progress_end(env);
     if (env->json) {
-        printf("{\"file\": ");
-        cli_json_string(stdout, path);
-        printf(", \"kind\": \"image\", \"format\": \"%s\", \"width\": %u, \"height\": %u, \"channels\": %u}\n",
-               type->format, hd.width, hd.height, hd.channels);
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "file", path);
+        cJSON_AddStringToObject(o, "kind", "image");
+        cJSON_AddStringToObject(o, "format", type->format);
+        cJSON_AddNumberToObject(o, "width", hd.width);
+        cJSON_AddNumberToObject(o, "height", hd.height);
+        cJSON_AddNumberToObject(o, "channels", hd.channels);
+        return cli_json_print(env, o);
     } else {
         printf("file        %s\nkind        image (%s)\nsize        %ux%u\nchannels    %u (%s)\n", path, type->format,
                hd.width, hd.height, hd.channels, layout[hd.channels]);
@@ -317,44 +406,52 @@ static void print_mesh_text(const char *path, const asp_file_type *type, const a
     printf("up          %s (%s)\n", up_name(m->up), m->up_rule);
 }
 
-static void print_mesh_json(const char *path, const asp_file_type *type, const asp_mesh *m, const double lo[3],
-                            const double hi[3], const unsigned char *used_by, size_t found, size_t missing)
+static int print_mesh_json(const struct cli_env *env, const char *path, const asp_file_type *type,
+                           const asp_mesh *m, const double lo[3], const double hi[3], const unsigned char *used_by,
+                           size_t found, size_t missing)
 {
-    printf("{\"file\": ");
-    cli_json_string(stdout, path);
-    printf(", \"kind\": \"mesh\", \"format\": \"%s\", \"vertices\": %zu, \"faces\": %zu, \"uv_sets\": %u, "
-           "\"vertex_colors\": %s, \"materials\": [",
-           type->format, m->vertex_count, m->triangle_count, m->uv_set_count, m->colors ? "true" : "false");
-    for (size_t i = 0, k = 0; i < m->material_count; i++) {
+    cJSON *o = cJSON_CreateObject(), *mats = cJSON_CreateArray(), *miss = cJSON_CreateArray();
+    cJSON_AddStringToObject(o, "file", path);
+    cJSON_AddStringToObject(o, "kind", "mesh");
+    cJSON_AddStringToObject(o, "format", type->format);
+    cJSON_AddNumberToObject(o, "vertices", (double)m->vertex_count);
+    cJSON_AddNumberToObject(o, "faces", (double)m->triangle_count);
+    cJSON_AddNumberToObject(o, "uv_sets", m->uv_set_count);
+    cJSON_AddBoolToObject(o, "vertex_colors", m->colors != NULL);
+    for (size_t i = 0; i < m->material_count; i++) {
         const asp_material *mt = &m->materials[i];
         if (!used_by[i])
             continue;
-        printf("%s{\"name\": ", k++ ? ", " : "");
-        cli_json_string(stdout, mt->name);
-        if (mt->has_color)
-            printf(", \"color\": [%.6g, %.6g, %.6g, %.6g]", mt->diffuse[0], mt->diffuse[1], mt->diffuse[2],
-                   mt->diffuse[3]);
-        else
-            printf(", \"color\": null");
-        printf(", \"texture\": ");
-        if (mt->texture_path[0])
-            cli_json_string(stdout, mt->texture_path);
-        else
-            printf("null");
-        printf(", \"texture_missing\": %s}", mt->texture_missing ? "true" : "false");
-    }
-    printf("], \"textures_found\": %zu, \"textures_missing\": [", found);
-    for (size_t i = 0, k = 0; i < m->material_count; i++)
-        if (m->materials[i].texture_missing && used_by[i]) {
-            printf("%s", k++ ? ", " : "");
-            cli_json_string(stdout, m->materials[i].texture_path);
+        cJSON *j = cJSON_CreateObject();
+        cJSON_AddStringToObject(j, "name", mt->name);
+        if (mt->has_color) {
+            cJSON *col = cJSON_CreateArray();
+            for (int k = 0; k < 4; k++)
+                cJSON_AddItemToArray(col, cli_json_number("%.6g", mt->diffuse[k]));
+            cJSON_AddItemToObject(j, "color", col);
+        } else {
+            cJSON_AddNullToObject(j, "color");
         }
-    printf("], \"textures_missing_count\": %zu, \"bbox_min\": [%.17g, %.17g, %.17g], "
-           "\"bbox_max\": [%.17g, %.17g, %.17g], \"area\": %.9g",
-           missing, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], asp_mesh_area(m));
-    printf(", \"up\": \"%s\", \"up_rule\": ", up_name(m->up));
-    cli_json_string(stdout, m->up_rule);
-    printf("}\n");
+        if (mt->texture_path[0])
+            cJSON_AddStringToObject(j, "texture", mt->texture_path);
+        else
+            cJSON_AddNullToObject(j, "texture");
+        cJSON_AddBoolToObject(j, "texture_missing", mt->texture_missing);
+        cJSON_AddItemToArray(mats, j);
+    }
+    cJSON_AddItemToObject(o, "materials", mats);
+    cJSON_AddNumberToObject(o, "textures_found", (double)found);
+    for (size_t i = 0; i < m->material_count; i++)
+        if (m->materials[i].texture_missing && used_by[i])
+            cJSON_AddItemToArray(miss, cJSON_CreateString(m->materials[i].texture_path));
+    cJSON_AddItemToObject(o, "textures_missing", miss);
+    cJSON_AddNumberToObject(o, "textures_missing_count", (double)missing);
+    cJSON_AddItemToObject(o, "bbox_min", cli_json_doubles(lo, 3));
+    cJSON_AddItemToObject(o, "bbox_max", cli_json_doubles(hi, 3));
+    cJSON_AddItemToObject(o, "area", cli_json_number("%.9g", asp_mesh_area(m)));
+    cJSON_AddStringToObject(o, "up", up_name(m->up));
+    cJSON_AddStringToObject(o, "up_rule", m->up_rule);
+    return cli_json_print(env, o);
 }
 
 /* A point file (or a PLY's vertices): counts, attributes, bounds, radii. */
@@ -376,12 +473,13 @@ static int info_points(const char *path, struct cli_env *env)
     }
     struct radius_stats r = radius_stats(c);
     cli_progress_end(env);
+    int rc = 0;
     if (env->json)
-        print_json(path, c, lo, hi, r);
+        rc = print_json(env, path, c, lo, hi, r);
     else
         print_text(path, c, lo, hi, r);
     asp_cloud_destroy(c);
-    return 0;
+    return rc;
 }
 
 /* A mesh, loaded as 'sample' would but tolerating missing textures, so they can be named. */
@@ -415,13 +513,14 @@ static int info_mesh(const char *path, const asp_file_type *type, struct cli_env
         missing += m->materials[i].texture_missing != 0;
     }
     cli_progress_end(env);
+    int rc = 0;
     if (env->json)
-        print_mesh_json(path, type, m, lo, hi, used_by, found, missing);
+        rc = print_mesh_json(env, path, type, m, lo, hi, used_by, found, missing);
     else
         print_mesh_text(path, type, m, lo, hi, used_by, used, found, missing);
     free(used_by);
     asp_mesh_destroy(m);
-    return 0;
+    return rc;
 }
 
 int cmd_info(int argc, char **argv, struct cli_env *env)

@@ -18,7 +18,7 @@
 static const char usage[] =
     "usage: amgsplat render IN.ply -o OUT.png [--size WxH] [--view AZ,EL[,DIST]] [--views N]\n"
     "                      [--renderer disc|splat|square] [--tolerance PX | --budget N] [--kernel A,B,N]\n"
-    "                      [--epsilon X] [--lighting gouraud|pixel|flat] [--opaque] [--point-size PX]\n"
+    "                      [--epsilon X] [--lighting gouraud|pixel|flat] [--opaque] [--unlit] [--point-size PX]\n"
     "                      [--background R,G,B[,A] | --transparent] [--light AZ,EL]\n"
     "                      [--preset thesis|journal|pajarola|schwarz] [--kernel-rim 1|b] [--kernel-shape psi-e|psi-g]\n"
     "                      [--epsilon-uniform X] [--tolerance-area PCT] [--axes sqrt|lambda] [--cull-backfaces]\n"
@@ -66,6 +66,7 @@ struct render_opts {
     double epsilon;
     double point_size;
     int opaque;
+    int unlit; /* --unlit: the colours as they are, no shading (ASP_RENDER_UNLIT) */
     const char *method;
     const char *preset; /* --preset: applied by cli_parse (docs/seeds.md) */
     const char *kernel_shape, *kernel_rim, *axes; /* seed 001 eq. 11-12, eq. 5-6 (docs/seeds.md) */
@@ -360,7 +361,8 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
 {
     vs->min_count = SIZE_MAX;
     asp_render_desc desc = {.width = o->width, .height = o->height, .samples = (uint32_t)o->samples,
-                            .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el};
+                            .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el,
+                            .flags = o->unlit ? ASP_RENDER_UNLIT : 0u};
     memcpy(desc.background, o->bg, 4);
     for (size_t i = 0; i < o->views; i++) {
         asp_camera cam;
@@ -385,33 +387,39 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
     return 0;
 }
 
-static void print_json(const struct render_opts *o, size_t count, const asp_scene *s, asp_gl_context *gl, const char *renderer,
-                       const asp_image *img, const struct view_stats *vs, double seconds)
+static int print_json(const struct cli_env *env, const struct render_opts *o, size_t count, const asp_scene *s,
+                      asp_gl_context *gl, const char *renderer, const asp_image *img, const struct view_stats *vs,
+                      double seconds)
 {
-    printf("{\"output\": ");
-    cli_json_string(stdout, o->output);
-    printf(", \"width\": %u, \"height\": %u, \"tile_width\": %u, \"tile_height\": %u, \"views\": %zu, "
-           "\"points\": %zu, \"renderer\": ",
-           img->width, img->height, o->width, o->height, o->views, count);
-    cli_json_string(stdout, renderer);
+    cJSON *j = cJSON_CreateObject(), *frame = cJSON_CreateArray();
+    cJSON_AddStringToObject(j, "output", o->output);
+    cJSON_AddNumberToObject(j, "width", img->width);
+    cJSON_AddNumberToObject(j, "height", img->height);
+    cJSON_AddNumberToObject(j, "tile_width", o->width);
+    cJSON_AddNumberToObject(j, "tile_height", o->height);
+    cJSON_AddNumberToObject(j, "views", (double)o->views);
+    cJSON_AddNumberToObject(j, "points", (double)count);
+    cJSON_AddStringToObject(j, "renderer", renderer);
     if (o->dps_input) {
-        printf(", \"method\": ");
-        cli_json_string(stdout, asp_prim_render_method_name(o->prim.method));
-        printf(", \"level\": %u", asp_scene_dps_level(s)->level);
+        cJSON_AddStringToObject(j, "method", asp_prim_render_method_name(o->prim.method));
+        cJSON_AddNumberToObject(j, "level", asp_scene_dps_level(s)->level);
     }
-    printf(", \"gl_renderer\": ");
-    cli_json_string(stdout, asp_gl_context_renderer(gl));
-    printf(", \"gl_backend\": ");
-    cli_json_string(stdout, asp_gl_context_backend(gl));
+    cJSON_AddStringToObject(j, "gl_renderer", asp_gl_context_renderer(gl));
+    cJSON_AddStringToObject(j, "gl_backend", asp_gl_context_backend(gl));
     int lod = strcmp(renderer, "disc") && strcmp(renderer, "prim") && strcmp(renderer, "mesh");
-    printf(", \"primitives\": %zu, \"primitives_min\": %zu, \"primitives_max\": %zu, \"tolerance\": %g, "
-           "\"budget\": %zu, \"view_ms\": %.3f",
-           vs->last_count, vs->min_count, vs->max_count, lod && !o->budget ? o->tolerance : 0.0, o->budget,
-           1e3 * vs->seconds / (double)o->views);
+    cJSON_AddNumberToObject(j, "primitives", (double)vs->last_count);
+    cJSON_AddNumberToObject(j, "primitives_min", (double)vs->min_count);
+    cJSON_AddNumberToObject(j, "primitives_max", (double)vs->max_count);
+    cJSON_AddItemToObject(j, "tolerance", cli_json_number("%g", lod && !o->budget ? o->tolerance : 0.0));
+    cJSON_AddNumberToObject(j, "budget", (double)o->budget);
+    cJSON_AddItemToObject(j, "view_ms", cli_json_number("%.3f", 1e3 * vs->seconds / (double)o->views));
     // the camera's sphere, so two inputs of one model can be checked to frame alike
-    printf(", \"frame\": [%.9g, %.9g, %.9g, %.9g]", s->frame.center[0], s->frame.center[1], s->frame.center[2],
-           s->frame.radius);
-    printf(", \"seconds\": %.3f}\n", seconds);
+    for (int k = 0; k < 3; k++)
+        cJSON_AddItemToArray(frame, cli_json_number("%.9g", s->frame.center[k]));
+    cJSON_AddItemToArray(frame, cli_json_number("%.9g", s->frame.radius));
+    cJSON_AddItemToObject(j, "frame", frame);
+    cJSON_AddItemToObject(j, "seconds", cli_json_number("%.3f", seconds));
+    return cli_json_print(env, j);
 }
 
 int cmd_render(int argc, char **argv, struct cli_env *env)
@@ -442,6 +450,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"axes", 0, CLI_STRING, &o.axes, "A", "splat, square: ellipse axis ratio sqrt (default) or lambda (seed 001 eq. 5-6)"},
         {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
         {"opaque", 0, CLI_FLAG, &o.opaque, NULL, "splat: opaque ellipses, no blending"},
+        {"unlit", 0, CLI_FLAG, &o.unlit, NULL, "colours as they are, no shading (the seeds' flat textured primitives; web viewer's light=off)"},
         {"point-size", 0, CLI_DOUBLE, &o.point_size, "PX", "square: fixed side in pixels (default 0: projected size)"},
         {"color-by", 0, CLI_STRING, &o.color_by, "MODE", ".amg input: classifier, domains or strict; .dps input: domain"},
         {"level", 0, CLI_STRING, &o.level, "L", ".amg: level of the domain colours (default L-3); .dps: level drawn (default the finest in the file)"},
@@ -555,7 +564,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     } else {
         cli_progress_end(env);
         if (env->json)
-            print_json(&o, count, &s, gl, kind->name, result, &vs, seconds);
+            status = print_json(env, &o, count, &s, gl, kind->name, result, &vs, seconds);
         else
             cli_info(env,
                      "rendered %zu view%s of %zu %s (%s, %zu primitives in the last view, %.1f ms per view, %s) "

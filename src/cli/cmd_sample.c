@@ -144,15 +144,22 @@ int cmd_sample(int argc, char **argv, struct cli_env *env)
         return cli_fail(env, &err);
     cli_progress_end(env);
     if (env->json) {
-        printf("{\"mesh\": ");
-        cli_json_string(stdout, argv[0]);
-        printf(", \"output\": ");
-        cli_json_string(stdout, output);
-        printf(", \"method\": \"%s\", \"vertices\": %zu, \"triangles\": %zu, \"points\": %zu, \"area\": %.9g, "
-               "\"mean_radius\": %.9g, \"colors\": %s, \"seconds\": {\"load\": %.4f, \"sample\": %.4f, "
-               "\"radii\": %.4f, \"save\": %.4f}}\n",
-               method_name, nv, nt, st.points, st.area, st.mean_radius, has_colors ? "true" : "false", t_load,
-               st.sample_seconds, st.radii_seconds, t_save);
+        cJSON *o = cJSON_CreateObject(), *sec = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "mesh", argv[0]);
+        cJSON_AddStringToObject(o, "output", output);
+        cJSON_AddStringToObject(o, "method", method_name);
+        cJSON_AddNumberToObject(o, "vertices", (double)nv);
+        cJSON_AddNumberToObject(o, "triangles", (double)nt);
+        cJSON_AddNumberToObject(o, "points", (double)st.points);
+        cJSON_AddItemToObject(o, "area", cli_json_number("%.9g", st.area));
+        cJSON_AddItemToObject(o, "mean_radius", cli_json_number("%.9g", st.mean_radius));
+        cJSON_AddBoolToObject(o, "colors", has_colors);
+        cJSON_AddItemToObject(sec, "load", cli_json_number("%.4f", t_load));
+        cJSON_AddItemToObject(sec, "sample", cli_json_number("%.4f", st.sample_seconds));
+        cJSON_AddItemToObject(sec, "radii", cli_json_number("%.4f", st.radii_seconds));
+        cJSON_AddItemToObject(sec, "save", cli_json_number("%.4f", t_save));
+        cJSON_AddItemToObject(o, "seconds", sec);
+        return cli_json_print(env, o);
     } else if (!env->quiet) {
         printf("%s: %zu points (%s) from %zu triangles, area %.6g, mean radius %.4g%s, %.2f s\n", output, st.points,
                method_name, nt, st.area, st.mean_radius, has_colors ? ", coloured" : "",

@@ -22,22 +22,35 @@ static const char usage[] =
 #include "cli/commands.h"
 #include "util/banned.h"
 
-static void print_json(const char *in, const char *out, const asp_mesh_simplify_stats *st, const asp_mesh_bytes *bi,
-                       const asp_mesh_bytes *bo)
+static cJSON *bytes_json(const asp_mesh_bytes *b)
 {
-    printf("{\"input\": ");
-    cli_json_string(stdout, in);
-    printf(", \"output\": ");
-    cli_json_string(stdout, out);
-    printf(", \"target_triangles\": %zu, \"input_triangles\": %zu, \"input_vertices\": %zu, "
-           "\"triangles\": %zu, \"vertices\": %zu, \"error\": %.9g, \"error_world\": %.9g, "
-           "\"short_of_target\": %s, \"sloppy\": %s, \"material_groups\": %zu, "
-           "\"input_bytes\": {\"vertex\": %zu, \"index\": %zu, \"texture\": %zu, \"total\": %zu}, "
-           "\"bytes\": {\"vertex\": %zu, \"index\": %zu, \"texture\": %zu, \"total\": %zu}}\n",
-           st->target_triangles, st->input_triangles, st->input_vertices, st->output_triangles, st->output_vertices,
-           st->error, st->error_world, st->short_of_target ? "true" : "false", st->sloppy ? "true" : "false",
-           st->material_groups, bi->vertex, bi->index, bi->texture, bi->total, bo->vertex, bo->index, bo->texture,
-           bo->total);
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "vertex", (double)b->vertex);
+    cJSON_AddNumberToObject(o, "index", (double)b->index);
+    cJSON_AddNumberToObject(o, "texture", (double)b->texture);
+    cJSON_AddNumberToObject(o, "total", (double)b->total);
+    return o;
+}
+
+static int print_json(const struct cli_env *env, const char *in, const char *out, const asp_mesh_simplify_stats *st,
+                      const asp_mesh_bytes *bi, const asp_mesh_bytes *bo)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "input", in);
+    cJSON_AddStringToObject(o, "output", out);
+    cJSON_AddNumberToObject(o, "target_triangles", (double)st->target_triangles);
+    cJSON_AddNumberToObject(o, "input_triangles", (double)st->input_triangles);
+    cJSON_AddNumberToObject(o, "input_vertices", (double)st->input_vertices);
+    cJSON_AddNumberToObject(o, "triangles", (double)st->output_triangles);
+    cJSON_AddNumberToObject(o, "vertices", (double)st->output_vertices);
+    cJSON_AddItemToObject(o, "error", cli_json_number("%.9g", st->error));
+    cJSON_AddItemToObject(o, "error_world", cli_json_number("%.9g", st->error_world));
+    cJSON_AddBoolToObject(o, "short_of_target", st->short_of_target);
+    cJSON_AddBoolToObject(o, "sloppy", st->sloppy);
+    cJSON_AddNumberToObject(o, "material_groups", (double)st->material_groups);
+    cJSON_AddItemToObject(o, "input_bytes", bytes_json(bi));
+    cJSON_AddItemToObject(o, "bytes", bytes_json(bo));
+    return cli_json_print(env, o);
 }
 
 int cmd_simplify(int argc, char **argv, struct cli_env *env)
@@ -104,8 +117,9 @@ int cmd_simplify(int argc, char **argv, struct cli_env *env)
     asp_mesh_bytes bi, bo;
     asp_mesh_gpu_bytes(mesh, &bi);
     asp_mesh_gpu_bytes(simple, &bo);
+    int status = 0;
     if (env->json) {
-        print_json(argv[0], output, &st, &bi, &bo);
+        status = print_json(env, argv[0], output, &st, &bi, &bo);
     } else if (!env->quiet) {
         printf("simplified '%s' -> '%s': %zu -> %zu triangles (target %zu), %zu -> %zu vertices\n", argv[0],
                output, st.input_triangles, st.output_triangles, st.target_triangles, st.input_vertices,
@@ -122,5 +136,5 @@ int cmd_simplify(int argc, char **argv, struct cli_env *env)
                  sloppy ? "; the sloppy fallback got no closer" : "; --sloppy can go further");
     asp_mesh_destroy(simple);
     asp_mesh_destroy(mesh);
-    return 0;
+    return status;
 }

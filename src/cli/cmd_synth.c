@@ -57,10 +57,13 @@ int cmd_synth(int argc, char **argv, struct cli_env *env)
         return cli_fail(env, &err);
     cli_progress_end(env);
     if (env->json) {
-        printf("{\"shape\": \"%s\", \"output\": ", asp_synth_shape_name(shape));
-        cli_json_string(stdout, output);
-        printf(", \"points\": %zu, \"labels\": %s, \"seconds\": %.4f}\n", count, labels ? "true" : "false",
-               asp_time_now() - t0);
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "shape", asp_synth_shape_name(shape));
+        cJSON_AddStringToObject(o, "output", output);
+        cJSON_AddNumberToObject(o, "points", (double)count);
+        cJSON_AddBoolToObject(o, "labels", labels);
+        cJSON_AddItemToObject(o, "seconds", cli_json_number("%.4f", asp_time_now() - t0));
+        return cli_json_print(env, o);
     } else if (!env->quiet) {
         printf("%s: %s, %zu points%s\n", output, asp_synth_shape_name(shape), count, labels ? ", labels" : "");
     }

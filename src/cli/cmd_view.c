@@ -132,24 +132,26 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
     return 0;
 }
 
-static void print_json(const char *path, const asp_viewer_desc *d, const asp_viewer_stats *s)
+static int print_json(const struct cli_env *env, const char *path, const asp_viewer_desc *d,
+                      const asp_viewer_stats *s)
 {
-    printf("{\"input\": ");
-    cli_json_string(stdout, path);
-    printf(", \"frames\": %zu, \"mean_frame_ms\": %.3f, \"last_frame_ms\": %.3f, \"count\": %zu, \"renderer\": ",
-           s->frames, s->mean_frame_ms, s->last_frame_ms, s->count);
-    cli_json_string(stdout, s->renderer);
-    printf(", \"width\": %u, \"height\": %u, \"screenshots\": %zu, \"screenshot\": ", s->width, s->height,
-           s->screenshots);
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "input", path);
+    cJSON_AddNumberToObject(o, "frames", (double)s->frames);
+    cJSON_AddItemToObject(o, "mean_frame_ms", cli_json_number("%.3f", s->mean_frame_ms));
+    cJSON_AddItemToObject(o, "last_frame_ms", cli_json_number("%.3f", s->last_frame_ms));
+    cJSON_AddNumberToObject(o, "count", (double)s->count);
+    cJSON_AddStringToObject(o, "renderer", s->renderer);
+    cJSON_AddNumberToObject(o, "width", s->width);
+    cJSON_AddNumberToObject(o, "height", s->height);
+    cJSON_AddNumberToObject(o, "screenshots", (double)s->screenshots);
     if (d->screenshot)
-        cli_json_string(stdout, d->screenshot);
+        cJSON_AddStringToObject(o, "screenshot", d->screenshot);
     else
-        printf("null");
-    printf(", \"gl_renderer\": ");
-    cli_json_string(stdout, s->gl_renderer);
-    printf(", \"title\": ");
-    cli_json_string(stdout, s->title);
-    printf("}\n");
+        cJSON_AddNullToObject(o, "screenshot");
+    cJSON_AddStringToObject(o, "gl_renderer", s->gl_renderer);
+    cJSON_AddStringToObject(o, "title", s->title);
+    return cli_json_print(env, o);
 }
 
 #ifndef ASP_HAVE_GL
@@ -208,10 +210,9 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
     if (asp_viewer_run(argv[0], &desc, &env->ctx, &stats, &err))
         return cli_fail(env, &err);
     if (env->json)
-        print_json(argv[0], &desc, &stats);
-    else
-        cli_info(env, "drew %zu frames of '%s' (%s, %zu %s, %.2f ms per frame)\n", stats.frames, argv[0],
-                 stats.renderer, stats.count, "primitives", stats.mean_frame_ms);
+        return print_json(env, argv[0], &desc, &stats);
+    cli_info(env, "drew %zu frames of '%s' (%s, %zu %s, %.2f ms per frame)\n", stats.frames, argv[0], stats.renderer,
+             stats.count, "primitives", stats.mean_frame_ms);
     return 0;
 }
 #endif

@@ -20,5 +20,8 @@ int cmd_view(int argc, char **argv, struct cli_env *env);
 int cmd_eval(int argc, char **argv, struct cli_env *env);
 int cmd_simplify(int argc, char **argv, struct cli_env *env);
 int cmd_bench_paper(int argc, char **argv, struct cli_env *env);
+int cmd_export(int argc, char **argv, struct cli_env *env);
+int cmd_experiment_analyze(int argc, char **argv, struct cli_env *env);
+int cmd_experiment_ttest(int argc, char **argv, struct cli_env *env);
 
 #endif

@@ -26,6 +26,7 @@ static const struct cli_command commands[] = {
     {"decompose", cmd_decompose, "multiscale AMG decomposition of a point set into domains"},
     {"simplify", cmd_simplify, "simplify a mesh to N triangles (meshoptimizer), keeping UVs and textures"},
     {"build", cmd_build, "domain primitives (textured polygons) of AMG levels into a .dps file"},
+    {"export", cmd_export, "glTF 2.0 (.glb/.gltf) of domain primitives, point sets and hierarchies"},
     {"view", cmd_view, "open a window on points or an .amg decomposition (interactive viewer)"},
     {"eval", cmd_eval, "measure every representation against the reference: PSNR, SSIM, IoU, frame time"},
     {"bench-paper", cmd_bench_paper, "print the seeds' tables (journal Tables 1-2, thesis Tables 5.1-5.4)"},

@@ -384,19 +384,55 @@ int cli_parse_size2(const char *s, unsigned *w, unsigned *h)
     return 0;
 }
 
-void cli_json_string(FILE *fp, const char *s)
+cJSON *cli_json_number(const char *fmt, double v)
 {
-    fputc('"', fp);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            fprintf(fp, "\\%c", c);
-        else if (c < 0x20)
-            fprintf(fp, "\\u%04x", c);
-        else
-            fputc(c, fp);
+    char text[64];
+    if (!isfinite(v))
+        return cJSON_CreateNull(); // JSON has no NaN or infinity; the old writers printed invalid JSON there
+    snprintf(text, sizeof text, fmt, v);
+    return cJSON_CreateNumber(strtod(text, NULL));
+}
+
+cJSON *cli_json_doubles(const double *v, int n)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; a && i < n; i++)
+        cJSON_AddItemToArray(a, cli_json_number("%.17g", v[i]));
+    return a;
+}
+
+int cli_json_print(const struct cli_env *env, cJSON *root)
+{
+    char *text = root ? cJSON_PrintUnformatted(root) : NULL;
+    cJSON_Delete(root);
+    if (!text) {
+        fprintf(stderr, "amgsplat %s: error: out of memory for the JSON output\n", env->cmd);
+        return 1;
     }
-    fputc('"', fp);
+    /*
+     * cJSON's compact text with a space after each ':' and ',' outside strings: the one-line
+     * layout amgsplat has always printed ({"points": 4, "attributes": ["normals", "colors"]}),
+     * easy to read and to grep, and the same tokens
+     */
+    int in_string = 0, escaped = 0;
+    for (const char *c = text; *c; c++) {
+        putchar(*c);
+        if (in_string) {
+            if (escaped)
+                escaped = 0;
+            else if (*c == '\\')
+                escaped = 1;
+            else if (*c == '"')
+                in_string = 0;
+        } else if (*c == '"') {
+            in_string = 1;
+        } else if (*c == ':' || *c == ',') {
+            putchar(' ');
+        }
+    }
+    putchar('\n');
+    cJSON_free(text);
+    return 0;
 }
 
 int cli_check_output(const struct cli_env *env, const char *output, const char *format, int allow_bare,

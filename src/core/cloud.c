@@ -103,6 +103,12 @@ void asp_cloud_destroy(asp_cloud *c)
     asp_free(&ctx, c->faces);
     free_strings(&ctx, c->comments, c->comment_count);
     free_strings(&ctx, c->obj_info, c->obj_info_count);
+    if (c->las) {
+        for (size_t i = 0; i < c->las->vlr_count; i++)
+            asp_free(&ctx, c->las->vlrs[i].data);
+        asp_free(&ctx, c->las->vlrs);
+        asp_free(&ctx, c->las);
+    }
     asp_free(&ctx, c);
 }
 
@@ -241,6 +247,29 @@ int asp_cloud_validate(const asp_cloud *c, asp_error *err)
     return 0;
 }
 
+/* Deep copy of the LAS metadata into c (which has none yet). */
+static int clone_las(asp_cloud *c, const asp_las_meta *src, asp_error *err)
+{
+    c->las = asp_alloc(&c->ctx, sizeof *c->las);
+    if (!c->las)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory");
+    *c->las = *src;
+    c->las->vlr_count = 0;
+    c->las->vlrs = src->vlr_count ? asp_calloc(&c->ctx, src->vlr_count, sizeof *c->las->vlrs) : NULL;
+    if (src->vlr_count && !c->las->vlrs)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory");
+    for (size_t i = 0; i < src->vlr_count; i++) {
+        asp_las_vlr *v = &c->las->vlrs[i];
+        *v = src->vlrs[i];
+        v->data = asp_alloc(&c->ctx, v->size ? v->size : 1);
+        if (!v->data)
+            return asp_error_set(err, ASP_ENOMEM, "out of memory");
+        memcpy(v->data, src->vlrs[i].data, v->size);
+        c->las->vlr_count = i + 1;
+    }
+    return 0;
+}
+
 int asp_cloud_clone(const asp_cloud *src, asp_cloud **out, asp_error *err)
 {
     ASP_ASSERT(src && out);
@@ -270,6 +299,8 @@ int asp_cloud_clone(const asp_cloud *src, asp_cloud **out, asp_error *err)
         rc = asp_cloud_add_obj_info(c, src->obj_info[i], err);
     if (rc == 0 && src->face_count)
         rc = asp_cloud_set_faces(c, src->faces, src->face_count, err);
+    if (rc == 0 && src->las)
+        rc = clone_las(c, src->las, err);
     if (rc) {
         asp_cloud_destroy(c);
         return rc;

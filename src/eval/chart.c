@@ -3,6 +3,8 @@
  * primitive count" and "frame time against primitive count" figures the
  * evaluation shows (thesis Fig. 1.1 compares exactly these; journal section 5
  * Table 2). Text comes from stb_easy_font's quads, rasterised as rectangles.
+ * Scatter plots with error bars and histograms draw the experiment's figures
+ * (seed 004 Figs 4.1-4.5).
  */
 #include <math.h>
 #include <stdio.h>
@@ -111,6 +113,7 @@ static void text_vertical(const struct canvas *c, long x, long y, const char *s,
 struct axis {
     double lo, hi;
     int log;
+    int integer; /* ticks at whole numbers only */
     double ticks[MAX_TICKS];
     int nticks;
 };
@@ -137,6 +140,8 @@ static void axis_ticks(struct axis *a)
         return;
     }
     double step = nice_step(a->hi - a->lo);
+    if (a->integer && step < 1)
+        step = 1;
     for (double v = ceil(a->lo / step - 1e-9) * step; v <= a->hi + 1e-9 * step && a->nticks < MAX_TICKS; v += step)
         a->ticks[a->nticks++] = fabs(v) < 1e-12 * step ? 0 : v;
 }
@@ -146,8 +151,8 @@ static int usable(double v, int log)
     return isfinite(v) && (!log || v > 0);
 }
 
-static void axis_range(struct axis *a, const asp_chart_series *series, size_t n, int use_x, double fixed_lo,
-                       double fixed_hi)
+static void axis_range(struct axis *a, const asp_chart_series *series, size_t n, const double *const *y_err,
+                       int use_x, double fixed_lo, double fixed_hi, int bars, double bar_slot)
 {
     double lo = INFINITY, hi = -INFINITY;
     for (size_t s = 0; s < n; s++)
@@ -156,10 +161,22 @@ static void axis_range(struct axis *a, const asp_chart_series *series, size_t n,
             double other = use_x ? series[s].y[i] : series[s].x[i];
             if (!usable(v, a->log) || !isfinite(other))
                 continue;
-            v = a->log ? log10(v) : v;
-            lo = v < lo ? v : lo;
-            hi = v > hi ? v : hi;
+            // error bars and bars (from 0) must fit inside the y range too
+            double e = !use_x && y_err && y_err[s] && isfinite(y_err[s][i]) ? fabs(y_err[s][i]) : 0;
+            double vlo = v - e, vhi = v + e;
+            if (!use_x && bars)
+                vlo = vlo < 0 ? vlo : 0;
+            if (a->log) {
+                vlo = usable(vlo, 1) ? log10(vlo) : log10(v);
+                vhi = log10(vhi);
+            }
+            lo = vlo < lo ? vlo : lo;
+            hi = vhi > hi ? vhi : hi;
         }
+    if (use_x && bars && lo <= hi) {
+        lo -= 0.5 * bar_slot;
+        hi += 0.5 * bar_slot;
+    }
     if (!use_x && fixed_lo < fixed_hi && !a->log) {
         lo = fixed_lo;
         hi = fixed_hi;
@@ -171,7 +188,8 @@ static void axis_range(struct axis *a, const asp_chart_series *series, size_t n,
         hi += a->log ? 0.5 : 0.5 * (fabs(hi) > 0 ? fabs(hi) : 1);
     } else {
         double pad = 0.05 * (hi - lo);
-        lo -= pad;
+        // a histogram's bars stand on the x axis: no padding below 0
+        lo = bars && !use_x && lo == 0 ? 0 : lo - pad;
         hi += pad;
     }
     a->lo = lo;
@@ -231,7 +249,26 @@ static void draw_axes(const struct canvas *c, const struct plot *p, const asp_ch
     }
 }
 
-static void draw_series(const struct canvas *c, const struct plot *p, const asp_chart_series *s, const uint8_t rgb[3])
+static double clamp_y(const struct plot *p, double y)
+{
+    return y < p->ay.lo ? p->ay.lo : y > p->ay.hi ? p->ay.hi : y;
+}
+
+/* Vertical error bar with caps; on a log axis the lower end may fall below 0 and is clamped. */
+static void draw_error_bar(const struct canvas *c, const struct plot *p, long cx, double y, double e,
+                           const uint8_t rgb[3])
+{
+    double y0 = y - e, y1 = y + e;
+    y0 = p->ay.log ? (y0 > 0 ? log10(y0) : p->ay.lo) : y0;
+    y1 = p->ay.log ? log10(y1) : y1;
+    long a = map_y(p, clamp_y(p, y0)), b = map_y(p, clamp_y(p, y1));
+    line(c, cx, a, cx, b, 0, rgb);
+    line(c, cx - 3, a, cx + 3, a, 0, rgb);
+    line(c, cx - 3, b, cx + 3, b, 0, rgb);
+}
+
+static void draw_series(const struct canvas *c, const struct plot *p, const asp_chart_series *s, const double *y_err,
+                        const uint8_t rgb[3], unsigned flags)
 {
     int have_prev = 0;
     long px = 0, py = 0;
@@ -242,16 +279,52 @@ static void draw_series(const struct canvas *c, const struct plot *p, const asp_
             continue;
         }
         x = p->ax.log ? log10(x) : x;
+        double yv = y;
         y = p->ay.log ? log10(y) : y;
         // clamp to the plot so a fixed y range never draws outside it
-        y = y < p->ay.lo ? p->ay.lo : y > p->ay.hi ? p->ay.hi : y;
+        y = clamp_y(p, y);
         long cx = map_x(p, x), cy = map_y(p, y);
-        if (have_prev)
+        if (have_prev && !(flags & ASP_CHART_MARKERS))
             line(c, px, py, cx, cy, 1, rgb);
         rect(c, cx - 2, cy - 2, cx + 4, cy + 4, rgb);
+        if (y_err && isfinite(y_err[i]) && y_err[i] != 0)
+            draw_error_bar(c, p, cx + 1, yv, fabs(y_err[i]), rgb);
         px = cx;
         py = cy;
         have_prev = 1;
+    }
+}
+
+/* Smallest spacing of distinct x values within any series: the width of one histogram slot. */
+static double bar_slot_width(const asp_chart_series *series, size_t n)
+{
+    double slot = INFINITY;
+    for (size_t s = 0; s < n; s++)
+        for (size_t i = 0; i + 1 < series[s].count; i++) {
+            double d = fabs(series[s].x[i + 1] - series[s].x[i]);
+            if (isfinite(d) && d > 0 && d < slot)
+                slot = d;
+        }
+    return isfinite(slot) ? slot : 1;
+}
+
+/* Series k of nseries takes the k-th share of each slot, so bars of several series stand side by side. */
+static void draw_bars(const struct canvas *c, const struct plot *p, const asp_chart_series *s, const double *y_err,
+                      size_t k, size_t nseries, double slot, const uint8_t rgb[3])
+{
+    double w = 0.9 * slot / (double)nseries;
+    for (size_t i = 0; i < s->count; i++) {
+        double x = s->x[i], y = s->y[i];
+        if (!isfinite(x) || !isfinite(y))
+            continue;
+        double left = x - 0.45 * slot + (double)k * w;
+        long x0 = map_x(p, left), x1 = map_x(p, left + w);
+        long y0 = map_y(p, clamp_y(p, 0)), y1 = map_y(p, clamp_y(p, y));
+        if (x1 <= x0)
+            x1 = x0 + 1;
+        rect(c, x0, y1 < y0 ? y1 : y0, x1, (y1 < y0 ? y0 : y1) + 1, rgb);
+        if (y_err && isfinite(y_err[i]) && y_err[i] != 0)
+            draw_error_bar(c, p, (x0 + x1) / 2, y, fabs(y_err[i]), (const uint8_t[3]){40, 40, 40});
     }
 }
 
@@ -310,13 +383,21 @@ int asp_chart_draw(const asp_chart_series *series, size_t nseries, const asp_cha
     if (legend > (int)d.width / 3)
         legend = (int)d.width / 3;
     struct plot p = {.x0 = 58, .y0 = 22, .x1 = (long)d.width - 14 - legend, .y1 = (long)d.height - 34};
-    p.ax.log = (d.flags & ASP_CHART_LOG_X) != 0;
-    p.ay.log = (d.flags & ASP_CHART_LOG_Y) != 0;
-    axis_range(&p.ax, series, nseries, 1, 0, 0);
-    axis_range(&p.ay, series, nseries, 0, d.y_min, d.y_max);
+    int bars = (d.flags & ASP_CHART_BARS) != 0;
+    p.ax.log = (d.flags & ASP_CHART_LOG_X) != 0 && !bars;
+    p.ay.log = (d.flags & ASP_CHART_LOG_Y) != 0 && !bars;
+    p.ax.integer = (d.flags & ASP_CHART_X_INTEGER) != 0 && !p.ax.log;
+    double slot = bars ? bar_slot_width(series, nseries) : 0;
+    axis_range(&p.ax, series, nseries, NULL, 1, 0, 0, bars, slot);
+    axis_range(&p.ay, series, nseries, d.y_err, 0, d.y_min, d.y_max, bars, slot);
     draw_axes(&c, &p, &d);
-    for (size_t s = 0; s < nseries; s++)
-        draw_series(&c, &p, &series[s], palette[s % 12]);
+    for (size_t s = 0; s < nseries; s++) {
+        const double *e = d.y_err ? d.y_err[s] : NULL;
+        if (bars)
+            draw_bars(&c, &p, &series[s], e, s, nseries, slot, palette[s % 12]);
+        else
+            draw_series(&c, &p, &series[s], e, palette[s % 12], d.flags);
+    }
     draw_legend(&c, &p, series, nseries);
     *dst = img;
     return 0;

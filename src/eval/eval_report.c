@@ -5,34 +5,26 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include <cjson/cJSON.h>
 
 #include "amgsplat/eval.h"
 #include "util/atomic_file.h"
 #include "util/banned.h"
 
-/* JSON has no NaN or infinity: null instead. */
-static void json_num(FILE *fp, double v, const char *fmt)
+/*
+ * A JSON number holding v as printf(fmt, v) writes it, so the file keeps the
+ * digits the CSV has; null for NaN and infinities, which JSON cannot hold.
+ */
+static cJSON *num(double v, const char *fmt)
 {
-    if (isfinite(v))
-        fprintf(fp, fmt, v);
-    else
-        fputs("null", fp);
-}
-
-static void json_str(FILE *fp, const char *s)
-{
-    fputc('"', fp);
-    for (; s && *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            fprintf(fp, "\\%c", c);
-        else if (c < 0x20)
-            fprintf(fp, "\\u%04x", c);
-        else
-            fputc(c, fp);
-    }
-    fputc('"', fp);
+    char text[64];
+    if (!isfinite(v))
+        return cJSON_CreateNull();
+    snprintf(text, sizeof text, fmt, v);
+    return cJSON_CreateNumber(strtod(text, NULL));
 }
 
 static const char csv_header[] = "representation,level,level_name,size,primitives,drawn,texels,psnr_mean,psnr_min,"
@@ -69,53 +61,63 @@ int asp_eval_save_csv(const asp_eval_result *res, const char *path, asp_error *e
     return asp__atomic_commit(&f, err);
 }
 
+static cJSON *row_json(const asp_eval_result *res, size_t i)
+{
+    const asp_eval_row *r = &res->rows[i];
+    cJSON *o = cJSON_CreateObject(), *ssim = cJSON_CreateArray(), *psnr = cJSON_CreateArray();
+    cJSON_AddStringToObject(o, "representation", r->representation);
+    cJSON_AddNumberToObject(o, "level", r->level);
+    cJSON_AddStringToObject(o, "level_name", r->level_name);
+    cJSON_AddNumberToObject(o, "size", r->size);
+    cJSON_AddNumberToObject(o, "primitives", (double)r->primitives);
+    cJSON_AddItemToObject(o, "drawn", num(r->drawn, "%.1f"));
+    cJSON_AddNumberToObject(o, "texels", (double)r->texels);
+    cJSON_AddNumberToObject(o, "bytes", (double)r->bytes);
+    cJSON_AddStringToObject(o, "note", r->note);
+    const char *names[7] = {"psnr_mean", "psnr_min", "ssim_mean", "ssim_min", "iou_mean", "iou_min", "frame_ms"};
+    const double vals[7] = {r->psnr_mean, r->psnr_min, r->ssim_mean, r->ssim_min, r->iou_mean, r->iou_min, r->frame_ms};
+    for (int k = 0; k < 7; k++)
+        cJSON_AddItemToObject(o, names[k], num(vals[k], "%.6g"));
+    for (size_t v = 0; v < res->views; v++) {
+        cJSON_AddItemToArray(ssim, num(res->ssim[i * res->views + v], "%.6f"));
+        cJSON_AddItemToArray(psnr, num(res->psnr[i * res->views + v], "%.4f"));
+    }
+    cJSON_AddItemToObject(o, "ssim_views", ssim);
+    cJSON_AddItemToObject(o, "psnr_views", psnr);
+    return o;
+}
+
 int asp_eval_save_json(const asp_eval_result *res, const char *model, const char *path, asp_error *err)
 {
+    cJSON *o = cJSON_CreateObject(), *rows = cJSON_CreateArray();
+    cJSON_AddStringToObject(o, "model", model ? model : "");
+    cJSON_AddNumberToObject(o, "points", (double)res->points);
+    cJSON_AddNumberToObject(o, "views", (double)res->views);
+    cJSON_AddNumberToObject(o, "levels", (double)res->level_count);
+    cJSON_AddStringToObject(o, "gl_renderer", res->gl_renderer);
+    cJSON_AddItemToObject(o, "crease_angle", num((double)res->crease_angle, "%g"));
+    cJSON_AddNumberToObject(o, "clipped_points", (double)res->clipped_points);
+    cJSON_AddNumberToObject(o, "mesh_triangles", (double)res->mesh_triangles);
+    cJSON_AddItemToObject(o, "simplify_seconds", num(res->t_simplify, "%.4f"));
+    cJSON_AddItemToObject(o, "decompose_seconds", num(res->t_decompose, "%.4f"));
+    cJSON_AddItemToObject(o, "build_seconds", num(res->t_build, "%.4f"));
+    cJSON_AddItemToObject(o, "render_seconds", num(res->t_render, "%.4f"));
+    for (size_t i = 0; i < res->row_count; i++)
+        cJSON_AddItemToArray(rows, row_json(res, i));
+    cJSON_AddItemToObject(o, "rows", rows);
+    char *text = o ? cJSON_Print(o) : NULL; // indented: eval.json is read by people as well as by scripts
+    cJSON_Delete(o);
+    if (!text)
+        return asp_error_set(err, ASP_ENOMEM, "cannot write '%s': out of memory", path);
     asp__atomic_file f;
     int rc = asp__atomic_open(&f, path, err);
-    if (rc)
-        return rc;
-    FILE *fp = f.fp;
-    fputs("{\"model\": ", fp);
-    json_str(fp, model ? model : "");
-    fprintf(fp, ", \"points\": %zu, \"views\": %zu, \"levels\": %zu, \"gl_renderer\": ", res->points, res->views,
-            res->level_count);
-    json_str(fp, res->gl_renderer);
-    fprintf(fp, ", \"crease_angle\": %g, \"clipped_points\": %zu", (double)res->crease_angle, res->clipped_points);
-    fprintf(fp, ", \"mesh_triangles\": %zu, \"simplify_seconds\": %.4f", res->mesh_triangles, res->t_simplify);
-    fprintf(fp, ", \"decompose_seconds\": %.4f, \"build_seconds\": %.4f, \"render_seconds\": %.4f,\n \"rows\": [",
-            res->t_decompose, res->t_build, res->t_render);
-    for (size_t i = 0; i < res->row_count; i++) {
-        const asp_eval_row *r = &res->rows[i];
-        fprintf(fp, "%s\n  {\"representation\": ", i ? "," : "");
-        json_str(fp, r->representation);
-        fprintf(fp, ", \"level\": %u, \"level_name\": ", r->level);
-        json_str(fp, r->level_name);
-        fprintf(fp, ", \"size\": %u, \"primitives\": %zu, \"drawn\": %.1f, \"texels\": %llu", r->size, r->primitives,
-                r->drawn, (unsigned long long)r->texels);
-        fprintf(fp, ", \"bytes\": %llu, \"note\": ", (unsigned long long)r->bytes);
-        json_str(fp, r->note);
-        const char *names[7] = {"psnr_mean", "psnr_min", "ssim_mean", "ssim_min", "iou_mean", "iou_min", "frame_ms"};
-        const double vals[7] = {r->psnr_mean, r->psnr_min, r->ssim_mean, r->ssim_min,
-                                r->iou_mean,  r->iou_min,  r->frame_ms};
-        for (int k = 0; k < 7; k++) {
-            fprintf(fp, ", \"%s\": ", names[k]);
-            json_num(fp, vals[k], "%.6g");
-        }
-        fputs(", \"ssim_views\": [", fp);
-        for (size_t v = 0; v < res->views; v++) {
-            fputs(v ? ", " : "", fp);
-            json_num(fp, res->ssim[i * res->views + v], "%.6f");
-        }
-        fputs("], \"psnr_views\": [", fp);
-        for (size_t v = 0; v < res->views; v++) {
-            fputs(v ? ", " : "", fp);
-            json_num(fp, res->psnr[i * res->views + v], "%.4f");
-        }
-        fputs("]}", fp);
+    if (rc == 0) {
+        fputs(text, f.fp);
+        fputc('\n', f.fp);
+        rc = asp__atomic_commit(&f, err);
     }
-    fputs("\n]}\n", fp);
-    return asp__atomic_commit(&f, err);
+    cJSON_free(text);
+    return rc;
 }
 
 enum { MAX_SERIES = 16 };

@@ -9,15 +9,18 @@
 #include <string.h>
 
 #include "amgsplat/io.h"
+#include "io/las_internal.h"
 #include "util/banned.h"
 
-static const char point_exts[] = ".ply, .xyz, .pts, .txt";
+static const char point_exts[] = ".ply, .xyz, .pts, .txt, .las";
 
-/* "ply" or "xyz" for a recognised point format, NULL otherwise. */
+/* "ply", "las", "laz" or "xyz" for a recognised point format, NULL otherwise. */
 static const char *reader_of(const asp_file_type *t)
 {
     if (strcmp(t->format, "ply") == 0)
         return "ply"; /* a PLY with faces is a mesh, but its vertices are points all the same */
+    if (strcmp(t->format, "las") == 0 || strcmp(t->format, "laz") == 0)
+        return t->format;
     if (t->kind == ASP_FILE_POINTS)
         return "xyz";
     return NULL;
@@ -72,7 +75,11 @@ int asp_cloud_load(const char *path, const asp_context *ctx, asp_cloud **out, as
     if (!fmt)
         return not_points(path, &t, err);
     asp_cloud *c = NULL;
-    rc = fmt[0] == 'p' ? asp_ply_read(path, ctx, &c, err) : asp_xyz_read(path, ctx, &c, err);
+    if (strcmp(fmt, "laz") == 0)
+        return asp__las_laz_error(path, err);
+    rc = strcmp(fmt, "ply") == 0   ? asp_ply_read(path, ctx, &c, err)
+         : strcmp(fmt, "las") == 0 ? asp_las_read(path, ctx, &c, err)
+                                   : asp_xyz_read(path, ctx, &c, err);
     if (rc)
         return rc;
     asp_error e2;
@@ -93,6 +100,12 @@ int asp_cloud_save(const asp_cloud *cloud, const char *path, const asp_save_desc
     asp_file_type t;
     if (asp_file_type_of_name(path, &t, NULL) || t.kind != ASP_FILE_POINTS)
         return unknown("write", path, err);
-    return strcmp(t.format, "ply") == 0 ? asp_ply_write(cloud, path, desc, err)
-                                        : asp_xyz_write(cloud, path, desc, err);
+    if (strcmp(t.format, "laz") == 0)
+        return asp_error_set(err, ASP_EUNSUPPORTED,
+                             "cannot write '%s': compressed LAS (LASzip) needs a compressor this build does not have; "
+                             "write .las",
+                             path);
+    return strcmp(t.format, "ply") == 0   ? asp_ply_write(cloud, path, desc, err)
+           : strcmp(t.format, "las") == 0 ? asp_las_write(cloud, path, desc, err)
+                                          : asp_xyz_write(cloud, path, desc, err);
 }

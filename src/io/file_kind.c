@@ -27,7 +27,8 @@ struct ext_row {
  */
 static const struct ext_row ext_table[] = {
     {".ply", ASP_FILE_POINTS, "ply"},   {".xyz", ASP_FILE_POINTS, "xyz"},   {".pts", ASP_FILE_POINTS, "pts"},
-    {".txt", ASP_FILE_POINTS, "txt"},   {".obj", ASP_FILE_MESH, "obj"},     {".off", ASP_FILE_MESH, "off"},
+    {".txt", ASP_FILE_POINTS, "txt"},   {".las", ASP_FILE_POINTS, "las"},   {".laz", ASP_FILE_POINTS, "laz"},
+    {".obj", ASP_FILE_MESH, "obj"},     {".off", ASP_FILE_MESH, "off"},
     {".stl", ASP_FILE_MESH, "stl"},     {".gltf", ASP_FILE_MESH, "gltf"},   {".glb", ASP_FILE_MESH, "glb"},
     {".3ds", ASP_FILE_MESH, "3ds"},     {".fbx", ASP_FILE_MESH, "fbx"},     {".dae", ASP_FILE_MESH, "dae"},
     {".amg", ASP_FILE_AMG, "amg"},      {".dps", ASP_FILE_DPS, "dps"},      {".hier", ASP_FILE_HIER, "hier"},
@@ -36,7 +37,7 @@ static const struct ext_row ext_table[] = {
 };
 enum { N_EXT = sizeof ext_table / sizeof ext_table[0] };
 
-static const char expected[] = ".ply, .xyz, .pts, .txt, .obj, .off, .stl, .gltf, .glb, .3ds, .fbx, .dae, .amg, .dps, "
+static const char expected[] = ".ply, .xyz, .pts, .txt, .las, .laz, .obj, .off, .stl, .gltf, .glb, .3ds, .fbx, .dae, .amg, .dps, "
                                ".hier, .png, .jpg, .bmp, .tga, .gif";
 
 const char *asp_file_kind_name(asp_file_kind kind)
@@ -107,9 +108,34 @@ static int ply_has_faces(const char *h, size_t n)
     return 0;
 }
 
+/*
+ * A LAS file is LASzip-compressed when bit 7 (or 6) of its point format byte
+ * is set or a "laszip encoded" VLR follows the header (those within the head
+ * bytes are looked at; LAS 1.4 R15 Table 3, LASzip's VLR 22204).
+ */
+static int las_is_compressed(const unsigned char *h, size_t n)
+{
+    if (n > 104 && (h[104] & 0xc0))
+        return 1;
+    if (n < 104)
+        return 0;
+    size_t at = (size_t)h[94] | (size_t)h[95] << 8;
+    uint32_t nvlr = (uint32_t)h[100] | (uint32_t)h[101] << 8 | (uint32_t)h[102] << 16 | (uint32_t)h[103] << 24;
+    for (uint32_t i = 0; i < nvlr && at + 54 <= n; i++) {
+        if (memcmp(h + at + 2, "laszip encoded", 14) == 0)
+            return 1;
+        at += 54 + ((size_t)h[at + 20] | (size_t)h[at + 21] << 8);
+    }
+    return 0;
+}
+
 /* 0 and *out filled when the first bytes name the format; 1 when they do not. */
 static int by_magic(const unsigned char *h, size_t n, asp_file_type *out)
 {
+    if (n >= 4 && memcmp(h, "LASF", 4) == 0) {
+        fill(out, ASP_FILE_POINTS, las_is_compressed(h, n) ? "laz" : "las", 1);
+        return 0;
+    }
     if (n >= 4 && memcmp(h, "ply", 3) == 0 && (h[3] == '\n' || h[3] == '\r')) {
         fill(out, ply_has_faces((const char *)h, n) ? ASP_FILE_MESH : ASP_FILE_POINTS, "ply", 1);
         return 0;

@@ -4,8 +4,23 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <cjson/cJSON.h>
+
 #include "harness.h"
 #include "amgsplat/eval.h"
+
+/* 1 when the JSON array holds exactly the n numbers want (NaN in want: null). */
+static int numbers_are(const cJSON *a, const double *want, int n)
+{
+    if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != n)
+        return 0;
+    for (int i = 0; i < n; i++) {
+        const cJSON *v = cJSON_GetArrayItem(a, i);
+        if (isnan(want[i]) ? !cJSON_IsNull(v) : !(cJSON_IsNumber(v) && v->valuedouble == want[i]))
+            return 0;
+    }
+    return 1;
+}
 
 static asp_eval_result *make_result(void)
 {
@@ -73,8 +88,15 @@ static void test_csv_json(void)
     CHECK(text && strstr(text, "\ndp-normalized,0,L,64,8,") != NULL);
     CHECK_OK(asp_eval_save_json(r, "m\"x", json, &err), &err);
     text = slurp(json);
-    CHECK(text && strstr(text, "\"model\": \"m\\\"x\"") != NULL);
-    CHECK(text && strstr(text, "\"ssim_views\": [0.500000, 0.600000, 0.950000, 0.400000]") != NULL);
+    cJSON *doc = text ? cJSON_Parse(text) : NULL;
+    CHECK(doc != NULL);
+    const cJSON *model = cJSON_GetObjectItemCaseSensitive(doc, "model");
+    CHECK(cJSON_IsString(model) && strcmp(model->valuestring, "m\"x") == 0);
+    const cJSON *rows = cJSON_GetObjectItemCaseSensitive(doc, "rows");
+    CHECK(cJSON_GetArraySize(rows) == 3);
+    CHECK(numbers_are(cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(rows, 1), "ssim_views"),
+                      (const double[]){0.5, 0.6, 0.95, 0.4}, 4));
+    cJSON_Delete(doc);
     unlink(csv);
     unlink(json);
     /* an unwritable path fails with ASP_EIO and names it */
@@ -123,8 +145,13 @@ static void test_row_without_figures(void)
     CHECK(text && strstr(text, "\npoints,0,L,64,8,0.0,0,0.0000,0.0000,0.500000,0.000000,0.000000,0.000000,1.5000,256,\n"));
     CHECK_OK(asp_eval_save_json(r, NULL, json, &err), &err);
     text = slurp(json);
-    CHECK(text && strstr(text, "\"note\": \"texture alone 5592405 bytes exceeds 1000\", \"psnr_mean\": null") != NULL);
-    CHECK(text && strstr(text, "\"ssim_views\": [null, null, null, null]") != NULL);
+    cJSON *doc = text ? cJSON_Parse(text) : NULL;
+    const cJSON *last = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(doc, "rows"), 2);
+    const cJSON *note = cJSON_GetObjectItemCaseSensitive(last, "note");
+    CHECK(cJSON_IsString(note) && strcmp(note->valuestring, "texture alone 5592405 bytes exceeds 1000") == 0);
+    CHECK(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(last, "psnr_mean")));
+    CHECK(numbers_are(cJSON_GetObjectItemCaseSensitive(last, "ssim_views"), (const double[]){NAN, NAN, NAN, NAN}, 4));
+    cJSON_Delete(doc);
     unlink(csv);
     unlink(json);
     /* the chart leaves the row out: the same picture as without it */

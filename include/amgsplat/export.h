@@ -1,0 +1,112 @@
+/*
+ * glTF 2.0 export (issue 16): domain primitives (.dps) as textured quads, point sets and
+ * hierarchies as POINTS with seed 001's splat ellipses through KHR_gaussian_splatting, so the
+ * results open in engines, web viewers and the tools users already have. JSON through cJSON.
+ */
+#ifndef AMGSPLAT_EXPORT_H
+#define AMGSPLAT_EXPORT_H
+
+#include "hier.h"
+#include "prim.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** How primitive materials treat alpha (glTF material.alphaMode). */
+typedef enum asp_gltf_alpha_mode {
+    ASP_GLTF_ALPHA_BLEND = 0, /* BLEND (default): alpha = the domain's basis function, blended */
+    ASP_GLTF_ALPHA_MASK = 1   /* MASK with alphaCutoff = alpha_cutoff: opaque where alpha > it */
+} asp_gltf_alpha_mode;
+
+/** Export flags (asp_gltf_desc.flags); 0 is the default. */
+enum asp_gltf_flags {
+    ASP_GLTF_LIT = 1 << 0,           /* primitives: metallic-roughness material instead of KHR_materials_unlit */
+    ASP_GLTF_NO_NORMAL_MAP = 1 << 1, /* primitives: leave the level's normal map out */
+    ASP_GLTF_NO_SPLATS = 1 << 2      /* points: plain POINTS, no KHR_gaussian_splatting attributes */
+};
+
+/** Options; the zero value means the defaults. */
+typedef struct asp_gltf_desc {
+    unsigned flags;               /* asp_gltf_flags */
+    asp_gltf_alpha_mode alpha_mode;
+    float alpha_cutoff;           /* MASK cutoff in (0, 1); 0 = 0.1, the renderer's alpha reference */
+    const size_t *levels;         /* .dps: indices into dps->levels to export; NULL = every level */
+    size_t level_count;
+} asp_gltf_desc;
+
+/** What an export wrote. */
+typedef struct asp_gltf_stats {
+    size_t nodes;        /* mesh nodes (one per level, or 1 for points) */
+    size_t primitives;   /* quads written (domain primitives) */
+    size_t points;       /* points written */
+    size_t images;       /* PNG images (atlases and normal maps) */
+    size_t json_bytes;   /* JSON chunk / .gltf size */
+    size_t bin_bytes;    /* binary chunk / .bin size (images included when embedded) */
+    size_t file_bytes;   /* bytes of every file written */
+    size_t files;        /* files written (1 for .glb) */
+    double origin[3];    /* world origin kept in the nodes' translation */
+} asp_gltf_stats;
+
+/**
+ * Writes dps to path as glTF 2.0: binary GLB when path ends in .glb, else
+ * JSON .gltf with a .bin and the PNG images beside it (same stem). Each
+ * exported level is one node named by level ("L-6 (354 primitives)") whose
+ * mesh has one quad per primitive, exactly the renderer's support rectangle
+ * (centre +- half_u axis_u +- half_v axis_v; texture coordinates on the
+ * texture rectangle's texel edges) with NORMAL, TANGENT (axis_u) and
+ * TEXCOORD_0; the atlas is a PNG in baseColorTexture (sRGB colour, straight
+ * alpha = basis function), double-sided, BLEND or MASK, unlit
+ * (KHR_materials_unlit) unless ASP_GLTF_LIT. A level's world-space normal
+ * atlas becomes a tangent-space normalTexture. Positions are relative to the
+ * origin dps->frame.center (the primitives' bounds centre when the frame is
+ * unknown), which the node's translation restores; the frame is also kept in
+ * scene.extras.amgsplat so a viewer can frame the camera as amgsplat render
+ * does. The file is written atomically. stats may be NULL.
+ * Errors: ASP_EINVAL (bad desc, level index out of range, unknown extension),
+ * ASP_EDEGENERATE (no primitives to write), ASP_ENOMEM, ASP_EIO.
+ * Thread-safe (no shared state).
+ */
+int asp_gltf_export_dps(const asp_dps *dps, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,
+                        asp_error *err);
+
+/**
+ * Writes the points of hier (its point splats, in input order) to path as
+ * glTF POINTS: POSITION, NORMAL, COLOR_0 (linear RGBA), and unless
+ * ASP_GLTF_NO_SPLATS the ellipses of seed 001 as a KHR_gaussian_splatting
+ * primitive (asp_gltf_gaussian_from_ellipse): ROTATION, SCALE, OPACITY and
+ * SH_DEGREE_0_COEF_0, the extension in extensionsUsed only. Positions are
+ * relative to the hierarchy's origin (asp_hier_origin), kept in the node's
+ * translation; the frame asp_hier_frame in scene.extras.amgsplat.
+ * Errors, file kinds and stats as asp_gltf_export_dps. Thread-safe.
+ */
+int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,
+                         asp_error *err);
+
+/**
+ * Builds the hierarchy of cloud (asp_hier_build with default options, which
+ * gives every point its seed 001 ellipse) and exports it with
+ * asp_gltf_export_hier. Runs with asp_context_threads(ctx) threads. Errors as
+ * both. Thread-safe.
+ */
+int asp_gltf_export_cloud(const asp_cloud *cloud, const char *path, const asp_gltf_desc *desc,
+                          const asp_context *ctx, asp_gltf_stats *stats, asp_error *err);
+
+/**
+ * The 3D Gaussian of KHR_gaussian_splatting (kernel "ellipse", cut at 3
+ * sigma) for a flat elliptical splat center + s a u + t b v, s^2 + t^2 <= 1:
+ * rotation quat (x, y, z, w) takes the local axes x, y, z to u, v and their
+ * normal (u x v); log_scale = ln of sigma along them, sigma_u = a / 2 and
+ * sigma_v = b / 2, so the splat rim lies at 2 sigma (weight 0.14, near
+ * amgsplat's splat kernel's 0.17 there) and the 3 sigma cut at 1.5 semi-axes,
+ * the B = 1.5 of that kernel; the normal's sigma is 1/100 of the smaller
+ * one (a flat disc). b = 0 is taken as a / 1000; a must be > 0. u and v must be
+ * unit and orthogonal. Pure.
+ */
+void asp_gltf_gaussian_from_ellipse(const float u[3], const float v[3], float a, float b, float quat[4],
+                                    float log_scale[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,233 @@
+/*
+ * Point sets and hierarchies as glTF POINTS (POSITION, NORMAL, COLOR_0) with the elliptical
+ * splats of seed 001 (Pajarola, Sainz, Guidotti 2003, section 3.4: each point's tangent
+ * ellipse) as 3D Gaussians of the KHR_gaussian_splatting extension (kernel "ellipse"), listed in
+ * extensionsUsed only so that viewers without it still show the points.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "export/internal.h"
+#include "util/banned.h"
+
+void asp_gltf_gaussian_from_ellipse(const float u[3], const float v[3], float a, float b, float quat[4],
+                                    float log_scale[3])
+{
+    ASP_ASSERT(a > 0);
+    double n[3] = {(double)u[1] * v[2] - (double)u[2] * v[1], (double)u[2] * v[0] - (double)u[0] * v[2],
+                   (double)u[0] * v[1] - (double)u[1] * v[0]};
+    // rotation matrix with columns u, v, u x v (a proper rotation whichever way v pointed)
+    double m[3][3];
+    for (int r = 0; r < 3; r++) {
+        m[r][0] = u[r];
+        m[r][1] = v[r];
+        m[r][2] = n[r];
+    }
+    double tr = m[0][0] + m[1][1] + m[2][2], q[4];
+    // Shepperd's method: divide by the largest of the four candidates for stability
+    if (tr > 0) {
+        double s = 2.0 * sqrt(tr + 1.0);
+        q[3] = 0.25 * s;
+        q[0] = (m[2][1] - m[1][2]) / s;
+        q[1] = (m[0][2] - m[2][0]) / s;
+        q[2] = (m[1][0] - m[0][1]) / s;
+    } else if (m[0][0] > m[1][1] && m[0][0] > m[2][2]) {
+        double s = 2.0 * sqrt(1.0 + m[0][0] - m[1][1] - m[2][2]);
+        q[3] = (m[2][1] - m[1][2]) / s;
+        q[0] = 0.25 * s;
+        q[1] = (m[0][1] + m[1][0]) / s;
+        q[2] = (m[0][2] + m[2][0]) / s;
+    } else if (m[1][1] > m[2][2]) {
+        double s = 2.0 * sqrt(1.0 + m[1][1] - m[0][0] - m[2][2]);
+        q[3] = (m[0][2] - m[2][0]) / s;
+        q[0] = (m[0][1] + m[1][0]) / s;
+        q[1] = 0.25 * s;
+        q[2] = (m[1][2] + m[2][1]) / s;
+    } else {
+        double s = 2.0 * sqrt(1.0 + m[2][2] - m[0][0] - m[1][1]);
+        q[3] = (m[1][0] - m[0][1]) / s;
+        q[0] = (m[0][2] + m[2][0]) / s;
+        q[1] = (m[1][2] + m[2][1]) / s;
+        q[2] = 0.25 * s;
+    }
+    double len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (int k = 0; k < 4; k++)
+        quat[k] = (float)(q[k] / len);
+    double bb = b > 0 ? (double)b : 1e-3 * a;
+    // the rim at 2 sigma, the 3-sigma cut of the ellipse kernel at 1.5 semi-axes (export.h)
+    double su = 0.5 * a, sv = 0.5 * bb, sn = 0.01 * sv;
+    log_scale[0] = (float)log(su);
+    log_scale[1] = (float)log(sv);
+    log_scale[2] = (float)log(sn);
+}
+
+static float srgb_to_linear(uint8_t c)
+{
+    double x = c / 255.0;
+    return (float)(x <= 0.04045 ? x / 12.92 : pow((x + 0.055) / 1.055, 2.4));
+}
+
+typedef struct point_arrays {
+    float *pos, *nrm, *rot, *scale, *opacity, *sh0;
+    uint16_t *color;
+    float lo[3], hi[3];
+} point_arrays;
+
+static void fill_points(const asp_hier *hier, point_arrays *a, int splats)
+{
+    const asp_hier_splat *all = asp_hier_splats(hier);
+    size_t nodes = asp_hier_node_count(hier), n = asp_hier_point_count(hier);
+    int colored = (asp_hier_flags(hier) & ASP_HIER_HAS_COLORS) != 0;
+    // a splat without extent (a lone point) gets a tiny one: log(0) is not a number
+    double tiny = asp_hier_frame(hier)->radius > 0 ? 1e-6 * asp_hier_frame(hier)->radius : 1e-6;
+    for (int k = 0; k < 3; k++) {
+        a->lo[k] = INFINITY;
+        a->hi[k] = -INFINITY;
+    }
+    for (size_t j = 0; j < n; j++) {
+        const asp_hier_splat *s = &all[nodes + j];
+        size_t i = s->index < n ? s->index : j; // input order
+        float nl = sqrtf(s->normal[0] * s->normal[0] + s->normal[1] * s->normal[1] + s->normal[2] * s->normal[2]);
+        for (int k = 0; k < 3; k++) {
+            a->pos[3 * i + k] = s->center[k];
+            a->lo[k] = fminf(a->lo[k], s->center[k]);
+            a->hi[k] = fmaxf(a->hi[k], s->center[k]);
+            // glTF requires unit normals; a point without one faces +z
+            a->nrm[3 * i + k] = nl > 0 ? s->normal[k] / nl : (k == 2 ? 1.0f : 0.0f);
+        }
+        // the renderers' light grey 200 for a set without colours (docs/cli/render.md)
+        uint8_t rgba[4] = {200, 200, 200, 255};
+        if (colored)
+            memcpy(rgba, s->color, 4);
+        for (int k = 0; k < 3; k++)
+            a->color[4 * i + k] = (uint16_t)lrintf(srgb_to_linear(rgba[k]) * 65535.0f); // glTF colours are linear
+        a->color[4 * i + 3] = (uint16_t)(rgba[3] * 257u);
+        if (!splats)
+            continue;
+        float ax = s->a > 0 ? s->a : (float)tiny, bx = s->a > 0 ? s->b : (float)tiny;
+        asp_gltf_gaussian_from_ellipse(s->u, s->v, ax, bx, a->rot + 4 * i, a->scale + 3 * i);
+        a->opacity[i] = rgba[3] / 255.0f;
+        for (int k = 0; k < 3; k++) // colour = SH0 * Y00 + 0.5 (srgb_rec709_display: the stored sRGB values)
+            a->sh0[3 * i + k] = (float)((rgba[k] / 255.0 - 0.5) / 0.2820947917738781);
+    }
+}
+
+static int add_points_mesh(asp__gltf *g, const point_arrays *a, size_t n, int splats)
+{
+    int pos = asp__gltf_accessor(g, asp__gltf_view(g, a->pos, n * 12, ASP__GL_ARRAY_BUFFER), ASP__GL_FLOAT, n,
+                                 "VEC3", 0, a->lo, a->hi);
+    int nrm = asp__gltf_accessor(g, asp__gltf_view(g, a->nrm, n * 12, ASP__GL_ARRAY_BUFFER), ASP__GL_FLOAT, n,
+                                 "VEC3", 0, NULL, NULL);
+    int col = asp__gltf_accessor(g, asp__gltf_view(g, a->color, n * 8, ASP__GL_ARRAY_BUFFER),
+                                 ASP__GL_UNSIGNED_SHORT, n, "VEC4", 1, NULL, NULL);
+    cJSON *attrs = cJSON_CreateObject();
+    cJSON_AddNumberToObject(attrs, "POSITION", pos);
+    cJSON_AddNumberToObject(attrs, "NORMAL", nrm);
+    cJSON_AddNumberToObject(attrs, "COLOR_0", col);
+    int ok = pos >= 0 && nrm >= 0 && col >= 0;
+    cJSON *pr = cJSON_CreateObject();
+    if (splats) {
+        int rot = asp__gltf_accessor(g, asp__gltf_view(g, a->rot, n * 16, ASP__GL_ARRAY_BUFFER), ASP__GL_FLOAT, n,
+                                     "VEC4", 0, NULL, NULL);
+        int sc = asp__gltf_accessor(g, asp__gltf_view(g, a->scale, n * 12, ASP__GL_ARRAY_BUFFER), ASP__GL_FLOAT, n,
+                                    "VEC3", 0, NULL, NULL);
+        int op = asp__gltf_accessor(g, asp__gltf_view(g, a->opacity, n * 4, ASP__GL_ARRAY_BUFFER), ASP__GL_FLOAT, n,
+                                    "SCALAR", 0, NULL, NULL);
+        int sh = asp__gltf_accessor(g, asp__gltf_view(g, a->sh0, n * 12, ASP__GL_ARRAY_BUFFER), ASP__GL_FLOAT, n,
+                                    "VEC3", 0, NULL, NULL);
+        ok = ok && rot >= 0 && sc >= 0 && op >= 0 && sh >= 0;
+        cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:ROTATION", rot);
+        cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:SCALE", sc);
+        cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:OPACITY", op);
+        cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:SH_DEGREE_0_COEF_0", sh);
+        cJSON *ext = cJSON_AddObjectToObject(pr, "extensions");
+        cJSON *k = cJSON_AddObjectToObject(ext, "KHR_gaussian_splatting");
+        cJSON_AddStringToObject(k, "kernel", "ellipse");
+        cJSON_AddStringToObject(k, "colorSpace", "srgb_rec709_display");
+        cJSON_AddStringToObject(k, "projection", "perspective");
+        cJSON_AddStringToObject(k, "sortingMethod", "cameraDistance");
+        asp__gltf_use_extension(g, "KHR_gaussian_splatting");
+    }
+    cJSON_AddItemToObject(pr, "attributes", attrs);
+    cJSON_AddNumberToObject(pr, "mode", 0); // POINTS
+    cJSON *mesh = cJSON_CreateObject();
+    cJSON_AddItemToArray(cJSON_AddArrayToObject(mesh, "primitives"), pr);
+    cJSON_AddStringToObject(mesh, "name", "points");
+    int m = asp__gltf_append(g, g->meshes, mesh);
+    return ok && m >= 0 ? m : -1;
+}
+
+int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,
+                         asp_error *err)
+{
+    ASP_ASSERT(hier && path);
+    static const asp_gltf_desc zero;
+    const asp_gltf_desc *d = desc ? desc : &zero;
+    int splats = !(d->flags & ASP_GLTF_NO_SPLATS);
+    size_t n = asp_hier_point_count(hier);
+    if (n == 0)
+        return asp_error_set(err, ASP_EDEGENERATE, "no points to export");
+    asp_gltf_stats st = {0};
+    asp_hier_origin(hier, st.origin);
+    asp__gltf g;
+    int rc = asp__gltf_init(&g, path, splats ? "(points, KHR_gaussian_splatting)" : "(points)", NULL, err);
+    if (rc)
+        return rc;
+    point_arrays a = {0};
+    a.pos = asp_alloc(NULL, n * 12);
+    a.nrm = asp_alloc(NULL, n * 12);
+    a.color = asp_alloc(NULL, n * 8);
+    if (splats) {
+        a.rot = asp_alloc(NULL, n * 16);
+        a.scale = asp_alloc(NULL, n * 12);
+        a.opacity = asp_alloc(NULL, n * 4);
+        a.sh0 = asp_alloc(NULL, n * 12);
+    }
+    if (!a.pos || !a.nrm || !a.color || (splats && (!a.rot || !a.scale || !a.opacity || !a.sh0))) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the glTF arrays of %zu points", n);
+        goto done;
+    }
+    fill_points(hier, &a, splats);
+    int mesh = add_points_mesh(&g, &a, n, splats);
+    char name[64];
+    snprintf(name, sizeof name, "points (%zu)", n);
+    cJSON *node = cJSON_CreateObject();
+    cJSON_AddStringToObject(node, "name", name);
+    cJSON_AddNumberToObject(node, "mesh", mesh);
+    cJSON_AddItemToObject(node, "translation", asp__gltf_numbers(st.origin, 3));
+    if (mesh < 0 || asp__gltf_append(&g, g.nodes, node) < 0) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the glTF document of '%s'", path);
+        goto done;
+    }
+    cJSON *scenes = cJSON_AddArrayToObject(g.root, "scenes"), *s = cJSON_CreateObject();
+    double zero_node = 0;
+    cJSON_AddStringToObject(s, "name", "points");
+    cJSON_AddItemToObject(s, "nodes", asp__gltf_numbers(&zero_node, 1));
+    cJSON_AddItemToObject(s, "extras", asp__gltf_extras("points", NULL, st.origin, asp_hier_frame(hier)));
+    asp__gltf_append(&g, scenes, s);
+    cJSON_AddNumberToObject(g.root, "scene", 0);
+    st.points = n;
+    st.nodes = 1;
+    rc = asp__gltf_write(&g, path, &st, err);
+done:
+    asp__gltf_release(&g);
+    void *blocks[] = {a.pos, a.nrm, a.color, a.rot, a.scale, a.opacity, a.sh0};
+    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
+        asp_free(NULL, blocks[i]);
+    if (!rc && stats)
+        *stats = st;
+    return rc;
+}
+
+int asp_gltf_export_cloud(const asp_cloud *cloud, const char *path, const asp_gltf_desc *desc,
+                          const asp_context *ctx, asp_gltf_stats *stats, asp_error *err)
+{
+    ASP_ASSERT(cloud && path);
+    asp_hier *hier = NULL;
+    int rc = asp_hier_build(cloud, NULL, ctx, &hier, err);
+    if (!rc)
+        rc = asp_gltf_export_hier(hier, path, desc, stats, err);
+    asp_hier_destroy(hier);
+    return rc;
+}

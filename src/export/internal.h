@@ -1,0 +1,72 @@
+/*
+ * The glTF 2.0 document builder shared by the primitive and point exports: a cJSON tree, one
+ * binary buffer of 4-byte aligned buffer views, PNG images embedded (GLB) or kept for files
+ * beside the .gltf, and the atomic writer of both layouts (glTF 2.0 spec 4.4 GLB, 3.6 buffers).
+ */
+#ifndef ASP_EXPORT_INTERNAL_H
+#define ASP_EXPORT_INTERNAL_H
+
+#include <cjson/cJSON.h>
+
+#include "amgsplat/export.h"
+
+/* glTF enums (spec 5.1.2 componentType, 5.11.1 bufferView.target, 5.24 sampler filters) */
+enum {
+    ASP__GL_BYTE = 5120,
+    ASP__GL_UNSIGNED_BYTE = 5121,
+    ASP__GL_UNSIGNED_SHORT = 5123,
+    ASP__GL_UNSIGNED_INT = 5125,
+    ASP__GL_FLOAT = 5126,
+    ASP__GL_ARRAY_BUFFER = 34962,
+    ASP__GL_ELEMENT_ARRAY_BUFFER = 34963,
+    ASP__GL_LINEAR = 9729,
+    ASP__GL_CLAMP_TO_EDGE = 33071
+};
+
+typedef struct asp__gltf_png {
+    unsigned char *data; /* the encoded PNG, through ctx's allocator */
+    size_t size;
+    char uri[256];       /* file name beside the .gltf */
+} asp__gltf_png;
+
+typedef struct asp__gltf {
+    cJSON *root;
+    cJSON *buffer_views, *accessors, *images, *textures, *samplers, *materials, *meshes, *nodes, *extensions_used;
+    uint8_t *bin;
+    size_t bin_size, bin_capacity;
+    asp__gltf_png *pngs;
+    size_t png_count;
+    int glb;             /* 1: one .glb, images in the binary chunk; 0: .gltf + .bin + .png files */
+    char stem[96];       /* base name of the outputs (no directory, no extension) */
+    const asp_context *ctx;
+    int failed;          /* an allocation failed: the document is incomplete */
+} asp__gltf;
+
+/* Starts a document for path (.glb or .gltf). Returns 0, ASP_EINVAL (other extension), ASP_ENOMEM. */
+int asp__gltf_init(asp__gltf *g, const char *path, const char *generator_note, const asp_context *ctx,
+                   asp_error *err);
+void asp__gltf_release(asp__gltf *g);
+
+/* Appends size bytes as a buffer view (target 0 = none); returns its index or -1 (out of memory). */
+int asp__gltf_view(asp__gltf *g, const void *data, size_t size, int target);
+/* An accessor over a whole view; min/max (ncomp values each) may be NULL. Returns its index or -1. */
+int asp__gltf_accessor(asp__gltf *g, int view, int component_type, size_t count, const char *type, int normalized,
+                       const float *min, const float *max);
+/* Encodes RGBA8 pixels as PNG and adds it as an image; returns its index or -1. */
+int asp__gltf_image(asp__gltf *g, const uint8_t *rgba, uint32_t width, uint32_t height, const char *name);
+/* A texture of image with the one linear, clamped, unmipmapped sampler; returns its index or -1. */
+int asp__gltf_texture(asp__gltf *g, int image);
+/* Adds name to extensionsUsed once. */
+void asp__gltf_use_extension(asp__gltf *g, const char *name);
+/* Adds obj to the array (ownership moves); returns its index or -1. */
+int asp__gltf_append(asp__gltf *g, cJSON *array, cJSON *obj);
+/* A cJSON array of n floats (doubles kept exact). */
+cJSON *asp__gltf_numbers(const double *v, int n);
+
+/* Writes the document and its files atomically; fills stats' byte and file counts. */
+int asp__gltf_write(asp__gltf *g, const char *path, asp_gltf_stats *stats, asp_error *err);
+
+/* The scene extras both exports write (origin, frame, kind) for viewers that frame like amgsplat. */
+cJSON *asp__gltf_extras(const char *kind, const char *source, const double origin[3], const asp_frame *frame);
+
+#endif
