@@ -4,6 +4,11 @@
 # points, a point renderer for a .dps) are dropped rather than refused.
 source "$(dirname "$0")/common.sh"
 A="$AMGSPLAT"
+# decompose and build start MPI, whose by-design leaks the ASan build's suppressions match only with
+# full stacks (CMakeLists.txt); bench-paper also renders a lot, so its leaks go unchecked as in
+# cli.bench_paper. The other commands keep the fast unwinding.
+mpi_asan="${ASAN_OPTIONS:-}:fast_unwind_on_malloc=0"
+bench_asan="${ASAN_OPTIONS:-}:detect_leaks=0"
 jget() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
 
 "$A" render -h | grep -- "--preset SEED" >/dev/null || fail "render -h lacks --preset"
@@ -37,8 +42,8 @@ expect_fail 2 "unknown preset 'qsplat'" "$A" render "$T/o.ply" -o "$T/e.png" --p
 expect_fail 2 "unknown preset 'qsplat'" "$A" view "$T/o.ply" --preset qsplat
 
 # journal on a .dps: the overlap method of journal Fig. 10; pajarola's point renderer is dropped there
-"$A" decompose "$T/o.ply" -o "$T/o.amg" -q
-"$A" build "$T/o.amg" -o "$T/o.dps" --primitives 8 -q >/dev/null
+ASAN_OPTIONS="$mpi_asan" "$A" decompose "$T/o.ply" -o "$T/o.amg" -q
+ASAN_OPTIONS="$mpi_asan" "$A" build "$T/o.amg" -o "$T/o.dps" --primitives 8 -q >/dev/null
 "$A" render "$T/o.dps" -o "$T/jd.png" --preset journal "${R[@]}" --json >"$T/jd.json"
 [[ $(jget "$T/jd.json" "d['method']") == "overlap" ]] || fail "journal .dps method: $(cat "$T/jd.json")"
 "$A" render "$T/o.dps" -o "$T/jt.png" --preset thesis --method prefix "${R[@]}" --json >"$T/jt.json"
@@ -46,14 +51,14 @@ expect_fail 2 "unknown preset 'qsplat'" "$A" view "$T/o.ply" --preset qsplat
 "$A" render "$T/o.dps" -o "$T/pd.png" --preset pajarola "${R[@]}" || fail "--preset pajarola on a .dps"
 
 # strict domains as primitives (thesis eq. 2.5), drawn without blending: one silhouette with the points
-"$A" build "$T/o.amg" -o "$T/s.dps" --level L-2 --domains strict -q >/dev/null
+ASAN_OPTIONS="$mpi_asan" "$A" build "$T/o.amg" -o "$T/s.dps" --level L-2 --domains strict -q >/dev/null
 "$A" info "$T/s.dps" --json | python3 -c "import json,sys; d=json.load(sys.stdin); assert d['levels'][0]['neighbour_pairs'] == 0, d" \
   || fail "strict domains have neighbours"
 "$A" render "$T/s.dps" -o "$T/sd.png" --method no-blend "${R[@]}"
 "$A" render "$T/o.ply" -o "$T/sp.png" --renderer splat --tolerance 0 "${R[@]}"
 "$A" imgdiff "$T/sd.png" "$T/sp.png" --json | python3 -c "import json,sys; d=json.load(sys.stdin); assert d['iou'] > 0.9, d" \
   || fail "strict primitives do not cover the points' silhouette"
-expect_fail 2 "--domains expects thresholded or strict" "$A" build "$T/o.amg" -o "$T/x.dps" --domains fuzzy
+ASAN_OPTIONS="$mpi_asan" expect_fail 2 "--domains expects thresholded or strict" "$A" build "$T/o.amg" -o "$T/x.dps" --domains fuzzy
 
 # overlap with back-facing neighbours (journal Fig. 10's pseudocode): an open sheet folded at x = 0
 # (a face z = 0 and a face z = 2x rising towards the eye) seen from azimuth 40: the fold's second face
@@ -68,8 +73,8 @@ for j in range(51):
 open(sys.argv[1], "w").write("ply\nformat ascii 1.0\nelement vertex %d\n" % len(rows) + "".join(
     "property float %s\n" % n for n in ("x", "y", "z", "nx", "ny", "nz")) + "end_header\n" + "\n".join(rows) + "\n")
 PY
-"$A" decompose "$T/fold.ply" -o "$T/fold.amg" --crease-cut -1 -q
-"$A" build "$T/fold.amg" -o "$T/fold.dps" --primitives 4 --neighbours 0.001 -q >/dev/null
+ASAN_OPTIONS="$mpi_asan" "$A" decompose "$T/fold.ply" -o "$T/fold.amg" --crease-cut -1 -q
+ASAN_OPTIONS="$mpi_asan" "$A" build "$T/fold.amg" -o "$T/fold.dps" --primitives 4 --neighbours 0.001 -q >/dev/null
 "$A" render "$T/fold.dps" -o "$T/fa.png" --method overlap --view 40,0 --size 128x128 --transparent -q
 "$A" render "$T/fold.dps" -o "$T/fb.png" --method overlap --view 40,0 --size 128x128 --transparent -q --overlap-backfaces
 "$A" imgdiff "$T/fa.png" "$T/fb.png" --json >"$T/fold.json"
@@ -83,7 +88,7 @@ PY
 expect_fail 2 "--overlap-backfaces" "$A" render "$T/o.ply" -o "$T/e.png" --overlap-backfaces
 
 # bench-paper: thesis Table 5.1 with its columns tc, AMG and cb
-"$A" bench-paper octahedron --sizes 64 --frames 1 --no-texture-methods >"$T/bp.txt"
+ASAN_OPTIONS="$bench_asan" "$A" bench-paper octahedron --sizes 64 --frames 1 --no-texture-methods >"$T/bp.txt"
 grep -F "Thesis Table 5.1" "$T/bp.txt" >/dev/null || fail "no Table 5.1: $(cat "$T/bp.txt")"
 grep -E "^model +#points +level +#poly +# tex +tc +AMG +cb +dpc$" "$T/bp.txt" >/dev/null || fail "Table 5.1 header"
 grep -E "^octahedron +16000 +L-[0-9]+ +[0-9]+ +[0-9]+ +la +[0-9.]+ +[0-9.]+ +[0-9.]+$" "$T/bp.txt" >/dev/null \
