@@ -123,6 +123,19 @@ typedef enum asp_amg_interp {
 } asp_amg_interp;
 
 /**
+ * Positive off-diagonal entries of A = (A~ + A~^T) / 2 (journal eq. 5-7, thesis 2.4). They come from
+ * obtuse angles of the lifted 3D fans (a fan Delaunay in the tangent plane need not be Delaunay on the
+ * surface). The seeds keep them; amgsplat clamps them to 0 by default because classical AMG
+ * interpolation is built for M-matrices: a positive coupling can give negative interpolation weights,
+ * which the hierarchy drops before renormalising the row (asp_amg_info.repaired_rows), so P stays a
+ * partition of unity with values in [0, 1] either way (docs/seeds.md has the measurement).
+ */
+typedef enum asp_amg_stiffness {
+    ASP_AMG_STIFFNESS_CLAMPED = 0,  /* positive A_ij set to 0 (diagonal = -sum of the rest), counted in info */
+    ASP_AMG_STIFFNESS_UNCLAMPED = 1 /* the seeds' matrix as assembled; still counted in info */
+} asp_amg_stiffness;
+
+/**
  * Options; the zero value means the documented defaults, so
  * `&(asp_amg_desc){ .k_min = 40 }` works.
  */
@@ -143,6 +156,7 @@ typedef struct asp_amg_desc {
     double drop_tol;         /* basis entries below this are dropped and rows renormalised (0 = 1e-4, < 0 keeps all) */
     double crease_cut;       /* cut coarse couplings whose interface classifier is below this times the smaller
                                 interior classifier of the two unknowns (0 = 0.25, < 0 = off; hierarchy.c) */
+    asp_amg_stiffness stiffness; /* 0 = CLAMPED */
 } asp_amg_desc;
 
 /** Opaque decomposition: points, classifier and the AMG hierarchy. */
@@ -155,7 +169,7 @@ typedef struct asp_amg_info {
     double mean_neighbourhood;  /* mean |N(x)| */
     double mean_fan;            /* mean fan size */
     size_t matrix_nnz;          /* non-zeros of A^0 */
-    size_t positive_offdiag;    /* positive A_ij clamped to 0 (obtuse 3D fans) */
+    size_t positive_offdiag;    /* positive A_ij (obtuse 3D fans): clamped to 0 unless desc.stiffness is UNCLAMPED */
     size_t isolated_points;     /* points without any fan neighbour */
     size_t repaired_rows;       /* P rows hypre left empty, filled to keep the partition of unity */
     double t_neighbours, t_classifier, t_fans, t_assembly, t_amg, t_basis;
@@ -172,6 +186,19 @@ typedef struct asp_amg_info {
  */
 int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out,
                       asp_error *err);
+
+/**
+ * Decomposes a triangle mesh through its own connectivity (journal eq. 4):
+ * as asp_amg_decompose on the mesh's vertices (the classifier still comes
+ * from each vertex's neighbourhood, journal 2.1), but the stiffness matrix is
+ * assembled on the mesh triangles incident to each vertex instead of the
+ * local Delaunay fans of journal 2.2 (desc->fan_k is unused). triangles holds
+ * 3 * triangle_count vertex indices, counter-clockwise; degenerate triangles
+ * are skipped. Errors as asp_amg_decompose, and ASP_EINVAL (no triangles, an
+ * index not below vertices->count).
+ */
+int asp_amg_decompose_mesh(const asp_cloud *vertices, const uint32_t *triangles, size_t triangle_count,
+                           const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out, asp_error *err);
 
 /** Frees a decomposition; NULL is accepted. */
 void asp_amg_destroy(asp_amg *amg);
@@ -249,6 +276,16 @@ int asp_amg_domains(const asp_amg_csr *psi, double tau, const asp_context *ctx, 
  * largest Psi at x (ties: the smaller index). label holds psi->rows entries.
  */
 void asp_amg_strict_domains(const asp_amg_csr *psi, asp_index *label);
+
+/**
+ * The strict domains (thesis eq. 2.5) as domain rows, in the layout of
+ * asp_amg_domains: one row per basis function listing, in increasing order,
+ * the points whose largest Psi is that function's (ties: the smaller index),
+ * each with value 1 (hard membership: strict domains do not overlap, thesis
+ * 2.5, so they are drawn without blending). Every point is in exactly one
+ * row. The caller frees *out. Returns 0 or ASP_ENOMEM.
+ */
+int asp_amg_strict_domain_rows(const asp_amg_csr *psi, const asp_context *ctx, asp_amg_csr **out, asp_error *err);
 
 /** Per-level figures for decompose --stats. */
 typedef struct asp_amg_level_stats {

@@ -22,5 +22,6 @@
 #include "scene.h"
 #include "viewer.h"
 #include "output.h"
+#include "preset.h"
 
 #endif

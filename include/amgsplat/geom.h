@@ -77,6 +77,30 @@ size_t asp_kdtree_radius(const asp_kdtree *tree, const float q[3], float radius,
 int asp_knn_all(const asp_kdtree *tree, size_t k, asp_index *idx, float *dist2,
                 const asp_context *ctx, asp_error *err);
 
+/* ---- critical neighbourhood size (src/geom/critical_k.c) ---- */
+
+/** Options of asp_critical_neighbourhood; the zero value means defaults. */
+typedef struct asp_critical_desc {
+    size_t k_min; /* smallest neighbourhood tried, the point included (0 = 8; at least 4) */
+    size_t k_max; /* largest (0 = 96; at most 1024, below the point count) */
+    size_t step;  /* sizes tried: k_min, k_min + step, ... (0 = 4) */
+    double jump;  /* smallest increase of sigma over one step that counts as a jump (0 = 0.02) */
+} asp_critical_desc;
+
+/**
+ * Critical neighbourhood size per point (thesis 2.3, Pauly et al. 2003): the
+ * surface variation sigma_k = l0 / (l0 + l1 + l2) of the k nearest points
+ * (the point included) for k = k_min, k_min + step, ..., k_max; k_out[i] is
+ * the size tried just before sigma's largest increase over one step, when
+ * that increase is at least desc->jump, else k_max (no jump: the
+ * neighbourhood stays on one part of the surface). k_out holds count values.
+ * Deterministic for any thread count. Returns 0; ASP_EINVAL (bad options,
+ * NULL arrays, non-finite coordinates); ASP_EDEGENERATE (count <= k_max);
+ * ASP_ENOMEM (count x k_max neighbour indices); ASP_ECANCELED.
+ */
+int asp_critical_neighbourhood(const float *positions, size_t count, const asp_critical_desc *desc,
+                               const asp_context *ctx, uint32_t *k_out, asp_error *err);
+
 /* ---- PCA (src/geom/eigen3.c) ---- */
 
 /**

@@ -55,7 +55,13 @@ typedef struct asp_hier_node {
 
 /** Build flags (asp_hier_desc.flags). */
 enum asp_hier_build_flags {
-    ASP_HIER_BUILD_IGNORE_RADII = 1 << 0 /* use k-neighbourhood ellipses even if the cloud has radii */
+    ASP_HIER_BUILD_IGNORE_RADII = 1 << 0, /* use k-neighbourhood ellipses even if the cloud has radii */
+    /*
+     * Seed 001 eq. 5-6 as written: axis ratio b'/a' = lambda_2 / lambda_1 of the tangent-plane covariance.
+     * Default: sqrt(lambda_2 / lambda_1), the ratio of the standard deviations, i.e. of the point spread
+     * (a uniform 4:1 rectangle gets a 4:1 ellipse, not 16:1); f rescales both axes either way.
+     */
+    ASP_HIER_BUILD_LAMBDA_AXES = 1 << 1
 };
 
 /** What the hierarchy was built from (asp_hier_flags()). */

@@ -59,6 +59,17 @@ typedef struct asp_prim_desc {
     double merge_flatness;   /* merge while l_min / sum l of both and the union is below this (0 = 0.01) */
     double merge_angle;      /* and their normals differ by less than this, degrees (0 = 15) */
     uint32_t padding;        /* atlas padding around each texture, texels (0 = 2) */
+    int normalise_color;     /* 1: the radial criterion decides for colour too, as eq. 3.3 reads (colour not
+                                divided where f < 1, so it darkens with alpha at a domain's border); 0:
+                                colour, stored straight, is always divided by f (an interpolation) */
+    int no_model_colors;     /* 1: every point light grey 200 (thesis appendix C "Use Model Colors" unchecked) */
+    double brightness;       /* thesis appendix C "Adjust Brightness": added to each point colour's HSV value,
+                                in [-1, 1] (1 = full scale); hue and saturation kept; 0 = unchanged */
+    int strict;              /* 1: primitives of the strict domains (thesis eq. 2.5, asp_amg_strict_domain_rows),
+                                alpha 1 inside, for the no-blend method; 0: thresholded domains Psi > tau */
+    double enlarge;          /* thesis appendix C "Enlarge Bounding Rectangle": > 0 grows the sides of the
+                                points' bounding rectangle by this percentage (at most 1000) instead of the
+                                default margin of one point footprint on every side (0) */
 } asp_prim_desc;
 
 /* ---- one primitive ---- */

@@ -361,8 +361,20 @@ enum asp_splat_renderer_flags {
     /* Drop subtrees whose normal cone faces away from the eye (seed 004
      * 3.2.2). Off by default: points whose normal faces slightly away can
      * still cover silhouette pixels. Ignored for unoriented hierarchies. */
-    ASP_SPLAT_CULL_BACKFACES = 1 << 0
+    ASP_SPLAT_CULL_BACKFACES = 1 << 0,
+    /* Seed 001 Fig. 11 / eq. 12 as written: the ellipse rim is the kernel's r = b, so psi_E(rim) =
+     * exp(-a) (0.0025 for a = 6) and b cancels out. Default: rim at r = 1 (see the desc). */
+    ASP_SPLAT_KERNEL_RIM_AT_B = 1 << 1,
+    /* Seed 001 section 5.3 as written: one depth offset epsilon for every splat, in world units of the
+     * cloud's local frame, instead of epsilon times each splat's major semi-axis. */
+    ASP_SPLAT_EPSILON_UNIFORM = 1 << 2
 };
+
+/** Blending kernel shape (asp_splat_renderer_desc.kernel). */
+typedef enum asp_splat_kernel {
+    ASP_SPLAT_KERNEL_PSI_E = 0, /* seed 001 eq. 12: exp(-a (r / b)^n) */
+    ASP_SPLAT_KERNEL_PSI_G = 1  /* seed 001 eq. 11: exp(-r^2 / (2 sigma^2)), cut at the ellipse rim */
+} asp_splat_kernel;
 
 /**
  * Options of the splat renderer; the zero value means defaults.
@@ -374,14 +386,19 @@ enum asp_splat_renderer_flags {
  * radius as in Fig. 10. Deviation: Fig. 11 maps the ellipse rim to r = b, where
  * b cancels out; b = 1 gives exactly that kernel, exp(-a r^n). With the
  * defaults a = 6, b = 1.5, n = 3 (Fig. 18 b) the weight is 1 at the centre,
- * 0.5 at r = 0.73 and 0.17 on the rim.
+ * 0.5 at r = 0.73 and 0.17 on the rim. ASP_SPLAT_KERNEL_RIM_AT_B gives the seed's
+ * mapping (rim at r = b, weight exp(-a) there); kernel = ASP_SPLAT_KERNEL_PSI_G the
+ * Gaussian of eq. 11 in the same r (sigma 0 = 0.5: weight 0.135 on the rim).
+ * asp_splat_kernel_weight evaluates the weight the blend pass uses.
  */
 typedef struct asp_splat_renderer_desc {
     float kernel_a;          /* width: larger = narrower kernel; 0 = 6; else > 0 */
     float kernel_b;          /* support radius in ellipse units; 0 = 1.5; else > 0 */
     float kernel_n;          /* drop-off sharpness; 0 = 3; else > 0 */
     float epsilon;           /* depth offset of the visibility pass (section 5.3, Fig. 15), along each
-                                eye ray, in units of each splat's major semi-axis; 0 = 1; < 0 = none */
+                                eye ray, in units of each splat's major semi-axis; 0 = 1; < 0 = none.
+                                With ASP_SPLAT_EPSILON_UNIFORM: in world units, 0 = the mean major
+                                semi-axis of the point splats */
     float tolerance;         /* tau in pixels (asp_hier_view.tau): splats whose projected ellipse is smaller
                                 are drawn instead of their children; 0 = every visible input point */
     float radius_scale;      /* multiplies every ellipse; 0 = 1 */
@@ -392,7 +409,27 @@ typedef struct asp_splat_renderer_desc {
     asp_hier_desc hier;      /* hierarchy build options for asp_splat_renderer_create */
     const float *clip_planes; /* 8 floats per INPUT point, by input point index (asp_crease_clip_planes in
                                  geom.h), NULL = none; only read during create */
+    asp_splat_kernel kernel;  /* 0 = PSI_E */
+    float kernel_sigma;       /* PSI_G: sigma in the kernel's r; 0 = 0.5; else > 0 */
 } asp_splat_renderer_desc;
+
+/**
+ * The blending weight the splat renderer's blend pass gives a fragment at
+ * ellipse radius r (r = 1 on the ellipse rim, in units of the semi-axes)
+ * with the kernel options of desc (NULL = defaults): psi_E or psi_G of the
+ * kernel radius (r, or b r with ASP_SPLAT_KERNEL_RIM_AT_B), r clamped to the
+ * support. Negative or non-finite options give NaN. Thread-safe, no GL.
+ */
+float asp_splat_kernel_weight(const asp_splat_renderer_desc *desc, float r);
+
+/**
+ * Seed 001 section 5.1 gives the screen tolerance tau "in percent of the
+ * window area": the pixel tolerance (asp_splat_renderer_desc.tolerance, a
+ * projected size) of a splat whose projected disc covers percent % of a
+ * width x height window, 2 sqrt(A / pi) with A = percent / 100 * width *
+ * height. Returns 0 for percent <= 0 or a non-finite value.
+ */
+float asp_render_tolerance_from_area(double percent, uint32_t width, uint32_t height);
 
 /**
  * Builds the point hierarchy of cloud (asp_hier_build with desc->hier; the
@@ -553,7 +590,11 @@ typedef enum asp_prim_render_method {
 enum asp_prim_render_flags {
     ASP_PRIM_RENDER_OUTLINE = 1 << 0,       /* draw each support rectangle's edges (journal Fig. 12b) */
     ASP_PRIM_RENDER_COLOR_BY_DOMAIN = 1 << 1, /* one colour per primitive, neighbours distinct (journal Fig. 5d) */
-    ASP_PRIM_RENDER_NO_NORMAL_MAP = 1 << 2  /* light with the primitive normal even when the level has a normal map */
+    ASP_PRIM_RENDER_NO_NORMAL_MAP = 1 << 2, /* light with the primitive normal even when the level has a normal map */
+    /* overlap method as the pseudocode of journal Fig. 10 / thesis 4.4.4 reads: the neighbours a
+     * front-facing primitive adds are drawn even when they face away (default: back faces culled,
+     * thesis 5.3.1) */
+    ASP_PRIM_RENDER_OVERLAP_BACKFACES = 1 << 3
 };
 
 /**

@@ -56,6 +56,9 @@ typedef struct asp_viewer_desc {
     const char *screenshot;  /* scripted: PNG written from the last frame's back buffer; may be NULL */
     const char *keys;        /* keys pressed one per frame from the first frame on, e.g. "]]l" (see docs/cli/view.md) */
     unsigned flags;          /* asp_viewer_flags */
+    unsigned lod_flags;      /* splat and square renderers: asp_splat_renderer_flags (ASP_SPLAT_CULL_BACKFACES,
+                                seed 004 3.2.2) */
+    uint32_t depth_limit;    /* splat and square renderers: traversal depth limit (seed 004 3.2.5); 0 = none */
     asp_viewer_log_fn log;   /* NULL = lines are dropped */
     void *log_user;
 } asp_viewer_desc;

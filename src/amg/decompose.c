@@ -172,8 +172,9 @@ static int stage(const asp_context *ctx, const char *name, double f, asp_error *
 }
 #endif
 
-int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out,
-                      asp_error *err)
+/* The pipeline; with triangles, the fans are the mesh's own (journal eq. 4) instead of journal 2.2's. */
+static int decompose(const asp_cloud *cloud, const uint32_t *triangles, size_t ntris, const asp_amg_desc *desc,
+                     const asp_context *ctx, asp_amg **out, asp_error *err)
 {
     int rc = check_cloud(cloud, err);
     if (rc)
@@ -185,6 +186,8 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
 #ifndef ASP_HAVE_HYPRE
     (void)ctx;
     (void)out;
+    (void)triangles;
+    (void)ntris;
     return asp_error_set(err, ASP_EUNSUPPORTED, "cannot decompose: this build has no hypre (ASP_WITH_HYPRE=OFF)");
 #else
     const size_t n = cloud->count;
@@ -229,7 +232,8 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
     t = t1;
     if ((rc = stage(ctx, "fans", 0, err)) != 0)
         goto fail;
-    rc = asp__amg_build_fans(pos, a->tangent, &nb, d.fan_k, ctx, &fans, err);
+    rc = triangles ? asp__amg_mesh_fans(n, triangles, ntris, ctx, &fans, err)
+                   : asp__amg_build_fans(pos, a->tangent, &nb, d.fan_k, ctx, &fans, err);
     if (rc)
         goto fail;
     asp__amg_nbhd_release(ctx, &nb);
@@ -243,7 +247,7 @@ int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const as
     if ((rc = stage(ctx, "assembly", 0, err)) != 0)
         goto fail;
     /* with the crease test, also the same fans with C = 1: its reference (hierarchy.c) */
-    rc = asp__amg_assemble(pos, a->classifier, &fans, ctx, &a->matrix, d.crease_cut > 0 ? &flat : NULL,
+    rc = asp__amg_assemble(pos, a->classifier, &fans, d.stiffness, ctx, &a->matrix, d.crease_cut > 0 ? &flat : NULL,
                            &a->info.positive_offdiag, err);
     if (rc)
         goto fail;
@@ -284,4 +288,18 @@ fail:
     asp_amg_destroy(a);
     return rc;
 #endif
+}
+
+int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out,
+                      asp_error *err)
+{
+    return decompose(cloud, NULL, 0, desc, ctx, out, err);
+}
+
+int asp_amg_decompose_mesh(const asp_cloud *vertices, const uint32_t *triangles, size_t triangle_count,
+                           const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out, asp_error *err)
+{
+    if (!triangles || triangle_count == 0)
+        return asp_error_set(err, ASP_EINVAL, "cannot decompose a mesh without triangles");
+    return decompose(vertices, triangles, triangle_count, desc, ctx, out, err);
 }

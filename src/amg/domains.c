@@ -58,6 +58,41 @@ void asp_amg_strict_domains(const asp_amg_csr *psi, asp_index *label)
     }
 }
 
+int asp_amg_strict_domain_rows(const asp_amg_csr *psi, const asp_context *ctx, asp_amg_csr **out, asp_error *err)
+{
+    asp_index *label = asp_alloc(ctx, (psi->rows ? psi->rows : 1) * sizeof *label);
+    if (!label)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for the strict domains of %zu points", psi->rows);
+    asp_amg_strict_domains(psi, label);
+    asp_amg_csr *d;
+    int rc = asp_amg_csr_create(psi->cols, psi->rows, psi->rows, ctx, &d, err);
+    if (rc) {
+        asp_free(ctx, label);
+        return rc;
+    }
+    for (size_t x = 0; x < psi->rows; x++)
+        d->row_ptr[label[x] + 1]++;
+    for (size_t i = 0; i < d->rows; i++)
+        d->row_ptr[i + 1] += d->row_ptr[i];
+    /* counting sort by label, points in increasing order within a row */
+    size_t *fill = asp_alloc(ctx, (d->rows + 1) * sizeof *fill);
+    if (!fill) {
+        asp_free(ctx, label);
+        asp_amg_csr_destroy(d);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for the strict domains");
+    }
+    memcpy(fill, d->row_ptr, (d->rows + 1) * sizeof *fill);
+    for (size_t x = 0; x < psi->rows; x++) {
+        size_t w = fill[label[x]]++;
+        d->col[w] = (asp_index)x;
+        d->val[w] = 1.0;
+    }
+    asp_free(ctx, fill);
+    asp_free(ctx, label);
+    *out = d;
+    return 0;
+}
+
 static int fill_stats(const asp_amg_csr *psi, size_t level, double tau, const asp_context *ctx,
                       asp_amg_level_stats *s, asp_error *err)
 {

@@ -48,10 +48,14 @@ int asp__amg_classify(const float *pos, const asp__amg_nbhd *nb, const asp_amg_d
 int asp__amg_build_fans(const float *pos, const float *normals, const asp__amg_nbhd *nb, size_t fan_k,
                         const asp_context *ctx, asp__amg_fans *out, asp_error *err);
 void asp__amg_fans_release(const asp_context *ctx, asp__amg_fans *f);
+/* Fans of the mesh triangles incident to each of n vertices (mesh_fans.c, journal eq. 4). */
+int asp__amg_mesh_fans(size_t n, const uint32_t *triangles, size_t ntris, const asp_context *ctx,
+                       asp__amg_fans *out, asp_error *err);
 
 /* A (journal eq. 5-7) and, when flat is not NULL, the same fans' matrix with C = 1 on A's pattern. */
-int asp__amg_assemble(const float *pos, const float *classifier, const asp__amg_fans *fans, const asp_context *ctx,
-                      asp_amg_csr **out, asp_amg_csr **flat, size_t *positive, asp_error *err);
+int asp__amg_assemble(const float *pos, const float *classifier, const asp__amg_fans *fans, asp_amg_stiffness form,
+                      const asp_context *ctx, asp_amg_csr **out, asp_amg_csr **flat, size_t *positive,
+                      asp_error *err);
 
 /* One BoomerAMG setup level on a: copies P (a->rows x nc) and A^1 = P^T a P; *p = NULL when hypre did not coarsen. */
 int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,

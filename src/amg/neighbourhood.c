@@ -61,7 +61,7 @@ int asp__amg_resolve_desc(const asp_amg_desc *in, size_t count, asp_amg_desc *ou
         return asp_error_set(err, ASP_EINVAL, "invalid classifier constants alpha %g, beta %g: expected > 0", d.alpha,
                              d.beta);
     if ((unsigned)d.classifier > ASP_AMG_CLASSIFIER_MOMENT || (unsigned)d.coarsen > ASP_AMG_COARSEN_HMIS ||
-        (unsigned)d.interp > ASP_AMG_INTERP_EXTENDED_I)
+        (unsigned)d.interp > ASP_AMG_INTERP_EXTENDED_I || (unsigned)d.stiffness > ASP_AMG_STIFFNESS_UNCLAMPED)
         return asp_error_set(err, ASP_EINVAL, "invalid classifier, coarsening or interpolation choice");
     if (!(d.strong_threshold > 0 && d.strong_threshold < 1))
         return asp_error_set(err, ASP_EINVAL, "invalid strong threshold %g: expected a value in (0, 1)",

@@ -91,8 +91,9 @@ static size_t tilde_row(const float *pos, const float *cls, const asp__amg_fans 
     return cnt;
 }
 
-int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f, const asp_context *ctx,
-                      asp_amg_csr **out, asp_amg_csr **flat_out, size_t *positive, asp_error *err)
+int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f, asp_amg_stiffness form,
+                      const asp_context *ctx, asp_amg_csr **out, asp_amg_csr **flat_out, size_t *positive,
+                      asp_error *err)
 {
     const size_t n = f->n;
     const int threads = asp_context_threads(ctx);
@@ -162,10 +163,12 @@ int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f
      * A_ij = (A~_ij + A~_ji) / 2 (eq. 6). A positive result comes from obtuse
      * 3D angles (a non-Delaunay lifted fan); classical AMG interpolation needs
      * an M-matrix (non-positive off-diagonals) to give weights in [0,1], so
-     * such entries are clamped to 0 and counted. Pass 1 counts, pass 2 fills.
-     * The flat matrix (C = 1, the crease test's reference) takes A's pattern,
-     * its positive entries clamped too, with zero row sums.
+     * such entries are clamped to 0 and counted. The seeds keep them (journal
+     * eq. 5-7, thesis 2.4): ASP_AMG_STIFFNESS_UNCLAMPED. Pass 1 counts, pass 2
+     * fills. The flat matrix (C = 1, the crease test's reference) takes A's
+     * pattern, its positive entries clamped as A's are, with zero row sums.
      */
+    const int clamp = form != ASP_AMG_STIFFNESS_UNCLAMPED;
     for (int pass = 0; pass < 2 && !rc; pass++) {
         if (pass == 1) {
             size_t total = 0;
@@ -219,7 +222,8 @@ int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f
                 if (v > 0) {
                     if (pass == 0 && j > i)
                         pos_count[t]++;
-                    continue;
+                    if (clamp)
+                        continue;
                 }
                 if (v == 0)
                     continue;
@@ -234,7 +238,7 @@ int asp__amg_assemble(const float *pos, const float *cls, const asp__amg_fans *f
                     a->val[w] = v;
                     if (fl) {
                         fl->col[w] = j;
-                        fl->val[w] = fv < 0 ? fv : 0.0;
+                        fl->val[w] = fv < 0 || !clamp ? fv : 0.0;
                         fdiag -= fl->val[w];
                     }
                 }

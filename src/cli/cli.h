@@ -25,6 +25,8 @@ struct cli_env {
     int quiet;           /* --quiet: no progress, no chatter */
     int json;            /* --json: machine-readable output on stdout */
     int threads;         /* --threads N (0 = all) */
+    const void *preset_values[32]; /* option values set by --preset and not given explicitly */
+    size_t preset_count;
     struct cli_progress_state progress;
 };
 
@@ -52,6 +54,13 @@ struct cli_option {
  */
 int cli_parse(int argc, char **argv, const struct cli_option *opts, const char *usage, struct cli_env *env,
               int *npos);
+
+/*
+ * 1 when the option whose value field is `value` holds a --preset value (not given on the command
+ * line), so a command may drop a preset setting that does not apply to its input (a .dps method for
+ * points) instead of refusing it as it refuses the same option given by hand.
+ */
+int cli_from_preset(const struct cli_env *env, const void *value);
 
 /* Prints "amgsplat CMD: error: MSG" and returns exit status 1. */
 int cli_fail(const struct cli_env *env, const asp_error *err);

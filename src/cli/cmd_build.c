@@ -15,6 +15,8 @@ static const char usage[] =
     "usage: amgsplat build IN.amg|IN.ply -o OUT.dps [--level L-5 | --level L-6..L | --primitives 400]\n"
     "                      [--texel-size X] [--method affine|radial] [--shape linear|constant|gaussian]\n"
     "                      [--width W] [--normalise positive|ge1] [--merge] [--normals] [--atlas X.png]\n"
+    "                      [--preset thesis|journal] [--domains thresholded|strict] [--enlarge PCT]\n"
+    "                      [--normalise-color] [--no-model-colors] [--brightness X]\n"
     "\n"
     "Turns every domain of the chosen AMG level(s) into one planar rectangle (weighted PCA of\n"
     "its points) with a texture: colour = the points' colours, alpha = the domain's basis\n"
@@ -146,13 +148,18 @@ static int save_atlases(const char *path, const asp_dps *dps, const asp_dps_summ
 
 int cmd_build(int argc, char **argv, struct cli_env *env)
 {
+    const char *preset = NULL; /* applied by cli_parse */
+    int norm_color = 0, no_colors = 0;
+    double brightness = 0;
+    const char *domain_set = "thresholded";
     const char *output = NULL, *level_text = NULL, *method = "affine", *shape = "linear", *norm = "positive";
     const char *atlas = NULL;
     size_t budget = SIZE_MAX, max_texture = 0, padding = 0; // SIZE_MAX: not given, so a given 0 is refused
-    double texel = 0, width = 0, tau = 0, fraction = 0, flat = 0, angle = 0;
+    double texel = 0, width = 0, tau = 0, fraction = 0, flat = 0, angle = 0, enlarge = 0;
     int unweighted = 0, project = 0, no_extend = 0, normals = 0, merge = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output primitives (.dps)"},
+        {"preset", 0, CLI_STRING, &preset, "SEED", "the seed's options: thesis, journal (docs/seeds.md)"},
         {"level", 'l', CLI_STRING, &level_text, "L", "level(s): L, L-5, 3, 'L-5,L-3' or 'L-6..L' (default L-3)"},
         {"primitives", 'p', CLI_SIZE, &budget, "N", "the finest level with at most N domains"},
         {"texel-size", 0, CLI_DOUBLE, &texel, "X", "texel edge in mean point radii (default 1)"},
@@ -171,6 +178,11 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         {"merge-flatness", 0, CLI_DOUBLE, &flat, "X", "merge while l_min/sum l < X (default 0.01)"},
         {"merge-angle", 0, CLI_DOUBLE, &angle, "DEG", "and normals within DEG degrees (default 15)"},
         {"padding", 0, CLI_SIZE, &padding, "N", "atlas padding in texels (default 2)"},
+        {"normalise-color", 0, CLI_FLAG, &norm_color, NULL, "radial: the --normalise criterion for colour too (thesis eq. 3.3 as written)"},
+        {"no-model-colors", 0, CLI_FLAG, &no_colors, NULL, "grey points instead of the model's colours (thesis app. C)"},
+        {"brightness", 0, CLI_DOUBLE, &brightness, "X", "add X (-1..1) to each point colour's HSV value (thesis app. C)"},
+        {"domains", 0, CLI_STRING, &domain_set, "SET", "thresholded (default, Psi > tau) or strict (thesis eq. 2.5; draw with --method no-blend)"},
+        {"enlarge", 0, CLI_DOUBLE, &enlarge, "PCT", "grow the points' rectangle by PCT % (thesis app. C; default: one footprint margin)"},
         {"atlas", 0, CLI_STRING, &atlas, "X.png", "also write each level's atlas as PNG"},
         {0},
     };
@@ -181,6 +193,8 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat build -h'", npos);
     if (!output)
         return cli_usage_error(env, "missing -o OUT.dps");
+    if (level_text && budget != SIZE_MAX && cli_from_preset(env, &level_text))
+        level_text = NULL; /* --primitives given by hand wins over the preset's level */
     if (level_text && budget != SIZE_MAX)
         return cli_usage_error(env, "--level and --primitives exclude each other");
     if (budget == 0 || (budget != SIZE_MAX && budget > UINT32_MAX))
@@ -192,11 +206,20 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     }
     if (max_texture > 8192 || padding > 64)
         return cli_usage_error(env, "--max-texture must be at most 8192 and --padding at most 64");
+    if (!(brightness >= -1 && brightness <= 1))
+        return cli_usage_error(env, "--brightness expects -1..1, got %g", brightness);
+    if (strcmp(domain_set, "thresholded") != 0 && strcmp(domain_set, "strict") != 0)
+        return cli_usage_error(env, "--domains expects thresholded or strict, got '%s'", domain_set);
+    if (!(enlarge >= 0 && enlarge <= 1000))
+        return cli_usage_error(env, "--enlarge expects a percentage in 0..1000, got %g", enlarge);
     asp_error err = {0};
     asp_prim_desc desc = {.tau = tau, .texel_size = texel, .max_texture = (uint32_t)max_texture, .width = width,
                           .unweighted = unweighted, .project_radii = project, .no_extend_color = no_extend,
                           .normal_map = normals, .neighbour_fraction = fraction, .merge = merge,
-                          .merge_flatness = flat, .merge_angle = angle, .padding = (uint32_t)padding};
+                          .merge_flatness = flat, .merge_angle = angle, .padding = (uint32_t)padding,
+                          .enlarge = enlarge, .normalise_color = norm_color,
+                          .strict = strcmp(domain_set, "strict") == 0, .no_model_colors = no_colors,
+                          .brightness = brightness};
     if (asp_prim_method_parse(method, &desc.method, &err) || asp_prim_shape_parse(shape, &desc.shape, &err) ||
         asp_prim_normalise_parse(norm, &desc.normalise, &err))
         return cli_usage_error(env, "%s", err.msg);

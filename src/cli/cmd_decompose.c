@@ -4,6 +4,7 @@
  */
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli/cli.h"
@@ -11,12 +12,14 @@
 #include "util/banned.h"
 
 static const char usage[] =
-    "usage: amgsplat decompose IN.ply -o OUT.amg [--k N] [--k-max N] [--epsilon X] [--fan-k N]\n"
+    "usage: amgsplat decompose IN.ply -o OUT.amg [--preset thesis|journal] [--k N] [--k-max N] [--epsilon X]\n"
+    "                          [--fan-k N] [--stiffness clamped|unclamped]\n"
     "                          [--classifier variation|moment] [--alpha X] [--beta X]\n"
     "                          [--coarsen rs|falgout|cljp|pmis|hmis] [--interp classical|direct|standard|ext+i]\n"
     "                          [--strong X] [--trunc X] [--max-levels N] [--max-coarse N] [--crease-cut X]\n"
     "                          [--weak-cut X]\n"
-    "                          [--drop X] [--stats] [--tau X] [--json]\n"
+    "                          [--drop X] [--stats] [--tau X] [--critical-k] [--json]\n"
+    "                          [--mesh-stiffness (MESH input)]\n"
     "                          [--export-colors classifier|domains|strict --level L-3 --colors-out X.ply]\n"
     "       amgsplat decompose IN.amg --stats | --export-colors ...\n"
     "\n"
@@ -43,6 +46,8 @@ static const struct name_code interps[] = {{"classical", ASP_AMG_INTERP_CLASSICA
                                            {"standard", ASP_AMG_INTERP_STANDARD},
                                            {"ext+i", ASP_AMG_INTERP_EXTENDED_I},
                                            {0, 0}};
+static const struct name_code stiffness_forms[] = {
+    {"clamped", ASP_AMG_STIFFNESS_CLAMPED}, {"unclamped", ASP_AMG_STIFFNESS_UNCLAMPED}, {0, 0}};
 static const struct name_code color_modes[] = {
     {"classifier", ASP_AMG_COLOR_CLASSIFIER}, {"domains", ASP_AMG_COLOR_DOMAINS}, {"strict", ASP_AMG_COLOR_STRICT}, {0, 0}};
 
@@ -148,6 +153,60 @@ static int export_colors(struct cli_env *env, const asp_amg *amg, int mode, cons
     return rc;
 }
 
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* --critical-k: the distribution of the per-point critical size, a guide for --k (thesis 2.3) */
+static int print_critical(struct cli_env *env, const asp_cloud *cloud, asp_error *err)
+{
+    const asp_critical_desc cd = {0};
+    uint32_t *k = asp_calloc(&env->ctx, cloud->count, sizeof *k);
+    if (!k)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu critical sizes", cloud->count);
+    int rc = asp_critical_neighbourhood(cloud->positions, cloud->count, &cd, &env->ctx, k, err);
+    cli_progress_end(env);
+    if (!rc) {
+        qsort(k, cloud->count, sizeof *k, cmp_u32);
+        size_t n = cloud->count, jumped = 0;
+        for (size_t i = 0; i < n; i++)
+            jumped += k[i] < 96;
+        // stderr with --json: stdout holds the one JSON document
+        fprintf(env->json ? stderr : stdout,
+                "critical neighbourhood size (thesis 2.3, k 8..96 step 4): 10%% %u, median %u, 90%% %u; "
+                "%.1f%% of the points see a jump in the surface variation\n",
+                k[n / 10], k[n / 2], k[n - 1 - n / 10], 100.0 * (double)jumped / (double)n);
+    }
+    asp_free(&env->ctx, k);
+    return rc;
+}
+
+/* --mesh-stiffness: the mesh and its vertices as the point set, index for index (journal eq. 4) */
+static int load_mesh_vertices(struct cli_env *env, const char *path, asp_mesh **mesh, asp_cloud **cloud,
+                              asp_error *err)
+{
+    int rc = asp_mesh_load(path, NULL, &env->ctx, mesh, err);
+    if (rc)
+        return rc;
+    const asp_mesh *m = *mesh;
+    rc = asp_cloud_create(m->vertex_count, ASP_ATTR_NORMALS | (m->colors ? ASP_ATTR_COLORS : 0u), &env->ctx, cloud,
+                          err);
+    if (rc) {
+        asp_mesh_destroy(*mesh);
+        *mesh = NULL;
+        return rc;
+    }
+    asp_cloud *c = *cloud;
+    memcpy(c->origin, m->origin, sizeof c->origin);
+    memcpy(c->positions, m->positions, 3 * m->vertex_count * sizeof *c->positions);
+    memcpy(c->normals, m->normals, 3 * m->vertex_count * sizeof *c->normals);
+    if (m->colors)
+        memcpy(c->colors, m->colors, 4 * m->vertex_count * sizeof *c->colors);
+    return 0;
+}
+
 #define UNSET SIZE_MAX
 
 /* The library's ranges (src/amg/neighbourhood.c), checked here so the message names the option. */
@@ -186,17 +245,21 @@ static int check_output_name(const struct cli_env *env, const char *input, const
 int cmd_decompose(int argc, char **argv, struct cli_env *env)
 {
     const char *output = NULL, *classifier = "variation", *coarsen = "rs", *interp = "classical";
+    const char *preset = NULL, *stiffness = "clamped"; /* --preset is applied by cli_parse */
     const char *export_mode = NULL, *level_name = "L-3", *colors_out = NULL;
     /* UNSET, not 0: 0 means "default" to the library, so a given 0 would pass silently */
     size_t k = UNSET, k_max = UNSET, fan_k = UNSET, max_levels = UNSET, max_coarse = UNSET;
     double epsilon = 0, alpha = 0, beta = 0, strong = 0, trunc = 0, weak = 0, drop = 0, tau = 0.05, crease = 0;
-    int stats = 0;
+    int stats = 0, critical = 0, mesh_stiffness = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output decomposition (.amg)"},
+        {"preset", 0, CLI_STRING, &preset, "SEED", "the seed's options: thesis, journal (docs/seeds.md)"},
         {"k", 'k', CLI_SIZE, &k, "N", "minimum neighbourhood size k_min (default 24)"},
         {"k-max", 0, CLI_SIZE, &k_max, "N", "cap with the epsilon-ball extension (default 2 k_min)"},
         {"epsilon", 0, CLI_DOUBLE, &epsilon, "X", "neighbourhood radius (default: median k_min-th distance)"},
         {"fan-k", 0, CLI_SIZE, &fan_k, "N", "nearest neighbours projected for the fan (default 16)"},
+        {"stiffness", 0, CLI_STRING, &stiffness, "F",
+         "positive off-diagonals: clamped (default, an M-matrix for AMG) or unclamped (the seeds)"},
         {"classifier", 0, CLI_STRING, &classifier, "C", "variation (default, thesis 2.3) or moment (journal eq. 3)"},
         {"alpha", 0, CLI_DOUBLE, &alpha, "X", "G(s) = 1/(alpha + beta s^2): alpha (default 0.01)"},
         {"beta", 0, CLI_DOUBLE, &beta, "X", "beta (default 100)"},
@@ -211,6 +274,8 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         {"weak-cut", 0, CLI_DOUBLE, &weak, "X", "cut coarse couplings below X times the median (default 0: off)"},
         {"drop", 0, CLI_DOUBLE, &drop, "X", "drop basis values below X, renormalised (default 1e-4)"},
         {"stats", 0, CLI_FLAG, &stats, NULL, "print per-level statistics"},
+        {"mesh-stiffness", 0, CLI_FLAG, &mesh_stiffness, NULL, "MESH input: the stiffness matrix on the mesh's own triangles (journal eq. 4)"},
+        {"critical-k", 0, CLI_FLAG, &critical, NULL, "print the points' critical neighbourhood sizes (thesis 2.3), to choose --k"},
         {"tau", 0, CLI_DOUBLE, &tau, "X", "domain threshold for --stats (default 0.05; thesis K = 0.01)"},
         {"export-colors", 0, CLI_STRING, &export_mode, "M", "write a coloured point file: classifier, domains, strict"},
         {"level", 'l', CLI_STRING, &level_name, "L", "level for --export-colors domains|strict (default L-3)"},
@@ -224,7 +289,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat decompose -h'", npos);
     const char *input = argv[0];
     /* the recogniser (magic, then extension in any case: O.AMG); a failure here resurfaces in the loader */
-    asp_file_type type;
+    asp_file_type type = {ASP_FILE_UNKNOWN, "", 0};
     int from_amg = asp_file_recognise(input, &type, NULL) == 0 && type.kind == ASP_FILE_AMG;
     int color_mode = 0;
     if (check_counts(env, k, k_max, fan_k, max_levels, max_coarse))
@@ -247,13 +312,20 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     if (lookup(interps, interp, &code))
         return cli_usage_error(env, "--interp must be classical, direct, standard or ext+i, got '%s'", interp);
     desc.interp = (asp_amg_interp)code;
+    if (lookup(stiffness_forms, stiffness, &code))
+        return cli_usage_error(env, "--stiffness must be clamped or unclamped, got '%s'", stiffness);
+    desc.stiffness = (asp_amg_stiffness)code;
     if (export_mode && lookup(color_modes, export_mode, &color_mode))
         return cli_usage_error(env, "--export-colors must be classifier, domains or strict, got '%s'", export_mode);
     if (export_mode && !colors_out)
         return cli_usage_error(env, "--export-colors needs --colors-out FILE.ply");
     if (!(tau >= 0 && tau < 1))
         return cli_usage_error(env, "--tau must be in [0, 1), got %g", tau);
-    if (!from_amg && !output && !stats && !export_mode)
+    if (mesh_stiffness && type.kind != ASP_FILE_MESH)
+        return cli_usage_error(env, "--mesh-stiffness needs a mesh input (OBJ, PLY with faces, OFF, STL, glTF, 3DS)");
+    if (critical && from_amg)
+        return cli_usage_error(env, "--critical-k needs a point input");
+    if (!from_amg && !output && !stats && !export_mode && !critical)
         return cli_usage_error(env, "missing -o OUT.amg (or --stats / --export-colors)");
     if (from_amg && output)
         return cli_usage_error(env, "'%s' is already a decomposition; -o applies to point input", input);
@@ -267,10 +339,23 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
             return cli_fail(env, &err);
     } else {
         asp_cloud *cloud = NULL;
-        if (asp_cloud_load(input, &env->ctx, &cloud, &err))
+        asp_mesh *mesh = NULL;
+        if (mesh_stiffness ? load_mesh_vertices(env, input, &mesh, &cloud, &err)
+                           : asp_cloud_load(input, &env->ctx, &cloud, &err))
             return cli_fail(env, &err);
-        rc = asp_amg_decompose(cloud, &desc, &env->ctx, &amg, &err);
+        if (critical && print_critical(env, cloud, &err)) {
+            asp_cloud_destroy(cloud);
+            return cli_fail(env, &err);
+        }
+        if (!output && !stats && !export_mode) {
+            asp_cloud_destroy(cloud);
+            asp_mesh_destroy(mesh);
+            return 0;
+        }
+        rc = mesh ? asp_amg_decompose_mesh(cloud, mesh->triangles, mesh->triangle_count, &desc, &env->ctx, &amg, &err)
+                  : asp_amg_decompose(cloud, &desc, &env->ctx, &amg, &err);
         asp_cloud_destroy(cloud);
+        asp_mesh_destroy(mesh);
         if (rc) {
             asp_amg_shutdown();
             return cli_fail(env, &err);
@@ -314,8 +399,8 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
             printf("%s: %zu points, %zu levels (L = %zu, coarsest %zu unknowns)", output ? output : input,
                    asp_amg_cloud(amg)->count, nl, nl - 1, asp_amg_level_size(amg, nl - 1));
             if (!from_amg)
-                printf(", epsilon %.4g, %zu positive couplings clamped, %.2f s", in->epsilon, in->positive_offdiag,
-                       t_total);
+                printf(", epsilon %.4g, %zu positive couplings %s, %.2f s", in->epsilon, in->positive_offdiag,
+                       desc.stiffness == ASP_AMG_STIFFNESS_UNCLAMPED ? "kept" : "clamped", t_total);
             printf("\n");
         }
         if (stats)

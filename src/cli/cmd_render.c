@@ -20,12 +20,15 @@ static const char usage[] =
     "                      [--renderer disc|splat|square] [--tolerance PX | --budget N] [--kernel A,B,N]\n"
     "                      [--epsilon X] [--lighting gouraud|pixel|flat] [--opaque] [--unlit] [--point-size PX]\n"
     "                      [--background R,G,B[,A] | --transparent] [--light AZ,EL]\n"
+    "                      [--preset thesis|journal|pajarola|schwarz] [--kernel-rim 1|b] [--kernel-shape psi-e|psi-g]\n"
+    "                      [--epsilon-uniform X] [--tolerance-area PCT] [--axes sqrt|lambda] [--cull-backfaces]\n"
+    "                      [--depth-limit N]\n"
     "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict] [--level L-3] ...\n"
     "       amgsplat render MESH -o OUT.png [--flat] [--texture IMG] [--renderer mesh|disc] ...\n"
     "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
     "                      dark-backface-soft|blend-all|no-blend|polygons] [--level L] [--alpha-ref X]\n"
     "                      [--transparency X] [--depth-window X] [--crease-angle DEG|off] [--outline]\n"
-    "                      [--color-by domain] ...\n"
+    "                      [--color-by domain] [--overlap-backfaces] ...\n"
     "\n"
     "Renders a point set (PLY, XYZ) or the points of an AMG decomposition (.amg) headlessly through\n"
     "EGL (a GPU, or Mesa llvmpipe without one) to a PNG. Renderers: disc (opaque discs in the tangent\n"
@@ -65,6 +68,13 @@ struct render_opts {
     int opaque;
     int unlit; /* --unlit: the colours as they are, no shading (ASP_RENDER_UNLIT) */
     const char *method;
+    const char *preset; /* --preset: applied by cli_parse (docs/seeds.md) */
+    const char *kernel_shape, *kernel_rim, *axes; /* seed 001 eq. 11-12, eq. 5-6 (docs/seeds.md) */
+    double sigma, epsilon_uniform, tolerance_area; /* NaN: not given */
+    unsigned splat_flags, hier_flags;
+    int cull_backfaces;  /* seed 004 3.2.2: normal-cone culling of hierarchy nodes */
+    size_t depth_limit;  /* seed 004 3.2.5: traversal depth limit (0 = none) */
+    asp_splat_kernel kernel_kind;
     double alpha_ref;
     double transparency;
     double depth_window;
@@ -74,6 +84,7 @@ struct render_opts {
     int flat;
     int outline;
     int no_normal_map;
+    int overlap_backfaces;
     /* parsed */
     unsigned width, height;
     double az, el, dist; /* dist 0 = fit */
@@ -116,9 +127,19 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
                                          .epsilon = o->epsilon > 0 ? (float)o->epsilon : -1.0f, // 0 = no offset
                                          .tolerance = (float)o->tolerance, .radius_scale = (float)o->radius_scale,
                                          .lighting = o->light_mode,
-                                         .mode = o->opaque ? ASP_SPLAT_OPAQUE : ASP_SPLAT_BLEND};
+                                         .mode = o->opaque ? ASP_SPLAT_OPAQUE : ASP_SPLAT_BLEND,
+                                         .flags = o->splat_flags, .kernel = o->kernel_kind,
+                                         .kernel_sigma = isnan(o->sigma) ? 0.0f : (float)o->sigma,
+                                         .hier = {.flags = o->hier_flags}};
+    if (!isnan(o->epsilon_uniform))
+        r->splat.epsilon = (float)o->epsilon_uniform; // world units; 0 = the mean point splat
     r->square = (asp_square_renderer_desc){.point_size = (float)o->point_size, .tolerance = (float)o->tolerance,
-                                           .radius_scale = (float)o->radius_scale};
+                                           .radius_scale = (float)o->radius_scale, .hier = {.flags = o->hier_flags},
+                                           .flags = o->cull_backfaces ? ASP_SPLAT_CULL_BACKFACES : 0u};
+    if (o->cull_backfaces)
+        r->splat.flags |= ASP_SPLAT_CULL_BACKFACES;
+    if (!isnan(o->tolerance_area)) // seed 001 5.1: tau in percent of the window (one view's) area
+        r->splat.tolerance = r->square.tolerance = asp_render_tolerance_from_area(o->tolerance_area, o->width, o->height);
     r->prim = o->prim;
     r->mesh.flags = o->flat ? ASP_MESH_RENDER_FLAT : 0u;
 }
@@ -170,6 +191,27 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
         for (int i = 0; i < 3; i++)
             o->kernel_abn[i] = (float)v[i];
     }
+    if (o->kernel_shape && strcmp(o->kernel_shape, "psi-e") != 0 && strcmp(o->kernel_shape, "psi-g") != 0)
+        return cli_usage_error(env, "--kernel-shape expects psi-e or psi-g, got '%s'", o->kernel_shape);
+    o->kernel_kind = o->kernel_shape && strcmp(o->kernel_shape, "psi-g") == 0 ? ASP_SPLAT_KERNEL_PSI_G
+                                                                              : ASP_SPLAT_KERNEL_PSI_E;
+    if (!isnan(o->sigma) && !(o->sigma > 0))
+        return cli_usage_error(env, "--sigma expects a number > 0, got %g", o->sigma);
+    if (o->kernel_rim && strcmp(o->kernel_rim, "1") != 0 && strcmp(o->kernel_rim, "b") != 0)
+        return cli_usage_error(env, "--kernel-rim expects 1 or b, got '%s'", o->kernel_rim);
+    if (o->kernel_rim && strcmp(o->kernel_rim, "b") == 0)
+        o->splat_flags |= ASP_SPLAT_KERNEL_RIM_AT_B;
+    if (!isnan(o->epsilon_uniform) && !(o->epsilon_uniform >= 0))
+        return cli_usage_error(env, "--epsilon-uniform expects world units >= 0 (0 = the mean splat), got %g",
+                               o->epsilon_uniform);
+    if (!isnan(o->epsilon_uniform))
+        o->splat_flags |= ASP_SPLAT_EPSILON_UNIFORM;
+    if (!isnan(o->tolerance_area) && !(o->tolerance_area >= 0 && o->tolerance_area <= 100))
+        return cli_usage_error(env, "--tolerance-area expects a percentage in 0..100, got %g", o->tolerance_area);
+    if (o->axes && strcmp(o->axes, "sqrt") != 0 && strcmp(o->axes, "lambda") != 0)
+        return cli_usage_error(env, "--axes expects sqrt or lambda, got '%s'", o->axes);
+    if (o->axes && strcmp(o->axes, "lambda") == 0)
+        o->hier_flags |= ASP_HIER_BUILD_LAMBDA_AXES;
     static const char *const modes[] = {"gouraud", "pixel", "flat"};
     if (o->lighting) {
         int found = -1;
@@ -207,10 +249,10 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
 {
     // NaN marks "not given": the option parser refuses non-finite values, so no user value collides with it
     int given = o->method || !isnan(o->alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
-                o->no_normal_map;
+                o->no_normal_map || o->overlap_backfaces;
     if (!o->dps_input) {
         if (given)
-            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline and "
+            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline, --overlap-backfaces and "
                                         "--no-normal-map need a .dps input (amgsplat build makes one)");
         double deg = 0;
         if (!o->crease_angle) {
@@ -264,7 +306,8 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
                                    o->crease_angle);
     }
     p->flags = (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
-               (o->no_normal_map ? ASP_PRIM_RENDER_NO_NORMAL_MAP : 0u);
+               (o->no_normal_map ? ASP_PRIM_RENDER_NO_NORMAL_MAP : 0u) |
+               (o->overlap_backfaces ? ASP_PRIM_RENDER_OVERLAP_BACKFACES : 0u);
     return 0;
 }
 
@@ -387,9 +430,11 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     // NaN marks the .dps numbers as not given
     struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .width = 512, .height = 512,
                             .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0, .alpha_ref = NAN,
+                            .sigma = NAN, .epsilon_uniform = NAN, .tolerance_area = NAN,
                             .transparency = NAN, .depth_window = NAN, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
+        {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
         {"size", 0, CLI_STRING, &o.size, "WxH", "image size of one view (default 512x512)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "camera azimuth, elevation (degrees), distance in radii (default 30,20)"},
         {"views", 0, CLI_SIZE, &o.views, "N", "N views around the object in a contact sheet (default 1)"},
@@ -398,6 +443,14 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"budget", 0, CLI_SIZE, &o.budget, "N", "splat, square: cut the hierarchy to N splats per view instead of a tolerance"},
         {"kernel", 0, CLI_STRING, &o.kernel, "A,B,N", "splat: kernel exp(-A (r/B)^N) (default 6,1.5,3)"},
         {"epsilon", 0, CLI_DOUBLE, &o.epsilon, "X", "splat: depth offset in splat radii for blending (default 1; 0 = none)"},
+        {"epsilon-uniform", 0, CLI_DOUBLE, &o.epsilon_uniform, "X", "splat: one depth offset for all splats in world units, seed 001 5.3 (0 = the mean splat)"},
+        {"kernel-shape", 0, CLI_STRING, &o.kernel_shape, "K", "splat: psi-e (default, seed 001 eq. 12) or psi-g (eq. 11, --sigma)"},
+        {"sigma", 0, CLI_DOUBLE, &o.sigma, "X", "splat: psi-g's sigma in kernel radii (default 0.5)"},
+        {"kernel-rim", 0, CLI_STRING, &o.kernel_rim, "1|b", "splat: the ellipse rim is the kernel's r = 1 (default) or r = b (seed 001 Fig. 11)"},
+        {"tolerance-area", 0, CLI_DOUBLE, &o.tolerance_area, "PCT", "splat, square: tau in percent of the view's area (seed 001 5.1); replaces --tolerance"},
+        {"cull-backfaces", 0, CLI_FLAG, &o.cull_backfaces, NULL, "splat, square: drop subtrees whose normal cone faces away (seed 004 3.2.2)"},
+        {"depth-limit", 0, CLI_SIZE, &o.depth_limit, "N", "splat, square: traverse the hierarchy to depth N at most (seed 004 3.2.5; default 0: none)"},
+        {"axes", 0, CLI_STRING, &o.axes, "A", "splat, square: ellipse axis ratio sqrt (default) or lambda (seed 001 eq. 5-6)"},
         {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
         {"opaque", 0, CLI_FLAG, &o.opaque, NULL, "splat: opaque ellipses, no blending"},
         {"unlit", 0, CLI_FLAG, &o.unlit, NULL, "colours as they are, no shading (the seeds' flat textured primitives; web viewer's light=off)"},
@@ -411,6 +464,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", "cut at creases sharper than DEG (default 60; off = as the seeds): .dps primitives; points with normals: discs, splats"},
         {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
+        {"overlap-backfaces", 0, CLI_FLAG, &o.overlap_backfaces, NULL, ".dps, overlap: also draw back-facing neighbours, as journal Fig. 10's pseudocode"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
         {"transparent", 0, CLI_FLAG, &o.transparent, NULL, "transparent background"},
         {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
@@ -434,6 +488,13 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         asp_file_type_of_name(argv[0], &type, NULL);
     o.amg_input = type.kind == ASP_FILE_AMG;
     o.dps_input = type.kind == ASP_FILE_DPS;
+    // a preset names the options of every input kind; those that do not fit this input are dropped
+    if (!o.dps_input && cli_from_preset(env, &o.method))
+        o.method = NULL;
+    if (!o.dps_input && cli_from_preset(env, &o.overlap_backfaces))
+        o.overlap_backfaces = 0;
+    if ((o.dps_input || type.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.renderer))
+        o.renderer = NULL;
     if (parse_options(env, &o))
         return 2;
     if (o.dps_input && o.renderer)
@@ -455,6 +516,10 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "renderer '%s' draws points; sample the mesh to points first (amgsplat sample "
                                     "'%s' -o points.ply) or draw it with --renderer mesh",
                                kind->name, argv[0]);
+    if ((o.depth_limit || o.cull_backfaces) && !kind->has_lod)
+        return cli_usage_error(env, "--depth-limit and --cull-backfaces need --renderer splat or square");
+    if (o.depth_limit > 64)
+        return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o.depth_limit);
     if (o.budget && !kind->has_lod)
         return cli_usage_error(env, "--budget needs --renderer splat or square (the %s renderer draws every %s)",
                                kind->name, o.dps_input ? "primitive" : "point");
@@ -482,6 +547,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     }
     if (!rc && o.budget)
         rc = asp_renderer_set_budget(r, o.budget, &err);
+    if (!rc && o.depth_limit)
+        rc = asp_renderer_set_lod(r, kind->has_lod ? ropts.splat.tolerance : 0.0f, (uint32_t)o.depth_limit, &err);
     if (!rc)
         rc = render_views(gl, r, &s, &o, env, tiles, &vs, &err);
     if (!rc && o.views > 1)

@@ -15,6 +15,7 @@ static const char usage[] =
     "usage: amgsplat view FILE [--size WxH] [--view AZ,EL[,DIST]] [--renderer NAME] [--tau PX]\n"
     "                     [--color MODE] [--level L] [--method NAME] [--alpha-ref X] [--unlit]\n"
     "                     [--background R,G,B] [--texture IMG] [--verbose]\n"
+    "                     [--preset thesis|journal|pajarola|schwarz]\n"
     "       amgsplat view FILE --frames N [--screenshot OUT.png] [--keys KEYS] [options above]\n"
     "\n"
     "Opens a window on a point file (.ply, .xyz, .pts, .txt), an AMG decomposition (.amg,\n"
@@ -39,6 +40,9 @@ struct view_opts {
     const char *screenshot;
     const char *keys;
     const char *method;
+    const char *preset; /* --preset: applied by cli_parse (docs/seeds.md) */
+    int cull_backfaces; /* seed 004 3.2.2 */
+    size_t depth_limit; /* seed 004 3.2.5 */
     double alpha_ref;
     size_t frames;
     double tau;
@@ -110,6 +114,10 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
             return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
         d->prim_alpha_ref = o->alpha_ref > 0 ? (float)o->alpha_ref : -1.0f; // the library's "exactly 0"
     }
+    if (o->depth_limit > 64)
+        return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o->depth_limit);
+    d->lod_flags = o->cull_backfaces ? ASP_SPLAT_CULL_BACKFACES : 0u;
+    d->depth_limit = (uint32_t)o->depth_limit;
     d->renderer = o->renderer;
     d->amg_level = o->level;
     d->texture = o->texture;
@@ -160,9 +168,12 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
     struct view_opts o = {.alpha_ref = NAN}; // NaN: not given (the parser refuses non-finite values)
     const struct cli_option opts[] = {
         {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
+        {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "first view as in 'amgsplat render' (default 30,20)"},
         {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y (default), z (scans, CAD), x, -y, -z or -x"},
         {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "first renderer (default disc, mesh for meshes; 'h' in the window lists them)"},
+        {"cull-backfaces", 0, CLI_FLAG, &o.cull_backfaces, NULL, "splat, square: drop subtrees whose normal cone faces away (seed 004 3.2.2)"},
+        {"depth-limit", 0, CLI_SIZE, &o.depth_limit, "N", "splat, square: traverse the hierarchy to depth N at most (seed 004 3.2.5; 0 = none)"},
         {"tau", 0, CLI_DOUBLE, &o.tau, "PX", "screen tolerance of the hierarchy renderers in pixels (default 0)"},
         {"color", 0, CLI_STRING, &o.color, "MODE", ".amg: classifier (default), domains, strict or input"},
         {"level", 0, CLI_STRING, &o.level, "L", ".amg: level for domain colours: L, L-2 or an index (default L); .dps: level drawn (default the finest in the file)"},
@@ -183,6 +194,14 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         return prc > 0 ? 0 : 2;
     if (npos != 1)
         return cli_usage_error(env, "expected one input file, got %d; see 'amgsplat view -h'", npos);
+    // a preset names the options of every input kind; those that do not fit this input are dropped
+    asp_file_type ft = {ASP_FILE_UNKNOWN, "", 0};
+    if (asp_file_recognise(argv[0], &ft, NULL) != 0)
+        asp_file_type_of_name(argv[0], &ft, NULL);
+    if (ft.kind != ASP_FILE_DPS && cli_from_preset(env, &o.method))
+        o.method = NULL;
+    if ((ft.kind == ASP_FILE_DPS || ft.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.renderer))
+        o.renderer = NULL;
     asp_viewer_desc desc = {.log = log_line, .log_user = env};
     if (parse_into(env, argv[0], &o, &desc))
         return 2;

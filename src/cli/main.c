@@ -29,7 +29,7 @@ static const struct cli_command commands[] = {
     {"export", cmd_export, "glTF 2.0 (.glb/.gltf) of domain primitives, point sets and hierarchies"},
     {"view", cmd_view, "open a window on points or an .amg decomposition (interactive viewer)"},
     {"eval", cmd_eval, "measure every representation against the reference: PSNR, SSIM, IoU, frame time"},
-    {"bench-paper", cmd_bench_paper, "print the seeds' tables (journal Tables 1-2, thesis Tables 5.2-5.4)"},
+    {"bench-paper", cmd_bench_paper, "print the seeds' tables (journal Tables 1-2, thesis Tables 5.1-5.4)"},
     {"experiment", cmd_experiment, "the perceptual experiment of seed 004: run (people or observer), analyze, ttest"},
 };
 enum { N_COMMANDS = sizeof commands / sizeof commands[0] };

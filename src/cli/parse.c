@@ -97,11 +97,86 @@ static int set_value(struct cli_env *env, const struct cli_option *o, const char
     return 2;
 }
 
+static void forget_preset(struct cli_env *env, const void *value)
+{
+    for (size_t k = 0; k < env->preset_count; k++)
+        if (env->preset_values[k] == value)
+            env->preset_values[k--] = env->preset_values[--env->preset_count];
+}
+
+int cli_from_preset(const struct cli_env *env, const void *value)
+{
+    for (size_t k = 0; k < env->preset_count; k++)
+        if (env->preset_values[k] == value)
+            return 1;
+    return 0;
+}
+
+static const struct cli_option *find_long(const struct cli_option *opts, const char *name)
+{
+    for (const struct cli_option *p = opts; p && p->name; p++)
+        if (strcmp(p->name, name) == 0)
+            return p;
+    return NULL;
+}
+
+/*
+ * --preset NAME (issue 17): the seed's values are set before the command line is parsed, so every
+ * option given explicitly wins, whatever its place. The table is the library's (asp_preset_settings);
+ * only commands whose option table has "preset" take one. The applied settings go to *applied for
+ * the informational line.
+ */
+static int apply_preset(int argc, char **argv, const struct cli_option *opts, struct cli_env *env, char *applied,
+                        size_t applied_size)
+{
+    const char *name = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--") == 0)
+            break;
+        if (strcmp(argv[i], "--preset") == 0 && i + 1 < argc)
+            name = argv[++i];
+        else if (strncmp(argv[i], "--preset=", 9) == 0)
+            name = argv[i] + 9;
+    }
+    if (!name || !find_long(opts, "preset"))
+        return 0; /* absent, or the main loop reports the unknown option */
+    asp_preset preset;
+    asp_error err = {0};
+    if (asp_preset_parse(name, &preset, &err))
+        return cli_usage_error(env, "--preset: %s", err.msg);
+    size_t count = 0;
+    const asp_preset_setting *set = asp_preset_settings(preset, &count);
+    int w0 = snprintf(applied, applied_size, "%s:", name);
+    size_t used = w0 > 0 ? (size_t)w0 : 0;
+    for (size_t k = 0; k < count; k++) {
+        if (strcmp(set[k].command, env->cmd) != 0)
+            continue;
+        const struct cli_option *o = find_long(opts, set[k].option);
+        if (!o)
+            return cli_usage_error(env, "preset '%s' sets --%s, which 'amgsplat %s' lacks", name, set[k].option,
+                                   env->cmd);
+        if (set_value(env, o, set[k].value))
+            return 2;
+        if (env->preset_count < sizeof env->preset_values / sizeof env->preset_values[0])
+            env->preset_values[env->preset_count++] = o->value;
+        if (used < applied_size) {
+            int w = snprintf(applied + used, applied_size - used, " --%s%s%s", set[k].option, set[k].value ? " " : "",
+                             set[k].value ? set[k].value : "");
+            used += w > 0 ? (size_t)w : 0;
+        }
+    }
+    return 0;
+}
+
 int cli_parse(int argc, char **argv, const struct cli_option *opts, const char *usage, struct cli_env *env,
               int *npos)
 {
     int n = 0;
     int only_positional = 0;
+    char applied[512];
+    applied[0] = '\0';
+    if (apply_preset(argc, argv, opts, env, applied, sizeof applied))
+        return -1;
     for (int i = 1; i < argc; i++) {
         char *a = argv[i];
         if (only_positional || a[0] != '-' || a[1] == '\0') {
@@ -175,8 +250,11 @@ int cli_parse(int argc, char **argv, const struct cli_option *opts, const char *
         }
         if (set_value(env, o, v))
             return -1;
+        forget_preset(env, o->value);
     }
     *npos = n;
+    if (applied[0])
+        cli_info(env, "amgsplat %s: preset %s (options given explicitly win)", env->cmd, applied);
     env->ctx.threads = env->threads;
     env->ctx.warning = warning_cb;
     env->ctx.warning_user = env;

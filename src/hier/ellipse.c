@@ -41,7 +41,7 @@ static double quad(const double c[6], const double t[3], const double s[3])
     return t[0] * cs0 + t[1] * cs1 + t[2] * cs2;
 }
 
-void asp__ellipse_axes(asp_hier_splat *s, const double c[6], double extent2)
+void asp__ellipse_axes(asp_hier_splat *s, const double c[6], double extent2, int lambda_axes)
 {
     double n[3] = {s->normal[0], s->normal[1], s->normal[2]};
     double t1[3], t2[3];
@@ -74,10 +74,13 @@ void asp__ellipse_axes(asp_hier_splat *s, const double c[6], double extent2)
         e1y = 1;
     }
     /*
-     * The paper takes a' = l1, b' = l2; only the ratio matters because f
-     * rescales. Standard deviations give the ratio of the point spread.
+     * The paper takes a' = l1, b' = l2 (eq. 5-6; lambda_axes); only the ratio
+     * matters because f rescales. Standard deviations give the ratio of the
+     * point spread, so that is the default (ASP_HIER_BUILD_LAMBDA_AXES).
      */
-    double ratio = l1 > 0 ? sqrt(l2 > 0 ? l2 / l1 : 0.0) : 1.0;
+    double ratio = l1 > 0 ? (l2 > 0 ? l2 / l1 : 0.0) : 1.0;
+    if (!lambda_axes)
+        ratio = sqrt(ratio);
     if (ratio < MIN_RATIO)
         ratio = MIN_RATIO;
     for (int i = 0; i < 3; i++) {
@@ -164,7 +167,8 @@ double asp__ellipse_cover_norm(const asp_hier_splat *s, const asp_hier_splat *m)
     return corner < spectral ? corner : spectral;
 }
 
-void asp__ellipse_fit(asp_hier_splat *s, const double c[6], const asp_hier_splat *members, size_t count)
+void asp__ellipse_fit(asp_hier_splat *s, const double c[6], const asp_hier_splat *members, size_t count,
+                      int lambda_axes)
 {
     /*
      * The covariance of the member centres ignores the members' own extent,
@@ -177,7 +181,7 @@ void asp__ellipse_fit(asp_hier_splat *s, const double c[6], const asp_hier_splat
     for (size_t i = 0; i < count; i++)
         extent2 += ((double)members[i].a * members[i].a + (double)members[i].b * members[i].b) * 0.125;
     extent2 /= (double)(count ? count : 1);
-    asp__ellipse_axes(s, c, extent2);
+    asp__ellipse_axes(s, c, extent2, lambda_axes);
     double f = 0;
     for (size_t i = 0; i < count; i++) {
         double r = asp__ellipse_cover_norm(s, &members[i]);

@@ -78,7 +78,7 @@ void asp__tangent_basis(const double n[3], double t1[3], double t2[3]);
  * provisional lengths a = 1, b = axis ratio, to be scaled by
  * asp__ellipse_scale.
  */
-void asp__ellipse_axes(asp_hier_splat *s, const double c[6], double extent2);
+void asp__ellipse_axes(asp_hier_splat *s, const double c[6], double extent2, int lambda_axes);
 /* Scales the provisional ellipse by f (Fig. 6), inflated for float rounding. */
 void asp__ellipse_scale(asp_hier_splat *s, double f);
 /*
@@ -89,7 +89,8 @@ double asp__ellipse_cover_norm(const asp_hier_splat *s, const asp_hier_splat *m)
 /* Ellipse norm of point p projected onto s's plane. */
 double asp__ellipse_point_norm(const asp_hier_splat *s, const float p[3]);
 /* Axes (from c) and scale so that all count member ellipses are covered. */
-void asp__ellipse_fit(asp_hier_splat *s, const double c[6], const asp_hier_splat *members, size_t count);
+void asp__ellipse_fit(asp_hier_splat *s, const double c[6], const asp_hier_splat *members, size_t count,
+                      int lambda_axes);
 
 /* ---- normal_cone.c: bounding sphere and normal cone of a node ---- */
 

@@ -258,6 +258,7 @@ typedef struct finisher {
     asp_hier *h;
     double *sums; /* 7 per node: normal sum xyz, linear colour sum rgba (alpha in 0..1) */
     float lin[256];
+    int lambda_axes; /* ASP_HIER_BUILD_LAMBDA_AXES */
 } finisher;
 
 /* PCA normal of the node's points, or 0 when they are (nearly) colinear */
@@ -344,7 +345,7 @@ static void finish_node(const finisher *f, uint32_t id)
         sp->color[d] = asp__linear_to_srgb8(f->lin, sums[3 + d] * inv);
     sp->color[3] = (uint8_t)lround(sums[6] * inv * 255.0);
     node_normal(f, sums, c, members, nd->point_count, sp->normal);
-    asp__ellipse_fit(sp, c, members, count);
+    asp__ellipse_fit(sp, c, members, count, f->lambda_axes);
     if (leaf) {
         asp__sphere_of_points(members, count, sp, nd->sphere);
     } else {
@@ -622,7 +623,7 @@ int asp_hier_build(const asp_cloud *cloud, const asp_hier_desc *desc, const asp_
     }
 
     /* bottom up: each subtree in decreasing id (children first), then the top nodes */
-    finisher fin = {.h = h, .sums = s.sums};
+    finisher fin = {.h = h, .sums = s.sums, .lambda_axes = (d.flags & ASP_HIER_BUILD_LAMBDA_AXES) != 0};
     asp__srgb_table(fin.lin);
 #pragma omp parallel for schedule(static, 1) num_threads(threads)
     for (long long j = 0; j < nj; j++) {

@@ -18,6 +18,7 @@ typedef struct point_job {
     const asp_index *knn; /* count * k neighbour rows, or NULL */
     size_t k;
     int use_radii;
+    int lambda_axes; /* ASP_HIER_BUILD_LAMBDA_AXES */
 } point_job;
 
 /* smallest-eigenvalue eigenvector of the neighbourhood of row i (the point and its neighbours) */
@@ -42,7 +43,7 @@ static void knn_ellipse(const point_job *job, size_t i, asp_hier_splat *s)
     const double at[3] = {s->center[0], s->center[1], s->center[2]};
     double mu[3], c[6];
     asp_covariance_sym3(pos, 3 * sizeof *pos, row, job->k, &(asp_covariance_desc){.center = at}, mu, c);
-    asp__ellipse_axes(s, c, 0.0);
+    asp__ellipse_axes(s, c, 0.0, job->lambda_axes);
     double f = 0;
     for (size_t j = 0; j < job->k; j++) {
         double r = asp__ellipse_point_norm(s, pos + 3 * (size_t)row[j]);
@@ -143,7 +144,8 @@ int asp__hier_point_splats(const asp_cloud *cloud, size_t k, unsigned build_flag
                            asp_error *err)
 {
     size_t n = cloud->count;
-    point_job job = {cloud, NULL, NULL, 0, cloud->radii && !(build_flags & ASP_HIER_BUILD_IGNORE_RADII)};
+    point_job job = {cloud, NULL, NULL, 0, cloud->radii && !(build_flags & ASP_HIER_BUILD_IGNORE_RADII),
+                     (build_flags & ASP_HIER_BUILD_LAMBDA_AXES) != 0};
     if ((!job.use_radii || !cloud->normals) && n >= 2) {
         job.k = k < n - 1 ? k : n - 1;
         int rc = knn_splats(cloud, &job, slot, order, ctx, dst, err);

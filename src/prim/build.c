@@ -74,6 +74,11 @@ static int check_desc(const asp_prim_desc *d, asp_error *err)
         return asp_error_set(err, ASP_EINVAL, "merge flatness must be in (0, 1/3], got %g", d->merge_flatness);
     if (!(d->merge_angle > 0 && d->merge_angle <= 180))
         return asp_error_set(err, ASP_EINVAL, "merge angle must be in (0, 180] degrees, got %g", d->merge_angle);
+    if (!(d->brightness >= -1 && d->brightness <= 1))
+        return asp_error_set(err, ASP_EINVAL, "brightness must be in [-1, 1], got %g", d->brightness);
+    if (!(d->enlarge >= 0 && d->enlarge <= 1000))
+        return asp_error_set(err, ASP_EINVAL, "rectangle enlargement must be in [0, 1000] percent, got %g",
+                             d->enlarge);
     if (d->padding > 64)
         return asp_error_set(err, ASP_EINVAL, "atlas padding must be at most 64 texels, got %u", d->padding);
     if ((unsigned)d->method > ASP_PRIM_RADIAL || (unsigned)d->shape > ASP_PRIM_GAUSSIAN ||
@@ -93,6 +98,23 @@ static double point_radius(const build_src *src, const asp__plane *pl, const asp
     return r;
 }
 
+/*
+ * The colour a point gives the texture: the model's or grey (thesis appendix C "Use Model Colors"),
+ * its HSV value shifted by desc->brightness ("Adjust Brightness"): scaling RGB by V' / V keeps hue
+ * and saturation.
+ */
+static void point_color(const build_src *src, const asp_prim_desc *d, size_t p, float out[3])
+{
+    for (int j = 0; j < 3; j++)
+        out[j] = src->colors && !d->no_model_colors ? src->colors[4 * p + (size_t)j] : 200.0f;
+    if (d->brightness == 0)
+        return;
+    float v = fmaxf(out[0], fmaxf(out[1], out[2]));
+    float nv = fminf(255.0f, fmaxf(0.0f, v + (float)d->brightness * 255.0f));
+    for (int j = 0; j < 3; j++)
+        out[j] = v > 0 ? out[j] * (nv / v) : nv;
+}
+
 /* Pass 1 for one domain: plane, rectangle with margin, texel grid. */
 static void plan_one(const build_src *src, const asp_amg_csr *dom, const asp_prim_desc *d, layout *L)
 {
@@ -109,6 +131,11 @@ static void plan_one(const build_src *src, const asp_amg_csr *dom, const asp_pri
     /* margin: the largest footprint, but at most 3x the domain's mean, so one outlier radius cannot bloat it */
     double margin = L->foot * fmin(rmax, 3 * rsum / (double)n);
     double ew = L->pl.smax - L->pl.smin + 2 * margin, eh = L->pl.tmax - L->pl.tmin + 2 * margin;
+    if (d->enlarge > 0) {
+        /* thesis appendix C: the sides grown by a percentage so the point samples fall inside */
+        ew = (L->pl.smax - L->pl.smin) * (1 + d->enlarge / 100);
+        eh = (L->pl.tmax - L->pl.tmin) * (1 + d->enlarge / 100);
+    }
     double T = d->texel_size * src->mean_radius;
     double wf = ceil(ew / T), hf = ceil(eh / T);
     L->capped = 0;
@@ -144,8 +171,7 @@ static void texture_one(const build_src *src, const asp_amg_csr *dom, const asp_
         y[k] = (float)((t - L->t0) / L->texel);
         r[k] = (float)(L->foot * point_radius(src, &L->pl, d, p) / L->texel);
         float *o = &attr[(size_t)C * k];
-        for (int j = 0; j < 3; j++)
-            o[j] = src->colors ? src->colors[4 * p + (size_t)j] : 200.0f;
+        point_color(src, d, p, o);
         o[3] = (float)dom->val[a + k];
         if (C == 7)
             for (int j = 0; j < 3; j++)
@@ -153,6 +179,7 @@ static void texture_one(const build_src *src, const asp_amg_csr *dom, const asp_
     }
     asp__tex_input in = {.n = n, .x = x, .y = y, .r = r, .attr = attr, .channels = C, .w = L->w, .h = L->h,
                          .method = d->method, .shape = d->shape, .normalise = d->normalise,
+                         .normalise_color = d->normalise_color,
                          .extend_color = !d->no_extend_color};
     size_t off = 4 * ((size_t)P->tex_y * atlas->width + P->tex_x);
     asp__prim_texture(&in, (uint8_t *)scratch + head, atlas->pixels + off, natlas ? natlas->pixels + off : NULL,
@@ -332,7 +359,7 @@ static int build_level(const asp_amg *amg, const build_src *src, size_t level, c
     uint32_t *bfirst = NULL, *bcount = NULL;
     int rc = asp_amg_basis(amg, level, ctx, &psi, err);
     if (!rc)
-        rc = asp_amg_domains(psi, d->tau, ctx, &dom, err);
+        rc = d->strict ? asp_amg_strict_domain_rows(psi, ctx, &dom, err) : asp_amg_domains(psi, d->tau, ctx, &dom, err);
     asp_amg_csr_destroy(psi);
     if (rc)
         return rc;

@@ -50,6 +50,7 @@ typedef struct asp__tex_input {
     asp_prim_method method;
     asp_prim_shape shape;
     asp_prim_normalise normalise;
+    int normalise_color; /* asp_prim_desc.normalise_color */
     int extend_color;
 } asp__tex_input;
 

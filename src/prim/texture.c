@@ -65,10 +65,12 @@ void asp__prim_texture(const asp__tex_input *in, void *scratch, uint8_t *rgba, u
         if (!(f[t] > 0) || covered[t])
             continue;
         /* colour is stored straight (not premultiplied), so it is always an interpolation: divide by f;
-         * the criterion decides only whether alpha is normalised too */
+         * the criterion decides only whether alpha is normalised too, unless normalise_color asks for
+         * eq. 3.3 as the thesis writes it (radial only: affine coverage is exact) */
         double inv = 1.0 / f[t];
+        int all = in->normalise_color && in->method == ASP_PRIM_RADIAL;
         for (int c = 0; c < C; c++)
-            if (c != 3 || crit == ASP_PRIM_NORM_POSITIVE || f[t] >= 1.0f)
+            if ((c != 3 && !all) || crit == ASP_PRIM_NORM_POSITIVE || f[t] >= 1.0f)
                 acc[t * (size_t)C + (size_t)c] *= (float)inv;
     }
     if (in->extend_color)

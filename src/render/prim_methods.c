@@ -302,9 +302,12 @@ static void draw_seed(asp__prim_renderer *r, const asp__frame *f)
     case ASP_PRIM_RENDER_OVERLAP:
         no = overlap_runs(r, f->eye, &nruns);
         glNamedBufferSubData(r->order_buffer.id, 0, (GLsizeiptr)(no * sizeof(uint32_t)), r->order);
-        // back faces are never drawn: the cause of the thesis's dark spots (5.3.1, Fig. 5.7)
-        glEnable(GL_CULL_FACE);
-        glCullFace(GL_BACK);
+        // back faces are never drawn: the cause of the thesis's dark spots (5.3.1, Fig. 5.7); the
+        // pseudocode (journal Fig. 10) adds every neighbour of a front face, back faces included
+        if (!(o->flags & ASP_PRIM_RENDER_OVERLAP_BACKFACES)) {
+            glEnable(GL_CULL_FACE);
+            glCullFace(GL_BACK);
+        }
         draw_runs(r, nruns);
         break;
     case ASP_PRIM_RENDER_TWO_PASS:

@@ -111,7 +111,8 @@ static int check_options(const asp_prim_render_options *o, asp_error *err)
     if ((unsigned)o->method >= METHOD_COUNT)
         return asp_error_set(err, ASP_EINVAL, "unknown rendering method %d (expected 0..%d)", (int)o->method,
                              METHOD_COUNT - 1);
-    unsigned known = ASP_PRIM_RENDER_OUTLINE | ASP_PRIM_RENDER_COLOR_BY_DOMAIN | ASP_PRIM_RENDER_NO_NORMAL_MAP;
+    unsigned known = ASP_PRIM_RENDER_OUTLINE | ASP_PRIM_RENDER_COLOR_BY_DOMAIN | ASP_PRIM_RENDER_NO_NORMAL_MAP |
+                     ASP_PRIM_RENDER_OVERLAP_BACKFACES;
     if (o->flags & ~known)
         return asp_error_set(err, ASP_EINVAL, "unknown primitive rendering flags 0x%x", o->flags & ~known);
     if (isnan(o->alpha_ref) || o->alpha_ref > 1)

@@ -25,6 +25,7 @@
 static const char *vertex_src =
     "#version 450 core\n" ASP__LOD_GLSL
     "uniform float u_epsilon;\n"
+    "uniform int u_eps_uniform;\n"
     "uniform float u_support;\n"
     "uniform float u_radius_scale;\n"
     "uniform uint u_node_count;\n"
@@ -61,7 +62,7 @@ static const char *vertex_src =
     // Fig. 15: pass 1 moves the corners away from the eye along their projectors
     "    vec3 ray = p - u_eye;\n"
     "    if (u_epsilon > 0.0 && dot(ray, ray) > 0.0)\n"
-    "        p += (u_epsilon * a) * normalize(ray);\n"
+    "        p += (u_epsilon * (u_eps_uniform != 0 ? 1.0 : a)) * normalize(ray);\n"
     "    v_local = q;\n"
     "    gl_Position = u_proj * (u_view * vec4(p, 1.0));\n"
     // PCA normals have no sign: face them to the eye. Oriented normals stay, so that blended
@@ -129,7 +130,8 @@ static const char *blend_fragment_src =
     "in vec3 v_color;\n"
     "in vec3 v_normal;\n"
     "uniform float u_support;\n"
-    "uniform float u_ka, u_kb, u_kn;\n"
+    "uniform float u_ka, u_kb, u_kn, u_kscale, u_ksigma;\n"
+    "uniform int u_kgauss;\n"
     "uniform int u_opaque;\n"
     "layout(location = 0) out vec4 o_accum;\n"
     "layout(location = 1) out vec4 o_normal;\n" COVERAGE_GLSL
@@ -143,8 +145,9 @@ static const char *blend_fragment_src =
     "        o_normal = vec4(0.0);\n"
     "        return;\n"
     "    }\n"
-    "    float r = min(length(v_local), u_support);\n"
-    "    float w = exp(-u_ka * pow(r / u_kb, u_kn));\n"
+    // the same formula as asp_splat_kernel_weight (kernel_weight below)
+    "    float r = min(length(v_local), u_support) * u_kscale;\n"
+    "    float w = u_kgauss != 0 ? exp(-r * r / (2.0 * u_ksigma * u_ksigma)) : exp(-u_ka * pow(r / u_kb, u_kn));\n"
     "    o_accum = vec4(w * v_color, w);\n"
     "    o_normal = vec4(w * v_normal, w);\n"
     "}\n";
@@ -195,10 +198,12 @@ static const char *resolve_fragment_src[2] = {
     "layout(binding = 2) uniform sampler2DMS u_depth;\n" RESOLVE_GLSL};
 
 enum { U_EPSILON = ASP__LOD_U_COUNT, U_SUPPORT, U_RADIUS_SCALE, U_NODE_COUNT, U_HAS_COLORS, U_DEFAULT_COLOR,
-       U_LIGHTING, U_KA, U_KB, U_KN, U_OPAQUE, U_UNORIENTED, U_HAS_CLIP, U_COUNT };
+       U_LIGHTING, U_KA, U_KB, U_KN, U_OPAQUE, U_UNORIENTED, U_HAS_CLIP, U_KSCALE, U_KSIGMA, U_KGAUSS,
+       U_EPS_UNIFORM, U_COUNT };
 static const char *uniform_names[U_COUNT] = {ASP__LOD_UNIFORM_NAMES, "u_epsilon", "u_support", "u_radius_scale",
                                              "u_node_count", "u_has_colors", "u_default_color", "u_lighting", "u_ka",
-                                             "u_kb", "u_kn", "u_opaque", "u_unoriented", "u_has_clip"};
+                                             "u_kb", "u_kn", "u_opaque", "u_unoriented", "u_has_clip",
+                                             "u_kscale", "u_ksigma", "u_kgauss", "u_eps_uniform"};
 enum { PROG_DEPTH, PROG_BLEND, PROG_COUNT };
 
 /* The float accumulation target of passes 1 and 2, kept while size and samples stay. */
@@ -220,7 +225,8 @@ typedef struct splat_renderer {
     asp__gl_buffer clips;     // 2 planes per point splat in hierarchy order; one zero plane pair without clipping
     int has_clip;
     accum_target acc;
-    float ka, kb, kn, epsilon, support, radius_scale;
+    float ka, kb, kn, epsilon, support, radius_scale, kscale, ksigma;
+    int kgauss, eps_uniform;
     asp_splat_lighting lighting;
     asp_splat_mode mode;
 } splat_renderer;
@@ -470,6 +476,10 @@ static void set_static_uniforms(splat_renderer *s)
         glProgramUniform1f(p, u[U_KN], s->kn);
         glProgramUniform1i(p, u[U_UNORIENTED], (asp_hier_flags(s->lod.hier) & ASP_HIER_UNORIENTED) != 0);
         glProgramUniform1i(p, u[U_HAS_CLIP], s->has_clip);
+        glProgramUniform1f(p, u[U_KSCALE], s->kscale);
+        glProgramUniform1f(p, u[U_KSIGMA], s->ksigma);
+        glProgramUniform1i(p, u[U_KGAUSS], s->kgauss);
+        glProgramUniform1i(p, u[U_EPS_UNIFORM], s->eps_uniform);
     }
 }
 
@@ -479,6 +489,7 @@ static int check_desc(const asp_splat_renderer_desc *d, asp_error *err)
         const char *name;
         float v;
     } opts[] = {{"kernel_a", d->kernel_a}, {"kernel_b", d->kernel_b}, {"kernel_n", d->kernel_n},
+                {"kernel_sigma", d->kernel_sigma},
                 {"tolerance", d->tolerance}, {"radius_scale", d->radius_scale}};
     for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
         int rc = asp__lod_check_option("splat", opts[i].name, opts[i].v, err);
@@ -491,7 +502,57 @@ static int check_desc(const asp_splat_renderer_desc *d, asp_error *err)
         return asp_error_set(err, ASP_EINVAL, "unknown splat lighting mode %d (expected 0..2)", (int)d->lighting);
     if ((unsigned)d->mode > ASP_SPLAT_OPAQUE)
         return asp_error_set(err, ASP_EINVAL, "unknown splat mode %d (expected 0..1)", (int)d->mode);
+    if ((unsigned)d->kernel > ASP_SPLAT_KERNEL_PSI_G)
+        return asp_error_set(err, ASP_EINVAL, "unknown splat kernel %d (expected 0..1)", (int)d->kernel);
     return 0;
+}
+
+/* The kernel constants of desc, shared by the blend shader's uniforms and asp_splat_kernel_weight. */
+typedef struct kernel_params {
+    float ka, kb, kn, sigma, scale, support;
+    int gauss;
+} kernel_params;
+
+static void kernel_params_of(const asp_splat_renderer_desc *d, kernel_params *k)
+{
+    k->ka = d->kernel_a > 0 ? d->kernel_a : 6.0f;
+    k->kb = d->kernel_b > 0 ? d->kernel_b : 1.5f;
+    k->kn = d->kernel_n > 0 ? d->kernel_n : 3.0f;
+    k->sigma = d->kernel_sigma > 0 ? d->kernel_sigma : 0.5f;
+    k->gauss = d->kernel == ASP_SPLAT_KERNEL_PSI_G;
+    if (d->flags & ASP_SPLAT_KERNEL_RIM_AT_B) {
+        // seed 001 Fig. 11: the ellipse is the kernel's disc of radius b
+        k->scale = k->kb;
+        k->support = 1.0f;
+    } else {
+        // the ellipse is the surfel's support (4.1); b < 1 narrows it to the kernel's own
+        k->scale = 1.0f;
+        k->support = fminf(k->kb, 1.0f);
+    }
+}
+
+float asp_splat_kernel_weight(const asp_splat_renderer_desc *desc, float r)
+{
+    static const asp_splat_renderer_desc zero_desc;
+    const asp_splat_renderer_desc *d = desc ? desc : &zero_desc;
+    const float v[4] = {d->kernel_a, d->kernel_b, d->kernel_n, d->kernel_sigma};
+    for (int i = 0; i < 4; i++)
+        if (!(v[i] >= 0) || !isfinite(v[i]))
+            return NAN;
+    if (!(r >= 0) || !isfinite(r) || (unsigned)d->kernel > ASP_SPLAT_KERNEL_PSI_G)
+        return NAN;
+    kernel_params k;
+    kernel_params_of(d, &k);
+    float rk = fminf(r, k.support) * k.scale;
+    return k.gauss ? expf(-rk * rk / (2.0f * k.sigma * k.sigma)) : expf(-k.ka * powf(rk / k.kb, k.kn));
+}
+
+float asp_render_tolerance_from_area(double percent, uint32_t width, uint32_t height)
+{
+    if (!(percent > 0) || !isfinite(percent))
+        return 0.0f;
+    double area = percent / 100.0 * (double)width * (double)height;
+    return (float)(2.0 * sqrt(area / 3.14159265358979323846));
 }
 
 static int check_clip_planes(const float *planes, size_t points, asp_error *err)
@@ -550,12 +611,20 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     if (rc)
         return rc;
     splat_renderer *s = (splat_renderer *)lr;
-    s->ka = desc->kernel_a > 0 ? desc->kernel_a : 6.0f;
-    s->kb = desc->kernel_b > 0 ? desc->kernel_b : 1.5f;
-    s->kn = desc->kernel_n > 0 ? desc->kernel_n : 3.0f;
-    // the ellipse is the surfel's support (4.1); b < 1 narrows it to the kernel's own
-    s->support = fminf(s->kb, 1.0f);
+    kernel_params k;
+    kernel_params_of(desc, &k);
+    s->ka = k.ka, s->kb = k.kb, s->kn = k.kn, s->ksigma = k.sigma, s->kgauss = k.gauss;
+    s->kscale = k.scale, s->support = k.support;
+    s->eps_uniform = (desc->flags & ASP_SPLAT_EPSILON_UNIFORM) != 0;
     s->epsilon = desc->epsilon > 0 ? desc->epsilon : desc->epsilon < 0 ? 0.0f : 1.0f;
+    if (s->eps_uniform && desc->epsilon == 0) {
+        // seed 001 5.3's one epsilon; by default the mean size of the input splats
+        const asp_hier_splat *sp = asp_hier_splats(s->lod.hier) + s->lod.nodes;
+        double sum = 0;
+        for (size_t j = 0; j < s->lod.points; j++)
+            sum += sp[j].a;
+        s->epsilon = s->lod.points ? (float)(sum / (double)s->lod.points) : 0.0f;
+    }
     s->radius_scale = desc->radius_scale > 0 ? desc->radius_scale : 1.0f;
     s->lighting = desc->lighting;
     s->mode = desc->mode;

@@ -112,6 +112,7 @@ struct viewer {
     size_t kind;           /* row of the renderer table (asp_renderer_kind_at) of r */
     asp_hier *hier;        /* point hierarchy of scene.cloud, built when a renderer first needs it */
     float tolerance;
+    uint32_t depth_limit;  /* desc->depth_limit, kept across tau changes */
     int unlit;
     asp_prim_render_options prim; /* .dps: options of the prim renderer, kept while the points are shown */
     asp_camera cam;
@@ -303,8 +304,14 @@ static int make_renderer(viewer *v, size_t k, asp_renderer **out, asp_error *err
     o.disc.radius_scale = 1;
     o.splat.tolerance = v->tolerance;
     o.square.tolerance = v->tolerance;
+    o.splat.flags = o.square.flags = v->desc->lod_flags;
     o.prim = v->prim;
-    return K(k)->create(v->gl, &src, &o, &v->ctx, out, err);
+    int rc = K(k)->create(v->gl, &src, &o, &v->ctx, out, err);
+    if (!rc && v->depth_limit && K(k)->has_lod && (rc = asp_renderer_set_lod(*out, v->tolerance, v->depth_limit, err))) {
+        asp_renderer_destroy(*out);
+        *out = NULL;
+    }
+    return rc;
 }
 
 /* A .dps whose source points were loaded (p) can be drawn by the point renderers too. */
@@ -415,7 +422,7 @@ static void change_tolerance(viewer *v, int dir)
         return;
     }
     asp_error e = {0, ""};
-    if (asp_renderer_set_lod(v->r, v->tolerance, 0, &e)) {
+    if (asp_renderer_set_lod(v->r, v->tolerance, v->depth_limit, &e)) {
         vlog(v, "cannot change tau to %g px: %s", v->tolerance, e.msg);
         v->tolerance = old;
     }
@@ -797,6 +804,7 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
     v.desc = desc;
     v.path = path;
     v.tolerance = desc->tolerance;
+    v.depth_limit = desc->depth_limit;
     v.unlit = (desc->flags & ASP_VIEWER_UNLIT) != 0;
     v.prim.method = (asp_prim_render_method)desc->prim_method;
     v.prim.alpha_ref = desc->prim_alpha_ref;
