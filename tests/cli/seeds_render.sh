@@ -91,7 +91,9 @@ expect_fail 2 "--overlap-backfaces" "$A" render "$T/o.ply" -o "$T/e.png" --overl
 ASAN_OPTIONS="$bench_asan" "$A" bench-paper octahedron --sizes 64 --frames 1 --no-texture-methods >"$T/bp.txt"
 grep -F "Thesis Table 5.1" "$T/bp.txt" >/dev/null || fail "no Table 5.1: $(cat "$T/bp.txt")"
 grep -E "^model +#points +level +#poly +# tex +tc +AMG +cb +dpc$" "$T/bp.txt" >/dev/null || fail "Table 5.1 header"
-grep -E "^octahedron +16000 +L-[0-9]+ +[0-9]+ +[0-9]+ +la +[0-9.]+ +[0-9.]+ +[0-9.]+$" "$T/bp.txt" >/dev/null \
+# times below 10 ms print as "< 0.01" (cb is often that fast on this machine)
+t='([0-9.]+|< 0\.01)'
+grep -E "^octahedron +16000 +L-[0-9]+ +[0-9]+ +[0-9]+ +la +$t +$t +$t$" "$T/bp.txt" >/dev/null \
   || fail "Table 5.1 row: $(cat "$T/bp.txt")"
 
 # seed 001 options one by one: each changes the blended image, none the silhouette; bad values are refused
