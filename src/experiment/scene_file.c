@@ -87,7 +87,7 @@ static int parse_scene(const cJSON *o, asp_experiment_scene *s, const char *wher
     }
     if ((rc = get_string(o, "answer", s->answer, sizeof s->answer, where, err)) < 0)
         return rc;
-    double v;
+    double v = 0; // written by get_number when it returns 1
 #define NUM(key, lo, hi, field, type)                                                                                  \
     if ((rc = get_number(o, key, lo, hi, &v, where, err)) < 0)                                                         \
         return rc;                                                                                                     \

@@ -19,8 +19,11 @@ static const char *reader_of(const asp_file_type *t)
 {
     if (strcmp(t->format, "ply") == 0)
         return "ply"; /* a PLY with faces is a mesh, but its vertices are points all the same */
-    if (strcmp(t->format, "las") == 0 || strcmp(t->format, "laz") == 0)
-        return t->format;
+    // literals, not t->format: t is the caller's local (gcc -O3 caught the dangling return)
+    if (strcmp(t->format, "las") == 0)
+        return "las";
+    if (strcmp(t->format, "laz") == 0)
+        return "laz";
     if (t->kind == ASP_FILE_POINTS)
         return "xyz";
     return NULL;

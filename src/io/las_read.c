@@ -496,7 +496,7 @@ static void fill_colors(asp_cloud *c)
 static int read_header(reader *r)
 {
     uint8_t h[LAS_HEADER_14] = {0}; // a copy: later fetches reuse the scratch buffer
-    const uint8_t *head;
+    const uint8_t *head = NULL; // set by fetch on success (gcc -O3 cannot see it)
     int rc = fetch(r, 0, r->size < LAS_HEADER_14 ? r->size : LAS_HEADER_14, &head);
     if (rc)
         return rc;

@@ -279,8 +279,9 @@ static void test_extra_bytes_typed_and_raw(void)
     memcpy(d + 4, "h", 1);
     put_f64(d + 112, 0.01);
     put_f64(d + 136, 5.0);
-    static uint8_t buf[375 + sizeof vlr + 30 * 3];
-    size_t reclen = 30 + 4;
+    enum { RECLEN = 30 + 4 }; // format 6 (30 bytes) and 4 extra bytes
+    static uint8_t buf[375 + sizeof vlr + RECLEN * 3];
+    size_t reclen = RECLEN;
     size_t size = make_las(buf, 4, 6, reclen, 3, 0.001, 0, 0, vlr, sizeof vlr);
     uint8_t *rec = buf + 375 + sizeof vlr;
     put(rec + 30, (uint16_t)-250, 2);
