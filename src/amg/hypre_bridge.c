@@ -4,6 +4,7 @@
  * matrices (journal 2.3: A^l = (P^l)^T A^(l-1) P^l). No solve is ever done.
  */
 #include <errno.h>
+#include <stdint.h>
 #include <limits.h>
 #include <mpi.h>
 #include <stdio.h>
@@ -15,6 +16,9 @@
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 /*
  * hypre's internal header (needed for the P matrices, journal 2.3) is not
@@ -46,13 +50,11 @@ static int hypre_started;
  * MPI_Init_thread as 25 lines on fd 2 (its own and its orted helper's) and
  * then calls _exit(1) from inside the call (ess singleton abort): no error
  * code comes back, no atexit handler runs, and MPI_ERRORS_RETURN cannot be
- * set before MPI exists. So a forked child tries MPI_Init_thread first, its
- * fds 1 and 2 going to a log file: when it fails, this process has not
- * started MPI and returns an error naming the reason and the log; when it
- * works, this process starts MPI itself. The probe doubles MPI's start-up
- * (0.4-0.5 s measured on the 2-core CI machine), so it runs only where
- * start-up can be made to fail: Open MPI settings in the environment
- * (OMPI_MCA_*, the issue's case) or a memory limit (RLIMIT_AS, RLIMIT_DATA).
+ * set before MPI exists. Where start-up can be made to fail (Open MPI
+ * settings in the environment, OMPI_MCA_*, the issue's case; a memory limit,
+ * RLIMIT_AS or RLIMIT_DATA) the solver runs in a child process
+ * (coarsen_isolated, at the end of this file) and this process turns its
+ * report into one line naming the reason and the log file that keeps it.
  */
 static char mpi_log[4096];
 extern char **environ;
@@ -134,58 +136,6 @@ static int mpi_start_at_risk(void)
            (getrlimit(RLIMIT_DATA, &data) == 0 && data.rlim_cur != RLIM_INFINITY);
 }
 
-/* 0 when a child process could start MPI (or no probe is needed); otherwise the reason, with the log kept. */
-static int mpi_probe(asp_error *err)
-{
-    if (!mpi_start_at_risk())
-        return 0;
-    const char *dir = getenv("TMPDIR");
-    snprintf(mpi_log, sizeof mpi_log, "%s/amgsplat-mpi-XXXXXX", dir && *dir ? dir : "/tmp");
-    int fd = mkstemp(mpi_log);
-    if (fd < 0)
-        return 0; // no log to read: the real start-up speaks for itself
-    fflush(stdout);
-    fflush(stderr);
-    pid_t pid = fork();
-    if (pid < 0) {
-        close(fd);
-        unlink(mpi_log);
-        return 0;
-    }
-    if (pid == 0) {
-        dup2(fd, 1);
-        dup2(fd, 2);
-        int provided = 0;
-        if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
-            _exit(2);
-        _exit(0); // no MPI_Finalize: the helper it waits for costs more than the probe itself
-    }
-    close(fd);
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
-        ;
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
-        unlink(mpi_log);
-        return 0;
-    }
-    // Open MPI's helper (orted) prints part of the report for the child, after the child has gone: wait
-    // until the log has not grown for 0.3 s, at most 3 s
-    off_t last = -1;
-    for (int i = 0, still = 0; i < 60 && still < 6; i++) {
-        struct stat st;
-        off_t now = stat(mpi_log, &st) == 0 ? st.st_size : -1;
-        still = now > 0 && now == last ? still + 1 : 0;
-        last = now;
-        nanosleep(&(struct timespec){0, 50 * 1000 * 1000}, NULL);
-    }
-    char reason[512];
-    mpi_reason(mpi_log, reason, sizeof reason);
-    if (WIFSIGNALED(status))
-        snprintf(reason + strlen(reason), sizeof reason - strlen(reason), " (killed by signal %d)", WTERMSIG(status));
-    return asp_error_set(err, ASP_ESOLVER, "cannot start MPI for the AMG solver: %s; Open MPI's report is in '%s'",
-                         reason, mpi_log);
-}
-
 static int ensure_mpi(asp_error *err)
 {
     int flag = 0, done = 0;
@@ -195,9 +145,6 @@ static int ensure_mpi(asp_error *err)
     MPI_Initialized(&flag);
     if (!flag) {
         int provided = 0;
-        int rc = mpi_probe(err);
-        if (rc)
-            return rc;
         /* a singleton run: no mpirun needed, no argc/argv */
         if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
             return asp_error_set(err, ASP_ESOLVER, "cannot start MPI for the AMG solver: MPI_Init_thread failed");
@@ -283,11 +230,9 @@ static int copy_parcsr(hypre_ParCSRMatrix *p, const asp_context *ctx, asp_amg_cs
     return 0;
 }
 
-int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
-                           asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
+static int coarsen_here(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
+                        asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
 {
-    if (a->rows > (size_t)INT_MAX - 1 || a->row_ptr[a->rows] > (size_t)INT_MAX)
-        return asp_error_set(err, ASP_EUNSUPPORTED, "matrix of %zu rows is too large for this hypre build", a->rows);
     int rc = ensure_mpi(err);
     if (rc)
         return rc;
@@ -385,4 +330,216 @@ done:
     *p_out = p;
     *ac_out = ac;
     return 0;
+}
+
+/* ---- the isolated run (issue #13: MPI under a memory limit or Open MPI settings) ---- */
+
+/* Writes n bytes, across short writes and EINTR; 0 or -1. */
+static int write_all(int fd, const void *buf, size_t n)
+{
+    const char *b = buf;
+    while (n > 0) {
+        ssize_t w = write(fd, b, n);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            return -1;
+        b += w;
+        n -= (size_t)w;
+    }
+    return 0;
+}
+
+/* Reads exactly n bytes; 0, or -1 at an early end (the child died) or an error. */
+static int read_all(int fd, void *buf, size_t n)
+{
+    char *b = buf;
+    while (n > 0) {
+        ssize_t r = read(fd, b, n);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0)
+            return -1;
+        b += r;
+        n -= (size_t)r;
+    }
+    return 0;
+}
+
+static int write_csr(int fd, const asp_amg_csr *m)
+{
+    uint64_t dims[3] = {m->rows, m->cols, m->row_ptr[m->rows]};
+    return write_all(fd, dims, sizeof dims) || write_all(fd, m->row_ptr, (m->rows + 1) * sizeof *m->row_ptr) ||
+                   write_all(fd, m->col, dims[2] * sizeof *m->col) || write_all(fd, m->val, dims[2] * sizeof *m->val)
+               ? -1
+               : 0;
+}
+
+/* 1 when read, 0 at an early end of the pipe (the child died), <0 an error code set in err. */
+static int read_csr(int fd, const asp_context *ctx, asp_amg_csr **out, asp_error *err)
+{
+    uint64_t dims[3];
+    if (read_all(fd, dims, sizeof dims))
+        return 0;
+    asp_amg_csr *m;
+    int rc = asp_amg_csr_create((size_t)dims[0], (size_t)dims[1], (size_t)dims[2], ctx, &m, err);
+    if (rc)
+        return -rc;
+    if (read_all(fd, m->row_ptr, (m->rows + 1) * sizeof *m->row_ptr) || read_all(fd, m->col, dims[2] * sizeof *m->col) ||
+        read_all(fd, m->val, dims[2] * sizeof *m->val)) {
+        asp_amg_csr_destroy(m);
+        return 0;
+    }
+    *out = m;
+    return 1;
+}
+
+/*
+ * The coarsening in a forked child, this process never starting MPI. Open MPI
+ * cannot be made to fail politely: a failed MPI_Init_thread exits the
+ * process from inside the call with a 25-line report (no error code, no
+ * atexit handler), and under an address-space limit it may instead crash
+ * later in its own progress thread (measured: bunny 100k points, ulimit -v
+ * 200000: SIGSEGV in orte_util_print_jobids, a snprintf into a NULL buffer
+ * after a failed allocation; at 180000 and 220000 the run works). So where
+ * start-up can fail (Open MPI settings in the environment, a memory limit:
+ * mpi_start_at_risk) each coarsening runs in a child that inherits the matrix
+ * (fork), sends P and A^c back through a pipe, and has its fds 1 and 2 in a
+ * log file; whatever Open MPI does to the child, this process reports one
+ * line. Cost: MPI's start-up (0.4-0.5 s) per level, only in such runs; the
+ * child runs hypre on one thread (libgomp's pool is not safe across fork).
+ */
+static int coarsen_isolated(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
+                            asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
+{
+    const char *dir = getenv("TMPDIR");
+    snprintf(mpi_log, sizeof mpi_log, "%s/amgsplat-mpi-XXXXXX", dir && *dir ? dir : "/tmp");
+    int logfd = mkstemp(mpi_log);
+    if (logfd < 0)
+        return asp_error_set(err, ASP_EIO, "cannot create the log file '%s' of the AMG solver: %s", mpi_log,
+                             strerror(errno));
+    int fds[2];
+    if (pipe(fds) != 0) {
+        int e = errno;
+        close(logfd);
+        unlink(mpi_log);
+        return asp_error_set(err, ASP_ESOLVER, "cannot start the AMG solver's process: pipe: %s", strerror(e));
+    }
+    fflush(stdout);
+    fflush(stderr);
+    pid_t pid = fork();
+    if (pid < 0) {
+        int e = errno;
+        close(logfd);
+        close(fds[0]);
+        close(fds[1]);
+        unlink(mpi_log);
+        return asp_error_set(err, ASP_ESOLVER, "cannot start the AMG solver's process: fork: %s", strerror(e));
+    }
+    if (pid == 0) {
+        close(fds[0]);
+        dup2(logfd, 1);
+        dup2(logfd, 2);
+        close(logfd);
+#ifdef _OPENMP
+        omp_set_num_threads(1);
+#endif
+        asp_error cerr = {0, ""};
+        int32_t rc = ensure_mpi(&cerr);
+        char started = 'M'; // MPI is up: a failure from here on is the solver's, not start-up's
+        if (!rc && write_all(fds[1], &started, 1))
+            _exit(3);
+        asp_amg_csr *p = NULL, *ac = NULL;
+        if (!rc)
+            rc = coarsen_here(a, desc, ctx, &p, &ac, &cerr);
+        int32_t has = p != NULL;
+        if (rc) {
+            uint32_t len = (uint32_t)strlen(cerr.msg);
+            if (write_all(fds[1], &rc, sizeof rc) || write_all(fds[1], &len, sizeof len) ||
+                write_all(fds[1], cerr.msg, len))
+                _exit(3);
+        } else if (write_all(fds[1], &rc, sizeof rc) || write_all(fds[1], &has, sizeof has) ||
+                   (has && (write_csr(fds[1], p) || write_csr(fds[1], ac)))) {
+            _exit(3);
+        }
+        _exit(0); // no MPI_Finalize: the helper it waits for costs more than the run itself
+    }
+    close(logfd);
+    close(fds[1]);
+    char started = 0;
+    int32_t crc = 0, has = 0;
+    asp_amg_csr *p = NULL, *ac = NULL;
+    int got = 0, rc = 0; // got: the child's whole answer arrived
+    if (read_all(fds[0], &started, 1) == 0 && read_all(fds[0], &crc, sizeof crc) == 0) {
+        if (crc) {
+            uint32_t len = 0;
+            char msg[sizeof err->msg] = "";
+            if (read_all(fds[0], &len, sizeof len) == 0 && len < sizeof msg && read_all(fds[0], msg, len) == 0) {
+                msg[len] = '\0';
+                rc = asp_error_set(err, crc, "%s", msg);
+                got = 1;
+            }
+        } else if (read_all(fds[0], &has, sizeof has) == 0) {
+            if (!has) {
+                got = 1;
+            } else {
+                int r = read_csr(fds[0], ctx, &p, err);
+                if (r == 1)
+                    r = read_csr(fds[0], ctx, &ac, err);
+                if (r < 0)
+                    rc = -r;
+                got = r == 1;
+            }
+        }
+    }
+    close(fds[0]);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
+        ;
+    if (got && !rc && WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+        unlink(mpi_log);
+        *p_out = p;
+        *ac_out = ac;
+        return 0;
+    }
+    asp_amg_csr_destroy(p);
+    asp_amg_csr_destroy(ac);
+    if (got || rc) { // the solver's own error, already in err
+        unlink(mpi_log);
+        return rc ? rc : asp_error_set(err, ASP_ESOLVER, "the AMG solver's process exited with status %d",
+                                       WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+    }
+    // Open MPI's helper (orted) prints part of the report after the child has gone: wait until the
+    // log has not grown for 0.3 s, at most 3 s
+    off_t last = -1;
+    for (int i = 0, still = 0; i < 60 && still < 6; i++) {
+        struct stat st;
+        off_t now = stat(mpi_log, &st) == 0 ? st.st_size : -1;
+        still = now > 0 && now == last ? still + 1 : 0;
+        last = now;
+        nanosleep(&(struct timespec){0, 50 * 1000 * 1000}, NULL);
+    }
+    char reason[512];
+    mpi_reason(mpi_log, reason, sizeof reason);
+    if (WIFSIGNALED(status))
+        snprintf(reason + strlen(reason), sizeof reason - strlen(reason), " (killed by signal %d)", WTERMSIG(status));
+    if (started != 'M')
+        return asp_error_set(err, ASP_ESOLVER, "cannot start MPI for the AMG solver: %s; Open MPI's report is in '%s'",
+                             reason, mpi_log);
+    return asp_error_set(err, ASP_ESOLVER,
+                         "the AMG solver (hypre on Open MPI) failed in its process on a %zu x %zu matrix: %s; "
+                         "Open MPI's report is in '%s'",
+                         a->rows, a->rows, reason, mpi_log);
+}
+
+int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
+                           asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
+{
+    if (a->rows > (size_t)INT_MAX - 1 || a->row_ptr[a->rows] > (size_t)INT_MAX)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "matrix of %zu rows is too large for this hypre build", a->rows);
+    int started = 0;
+    MPI_Initialized(&started);
+    if (!started && mpi_start_at_risk())
+        return coarsen_isolated(a, desc, ctx, p_out, ac_out, err);
+    return coarsen_here(a, desc, ctx, p_out, ac_out, err);
 }
