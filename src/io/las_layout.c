@@ -93,10 +93,11 @@ size_t asp__las_fields(unsigned fmt, las_field *out)
 
 int asp__las_laz_error(const char *name, asp_error *err)
 {
-    const char *slash = strrchr(name, '/'), *dot = strrchr(slash ? slash + 1 : name, '.');
-    int stem = (int)(dot ? (size_t)(dot - name) : strlen(name));
+    // the example names the file without its folder: the whole path twice overran the message (256 bytes)
+    const char *slash = strrchr(name, '/'), *base = slash ? slash + 1 : name, *dot = strrchr(base, '.');
+    int stem = (int)(dot ? (size_t)(dot - base) : strlen(base));
     return asp_error_set(err, ASP_EUNSUPPORTED,
                          "cannot read '%s': compressed LAS (LASzip) needs a decompressor this build does not have; "
                          "decompress it first (e.g. `laszip -i %s -o %.*s.las`)",
-                         name, name, stem, name);
+                         name, base, stem, base);
 }
