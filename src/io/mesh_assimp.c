@@ -21,6 +21,7 @@
 #include "amgsplat/io.h"
 #include "amgsplat/mesh.h"
 #include "io/mesh_precheck.h"
+#include "io/ply_internal.h"
 #include "util/regular_file.h"
 #include "util/banned.h"
 
@@ -584,14 +585,20 @@ static int ply_precheck(const char *path, const asp_context *ctx, char *tmp_path
 {
     tmp_path[0] = '\0';
     asp_cloud *c = NULL;
-    int rc = asp_ply_read(path, ctx, &c, err);
+    size_t short_faces = 0;
+    int rc = asp__ply_read_counting(path, ctx, &c, &short_faces, err);
     if (rc)
         return rc;
     if (c->face_count == 0) {
         asp_cloud_destroy(c);
         return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': its face elements hold no triangles", path);
     }
-    if (ply_has_strips(path)) {
+    if (short_faces)
+        asp_warn(ctx, "'%s': %zu face%s with fewer than 3 vertices (no surface) left out", path, short_faces,
+                 short_faces == 1 ? "" : "s");
+    // assimp reads strips as one triangle and aborts (ai_assert in TriangulateProcess) on an empty face:
+    // it gets amgsplat's own triangles instead
+    if (short_faces || ply_has_strips(path)) {
         const char *dir = getenv("TMPDIR");
         snprintf(tmp_path, cap, "%s/amgsplat-strips-XXXXXX", dir && *dir ? dir : "/tmp");
         int fd = mkstemp(tmp_path);

@@ -64,4 +64,12 @@ size_t asp__format_double(char buf[32], double v);
 /* Text of one native scalar of type t (integers exact, floats shortest). */
 size_t asp__format_scalar(char buf[32], const void *p, asp_scalar_type t);
 
+/*
+ * As asp_ply_read, and counts the face lists of fewer than 3 indices (no
+ * surface; left out of the triangles): the mesh path rewrites such files for
+ * assimp, whose triangulation aborts on an empty face (fuzz_mesh, issue #13).
+ */
+int asp__ply_read_counting(const char *path, const asp_context *ctx, asp_cloud **out, size_t *short_faces,
+                           asp_error *err);
+
 #endif

@@ -52,6 +52,7 @@ typedef struct reader {
     size_t notes_len, notes_cap;
     size_t line;            /* lines consumed so far (header and ascii body) */
     ply_element *vertex;
+    size_t short_faces;     /* face lists of fewer than 3 indices: no surface (issue #13) */
     const ply_prop *pos[3]; /* x, y, z of the vertex element */
     asp_cloud *cloud;
     double origin[3];
@@ -822,6 +823,7 @@ static int bin_list(reader *r, const ply_element *e, uint64_t index, const ply_p
                         (unsigned long long)asp__src_remaining(&r->src));
     if (p->dest != D_FACE && p->dest != D_STRIP)
         return bin_skip(r, e, index, bytes);
+    r->short_faces += p->dest == D_FACE && n < 3;
     fan f = {0, 0, 0, p->dest == D_STRIP};
     for (uint64_t k = 0; k < (uint64_t)n; k++) {
         at = asp__src_offset(&r->src);
@@ -967,6 +969,7 @@ static int read_element_ascii(reader *r, ply_element *e)
                 double n = asp__scalar_load(raw, q->count_type);
                 if (n < 0)
                     return FAIL_LINE(r, r->line, "list '%s' has negative count %.0f", q->name, n);
+                r->short_faces += q->dest == D_FACE && n < 3;
                 fan f = {0, 0, 0, q->dest == D_STRIP};
                 for (double k = 0; k < n; k++) {
                     if ((rc = ascii_value(r, e, &p, q->type, q->name, used++, raw)))
@@ -1105,6 +1108,22 @@ int asp_ply_read(const char *path, const asp_context *ctx, asp_cloud **out, asp_
     if (rc)
         return rc;
     return read_all(&r, out);
+}
+
+int asp__ply_read_counting(const char *path, const asp_context *ctx, asp_cloud **out, size_t *short_faces,
+                           asp_error *err)
+{
+    reader r;
+    memset(&r, 0, sizeof r);
+    r.ctx = ctx;
+    r.name = path;
+    r.err = err;
+    int rc = asp__src_open_file(&r.src, path, ctx, err);
+    if (rc)
+        return rc;
+    rc = read_all(&r, out);
+    *short_faces = r.short_faces;
+    return rc;
 }
 
 int asp_ply_read_memory(const void *data, size_t size, const char *name, const asp_context *ctx, asp_cloud **out,
