@@ -290,7 +290,7 @@ static int plan_extra_bytes(reader *r)
             if (elems == 1)
                 snprintf(nm, sizeof nm, "%s", name);
             else
-                snprintf(nm, sizeof nm, "%.55s_%u", name, k);
+                snprintf(nm, sizeof nm, "%.50s_%u", name, k);
             unique_name(r, nm, sizeof nm);
             column *c = t == 0 ? add_column(r, nm, ASP_SCALAR_UINT8, at + k, 1, 'u')
                                : add_column(r, nm, type_of[t], at + k * size_of[t], size_of[t], kind_of[t]);

@@ -81,6 +81,22 @@ static int check_off(const char *b, size_t size, const char *name, asp_error *er
     while (s < e && *s != ' ' && *s != '\t')
         s++;
     size_t kl = (size_t)(s - kw);
+    // the keyword is [ST][C][N][4][n]OFF; assimp also reads counts glued to it ("OFF99999...": fuzz_mesh,
+    // a 10-minute run, made it allocate 51 GB), so a keyword followed by more is cut after "OFF"
+    for (size_t i = 0; i + 3 <= kl && kl > 3; i++) {
+        if (memcmp(kw + i, "OFF", 3) == 0) {
+            int prefix = 1;
+            for (size_t j = 0; j < i; j++)
+                prefix &= strchr("STCN4n", kw[j]) != NULL;
+            if (prefix) {
+                s = kw + i + 3;
+                kl = i + 3;
+            }
+            break;
+        }
+        if (!strchr("STCN4n", kw[i]))
+            break;
+    }
     if (kl < 3 || memcmp(kw + kl - 3, "OFF", 3) != 0)
         return 0; // no keyword: assimp decides what this is
     for (size_t i = 0; i + 3 < kl; i++)

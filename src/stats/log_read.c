@@ -74,7 +74,7 @@ static int read_header(asp_stats_log *log, const cJSON *h, asp_error *err)
     if (!log->subject[0] || !log->test[0] || !log->run[0] || !log->condition[0])
         return fail_line(err, log->file, 1, "header lacks one of 'subject', 'test', 'run', 'condition'");
     double v;
-    if (number(h, "seed", &v) == 0 && v >= 0)
+    if (number(h, "seed", &v) == 0 && v >= 0 && v < 18446744073709551616.0) // 2^64: the cast is defined below it
         log->seed = (uint64_t)v;
     log->observer = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(h, "observer"));
     const cJSON *screen = cJSON_GetObjectItemCaseSensitive(h, "screen");
