@@ -52,7 +52,8 @@ static size_t make_las(uint8_t *buf, int minor, int fmt, size_t reclen, size_t n
     }
     if (minor >= 4)
         put(buf + 247, n, 8);
-    memcpy(buf + hs, vlr, vlr_size);
+    if (vlr_size)
+        memcpy(buf + hs, vlr, vlr_size); // memcpy from NULL is undefined even for 0 bytes
     for (size_t i = 0; i < n; i++)
         put(buf + hs + vlr_size + i * reclen, (uint64_t)(x0 + 1000 * (int64_t)i), 4);
     return hs + vlr_size + n * reclen;
@@ -85,6 +86,9 @@ static asp_cloud *make_cloud(size_t n)
     asp_property *p[10];
     for (int k = 0; k < 10; k++)
         CHECK_OK(asp_cloud_add_property(c, props[k].name, props[k].type, &p[k], err), err);
+    // each add may move the property table: look the entries up once all are added (ASan: use after free)
+    for (int k = 0; k < 10; k++)
+        p[k] = asp_cloud_find_property(c, props[k].name);
     for (size_t i = 0; i < n; i++) {
         // positions on the 0.001 grid give exact integers; others test the rounding
         c->positions[3 * i] = (float)(-600.0 + 1200.0 * (double)i / (double)n + 0.0004 * (double)(i % 3));
