@@ -12,27 +12,13 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "fuzz_support.h"
 #include "amgsplat/image.h"
 #include "amgsplat/io.h"
 
-static char path[64];
-
-static void cleanup(void)
-{
-    if (path[0])
-        unlink(path);
-}
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    if (!path[0]) {
-        snprintf(path, sizeof path, "/tmp/fuzz_image_%d.png", (int)getpid());
-        atexit(cleanup);
-    }
-    FILE *f = fopen(path, "wb");
-    if (!f || fwrite(data, 1, size, f) != size)
-        abort();
-    fclose(f);
+    const char *path = fuzz_input_file("fuzz_image", "png", data, size);
     asp_image img = {0};
     asp_error err = {0};
     if (asp_image_load(&img, path, &err) == 0) {

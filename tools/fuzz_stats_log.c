@@ -13,26 +13,12 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "fuzz_support.h"
 #include "amgsplat/stats.h"
-
-static char path[64];
-
-static void cleanup(void)
-{
-    if (path[0])
-        unlink(path);
-}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    if (!path[0]) {
-        snprintf(path, sizeof path, "/tmp/fuzz_stats_log_%d.jsonl", (int)getpid());
-        atexit(cleanup);
-    }
-    FILE *f = fopen(path, "wb");
-    if (!f || fwrite(data, 1, size, f) != size)
-        abort();
-    fclose(f);
+    const char *path = fuzz_input_file("fuzz_stats_log", "jsonl", data, size);
     asp_stats_log log;
     asp_error err = {0};
     if (asp_stats_log_load(&log, path, &err) != 0) {

@@ -1,7 +1,8 @@
 /*
- * Shared by the fuzzers of the checksummed formats (fuzz_amg.c, fuzz_dps.c): an
- * allocator that aborts past a byte budget, and the retry of each input with its
- * payload size and CRC-32 trailer made consistent. Static inline in a header,
+ * Shared by the fuzzers: for the checksummed formats (fuzz_amg.c, fuzz_dps.c)
+ * an allocator that aborts past a byte budget and the retry of each input with
+ * its payload size and CRC-32 trailer made consistent; for the readers that
+ * take a path (fuzz_image.c, fuzz_stats_log.c) one temporary file per process. Static inline in a header,
  * not a .c file, because CMake builds every tools/fuzz_*.c as its own fuzzer
  * from that one file; this name stays outside that glob.
  */
@@ -12,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "amgsplat/core.h"
 #include "util/checksum.h"
@@ -78,6 +80,32 @@ static inline void fuzz_with_fixed_trailer(const uint8_t *data, size_t size, siz
     if (memcmp(fixed, data, size) != 0)
         one(fixed, size);
     free(fixed);
+}
+
+/* The temporary file of fuzz_input_file, removed at exit. */
+static char fuzz_path[64];
+
+static inline void fuzz_remove_path(void)
+{
+    if (fuzz_path[0])
+        unlink(fuzz_path);
+}
+
+/*
+ * Writes the input to /tmp/<who>_<pid>.<ext> (one file per process, rewritten
+ * for each input, removed at exit) for readers that take a path; returns it.
+ */
+static inline const char *fuzz_input_file(const char *who, const char *ext, const uint8_t *data, size_t size)
+{
+    if (!fuzz_path[0]) {
+        snprintf(fuzz_path, sizeof fuzz_path, "/tmp/%s_%d.%s", who, (int)getpid(), ext);
+        atexit(fuzz_remove_path);
+    }
+    FILE *f = fopen(fuzz_path, "wb");
+    if (!f || fwrite(data, 1, size, f) != size)
+        abort();
+    fclose(f);
+    return fuzz_path;
 }
 
 #endif
