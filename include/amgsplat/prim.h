@@ -123,6 +123,8 @@ typedef struct asp_dps_level {
     uint32_t degenerate;      /* primitives flagged DEGENERATE */
     uint32_t capped;          /* primitives flagged CAPPED */
     uint32_t merges;          /* merge operations performed */
+    uint32_t strict;          /* 1: built from strict domains (thesis eq. 2.5, desc.strict), drawn with the
+                                 no-blend method; a .dps may hold thresholded and strict levels side by side */
 } asp_dps_level;
 
 /** A set of levels; create with asp_prim_build or asp_dps_load, free with asp_dps_destroy. */

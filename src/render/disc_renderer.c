@@ -165,7 +165,7 @@ static int disc_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     return asp__gl_check(base->gl, "draw discs", err);
 }
 
-static const asp__renderer_vtable disc_vtable = {"disc", disc_draw, disc_destroy};
+static const asp__renderer_vtable disc_vtable = {.name = "disc", .draw = disc_draw, .destroy = disc_destroy};
 
 /* Uploads one attribute array into an immutable buffer and binds it at binding == location. */
 static void upload(disc_renderer *d, int attr, const void *data, size_t bytes, GLint comps, GLenum type,

@@ -97,6 +97,18 @@ typedef struct asp__renderer_vtable {
     const char *name;
     int (*draw)(asp_renderer *r, const asp__frame *frame, asp_error *err);
     void (*destroy)(asp_renderer *r);
+    /* Optional (NULL = not supported). Renderers with a level of detail of their own (beyond the
+     * point hierarchy of splat_lod.c) take the screen tolerance in pixels here, so one controller
+     * (a frame budget, asp_renderer_set_lod) drives points, primitives and hybrids alike. */
+    int (*set_lod)(asp_renderer *r, float tolerance, uint32_t depth_limit, asp_error *err);
+    /* Optional: figures of the last frame for asp_renderer_stats_get (count is preset to r->count). */
+    void (*stats)(const asp_renderer *r, asp_renderer_stats *out);
+    /* Optional: draws count instances in one frame, instance i placed by models[16 i .. 16 i + 15]
+     * (renderer-local to world, column-major), sharing one accumulation/normalisation where the
+     * renderer has one, so instances occlude and blend as one surface set. NULL: a scene draws
+     * such a renderer once per instance with the model folded into frame->view. */
+    int (*draw_instances)(asp_renderer *r, const asp__frame *frame, const float *models, size_t count,
+                          asp_error *err);
 } asp__renderer_vtable;
 
 struct asp_renderer {

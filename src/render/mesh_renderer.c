@@ -150,7 +150,7 @@ static int mesh_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     return asp__gl_check(base->gl, "draw the mesh", err);
 }
 
-static const asp__renderer_vtable mesh_vtable = {"mesh", mesh_draw, mesh_destroy};
+static const asp__renderer_vtable mesh_vtable = {.name = "mesh", .draw = mesh_draw, .destroy = mesh_destroy};
 
 static void upload(mesh_renderer *m, int attr, const void *data, size_t bytes, GLint comps, GLenum type,
                    GLboolean normalized, GLsizei stride)

@@ -247,7 +247,7 @@ static int prim_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     return asp__prim_draw((asp__prim_renderer *)base, f, err);
 }
 
-const asp__renderer_vtable asp__prim_vtable = {"prim", prim_draw, prim_destroy};
+const asp__renderer_vtable asp__prim_vtable = {.name = "prim", .draw = prim_draw, .destroy = prim_destroy};
 
 /* CPU copies used every frame by the sorted methods. */
 static int alloc_cpu(asp__prim_renderer *r, asp_error *err)

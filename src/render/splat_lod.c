@@ -244,12 +244,14 @@ void asp__lod_release(const asp_context *actx, asp__lod *lod)
 int asp_renderer_set_lod(asp_renderer *r, float tolerance, uint32_t depth_limit, asp_error *err)
 {
     asp__lod_renderer *lr = asp__lod_renderer_of(r);
-    if (!lr)
+    if (!lr && !(r && r->vt->set_lod))
         return asp_error_set(err, ASP_EUNSUPPORTED, "the %s renderer has no level of detail to set",
                              asp_renderer_name(r));
     if (!(tolerance >= 0) || !isfinite(tolerance))
         return asp_error_set(err, ASP_EINVAL, "screen tolerance %g is not a finite number of pixels >= 0",
                              (double)tolerance);
+    if (!lr)
+        return r->vt->set_lod(r, tolerance, depth_limit, err);
     lr->lod.tolerance = tolerance;
     lr->lod.depth_limit = depth_limit;
     return 0;
@@ -271,8 +273,11 @@ void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out)
     out->count = r->count;
     out->points = r->count;
     asp__lod_renderer *lr = asp__lod_renderer_of((asp_renderer *)r);
-    if (!lr)
+    if (!lr) {
+        if (r->vt->stats)
+            r->vt->stats(r, out);
         return;
+    }
     out->count = lr->lod.count;
     out->points = lr->lod.points;
     out->nodes = lr->lod.nodes;

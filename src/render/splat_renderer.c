@@ -459,7 +459,7 @@ static int splat_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     return asp__gl_check(base->gl, "draw splats", err);
 }
 
-const asp__renderer_vtable asp__splat_vtable = {"splat", splat_draw, splat_destroy};
+const asp__renderer_vtable asp__splat_vtable = {.name = "splat", .draw = splat_draw, .destroy = splat_destroy};
 
 static void set_static_uniforms(splat_renderer *s)
 {

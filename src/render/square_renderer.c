@@ -90,7 +90,7 @@ static int square_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     return asp__gl_check(base->gl, "draw squares", err);
 }
 
-const asp__renderer_vtable asp__square_vtable = {"square", square_draw, square_destroy};
+const asp__renderer_vtable asp__square_vtable = {.name = "square", .draw = square_draw, .destroy = square_destroy};
 
 static int check_desc(const asp_square_renderer_desc *d, asp_error *err)
 {
