@@ -27,7 +27,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         asp_error err = {0};
         int rc = asp_file_recognise_memory(head, size, names[i], &t, &err);
         if (rc == 0) {
-            if (t.kind < ASP_FILE_POINTS || t.kind > ASP_FILE_IMAGE || !memchr(t.format, '\0', sizeof t.format) ||
+            if (t.kind < ASP_FILE_POINTS || t.kind > ASP_FILE_SCENE || !memchr(t.format, '\0', sizeof t.format) ||
                 !t.format[0])
                 abort();
             for (const char *c = t.format; *c; c++)

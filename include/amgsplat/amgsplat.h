@@ -20,6 +20,8 @@
 #include "export.h"
 #include "render.h"
 #include "scene.h"
+#include "instances.h"
+#include "scene_renderer.h"
 #include "viewer.h"
 #include "output.h"
 #include "preset.h"

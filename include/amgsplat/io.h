@@ -239,7 +239,8 @@ typedef enum asp_file_kind {
     ASP_FILE_AMG = 3,    /* AMG decomposition (amgsplat decompose) */
     ASP_FILE_DPS = 4,    /* domain primitives (amgsplat build) */
     ASP_FILE_HIER = 5,   /* point hierarchy (asp_hier_save) */
-    ASP_FILE_IMAGE = 6   /* PNG, JPEG, BMP, TGA, ... (stb_image) */
+    ASP_FILE_IMAGE = 6,  /* PNG, JPEG, BMP, TGA, ... (stb_image) */
+    ASP_FILE_SCENE = 7   /* a scene of instances (JSON with "instances", instances.h) */
 } asp_file_kind;
 
 /** What asp_file_recognise found. */
@@ -247,7 +248,7 @@ typedef struct asp_file_type {
     asp_file_kind kind;
     char format[16]; /* lower-case short name: "ply", "xyz", "pts", "txt", "las", "laz", "obj", "off", "stl", "gltf",
                         "glb", "3ds", "fbx", "dae", "amg", "dps", "hier", "png", "jpeg", "bmp", "tga",
-                        "gif"; "" when unknown */
+                        "gif", "json" (scenes); "" when unknown */
     int by_magic;    /* 1: told by the first bytes of the file, 0: by its extension */
 } asp_file_type;
 
@@ -301,7 +302,7 @@ int asp_image_probe(const char *path, asp_image_header *out, asp_error *err);
  */
 int asp_file_name_is(const char *path, const char *format);
 
-/** "unknown", "points", "mesh", "amg", "dps", "hier", "image". Never NULL. */
+/** "unknown", "points", "mesh", "amg", "dps", "hier", "image", "scene". Never NULL. */
 const char *asp_file_kind_name(asp_file_kind kind);
 
 #ifdef __cplusplus

@@ -523,6 +523,38 @@ static int info_mesh(const char *path, const asp_file_type *type, struct cli_env
     return rc;
 }
 
+/* A scene of instances: parsed and validated, sources named, nothing loaded (instances.h). */
+static int info_scene(const char *path, struct cli_env *env)
+{
+    asp_instance_scene s;
+    asp_error err = {0};
+    if (asp_instance_scene_read(path, &s, &err))
+        return cli_fail(env, &err);
+    int rc = 0;
+    if (env->json) {
+        cJSON *j = cJSON_CreateObject(), *srcs = cJSON_CreateArray();
+        cJSON_AddStringToObject(j, "file", path);
+        cJSON_AddStringToObject(j, "kind", "scene");
+        cJSON_AddNumberToObject(j, "instances", (double)s.instance_count);
+        for (size_t i = 0; i < s.source_count; i++) {
+            cJSON *o = cJSON_CreateObject();
+            cJSON_AddStringToObject(o, "source", s.sources[i].name);
+            cJSON_AddNumberToObject(o, "instances", (double)asp_instance_scene_count(&s, i));
+            cJSON_AddItemToArray(srcs, o);
+        }
+        cJSON_AddItemToObject(j, "sources", srcs);
+        cJSON_AddBoolToObject(j, "camera", s.camera.given);
+        rc = cli_json_print(env, j);
+    } else {
+        printf("%s: scene of %zu instances of %zu source%s%s\n", path, s.instance_count, s.source_count,
+               s.source_count == 1 ? "" : "s", s.camera.given ? ", with a camera" : "");
+        for (size_t i = 0; i < s.source_count; i++)
+            printf("  %s: %zu instances\n", s.sources[i].name, asp_instance_scene_count(&s, i));
+    }
+    asp_instance_scene_release(&s);
+    return rc;
+}
+
 int cmd_info(int argc, char **argv, struct cli_env *env)
 {
     const struct cli_option opts[] = {{0}};
@@ -547,6 +579,8 @@ int cmd_info(int argc, char **argv, struct cli_env *env)
         return info_image(path, &type, env);
     case ASP_FILE_MESH:
         return info_mesh(path, &type, env);
+    case ASP_FILE_SCENE:
+        return info_scene(path, env);
     case ASP_FILE_POINTS:
     case ASP_FILE_UNKNOWN:
         break;

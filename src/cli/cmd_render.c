@@ -11,6 +11,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "amgsplat/instances.h"
+#include "amgsplat/scene_renderer.h"
 #include "cli/cli.h"
 #include "cli/commands.h"
 #include "util/banned.h"
@@ -425,6 +427,119 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     return cli_json_print(env, j);
 }
 
+/* The scene's own camera, or orbit views around its frame when --view or --views asks for them. */
+static void scene_camera(const asp_instance_scene *s, const struct render_opts *o, size_t i, asp_camera *cam)
+{
+    int orbit = o->view != NULL || o->views > 1;
+    float az = (float)(o->az + 360.0 * (double)i / (double)o->views), el = (float)(i % 2 ? -o->el : o->el);
+    asp_instance_scene_camera(s, orbit, (float)o->width / (float)o->height, (float)o->fov, az, el, (float)o->dist,
+                              cam);
+}
+
+static int print_scene_json(const struct cli_env *env, const struct render_opts *o, const asp_instance_scene *s,
+                            asp_gl_context *gl, const asp_image *img, const struct view_stats *vs, size_t drawn,
+                            double seconds)
+{
+    cJSON *j = cJSON_CreateObject(), *frame = cJSON_CreateArray();
+    cJSON_AddStringToObject(j, "output", o->output);
+    cJSON_AddNumberToObject(j, "width", img->width);
+    cJSON_AddNumberToObject(j, "height", img->height);
+    cJSON_AddNumberToObject(j, "views", (double)o->views);
+    cJSON_AddNumberToObject(j, "instances", (double)s->instance_count);
+    cJSON_AddNumberToObject(j, "sources", (double)s->source_count);
+    cJSON_AddNumberToObject(j, "instances_drawn", (double)drawn);
+    cJSON_AddStringToObject(j, "renderer", "scene");
+    cJSON_AddStringToObject(j, "gl_renderer", asp_gl_context_renderer(gl));
+    cJSON_AddNumberToObject(j, "primitives", (double)vs->last_count);
+    cJSON_AddNumberToObject(j, "primitives_min", (double)vs->min_count);
+    cJSON_AddNumberToObject(j, "primitives_max", (double)vs->max_count);
+    cJSON_AddItemToObject(j, "view_ms", cli_json_number("%.3f", 1e3 * vs->seconds / (double)o->views));
+    for (int k = 0; k < 3; k++)
+        cJSON_AddItemToArray(frame, cli_json_number("%.9g", s->frame.center[k]));
+    cJSON_AddItemToArray(frame, cli_json_number("%.9g", s->frame.radius));
+    cJSON_AddItemToObject(j, "frame", frame);
+    cJSON_AddItemToObject(j, "seconds", cli_json_number("%.3f", seconds));
+    return cli_json_print(env, j);
+}
+
+/* A scene of instances (instances.h): every source drawn by its row of the table, all in one frame. */
+static int render_instance_scene(const char *path, struct render_opts *o, struct cli_env *env)
+{
+    if (o->budget)
+        return cli_usage_error(env, "--budget is per model; a scene takes --tolerance (every instance's cut)");
+    const asp_renderer_kind *kind = NULL;
+    asp_error err = {0, ""};
+    if (o->renderer && asp_renderer_kind_find(o->renderer, ASP_RENDER_INPUT_POINTS, &kind, &err))
+        return cli_usage_error(env, "--renderer is the scene's point sources' renderer: %s", err.msg);
+    if (o->depth_limit > 64)
+        return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o->depth_limit);
+    double t0 = asp_time_now();
+    asp_instance_scene s;
+    memset(&s, 0, sizeof s);
+    asp_gl_context *gl = NULL;
+    asp_renderer *r = NULL;
+    asp_image tiles[MAX_VIEWS];
+    asp_image sheet = {0, 0, NULL};
+    memset(tiles, 0, sizeof tiles);
+    struct view_stats vs = {SIZE_MAX, 0, 0, 0};
+    asp_renderer_options ropts;
+    renderer_options(o, &ropts);
+    asp_scene_desc d = {.level = o->level, .texture = o->texture};
+    int rc = asp_instance_scene_load(path, &d, &env->ctx, &s, &err);
+    if (!rc)
+        rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err);
+    if (!rc)
+        rc = asp_instance_scene_renderer_create(gl, &s, o->renderer, &ropts, &env->ctx, &r, &err);
+    if (!rc && o->depth_limit)
+        rc = asp_renderer_set_lod(r, ropts.splat.tolerance, (uint32_t)o->depth_limit, &err);
+    asp_render_desc desc = {.width = o->width, .height = o->height, .samples = (uint32_t)o->samples,
+                            .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el,
+                            .flags = o->unlit ? ASP_RENDER_UNLIT : 0u};
+    memcpy(desc.background, s.has_background && !o->background && !o->transparent ? s.background : o->bg, 4);
+    for (size_t i = 0; !rc && i < o->views; i++) {
+        asp_camera cam;
+        scene_camera(&s, o, i, &cam);
+        double tv = asp_time_now();
+        rc = asp_render_to_image(gl, r, &cam, &desc, &tiles[i], &err);
+        vs.seconds += asp_time_now() - tv;
+        if (rc)
+            break;
+        vs.last_count = asp_renderer_count(r);
+        vs.min_count = vs.last_count < vs.min_count ? vs.last_count : vs.min_count;
+        vs.max_count = vs.last_count > vs.max_count ? vs.last_count : vs.max_count;
+        if ((rc = asp_progress(&env->ctx, "render", (double)(i + 1) / (double)o->views)) != 0)
+            asp_error_set(&err, rc, "rendering canceled");
+    }
+    if (!rc && o->views > 1)
+        rc = asp_image_contact_sheet(tiles, o->views, 0, &sheet, &err);
+    const asp_image *result = o->views > 1 ? &sheet : &tiles[0];
+    if (!rc)
+        rc = asp_image_save_png(result, o->output, &err);
+    size_t drawn = asp_scene_renderer_drawn(r);
+    int status = 0;
+    if (rc) {
+        status = cli_fail(env, &err);
+    } else {
+        cli_progress_end(env);
+        if (env->json)
+            status = print_scene_json(env, o, &s, gl, result, &vs, drawn, asp_time_now() - t0);
+        else
+            cli_info(env,
+                     "rendered %zu view%s of a scene of %zu instances of %zu source%s (%zu instances and %zu "
+                     "primitives in the last view, %.1f ms per view, %s) to '%s' (%ux%u) in %.2f s\n",
+                     o->views, o->views > 1 ? "s" : "", s.instance_count, s.source_count,
+                     s.source_count == 1 ? "" : "s", drawn, vs.last_count, 1e3 * vs.seconds / (double)o->views,
+                     asp_gl_context_renderer(gl), o->output, result->width, result->height, asp_time_now() - t0);
+    }
+    asp_image_release(&sheet);
+    for (size_t i = 0; i < o->views; i++)
+        asp_image_release(&tiles[i]);
+    asp_renderer_destroy(r);
+    asp_gl_context_destroy(gl);
+    asp_instance_scene_release(&s);
+    return status;
+}
+
 int cmd_render(int argc, char **argv, struct cli_env *env)
 {
     // NaN marks the .dps numbers as not given
@@ -487,7 +602,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     if (asp_file_recognise(argv[0], &type, NULL) != 0)
         asp_file_type_of_name(argv[0], &type, NULL);
     o.amg_input = type.kind == ASP_FILE_AMG;
-    o.dps_input = type.kind == ASP_FILE_DPS;
+    // a scene takes the .dps options for its .dps sources (and its point sources stay unclipped)
+    o.dps_input = type.kind == ASP_FILE_DPS || type.kind == ASP_FILE_SCENE;
     // a preset names the options of every input kind; those that do not fit this input are dropped
     if (!o.dps_input && cli_from_preset(env, &o.method))
         o.method = NULL;
@@ -497,6 +613,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         o.renderer = NULL;
     if (parse_options(env, &o))
         return 2;
+    if (type.kind == ASP_FILE_SCENE)
+        return render_instance_scene(argv[0], &o, env);
     if (o.dps_input && o.renderer)
         return cli_usage_error(env, "--renderer is for point inputs; a .dps input is drawn with --method");
     o.mesh_input = type.kind == ASP_FILE_MESH;

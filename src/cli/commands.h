@@ -21,6 +21,7 @@ int cmd_eval(int argc, char **argv, struct cli_env *env);
 int cmd_simplify(int argc, char **argv, struct cli_env *env);
 int cmd_bench_paper(int argc, char **argv, struct cli_env *env);
 int cmd_export(int argc, char **argv, struct cli_env *env);
+int cmd_scene(int argc, char **argv, struct cli_env *env);
 int cmd_experiment(int argc, char **argv, struct cli_env *env);
 /* the experiment's analysis (src/cli/cmd_experiment_analyze.c, cmd_experiment_ttest.c), called by cmd_experiment */
 int cmd_experiment_analyze(int argc, char **argv, struct cli_env *env);

@@ -30,6 +30,7 @@ static const struct cli_command commands[] = {
     {"view", cmd_view, "open a window on points or an .amg decomposition (interactive viewer)"},
     {"eval", cmd_eval, "measure every representation against the reference: PSNR, SSIM, IoU, frame time"},
     {"bench-paper", cmd_bench_paper, "print the seeds' tables (journal Tables 1-2, thesis Tables 5.1-5.4)"},
+    {"scene", cmd_scene, "scene files of instances: 'scene field' writes N models receding to the horizon"},
     {"experiment", cmd_experiment, "the perceptual experiment of seed 004: run (people or observer), analyze, ttest"},
 };
 enum { N_COMMANDS = sizeof commands / sizeof commands[0] };

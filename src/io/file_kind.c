@@ -42,7 +42,7 @@ static const char expected[] = ".ply, .xyz, .pts, .txt, .las, .laz, .obj, .off, 
 
 const char *asp_file_kind_name(asp_file_kind kind)
 {
-    static const char *const names[] = {"unknown", "points", "mesh", "amg", "dps", "hier", "image"};
+    static const char *const names[] = {"unknown", "points", "mesh", "amg", "dps", "hier", "image", "scene"};
     return (unsigned)kind < sizeof names / sizeof names[0] ? names[kind] : "unknown";
 }
 
@@ -129,6 +129,29 @@ static int las_is_compressed(const unsigned char *h, size_t n)
     return 0;
 }
 
+/*
+ * A scene of instances (instances.h) by content: JSON text whose first
+ * non-blank byte opens an object and whose head holds the key "instances"
+ * (the scene writer puts it before the camera). JSON has no magic, and a
+ * .json name says nothing: the experiment's scene list ("format":
+ * "amgsplat-scenes 1", no "instances") stays unknown, as before.
+ */
+static int is_instance_scene(const unsigned char *h, size_t n)
+{
+    size_t i = 0;
+    if (n >= 3 && h[0] == 0xef && h[1] == 0xbb && h[2] == 0xbf)
+        i = 3; // a UTF-8 byte order mark
+    while (i < n && (h[i] == ' ' || h[i] == '\t' || h[i] == '\n' || h[i] == '\r'))
+        i++;
+    if (i >= n || h[i] != '{')
+        return 0;
+    static const char key[] = "\"instances\"";
+    for (; i + sizeof key - 1 <= n; i++)
+        if (memcmp(h + i, key, sizeof key - 1) == 0)
+            return 1;
+    return 0;
+}
+
 /* 0 and *out filled when the first bytes name the format; 1 when they do not. */
 static int by_magic(const unsigned char *h, size_t n, asp_file_type *out)
 {
@@ -172,6 +195,10 @@ static int by_magic(const unsigned char *h, size_t n, asp_file_type *out)
     if (k + 3 <= n && memcmp(h + k, "OFF", 3) == 0 &&
         (k + 3 == n || h[k + 3] == '\n' || h[k + 3] == '\r' || h[k + 3] == ' ' || h[k + 3] == '\t')) {
         fill(out, ASP_FILE_MESH, "off", 1);
+        return 0;
+    }
+    if (is_instance_scene(h, n)) {
+        fill(out, ASP_FILE_SCENE, "json", 1);
         return 0;
     }
     // 3DS: the main chunk 0x4D4D, then its length (little endian), then the version chunk 0x0002

@@ -1,0 +1,87 @@
+/*
+ * The renderer of a scene of instances (issue 18 item 4): one renderer of the
+ * table per distinct source, handed with its instances' models to the scene
+ * renderer of render (scene_renderer.h), so render, view and eval build it alike.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "amgsplat/instances.h"
+#include "amgsplat/scene_renderer.h"
+#include "util/banned.h"
+
+#ifndef ASP_HAVE_GL
+int asp_instance_scene_renderer_create(asp_gl_context *gl, const asp_instance_scene *s, const char *point_renderer,
+                                       const asp_renderer_options *options, const asp_context *ctx,
+                                       asp_renderer **out, asp_error *err)
+{
+    (void)gl, (void)s, (void)point_renderer, (void)options, (void)ctx, (void)out;
+    return asp_error_set(err, ASP_EUNSUPPORTED, "this amgsplat was built without OpenGL (ASP_WITH_GL=OFF)");
+}
+#else
+
+/* The row of the renderer table drawing source sc. */
+static int pick_kind(const asp_scene *sc, const char *point_renderer, const asp_renderer_kind **out, asp_error *err)
+{
+    unsigned inputs = asp_scene_inputs(sc);
+    const char *name = sc->dps    ? "prim"
+                       : sc->mesh ? "mesh"
+                       : point_renderer ? point_renderer
+                       : sc->hier && !sc->cloud ? "splat"
+                                                : "disc";
+    return asp_renderer_kind_find(name, inputs, out, err);
+}
+
+int asp_instance_scene_renderer_create(asp_gl_context *gl, const asp_instance_scene *s, const char *point_renderer,
+                                       const asp_renderer_options *options, const asp_context *ctx,
+                                       asp_renderer **out, asp_error *err)
+{
+    ASP_ASSERT(gl && s && out);
+    asp_context actx = s->ctx;
+    asp_scene_renderer_group *groups = asp_calloc(&actx, s->source_count, sizeof *groups);
+    if (!groups)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu sources", s->source_count);
+    int rc = 0;
+    size_t made = 0;
+    for (size_t i = 0; i < s->source_count && !rc; i++) {
+        const asp_scene *sc = &s->sources[i].scene;
+        asp_scene_renderer_group *g = &groups[i];
+        const asp_renderer_kind *kind = NULL;
+        asp_error e = {0, ""};
+        rc = pick_kind(sc, point_renderer, &kind, &e);
+        if (!rc) {
+            asp_render_source src;
+            asp_scene_render_source(sc, &src);
+            rc = kind->create(gl, &src, options, ctx, &g->renderer, &e);
+        }
+        if (rc) {
+            asp_error_set(err, rc, "source '%s': %s", s->sources[i].name, e.msg);
+            break;
+        }
+        made++;
+        g->count = asp_instance_scene_count(s, i);
+        float *models = asp_alloc(&actx, 16 * (g->count ? g->count : 1) * sizeof(float));
+        if (!models) {
+            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu instances", g->count);
+            break;
+        }
+        asp_instance_scene_models(s, i, models);
+        g->models = models;
+        // the source's frame in its renderer's local frame: the sphere the instances are culled by
+        for (int a = 0; a < 3; a++)
+            g->center[a] = (float)(sc->frame.center[a] - sc->origin[a]);
+        g->radius = (float)sc->frame.radius;
+    }
+    if (rc) {
+        for (size_t i = 0; i < made; i++)
+            asp_renderer_destroy(groups[i].renderer);
+    } else {
+        // the scene renderer owns the source renderers from here on, also when it fails
+        rc = asp_scene_renderer_create(gl, groups, s->source_count, out, err);
+    }
+    for (size_t i = 0; i < s->source_count; i++)
+        asp_free(&actx, (void *)groups[i].models);
+    asp_free(&actx, groups);
+    return rc;
+}
+#endif
