@@ -20,8 +20,9 @@ static const char usage[] =
     "\n"
     "Opens a window on a point file (.ply, .xyz, .pts, .txt), an AMG decomposition (.amg,\n"
     "coloured by classifier or domains), domain primitives (.dps, one level at a time, blended\n"
-    "by --method as in amgsplat render) or a mesh (OBJ+MTL, PLY with faces, OFF, STL, glTF, 3DS;\n"
-    "--texture as in amgsplat sample). Left drag orbits, the wheel or right drag zooms, middle\n"
+    "by --method as in amgsplat render), a mesh (OBJ+MTL, PLY with faces, OFF, STL, glTF, 3DS;\n"
+    "--texture as in amgsplat sample) or a scene of instances (docs/scene-format.md; the point\n"
+    "renderer keys pick how its point sources are drawn). Left drag orbits, the wheel or right drag zooms, middle\n"
     "drag or shift + left drag pans; press h in the window for the keys (docs/cli/view.md).\n"
     "With --frames N the viewer draws N frames, pressing KEYS one per frame, saves the last\n"
     "frame to OUT.png and exits (needs a display: run under xvfb-run without one).";
@@ -99,7 +100,7 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
     asp_file_type type = {ASP_FILE_UNKNOWN, "", 0};
     if (asp_file_recognise(path, &type, NULL) != 0)
         asp_file_type_of_name(path, &type, NULL);
-    int dps = type.kind == ASP_FILE_DPS;
+    int dps = type.kind == ASP_FILE_DPS || type.kind == ASP_FILE_SCENE; // a scene's .dps sources take them
     if ((o->method || !isnan(o->alpha_ref)) && !dps)
         return cli_usage_error(env, "--method and --alpha-ref need a .dps input (amgsplat build makes one)");
     if (o->method) {

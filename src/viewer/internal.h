@@ -5,6 +5,7 @@
 #ifndef ASP_VIEWER_INTERNAL_H
 #define ASP_VIEWER_INTERNAL_H
 
+#include "amgsplat/instances.h"
 #include "amgsplat/scene.h"
 #include "amgsplat/viewer.h"
 
@@ -102,6 +103,25 @@ int asp__viewer_scene_load(asp_scene *s, const char *path, const asp_viewer_desc
  * unchanged.
  */
 int asp__viewer_scene_action(asp_scene *s, enum asp__viewer_action a, char *note, size_t note_cap, asp_error *err);
+
+/* ---- scenes of instances (instances_view.c, instances.h) ---- */
+
+/*
+ * When path is a scene file: loads it into *is and fills *stand_in (zeroed
+ * first) with its kind, path and frame, origin = the frame's centre (what the
+ * scene renderer draws in), and returns 1. Returns 0 for any other file
+ * (nothing touched), or the loader's negative error.
+ */
+int asp__viewer_instances_load(asp_instance_scene *is, asp_scene *stand_in, const char *path,
+                               const asp_viewer_desc *desc, const asp_context *ctx, asp_error *err);
+
+/* The scene renderer of is with point_renderer ("disc", "splat", "square") for its point sources. */
+int asp__viewer_instances_renderer(asp_gl_context *gl, const asp_instance_scene *is, const char *point_renderer,
+                                   const asp_renderer_options *o, const asp_context *ctx, asp_renderer **out,
+                                   asp_error *err);
+
+/* Title text, "scene of 1000 instances of 1 source". */
+void asp__viewer_instances_status(const asp_instance_scene *is, char *status, size_t cap);
 
 /* Title text for the scene, e.g. "domains, level 3 (L-2), 40 domains" or "level 2 (L-1)"; "" for points. */
 void asp__viewer_scene_status(const asp_scene *s, char *status, size_t cap);

@@ -102,6 +102,8 @@ struct viewer {
     const asp_viewer_desc *desc;
     const char *path;
     asp_scene scene;
+    asp_instance_scene instances; /* a scene file: its instances; scene is then a stand-in holding its frame */
+    int is_scene;
     char status[96];       /* the scene's title text (asp__viewer_scene_status) */
     float center[3];       /* the scene's frame in its renderers' local frame (scene.origin) */
     float radius;
@@ -175,6 +177,9 @@ static void reset_view(viewer *v)
     v->cam.elevation = d->set_view ? d->elevation : 20.0f;
     // the one framing of amgsplat render, so a scripted view matches its --view
     asp_camera_frame(&v->cam, &v->scene.frame, v->scene.origin, aspect, d->set_view ? d->distance : 0.0f);
+    if (v->is_scene && !d->set_view) // the scene file's own camera, when it has one
+        asp_instance_scene_camera(&v->instances, 0, aspect, v->cam.fov_y, v->cam.azimuth, v->cam.elevation, 0.0f,
+                                  &v->cam);
     v->dirty = 1;
 }
 
@@ -306,7 +311,8 @@ static int make_renderer(viewer *v, size_t k, asp_renderer **out, asp_error *err
     o.square.tolerance = v->tolerance;
     o.splat.flags = o.square.flags = v->desc->lod_flags;
     o.prim = v->prim;
-    int rc = K(k)->create(v->gl, &src, &o, &v->ctx, out, err);
+    int rc = v->is_scene ? asp__viewer_instances_renderer(v->gl, &v->instances, K(k)->name, &o, &v->ctx, out, err)
+                         : K(k)->create(v->gl, &src, &o, &v->ctx, out, err);
     if (!rc && v->depth_limit && K(k)->has_lod && (rc = asp_renderer_set_lod(*out, v->tolerance, v->depth_limit, err))) {
         asp_renderer_destroy(*out);
         *out = NULL;
@@ -317,6 +323,8 @@ static int make_renderer(viewer *v, size_t k, asp_renderer **out, asp_error *err
 /* A .dps whose source points were loaded (p) can be drawn by the point renderers too. */
 static int kind_accepts(const viewer *v, size_t k)
 {
+    if (v->is_scene) // the point renderers pick how a scene's point sources are drawn
+        return (K(k)->inputs & ASP_RENDER_INPUT_POINTS) != 0;
     return (K(k)->inputs & asp_scene_inputs(&v->scene)) != 0;
 }
 
@@ -810,10 +818,16 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
     v.prim.alpha_ref = desc->prim_alpha_ref;
     if (ctx)
         v.ctx = *ctx;
-    rc = asp__viewer_scene_load(&v.scene, path, desc, ctx, err);
-    if (rc)
+    rc = asp__viewer_instances_load(&v.instances, &v.scene, path, desc, ctx, err);
+    v.is_scene = rc == 1;
+    if (rc == 0)
+        rc = asp__viewer_scene_load(&v.scene, path, desc, ctx, err);
+    if (rc < 0)
         return rc;
-    asp__viewer_scene_status(&v.scene, v.status, sizeof v.status);
+    if (v.is_scene)
+        asp__viewer_instances_status(&v.instances, v.status, sizeof v.status);
+    else
+        asp__viewer_scene_status(&v.scene, v.status, sizeof v.status);
     for (int k = 0; k < 3; k++)
         v.center[k] = (float)(v.scene.frame.center[k] - v.scene.origin[k]);
     v.radius = (float)v.scene.frame.radius;
@@ -853,5 +867,6 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
     asp_hier_destroy(v.hier);
     asp_gl_context_destroy(v.gl);
     asp_scene_release(&v.scene);
+    asp_instance_scene_release(&v.instances);
     return rc;
 }
