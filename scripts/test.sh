@@ -132,6 +132,7 @@ fuzz_smoke() {
       fuzz_mesh) seed "$corpus" "$seeds"/*.ply tests/data/bad/mesh ;;
       fuzz_las) seed "$corpus" "$seeds"/*.las ;;
       fuzz_stats_log) seed "$corpus" tests/data/experiment ;;
+      fuzz_scene_file) : ;; # JSON only: its committed corpus below
       *) seed "$corpus" "$seeds" tests/data/bad ;; # a new target: every format as a start
     esac
     if [[ -d tools/corpus/$name ]]; then
