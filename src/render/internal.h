@@ -111,6 +111,13 @@ typedef struct asp__renderer_vtable {
                           asp_error *err);
 } asp__renderer_vtable;
 
+/*
+ * The frame of an instance placed by model (renderer-local to world, column-major, affine): view *
+ * model as the view, the eye moved into the local frame (model^-1 eye). scene_renderer.c; the
+ * per-instance draws of the scene renderer and of draw_instances implementations share it.
+ */
+void asp__frame_fold(const asp__frame *f, const float model[16], asp__frame *out);
+
 struct asp_renderer {
     const asp__renderer_vtable *vt;
     asp_gl_context *gl;

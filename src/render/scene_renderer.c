@@ -120,11 +120,18 @@ static int far_first(const void *a, const void *b)
     return x->group != y->group ? (x->group < y->group ? -1 : 1) : (x->index < y->index ? -1 : x->index > y->index);
 }
 
-static int draw_folded(asp_renderer *r, const asp__frame *f, const float model[16], asp_error *err)
+void asp__frame_fold(const asp__frame *f, const float model[16], asp__frame *out)
 {
     asp__frame local = *f;
     mul4(f->view, model, local.view);
     eye_to_local(model, f->eye, local.eye);
+    *out = local;
+}
+
+static int draw_folded(asp_renderer *r, const asp__frame *f, const float model[16], asp_error *err)
+{
+    asp__frame local;
+    asp__frame_fold(f, model, &local);
     return r->vt->draw(r, &local, err);
 }
 

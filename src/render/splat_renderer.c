@@ -214,6 +214,12 @@ typedef struct accum_target {
     GLuint color, normal, depth; /* textures */
 } accum_target;
 
+/* One instance of a draw_instances call: its frame and its cut's range in the instanced id buffer. */
+typedef struct splat_instance {
+    asp__frame frame;
+    size_t first, count;
+} splat_instance;
+
 typedef struct splat_renderer {
     asp_renderer base; // first two members as asp__lod_renderer
     asp__lod lod;
@@ -229,6 +235,13 @@ typedef struct splat_renderer {
     int kgauss, eps_uniform;
     asp_splat_lighting lighting;
     asp_splat_mode mode;
+    /* draw_instances: every instance's cut side by side (ranges aligned for glBindBufferRange) */
+    asp__gl_buffer inst_ids;
+    size_t inst_ids_capacity; /* ids the GPU buffer holds */
+    asp_index *inst_cut;      /* CPU copy, inst_cut_capacity ids */
+    size_t inst_cut_capacity;
+    splat_instance *insts;
+    size_t insts_capacity;
 } splat_renderer;
 
 static void accum_release(accum_target *t)
@@ -308,6 +321,10 @@ static void splat_destroy(asp_renderer *base)
         glDeleteVertexArrays(1, &s->vao.id);
     if (s->clips.id)
         glDeleteBuffers(1, &s->clips.id);
+    if (s->inst_ids.id)
+        glDeleteBuffers(1, &s->inst_ids.id);
+    asp_free(&base->gl->actx, s->inst_cut);
+    asp_free(&base->gl->actx, s->insts);
     asp__lod_renderer_free((asp__lod_renderer *)s);
 }
 
@@ -377,7 +394,34 @@ static void restore_state(GLint fbo)
     glUseProgram(0);
 }
 
-static int draw_blended(splat_renderer *s, const asp__frame *f, GLint caller_fbo, asp_error *err)
+/*
+ * One pass of the splats: the last cut with frame f, or with batch (n > 0) each instance's cut with
+ * its own frame, all into the same target, so every instance's depth is down before any blends.
+ */
+static void draw_pass(splat_renderer *s, int prog, const asp__frame *f, float epsilon, const splat_instance *batch,
+                      size_t n)
+{
+    if (!n) {
+        set_frame_uniforms(s, prog, f, epsilon, 0);
+        draw_splats(s, prog);
+        return;
+    }
+    glUseProgram(s->programs[prog].id);
+    glBindVertexArray(s->vao.id);
+    for (size_t i = 0; i < n; i++) {
+        if (!batch[i].count)
+            continue;
+        set_frame_uniforms(s, prog, &batch[i].frame, epsilon, 0);
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_IDS, s->inst_ids.id,
+                          (GLintptr)(batch[i].first * sizeof(asp_index)),
+                          (GLsizeiptr)(batch[i].count * sizeof(asp_index)));
+        glDrawArraysInstanced(GL_TRIANGLES, 0, 3, (GLsizei)batch[i].count);
+    }
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_IDS, s->lod.ids.id);
+}
+
+static int draw_blended(splat_renderer *s, const asp__frame *f, GLint caller_fbo, const splat_instance *batch,
+                        size_t nbatch, asp_error *err)
 {
     asp_gl_context *gl = s->base.gl;
     int pixel_light = lighting_code(s, f) == 1;
@@ -400,22 +444,20 @@ static int draw_blended(splat_renderer *s, const asp__frame *f, GLint caller_fbo
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, s->acc.fbo.id);
 
     // pass 1: the epsilon-offset depth of the visible surface
-    set_frame_uniforms(s, PROG_DEPTH, f, s->epsilon, 0);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    draw_splats(s, PROG_DEPTH);
+    draw_pass(s, PROG_DEPTH, f, s->epsilon, batch, nbatch);
 
     // pass 2: every splat within epsilon of it adds (psi c, psi); depth read-only
-    set_frame_uniforms(s, PROG_BLEND, f, 0.0f, 0);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_FALSE);
     glDepthFunc(GL_LEQUAL);
     glEnable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
-    draw_splats(s, PROG_BLEND);
+    draw_pass(s, PROG_BLEND, f, 0.0f, batch, nbatch);
 
     // pass 3: normalise into the caller's framebuffer
     glDisable(GL_BLEND);
@@ -451,7 +493,7 @@ static int splat_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
         set_frame_uniforms(s, PROG_BLEND, f, 0.0f, 1);
         draw_splats(s, PROG_BLEND);
     } else {
-        rc = draw_blended(s, f, caller_fbo, err);
+        rc = draw_blended(s, f, caller_fbo, NULL, 0, err);
     }
     restore_state(caller_fbo);
     if (rc)
@@ -459,7 +501,112 @@ static int splat_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     return asp__gl_check(base->gl, "draw splats", err);
 }
 
-const asp__renderer_vtable asp__splat_vtable = {.name = "splat", .draw = splat_draw, .destroy = splat_destroy};
+/* Grows *p (elem bytes each) to hold need entries; contents kept. */
+static int grow(asp_context *a, void **p, size_t *cap, size_t need, size_t elem, asp_error *err)
+{
+    if (need <= *cap)
+        return 0;
+    size_t n = *cap ? *cap : 64;
+    while (n < need)
+        n *= 2;
+    void *q = asp_alloc(a, n * elem);
+    if (!q)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu splat instances' cuts", need);
+    if (*p)
+        memcpy(q, *p, *cap * elem);
+    asp_free(a, *p);
+    *p = q;
+    *cap = n;
+    return 0;
+}
+
+/*
+ * Selects every instance's cut (each with its own view: far instances get coarse cuts) into one id
+ * buffer, ranges aligned to GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT so each binds on its own.
+ */
+static int select_instances(splat_renderer *s, const asp__frame *f, const float *models, size_t count,
+                            size_t *total, asp_error *err)
+{
+    asp_context *a = &s->base.gl->actx;
+    GLint align_bytes = 16;
+    glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &align_bytes);
+    size_t align = align_bytes > (GLint)sizeof(asp_index) ? (size_t)align_bytes / sizeof(asp_index) : 1;
+    int rc = grow(a, (void **)&s->insts, &s->insts_capacity, count, sizeof *s->insts, err);
+    size_t used = 0;
+    for (size_t i = 0; !rc && i < count; i++) {
+        splat_instance *in = &s->insts[i];
+        asp__frame_fold(f, models + 16 * i, &in->frame);
+        rc = asp__lod_select((asp__lod_renderer *)s, &in->frame, err);
+        if (rc)
+            break;
+        in->first = (used + align - 1) / align * align;
+        in->count = s->lod.count;
+        rc = grow(a, (void **)&s->inst_cut, &s->inst_cut_capacity, in->first + in->count, sizeof *s->inst_cut, err);
+        if (!rc && in->count)
+            memcpy(s->inst_cut + in->first, s->lod.cut, in->count * sizeof *s->inst_cut);
+        used = in->first + in->count;
+    }
+    if (rc)
+        return rc;
+    if (used > s->inst_ids_capacity) {
+        if (s->inst_ids.id)
+            glDeleteBuffers(1, &s->inst_ids.id);
+        s->inst_ids_capacity = used + used / 2;
+        glCreateBuffers(1, &s->inst_ids.id);
+        glNamedBufferData(s->inst_ids.id, (GLsizeiptr)(s->inst_ids_capacity * sizeof(asp_index)), NULL,
+                          GL_STREAM_DRAW);
+    }
+    if (used)
+        glNamedBufferSubData(s->inst_ids.id, 0, (GLsizeiptr)(used * sizeof(asp_index)), s->inst_cut);
+    *total = used;
+    return asp__gl_check(s->base.gl, "upload the splat instances' cuts", err);
+}
+
+/*
+ * Every instance in one accumulation (seed 001 section 5): all depth passes, then all blend passes,
+ * then one normalisation, so touching instances blend and occlude as one surface set, and the
+ * full-screen clear and resolve are paid once, not per instance. Opaque splats are depth-tested
+ * alone: one ordinary draw per instance composes.
+ */
+static int splat_draw_instances(asp_renderer *base, const asp__frame *f, const float *models, size_t count,
+                                asp_error *err)
+{
+    splat_renderer *s = (splat_renderer *)base;
+    if (s->mode == ASP_SPLAT_OPAQUE) {
+        size_t drawn = 0;
+        for (size_t i = 0; i < count; i++) {
+            asp__frame fi;
+            asp__frame_fold(f, models + 16 * i, &fi);
+            int rc = splat_draw(base, &fi, err);
+            if (rc)
+                return rc;
+            drawn += base->count;
+        }
+        base->count = drawn;
+        return 0;
+    }
+    GLint caller_fbo = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &caller_fbo);
+    size_t used = 0;
+    int rc = select_instances(s, f, models, count, &used, err);
+    if (rc)
+        return rc;
+    size_t drawn = 0;
+    for (size_t i = 0; i < count; i++)
+        drawn += s->insts[i].count;
+    base->count = drawn;
+    if (!drawn)
+        return 0; // everything culled: the background stays
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_CLIPS, s->clips.id);
+    rc = draw_blended(s, f, caller_fbo, s->insts, count, err);
+    restore_state(caller_fbo);
+    if (rc)
+        return rc;
+    return asp__gl_check(base->gl, "draw splat instances", err);
+}
+
+const asp__renderer_vtable asp__splat_vtable = {.name = "splat", .draw = splat_draw, .destroy = splat_destroy,
+                                                .draw_instances = splat_draw_instances};
 
 static void set_static_uniforms(splat_renderer *s)
 {
