@@ -172,6 +172,61 @@ int asp_instance_scene_renderer_create(asp_gl_context *gl, const asp_instance_sc
                                        const asp_renderer_options *options, const asp_context *ctx,
                                        asp_renderer **out, asp_error *err);
 
+/** Options of asp_instance_scene_eval; the zero value means defaults. */
+typedef struct asp_instance_eval_desc {
+    uint32_t width, height;    /* image size; 0 = 256 x 256 */
+    size_t frames;             /* timed frames per row, median; 0 = 3 */
+    const float *tolerances;   /* splat tolerances tau in pixels measured against the reference; NULL = 1, 2, 4, 8 */
+    size_t tolerance_count;
+    const asp_renderer_options *options; /* NULL = defaults; splat.tolerance and square.tolerance are set per row */
+    int orbit;                 /* 1: view from azimuth/elevation (degrees) instead of the file's camera */
+    float azimuth, elevation;
+} asp_instance_eval_desc;
+
+/** One representation of the whole scene against the reference (asp_instance_scene_eval). */
+typedef struct asp_instance_eval_row {
+    char renderer[16];      /* "splat", "disc", "square" */
+    float tolerance;        /* tau in pixels (splat, square); 0 for disc */
+    size_t primitives;      /* splats or discs drawn in the last frame, over all instances */
+    size_t instances_drawn; /* after frustum culling */
+    double psnr, ssim, iou; /* against the reference image (asp_image_psnr, _ssim, _silhouette_iou) */
+    double frame_ms;        /* median over desc->frames frames: draw, resolve and read back */
+    asp_image image;        /* the row's render (owned by the result) */
+} asp_instance_eval_row;
+
+/** What asp_instance_scene_eval measured; free with asp_instance_eval_result_destroy. */
+typedef struct asp_instance_eval_result {
+    size_t row_count;
+    asp_instance_eval_row *rows; /* rows[0] is the reference itself: splats at tau 0 (every point of every instance) */
+    const char *gl_renderer;     /* GL_RENDERER of the context used; static storage of the result */
+    char gl_renderer_text[128];
+} asp_instance_eval_result;
+
+/**
+ * issue 18's scene measure: renders the whole scene s (loaded) from its
+ * camera (or desc's orbit view) as the reference, blended splats at tau 0
+ * (full detail), then as discs (every point), as splats at each tolerance
+ * and as squares at the largest, and compares each image with the
+ * reference (PSNR, SSIM, silhouette IoU on white) and times it (median
+ * frame in ms). Makes its own headless GL context. Returns 0 and *out;
+ * ASP_EINVAL (a negative or non-finite tolerance, more than 32); the
+ * renderers' and metrics' errors; ASP_EUNSUPPORTED without GL; ASP_ENOMEM.
+ */
+int asp_instance_scene_eval(const asp_instance_scene *s, const asp_instance_eval_desc *desc, const asp_context *ctx,
+                            asp_instance_eval_result **out, asp_error *err);
+
+/**
+ * Writes res as JSON (scene, gl_renderer, and per row renderer, tolerance,
+ * primitives, instances_drawn, psnr (null when identical), ssim, iou,
+ * frame_ms) to path through the atomic writer. Returns 0, ASP_ENOMEM or
+ * ASP_EIO.
+ */
+int asp_instance_eval_save_json(const asp_instance_eval_result *res, const char *scene, const char *path,
+                                asp_error *err);
+
+/** Frees a result of asp_instance_scene_eval; NULL is accepted. */
+void asp_instance_eval_result_destroy(asp_instance_eval_result *r);
+
 /** Frees everything s owns (the loaded sources too) and zeroes it; a zeroed scene is accepted. */
 void asp_instance_scene_release(asp_instance_scene *s);
 

@@ -111,15 +111,16 @@ int asp_instance_field(const asp_scene *model, const char *source_name, const as
         m[13] = -floor_y;
         m[14] = z - (-sy * c[0] + cy * c[2]);
     }
-    // at the near edge, half a model high, looking level along the field to its far end
-    double eye_h = r;
+    // at the near edge, half a model high, looking along the field to its far end, pitched 8 degrees
+    // down so the horizon sits in the upper third of a 50-degree view and the field fills the rest
+    double eye_h = r, depth = ((double)(rows > 1 ? rows - 1 : 1) + 0.8) * step;
     s.camera.given = 1;
     s.camera.eye[0] = 0;
     s.camera.eye[1] = eye_h;
-    s.camera.eye[2] = 1.5 * step;
+    s.camera.eye[2] = 0.8 * step;
     s.camera.target[0] = 0;
-    s.camera.target[1] = 0.5 * eye_h;
-    s.camera.target[2] = -(double)(rows > 1 ? rows - 1 : 1) * step;
+    s.camera.target[1] = eye_h - depth * tan(8.0 * pi / 180.0);
+    s.camera.target[2] = s.camera.eye[2] - depth;
     s.camera.fov_y = 50.0f;
     *out = s;
     return 0;

@@ -57,6 +57,22 @@ check "$T/f1.png" "w == 160 and h == 120 and 0.05 < fg < 0.8"
 "$A" render "$T/f1.json" -o "$T/f1s.png" --size 160x120 --renderer splat --tolerance 2 -q
 check "$T/f1s.png" "0.05 < fg < 0.8"
 
+# eval of a scene: the reference against itself is exact; coarser cuts draw fewer splats
+"$A" scene field "$T/sphere.ply" --instances 6 -o "$T/f6.json" -q
+"$A" eval "$T/f6.json" -o "$T/ev" --sizes 64 --frames 1 --tolerances 2,8 --json >"$T/ev.out" || fail "eval of a scene"
+python3 - "$T/ev.out" "$T/ev/eval.json" <<'PY' || fail "eval --json: $(cat "$T/ev.out")"
+import json, sys
+out, saved = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+rows = out["rows"]
+assert [r["renderer"] for r in rows] == ["splat", "disc", "splat", "splat", "square"], rows
+assert rows[0]["psnr"] is None and rows[0]["ssim"] == 1 and rows[0]["iou"] == 1, rows[0]
+assert rows[3]["primitives"] < rows[2]["primitives"] < rows[0]["primitives"], rows
+assert all(0.3 < r["ssim"] <= 1 and r["frame_ms"] > 0 for r in rows), rows
+assert len(saved["rows"]) == 5 and saved["rows"][0]["reference"] is True
+PY
+check "$T/ev/sheet.png" "fg > 0.05"
+expect_fail 2 "--tolerances is for scene files" "$A" eval "$T/sphere.ply" --tolerances 1
+
 # occlusion with domain primitives: the near instance covers the centre whichever comes first
 cam='"camera": {"eye": [0, 0, 9], "target": [0, 0, 0], "fov": 40}'
 echo "{\"version\": 1, \"instances\": [{\"source\": \"cube.dps\"}], $cam}" >"$T/near_only.json"
