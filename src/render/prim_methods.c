@@ -402,8 +402,17 @@ static void draw_normalized(asp__prim_renderer *r, int prefix)
 static void resolve(asp__prim_renderer *r, GLuint caller_fbo, int normalize)
 {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, caller_fbo);
-    glDisable(GL_DEPTH_TEST);
-    glDepthMask(GL_FALSE);
+    if (normalize) {
+        // the front layer's depth goes along (LEQUAL: a cleared buffer takes every pixel, as before),
+        // so what the caller drew nearer stays in front: instances of a scene compose (issue 18)
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LEQUAL);
+        glDepthMask(GL_TRUE);
+        glBindTextureUnit(ASP__PRIM_UNIT_FRONT_DEPTH, r->t.depth);
+    } else {
+        glDisable(GL_DEPTH_TEST);
+        glDepthMask(GL_FALSE);
+    }
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glEnable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
@@ -417,7 +426,9 @@ static void resolve(asp__prim_renderer *r, GLuint caller_fbo, int normalize)
     glBindVertexArray(r->empty_vao.id);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindTextureUnit(ASP__PRIM_UNIT_ACCUM, 0);
+    glBindTextureUnit(ASP__PRIM_UNIT_FRONT_DEPTH, 0);
     glDisable(GL_BLEND);
+    glDepthFunc(GL_LESS);
 }
 
 /*

@@ -229,16 +229,21 @@ const char *const asp__prim_resolve_vertex_src =
  * opacity u_transparency. Otherwise the seeds' sum is taken as premultiplied
  * colour with coverage min(sum a, 1): over black it is exactly the seeds'
  * framebuffer, over another background too-dark spots let it through. Blended
- * onto the caller's framebuffer with (1, 1 - alpha).
+ * onto the caller's framebuffer with (1, 1 - alpha). normalize also carries the
+ * front layer's depth into the caller's depth buffer (depth-tested, LEQUAL), so
+ * several draws in one frame (instances of a scene) occlude one another like
+ * the other renderers' surfaces.
  */
 const char *const asp__prim_resolve_fragment_src =
     "#version 450 core\n"
+    "layout(binding = 2) uniform sampler2D u_front_depth;\n"
     "layout(binding = 4) uniform sampler2D u_accum;\n"
     "uniform int u_normalize;\n"
     "uniform float u_transparency;\n"
     "layout(location = 0) out vec4 o_color;\n"
     "void main() {\n"
     "    vec4 acc = texelFetch(u_accum, ivec2(gl_FragCoord.xy), 0);\n"
+    "    gl_FragDepth = u_normalize != 0 ? texelFetch(u_front_depth, ivec2(gl_FragCoord.xy), 0).r : gl_FragCoord.z;\n"
     "    if (u_normalize != 0) {\n"
     "        if (!(acc.a > 0.0))\n"
     "            discard;\n"
