@@ -112,6 +112,10 @@ extern const asp__renderer_vtable asp__prim_vtable;
 
 /* Draws one frame with r->opt into the currently bound draw framebuffer. */
 int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err);
+/* draw_instances of the vtable: count instances placed by models (16 floats each), one accumulation
+ * for the normalized method, else one frame each far to near. */
+int asp__prim_draw_instances(asp__prim_renderer *r, const asp__frame *f, const float *models, size_t count,
+                             asp_error *err);
 
 /*
  * Finds the pairs of primitives of lv that cross at a sharp crease (more than

@@ -215,6 +215,19 @@ static void set_uniforms(asp__prim_renderer *r, const asp__frame *f)
     }
 }
 
+/* The uniforms that differ between instances of one frame: the view (model folded in) and projection. */
+static void frame_uniforms(asp__prim_renderer *r, const asp__frame *f)
+{
+    for (int p = 0; p < ASP__PROG_RESOLVE; p++) {
+        GLuint id = r->programs[p].id;
+        glProgramUniformMatrix4fv(id, r->uniforms[p][PU_VIEW], 1, GL_FALSE, f->view);
+        glProgramUniformMatrix4fv(id, r->uniforms[p][PU_PROJ], 1, GL_FALSE, f->proj);
+    }
+}
+
+/* Draws every primitive once, or once per instance frame (n > 0) into the same target. */
+static void draw_all_frames(asp__prim_renderer *r, const asp__frame *frames, size_t n);
+
 static void main_pass(asp__prim_renderer *r, enum asp__prim_pass pass)
 {
     glUseProgram(r->programs[ASP__PROG_MAIN].id);
@@ -233,6 +246,18 @@ static void draw_all(asp__prim_renderer *r)
 {
     glBindVertexArray(r->identity_vao.id);
     glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)r->count);
+}
+
+static void draw_all_frames(asp__prim_renderer *r, const asp__frame *frames, size_t n)
+{
+    if (!n) {
+        draw_all(r);
+        return;
+    }
+    for (size_t k = 0; k < n; k++) {
+        frame_uniforms(r, &frames[k]);
+        draw_all(r);
+    }
 }
 
 static void draw_run(asp__prim_renderer *r, const asp__run *run)
@@ -351,8 +376,12 @@ static void draw_seed(asp__prim_renderer *r, const asp__frame *f)
     glDisable(GL_CULL_FACE);
 }
 
-/* normalized and prefix: front layer, selected sums, then the division in the resolve. */
-static void draw_normalized(asp__prim_renderer *r, int prefix)
+/*
+ * normalized and prefix: front layer, selected sums, then the division in the resolve. With
+ * frames (n > 0), every instance's front layer first, then every instance's sums, so instances
+ * that touch blend as one surface and one clear and one resolve serve them all.
+ */
+static void draw_normalized(asp__prim_renderer *r, int prefix, const asp__frame *frames, size_t n)
 {
     const asp_prim_render_options *o = &r->opt;
     static const GLfloat zero[4] = {0, 0, 0, 0};
@@ -378,7 +407,7 @@ static void draw_normalized(asp__prim_renderer *r, int prefix)
     glDepthMask(GL_TRUE);
     glColorMask(prefix, prefix, prefix, prefix);
     depth_pass(r, prefix ? ASP__PROG_ID : ASP__PROG_DEPTH, 0.0f, o->alpha_ref);
-    draw_all(r);
+    draw_all_frames(r, frames, n);
 
     // pass 2: add what lies within the window behind it (and, for prefix, belongs to its neighbourhood)
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, r->t.accum_fbo.id);
@@ -393,7 +422,7 @@ static void draw_normalized(asp__prim_renderer *r, int prefix)
     // the opacity is applied after the division, where it is not divided away
     glProgramUniform1f(mp, r->uniforms[ASP__PROG_MAIN][PU_TRANSPARENCY], 1.0f);
     main_pass(r, ASP__PASS_ADD);
-    draw_all(r);
+    draw_all_frames(r, frames, n);
     glBindTextureUnit(ASP__PRIM_UNIT_FRONT_DEPTH, 0);
     glBindTextureUnit(ASP__PRIM_UNIT_FRONT_ID, 0);
     glDisable(GL_CULL_FACE);
@@ -484,7 +513,7 @@ int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err)
     glBindTextureUnit(ASP__PRIM_UNIT_NORMALS, r->normal_atlas ? r->normal_atlas : r->atlas);
     int normalize = r->opt.method == ASP_PRIM_RENDER_NORMALIZED || r->opt.method == ASP_PRIM_RENDER_PREFIX;
     if (normalize)
-        draw_normalized(r, r->opt.method == ASP_PRIM_RENDER_PREFIX);
+        draw_normalized(r, r->opt.method == ASP_PRIM_RENDER_PREFIX, NULL, 0);
     else
         draw_seed(r, f);
     resolve(r, (GLuint)caller, normalize);
@@ -494,4 +523,67 @@ int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err)
     glBindTextureUnit(ASP__PRIM_UNIT_NORMALS, 0);
     restore_state((GLuint)caller);
     return asp__gl_check(gl, "draw domain primitives", err);
+}
+
+/* Sort key of an instance: its frame's origin distance from the eye (the model's translation). */
+typedef struct instance_key {
+    float d2;
+    size_t i;
+} instance_key;
+
+static int far_first(const void *a, const void *b)
+{
+    const instance_key *x = a, *y = b;
+    return x->d2 != y->d2 ? (x->d2 > y->d2 ? -1 : 1) : (x->i > y->i) - (x->i < y->i);
+}
+
+int asp__prim_draw_instances(asp__prim_renderer *r, const asp__frame *f, const float *models, size_t count,
+                             asp_error *err)
+{
+    asp_gl_context *gl = r->base.gl;
+    asp__frame *frames = asp_alloc(&gl->actx, count * sizeof *frames);
+    instance_key *keys = asp_alloc(&gl->actx, count * sizeof *keys);
+    if (!frames || !keys) {
+        asp_free(&gl->actx, frames);
+        asp_free(&gl->actx, keys);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu primitive instances", count);
+    }
+    for (size_t i = 0; i < count; i++) {
+        asp__frame_fold(f, models + 16 * i, &frames[i]);
+        const float *m = models + 16 * i;
+        float dx = m[12] - f->eye[0], dy = m[13] - f->eye[1], dz = m[14] - f->eye[2];
+        keys[i] = (instance_key){dx * dx + dy * dy + dz * dz, i};
+    }
+    int rc = 0;
+    // the normalised sums blend every instance in one accumulation; prefix selects by primitive id,
+    // which instances share, and outlines and the seeds' methods draw their own passes per frame
+    if (r->opt.method == ASP_PRIM_RENDER_NORMALIZED && !(r->opt.flags & ASP_PRIM_RENDER_OUTLINE)) {
+        GLint caller = 0;
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &caller);
+        rc = targets_ensure(gl, &r->t, f->width, f->height, err);
+        if (!rc) {
+            set_uniforms(r, f);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_PRIMS, r->prim_buffer.id);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_NEIGHBOURS, r->neighbour_buffer.id);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_CLIPS, r->clip_buffer.id);
+            glBindTextureUnit(ASP__PRIM_UNIT_ATLAS, r->atlas);
+            glBindTextureUnit(ASP__PRIM_UNIT_NORMALS, r->normal_atlas ? r->normal_atlas : r->atlas);
+            draw_normalized(r, 0, frames, count);
+            resolve(r, (GLuint)caller, 1);
+            glBindTextureUnit(ASP__PRIM_UNIT_ATLAS, 0);
+            glBindTextureUnit(ASP__PRIM_UNIT_NORMALS, 0);
+            restore_state((GLuint)caller);
+            rc = asp__gl_check(gl, "draw domain primitive instances", err);
+        }
+        r->base.count = count * r->count;
+    } else {
+        // one frame each, far to near: the seeds' methods paint without a depth test
+        qsort(keys, count, sizeof *keys, far_first);
+        for (size_t k = 0; k < count && !rc; k++)
+            rc = asp__prim_draw(r, &frames[keys[k].i], err);
+        r->base.count = count * r->count;
+    }
+    asp_free(&gl->actx, frames);
+    asp_free(&gl->actx, keys);
+    return rc;
 }

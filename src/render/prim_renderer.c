@@ -247,7 +247,14 @@ static int prim_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     return asp__prim_draw((asp__prim_renderer *)base, f, err);
 }
 
-const asp__renderer_vtable asp__prim_vtable = {.name = "prim", .draw = prim_draw, .destroy = prim_destroy};
+static int prim_draw_instances(asp_renderer *base, const asp__frame *f, const float *models, size_t count,
+                               asp_error *err)
+{
+    return asp__prim_draw_instances((asp__prim_renderer *)base, f, models, count, err);
+}
+
+const asp__renderer_vtable asp__prim_vtable = {.name = "prim", .draw = prim_draw, .destroy = prim_destroy,
+                                               .draw_instances = prim_draw_instances};
 
 /* CPU copies used every frame by the sorted methods. */
 static int alloc_cpu(asp__prim_renderer *r, asp_error *err)

@@ -135,6 +135,21 @@ static int draw_folded(asp_renderer *r, const asp__frame *f, const float model[1
     return r->vt->draw(r, &local, err);
 }
 
+/*
+ * Whether g's renderer gets its instances in one instanced draw. Domain primitives only with the
+ * normalized method: the seeds' methods paint without a depth test and need the scene's global
+ * far-to-near order, and prefix selects by primitive id, which instances share.
+ */
+static int instanced(const group *g)
+{
+    if (!g->r->vt->draw_instances)
+        return 0;
+    asp_prim_render_options o;
+    if (asp_prim_renderer_options(g->r, &o, NULL) == 0)
+        return o.method == ASP_PRIM_RENDER_NORMALIZED && !(o.flags & ASP_PRIM_RENDER_OUTLINE);
+    return 1;
+}
+
 static int scene_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
 {
     scene_renderer *s = (scene_renderer *)base;
@@ -144,11 +159,12 @@ static int scene_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     for (size_t gi = 0; gi < s->group_count; gi++) {
         group *g = &s->groups[gi];
         size_t nb = 0;
+        int batch = instanced(g);
         for (size_t i = 0; i < g->count; i++) {
             float key;
             if (!visible(g, i, planes, f->eye, &key))
                 continue;
-            if (g->r->vt->draw_instances)
+            if (batch)
                 memcpy(s->batch + 16 * nb++, g->models + 16 * i, 16 * sizeof(float));
             else
                 s->refs[nref++] = (instance_ref){key, (uint32_t)gi, (uint32_t)i};
