@@ -113,7 +113,8 @@ int asp_instance_scene_save(const asp_instance_scene *s, const char *path, asp_e
  * azimuth and elevation (degrees) and distance_radii (0 = fit), fov_y_default. The frame of the returned camera is
  * the scene's world centred on s->frame.center (the origin the scene
  * renderer draws in: pass it to asp_instance_scene_models). Near and far
- * planes hold the whole scene (asp_camera_clip_to_sphere). Pure.
+ * planes hold the whole scene (asp_camera_clip_to_sphere). Pure. Only in
+ * builds with GL (the camera is render's).
  */
 void asp_instance_scene_camera(const asp_instance_scene *s, int orbit, float aspect, float fov_y_default,
                                float azimuth, float elevation, float distance_radii, asp_camera *cam);

@@ -21,6 +21,8 @@ typedef struct asp_scene_renderer_group {
     size_t count;           /* instances; 0 is allowed (the renderer is only kept) */
     float center[3];        /* bounding sphere of what renderer draws, in its local frame: instances whose */
     float radius;           /* moved sphere lies outside the view frustum are skipped; radius 0 = never skip */
+    int one_by_one;         /* 1: one draw per instance even when the renderer has an instanced draw (the
+                               reference path of tests and benchmarks) */
 } asp_scene_renderer_group;
 
 /**

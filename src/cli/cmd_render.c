@@ -31,6 +31,7 @@ static const char usage[] =
     "                      dark-backface-soft|blend-all|no-blend|polygons] [--level L] [--alpha-ref X]\n"
     "                      [--transparency X] [--depth-window X] [--crease-angle DEG|off] [--outline]\n"
     "                      [--color-by domain] [--overlap-backfaces] ...\n"
+    "       amgsplat render SCENE.json -o OUT.png [--renderer disc|splat|square] [--method M] ...\n"
     "\n"
     "Renders a point set (PLY, XYZ) or the points of an AMG decomposition (.amg) headlessly through\n"
     "EGL (a GPU, or Mesa llvmpipe without one) to a PNG. Renderers: disc (opaque discs in the tangent\n"
@@ -43,7 +44,8 @@ static const char usage[] =
     "the textured domain primitives of one level, blended by --method (docs/render-methods.md).\n"
     "A mesh (OBJ+MTL, PLY with faces, OFF, STL, glTF/GLB, 3DS) is drawn as textured triangles with\n"
     "the same lighting and framing as the points sampled from it (amgsplat sample); a texture that\n"
-    "cannot be found is drawn in its material colour, with a warning.";
+    "cannot be found is drawn in its material colour, with a warning. A scene file of instances\n"
+    "(docs/scene-format.md, amgsplat scene field) is drawn whole from its own camera.";
 
 enum { MAX_VIEWS = 256, MAX_SIDE = 16384 };
 
@@ -473,6 +475,8 @@ static int render_instance_scene(const char *path, struct render_opts *o, struct
         return cli_usage_error(env, "--renderer is the scene's point sources' renderer: %s", err.msg);
     if (o->depth_limit > 64)
         return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o->depth_limit);
+    if (o->up)
+        return cli_usage_error(env, "--up: a scene is y-up (turn its instances with rotate_deg instead)");
     double t0 = asp_time_now();
     asp_instance_scene s;
     memset(&s, 0, sizeof s);
@@ -486,6 +490,8 @@ static int render_instance_scene(const char *path, struct render_opts *o, struct
     renderer_options(o, &ropts);
     asp_scene_desc d = {.level = o->level, .texture = o->texture};
     int rc = asp_instance_scene_load(path, &d, &env->ctx, &s, &err);
+    for (size_t i = 0; !rc && i < s.source_count; i++)
+        warn_missing_textures(&s.sources[i].scene);
     if (!rc)
         rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err);
     if (!rc)

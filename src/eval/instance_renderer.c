@@ -3,6 +3,7 @@
  * table per distinct source, handed with its instances' models to the scene
  * renderer of render (scene_renderer.h), so render, view and eval build it alike.
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -19,6 +20,39 @@ int asp_instance_scene_renderer_create(asp_gl_context *gl, const asp_instance_sc
     return asp_error_set(err, ASP_EUNSUPPORTED, "this amgsplat was built without OpenGL (ASP_WITH_GL=OFF)");
 }
 #else
+
+static const double deg = 3.14159265358979323846 / 180.0;
+
+void asp_instance_scene_camera(const asp_instance_scene *s, int orbit, float aspect, float fov_y_default,
+                               float azimuth, float elevation, float distance_radii, asp_camera *cam)
+{
+    asp_camera_init(cam);
+    int file = s->camera.given && !orbit;
+    cam->fov_y = file && s->camera.fov_y > 0 ? s->camera.fov_y : fov_y_default;
+    const float zero[3] = {0, 0, 0};
+    if (!file) {
+        cam->azimuth = azimuth;
+        cam->elevation = elevation;
+        static const double origin[3];
+        asp_frame f = s->frame;
+        memset(f.center, 0, sizeof f.center); // the scene's frame is centred on s->frame.center
+        asp_camera_frame(cam, &f, origin, aspect, distance_radii);
+        return;
+    }
+    // the orbit camera that puts its eye at "eye" looking at "target" (render.h: eye = target + d (..))
+    double d[3], len = 0;
+    for (int a = 0; a < 3; a++) {
+        d[a] = s->camera.eye[a] - s->camera.target[a];
+        len += d[a] * d[a];
+        cam->target[a] = (float)(s->camera.target[a] - s->frame.center[a]);
+    }
+    len = sqrt(len);
+    cam->distance = (float)len;
+    cam->elevation = (float)(asin(fmax(-1.0, fmin(1.0, d[1] / len))) / deg);
+    cam->azimuth = (float)(atan2(d[0], d[2]) / deg);
+    cam->aspect = aspect > 0 ? aspect : 1.0f;
+    asp_camera_clip_to_sphere(cam, zero, (float)s->frame.radius);
+}
 
 /* The row of the renderer table drawing source sc. */
 static int pick_kind(const asp_scene *sc, const char *point_renderer, const asp_renderer_kind **out, asp_error *err)

@@ -19,6 +19,7 @@ typedef struct group {
     float *models; /* 16 per instance */
     size_t count;
     float center[3], radius;
+    int one_by_one;
 } group;
 
 typedef struct instance_ref {
@@ -142,7 +143,7 @@ static int draw_folded(asp_renderer *r, const asp__frame *f, const float model[1
  */
 static int instanced(const group *g)
 {
-    if (!g->r->vt->draw_instances)
+    if (!g->r->vt->draw_instances || g->one_by_one)
         return 0;
     asp_prim_render_options o;
     if (asp_prim_renderer_options(g->r, &o, NULL) == 0)
@@ -292,6 +293,7 @@ int asp_scene_renderer_create(asp_gl_context *gl, const asp_scene_renderer_group
         d->count = g->count;
         memcpy(d->center, g->center, sizeof d->center);
         d->radius = g->radius;
+        d->one_by_one = g->one_by_one != 0;
     }
     if (rc) {
         // the renderers belong to us from the call on: none leaks on failure

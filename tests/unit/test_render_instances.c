@@ -7,9 +7,11 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "amgsplat/eval.h"
 #include "amgsplat/instances.h"
 #include "amgsplat/sample.h"
 #include "amgsplat/scene_renderer.h"
@@ -87,7 +89,7 @@ static void setup_files(void)
 static void remove_files(void)
 {
     static const char *const names[] = {"cube.ply", "red.ply", "blue.ply", "two.json", "near_first.json",
-                                        "far_first.json", "behind.json"};
+                                        "far_first.json", "behind.json", "field.json"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
         char p[600];
         path_in(p, sizeof p, names[i]);
@@ -214,6 +216,74 @@ static void test_culling(void)
     asp_image_release(&img);
 }
 
+/* Renders s with the splat renderer, instanced (one accumulation) or one draw per instance. */
+static int render_splats(const asp_instance_scene *s, int one_by_one, asp_image *img)
+{
+    asp_error err = {0, ""};
+    const asp_scene *sc = &s->sources[0].scene;
+    asp_render_source src;
+    asp_scene_render_source(sc, &src);
+    asp_scene_renderer_group g = {.count = s->instance_count, .radius = (float)sc->frame.radius,
+                                  .one_by_one = one_by_one};
+    float *models = malloc(16 * s->instance_count * sizeof *models);
+    CHECK(models != NULL);
+    if (!models)
+        return 1;
+    asp_instance_scene_models(s, 0, models);
+    g.models = models;
+    int rc = asp_splat_renderer_create(gl, sc->cloud, &(asp_splat_renderer_desc){.tolerance = 1.0f}, NULL,
+                                       &g.renderer, &err);
+    CHECK_OK(rc, ep(&err));
+    asp_renderer *r = NULL;
+    if (!rc)
+        rc = asp_scene_renderer_create(gl, &g, 1, &r, &err);
+    free(models);
+    if (!rc) {
+        asp_camera cam;
+        asp_instance_scene_camera(s, 0, 1.0f, 40.0f, 0.0f, 0.0f, 0.0f, &cam);
+        asp_render_desc d = {.width = 128, .height = 128, .samples = 1, .background = {255, 255, 255, 255}};
+        rc = asp_render_to_image(gl, r, &cam, &d, img, &err);
+        CHECK_OK(rc, ep(&err));
+    }
+    asp_renderer_destroy(r);
+    return rc;
+}
+
+/* The splats' instanced draw (one accumulation) shows what one draw per instance shows. */
+static void test_instanced_matches(void)
+{
+    if (!gl)
+        return;
+    char p[600];
+    path_in(p, sizeof p, "cube.ply");
+    asp_scene model;
+    asp_instance_scene field, s;
+    asp_error err = {0, ""};
+    CHECK_OK(asp_scene_load(p, NULL, NULL, &model, &err), ep(&err));
+    CHECK_OK(asp_instance_field(&model, "cube.ply", &(asp_instance_field_desc){.instances = 12, .seed = 5}, &field,
+                                &err),
+             ep(&err));
+    path_in(p, sizeof p, "field.json");
+    CHECK_OK(asp_instance_scene_save(&field, p, &err), ep(&err));
+    CHECK_OK(asp_instance_scene_load(p, NULL, NULL, &s, &err), ep(&err));
+    asp_image a = {0}, b = {0};
+    if (s.instance_count == 12 && render_splats(&s, 0, &a) == 0 && render_splats(&s, 1, &b) == 0) {
+        double ssim = 0, psnr = 0;
+        CHECK_OK(asp_image_ssim(&a, &b, &ssim, &err), ep(&err));
+        CHECK_OK(asp_image_psnr(&a, &b, &psnr, &err), ep(&err));
+        CHECK_MSG(ssim > 0.995 && psnr > 35, "instanced against one by one: SSIM %.4f, PSNR %.1f", ssim, psnr);
+        size_t fg = 0;
+        for (size_t i = 0; i < (size_t)a.width * a.height; i++)
+            fg += a.pixels[4 * i] < 245 || a.pixels[4 * i + 2] < 245;
+        CHECK_MSG(fg > 2000, "only %zu pixels drawn", fg); // the near cube alone fills a large part
+    }
+    asp_image_release(&a);
+    asp_image_release(&b);
+    asp_instance_scene_release(&s);
+    asp_instance_scene_release(&field);
+    asp_scene_release(&model);
+}
+
 /* Bad groups are refused, and the renderers handed over are freed (ASan watches). */
 static void test_bad_groups(void)
 {
@@ -238,4 +308,4 @@ static void test_bad_groups(void)
 }
 
 TEST_MAIN(TEST_CASE(setup), TEST_CASE(setup_files), TEST_CASE(test_two_cubes), TEST_CASE(test_occlusion),
-          TEST_CASE(test_culling), TEST_CASE(test_bad_groups), TEST_CASE(remove_files), TEST_CASE(teardown))
+          TEST_CASE(test_culling), TEST_CASE(test_instanced_matches), TEST_CASE(test_bad_groups), TEST_CASE(remove_files), TEST_CASE(teardown))
