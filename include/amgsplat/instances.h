@@ -161,8 +161,9 @@ int asp_instance_field(const asp_scene *model, const char *source_name, const as
  * one renderer of the table (render.h) with options (NULL = defaults) and ctx,
  * and all its instances (asp_instance_scene_models), culled by the source's
  * frame. The row is point_renderer ("disc", "splat", "square") for sources
- * with points (point files, .amg, .hier; NULL = "disc", "splat" for a
- * .hier), "prim" for .dps files and "mesh" for meshes. Draw with a camera of
+ * with points (point files, .amg, .hier; NULL = "disc"; a .hier, which has
+ * no points for discs, is drawn by "splat" then), "prim" for .dps files and
+ * "mesh" for meshes. Draw with a camera of
  * asp_instance_scene_camera. s must outlive the renderer (hierarchies are
  * shared). Makes gl current. Returns 0; ASP_EINVAL (an unknown
  * point_renderer); a source renderer's errors prefixed with its name;

@@ -58,11 +58,13 @@ void asp_instance_scene_camera(const asp_instance_scene *s, int orbit, float asp
 static int pick_kind(const asp_scene *sc, const char *point_renderer, const asp_renderer_kind **out, asp_error *err)
 {
     unsigned inputs = asp_scene_inputs(sc);
+    // a .hier holds splats without their points: discs cannot draw it, the splats do
+    int splats_only = sc->hier && !sc->cloud;
     const char *name = sc->dps    ? "prim"
                        : sc->mesh ? "mesh"
-                       : point_renderer ? point_renderer
-                       : sc->hier && !sc->cloud ? "splat"
-                                                : "disc";
+                       : point_renderer && !(splats_only && strcmp(point_renderer, "disc") == 0) ? point_renderer
+                       : splats_only ? "splat"
+                                     : "disc";
     return asp_renderer_kind_find(name, inputs, out, err);
 }
 
