@@ -70,7 +70,8 @@ typedef struct asp_instance_scene {
  * > 0), composed as translate * rotate * scale. Optional "camera" {"eye",
  * "target", "fov"} and "background" [R,G,B(,A)] in 0..255. Unknown keys,
  * non-finite or out-of-range numbers (|x| <= ASP_INSTANCE_SCENE_MAX_COORD),
- * singular matrices, more than ASP_INSTANCE_SCENE_MAX_INSTANCES instances or
+ * singular or mirroring (negative determinant) transforms, more than
+ * ASP_INSTANCE_SCENE_MAX_INSTANCES instances or
  * ASP_INSTANCE_SCENE_MAX_SOURCES sources are refused. Returns 0 and *out
  * (zeroed or released before); ASP_EFORMAT "'f.json' instance 3: 'scale' must
  * be a number > 0 or three of them" naming the file, the instance and the

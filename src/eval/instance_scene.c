@@ -236,9 +236,16 @@ static int parse_instance(struct parse *p, const cJSON *o, size_t index, asp_ins
     }
     // relative to the axes' own size, so a tiny but regular scale passes and a flattened matrix does not
     double ms = max_axis_scale(inst->model);
-    if (!(fabs(det3(inst->model)) > 1e-9 * ms * ms * ms) || !(ms > 0))
+    double det = det3(inst->model);
+    if (!(fabs(det) > 1e-9 * ms * ms * ms) || !(ms > 0))
         return asp_error_set(err, ASP_EFORMAT, "'%s' instance %zu: the transform is singular (determinant 0)", path,
                              index);
+    // a mirror turns front faces into back faces, which the primitives and meshes cull
+    if (det < 0)
+        return asp_error_set(err, ASP_EFORMAT,
+                             "'%s' instance %zu: the transform mirrors (negative determinant); mirrored instances "
+                             "are not supported",
+                             path, index);
     return 0;
 }
 

@@ -95,6 +95,8 @@ static void test_bad_files(void)
         {"{\"version\": 1, \"instances\": [{\"source\": \"a.ply\", \"matrix\": [1,0,0,0, 0,1,0,0, 0,0,1,1, 0,0,0,1]}]}",
          "must be affine"},
         {"{\"version\": 1, \"instances\": [{\"source\": \"a.ply\", \"matrix\": [1,0,0,0]}]}", "'matrix' must be 16"},
+        {"{\"version\": 1, \"instances\": [{\"source\": \"a.ply\", \"matrix\": [-1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}]}",
+         "instance 0: the transform mirrors"},
         {"{\"version\": 1, \"instances\": [{\"source\": \"a.ply\", \"matrix\": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1],"
          " \"scale\": 2}]}",
          "'matrix' replaces translate"},
