@@ -28,7 +28,7 @@ static const char usage[] =
     "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
     "                      dark-backface-soft|blend-all|no-blend|polygons] [--level L] [--alpha-ref X]\n"
     "                      [--transparency X] [--depth-window X] [--crease-angle DEG|off] [--outline]\n"
-    "                      [--color-by domain] [--overlap-backfaces] ...\n"
+    "                      [--color-by domain] [--overlap-backfaces] [--hybrid] [--hybrid-points POINTS] ...\n"
     "\n"
     "Renders a point set (PLY, XYZ) or the points of an AMG decomposition (.amg) headlessly through\n"
     "EGL (a GPU, or Mesa llvmpipe without one) to a PNG. Renderers: disc (opaque discs in the tangent\n"
@@ -38,7 +38,8 @@ static const char usage[] =
     "angle above the horizon, both in degrees; DIST is the eye distance in bounding-sphere radii\n"
     "(default: the sphere fills the view). --views N renders N views at azimuths AZ + 360 i / N,\n"
     "elevation alternating +EL and -EL, into one contact sheet. A .dps input (amgsplat build) draws\n"
-    "the textured domain primitives of one level, blended by --method (docs/render-methods.md).\n"
+    "the textured domain primitives of one level, blended by --method (docs/render-methods.md);\n"
+    "with --hybrid, its source points (or POINTS) stand in where a primitive fails (docs/hybrid.md).\n"
     "A mesh (OBJ+MTL, PLY with faces, OFF, STL, glTF/GLB, 3DS) is drawn as textured triangles with\n"
     "the same lighting and framing as the points sampled from it (amgsplat sample); a texture that\n"
     "cannot be found is drawn in its material colour, with a warning.";
@@ -85,6 +86,8 @@ struct render_opts {
     int outline;
     int no_normal_map;
     int overlap_backfaces;
+    int hybrid;                /* --hybrid: primitives and points (docs/hybrid.md) */
+    const char *hybrid_points; /* --hybrid-points: the points instead of the .dps's source */
     /* parsed */
     unsigned width, height;
     double az, el, dist; /* dist 0 = fit */
@@ -141,6 +144,7 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
     if (!isnan(o->tolerance_area)) // seed 001 5.1: tau in percent of the window (one view's) area
         r->splat.tolerance = r->square.tolerance = asp_render_tolerance_from_area(o->tolerance_area, o->width, o->height);
     r->prim = o->prim;
+    r->hybrid = (asp_hybrid_desc){.prim = o->prim, .splat = r->splat};
     r->mesh.flags = o->flat ? ASP_MESH_RENDER_FLAT : 0u;
 }
 
@@ -392,7 +396,7 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
 
 static int print_json(const struct cli_env *env, const struct render_opts *o, size_t count, const asp_scene *s,
                       asp_gl_context *gl, const char *renderer, const asp_image *img, const struct view_stats *vs,
-                      double seconds)
+                      double seconds, const asp_hybrid_counts *hc)
 {
     cJSON *j = cJSON_CreateObject(), *frame = cJSON_CreateArray();
     cJSON_AddStringToObject(j, "output", o->output);
@@ -404,7 +408,7 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     cJSON_AddNumberToObject(j, "points", (double)count);
     cJSON_AddStringToObject(j, "renderer", renderer);
     if (o->dps_input) {
-        cJSON_AddStringToObject(j, "method", asp_prim_render_method_name(o->prim.method));
+        cJSON_AddStringToObject(j, "method", o->hybrid ? "hybrid" : asp_prim_render_method_name(o->prim.method));
         cJSON_AddNumberToObject(j, "level", asp_scene_dps_level(s)->level);
     }
     cJSON_AddStringToObject(j, "gl_renderer", asp_gl_context_renderer(gl));
@@ -422,6 +426,13 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     cJSON_AddItemToArray(frame, cli_json_number("%.9g", s->frame.radius));
     cJSON_AddItemToObject(j, "frame", frame);
     cJSON_AddItemToObject(j, "seconds", cli_json_number("%.3f", seconds));
+    if (hc) {
+        cJSON *h = cJSON_AddObjectToObject(j, "hybrid");
+        cJSON_AddNumberToObject(h, "primitives_kept", (double)hc->prims_kept);
+        cJSON_AddNumberToObject(h, "primitives_replaced", (double)hc->prims_replaced);
+        cJSON_AddNumberToObject(h, "points_drawn", (double)hc->points_drawn);
+        cJSON_AddNumberToObject(h, "points_total", (double)hc->points_total);
+    }
     return cli_json_print(env, j);
 }
 
@@ -464,6 +475,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", "cut at creases sharper than DEG (default 60; off = as the seeds): .dps primitives; points with normals: discs, splats"},
         {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
+        {"hybrid", 0, CLI_FLAG, &o.hybrid, NULL, ".dps: the source points (seed 001 splats) where a primitive fails (docs/hybrid.md)"},
+        {"hybrid-points", 0, CLI_STRING, &o.hybrid_points, "POINTS", ".dps: --hybrid with these points (point file or .amg) instead of the file's source"},
         {"overlap-backfaces", 0, CLI_FLAG, &o.overlap_backfaces, NULL, ".dps, overlap: also draw back-facing neighbours, as journal Fig. 10's pseudocode"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
         {"transparent", 0, CLI_FLAG, &o.transparent, NULL, "transparent background"},
@@ -497,6 +510,10 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         o.renderer = NULL;
     if (parse_options(env, &o))
         return 2;
+    if (o.hybrid_points)
+        o.hybrid = 1;
+    if (o.hybrid && !o.dps_input)
+        return cli_usage_error(env, "--hybrid needs a .dps input (amgsplat build makes one)");
     if (o.dps_input && o.renderer)
         return cli_usage_error(env, "--renderer is for point inputs; a .dps input is drawn with --method");
     o.mesh_input = type.kind == ASP_FILE_MESH;
@@ -509,7 +526,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     unsigned inputs = o.dps_input    ? (unsigned)ASP_RENDER_INPUT_PRIMS
                       : o.mesh_input ? (unsigned)(ASP_RENDER_INPUT_MESH | ASP_RENDER_INPUT_POINTS)
                                      : (unsigned)ASP_RENDER_INPUT_POINTS;
-    if (asp_renderer_kind_find(o.dps_input ? "prim" : o.renderer ? o.renderer : dflt, inputs, &kind, &err))
+    if (asp_renderer_kind_find(o.hybrid ? "hybrid" : o.dps_input ? "prim" : o.renderer ? o.renderer : dflt, inputs, &kind, &err))
         return cli_usage_error(env, "%s", err.msg);
     // a PLY with faces holds its vertices as points; other meshes hold triangles only
     if (o.mesh_input && !(kind->inputs & ASP_RENDER_INPUT_MESH) && strcmp(type.format, "ply") != 0)
@@ -539,6 +556,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     int rc = load_scene(argv[0], &o, env, &s, &err);
     if (!rc)
         warn_missing_textures(&s);
+    if (!rc && o.hybrid)
+        rc = asp_scene_load_source_from(&s, o.hybrid_points, &err);
     if (!rc)
         rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err);
     if (!rc) {
@@ -566,15 +585,18 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         status = cli_fail(env, &err);
     } else {
         cli_progress_end(env);
+        asp_hybrid_counts hc;
+        int hybrid = o.hybrid && asp_hybrid_renderer_counts(r, &hc, NULL) == 0;
         if (env->json)
-            status = print_json(env, &o, count, &s, gl, kind->name, result, &vs, seconds);
+            status = print_json(env, &o, count, &s, gl, kind->name, result, &vs, seconds, hybrid ? &hc : NULL);
         else
             cli_info(env,
                      "rendered %zu view%s of %zu %s (%s, %zu primitives in the last view, %.1f ms per view, %s) "
                      "to '%s' (%ux%u) in %.2f s\n",
                      o.views, o.views > 1 ? "s" : "", count,
                      o.dps_input ? "domain primitives" : mesh_drawn ? "triangles" : "points",
-                     o.dps_input ? asp_prim_render_method_name(o.prim.method) : kind->name, vs.last_count,
+                     o.hybrid ? "hybrid" : o.dps_input ? asp_prim_render_method_name(o.prim.method) : kind->name,
+                     vs.last_count,
                      1e3 * vs.seconds / (double)o.views, asp_gl_context_renderer(gl), o.output, result->width,
                      result->height, seconds);
     }

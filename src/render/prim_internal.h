@@ -127,6 +127,17 @@ int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err);
 int asp__prim_creases(const asp_dps_level *lv, const double origin[3], const asp_context *ctx, uint32_t *first,
                       uint32_t *count, float **entries, size_t *total, asp_error *err);
 
+/*
+ * The hybrid renderer's access (hybrid_renderer.c): begin sets the frame's
+ * uniforms (opacity 1, texture colours); pass binds r's buffers and textures
+ * and draws every front-facing primitive into the bound framebuffer with the
+ * caller's depth and blend state: depth_only 1 writes the alpha-tested depth
+ * pushed back by the depth window along the eye rays, 0 adds (colour x alpha,
+ * alpha) of every fragment.
+ */
+void asp__prim_hybrid_begin(asp__prim_renderer *r, const asp__frame *f);
+void asp__prim_hybrid_pass(asp__prim_renderer *r, int depth_only);
+
 /* Frees the offscreen targets. */
 void asp__prim_targets_release(asp__prim_targets *t);
 

@@ -80,12 +80,29 @@ static int make_mesh(asp_gl_context *gl, const asp_render_source *src, const asp
     return asp_mesh_renderer_create(gl, src->mesh, &d, out, err);
 }
 
+/* issue 18 item 3: the level's primitives where they hold, its source points where they fail */
+static int make_hybrid(asp_gl_context *gl, const asp_render_source *src, const asp_renderer_options *o,
+                       const asp_context *ctx, asp_renderer **out, asp_error *err)
+{
+    if (!src->level || !src->cloud)
+        return asp_error_set(err, ASP_EUNSUPPORTED,
+                             "renderer 'hybrid' draws domain primitives and their source points (a .dps input "
+                             "with its point file)");
+    asp_hybrid_desc d = o ? o->hybrid : (asp_hybrid_desc){0};
+    static const asp_prim_render_options zero_prim;
+    if (o && memcmp(&d.prim, &zero_prim, sizeof zero_prim) == 0)
+        d.prim = o->prim;
+    memcpy(d.origin, src->origin, sizeof d.origin);
+    return asp_hybrid_renderer_create(gl, src->level, src->cloud, &d, ctx, out, err);
+}
+
 static const asp_renderer_kind kinds[] = {
     {"disc", "points", ASP_RENDER_INPUT_POINTS, 0, make_disc},
     {"splat", "splats", ASP_RENDER_INPUT_POINTS, 1, make_splat},
     {"square", "splats", ASP_RENDER_INPUT_POINTS, 1, make_square},
     {"prim", "primitives", ASP_RENDER_INPUT_PRIMS, 0, make_prim},
     {"mesh", "triangles", ASP_RENDER_INPUT_MESH, 0, make_mesh},
+    {"hybrid", "primitives and splats", ASP_RENDER_INPUT_PRIMS, 0, make_hybrid},
 };
 enum { N_KINDS = sizeof kinds / sizeof kinds[0] };
 
