@@ -34,7 +34,7 @@ static const char *resolve_fragment_src =
 
 typedef struct hybrid_renderer {
     asp_renderer base;
-    asp_renderer *prims;  /* the kept primitives (a prim renderer), NULL when every one is replaced */
+    asp_renderer *prims;  /* the level (a prim renderer) drawing only the kept primitives; NULL when none is */
     asp_renderer *splats; /* the drawn points (a splat renderer owning their hierarchy), NULL when none */
     asp_hybrid_counts counts;
     asp__gl_program resolve;
@@ -112,7 +112,7 @@ static void restore_state(GLuint fbo)
 static void draw_parts(hybrid_renderer *h, const asp__frame *f, int depth_only)
 {
     if (h->prims)
-        asp__prim_hybrid_pass((asp__prim_renderer *)h->prims, depth_only);
+        asp__prim_hybrid_pass((asp__prim_renderer *)h->prims, h->counts.prims_kept, depth_only);
     if (h->splats)
         asp__splat_hybrid_pass(h->splats, f, depth_only);
 }
@@ -196,46 +196,6 @@ static const asp__renderer_vtable hybrid_vtable = {
     .name = "hybrid", .draw = hybrid_draw, .destroy = hybrid_destroy, .set_lod = hybrid_set_lod,
     .stats = hybrid_stats};
 
-/* The kept primitives as a level of their own: prims copied, neighbours remapped, atlases borrowed. */
-static int kept_level(const asp_dps_level *lv, const uint8_t *replaced, const asp_context *ctx, asp_dps_level *out,
-                      uint32_t **map_out, asp_error *err)
-{
-    size_t np = lv->prim_count;
-    uint32_t *map = asp_alloc(ctx, np * sizeof *map);
-    asp_prim *prims = asp_alloc(ctx, np * sizeof *prims);
-    uint32_t *nb = asp_alloc(ctx, (lv->neighbour_total + 1) * sizeof *nb);
-    if (!map || !prims || !nb) {
-        asp_free(ctx, map);
-        asp_free(ctx, prims);
-        asp_free(ctx, nb);
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for the kept primitives of level %u", lv->level);
-    }
-    size_t kept = 0;
-    for (size_t i = 0; i < np; i++)
-        map[i] = replaced[i] ? UINT32_MAX : (uint32_t)kept++;
-    size_t total = 0;
-    for (size_t i = 0; i < np; i++) {
-        if (replaced[i])
-            continue;
-        asp_prim *q = &prims[map[i]];
-        *q = lv->prims[i];
-        q->neighbour_first = (uint32_t)total;
-        for (uint32_t k = 0; k < lv->prims[i].neighbour_count; k++) {
-            uint32_t j = lv->neighbours[lv->prims[i].neighbour_first + k];
-            if (j < np && map[j] != UINT32_MAX)
-                nb[total++] = map[j];
-        }
-        q->neighbour_count = (uint32_t)(total - q->neighbour_first);
-    }
-    *out = *lv;
-    out->prim_count = kept;
-    out->prims = prims;
-    out->neighbours = nb;
-    out->neighbour_total = total;
-    *map_out = map;
-    return 0;
-}
-
 /*
  * The drawn points as a cloud in the frame of origin, with radii (estimated
  * over all points when missing) and, when planes is given (8 floats per
@@ -315,20 +275,15 @@ static int make_parts(hybrid_renderer *h, const asp_dps_level *level, const asp_
     }
     int rc = asp_hybrid_split(level, points, d, ctx, replaced, cover, NULL, &h->counts, err);
     if (!rc && h->counts.prims_kept) {
-        asp_dps_level kept;
-        uint32_t *map = NULL;
-        rc = kept_level(level, replaced, ctx, &kept, &map, err);
-        if (!rc) {
-            asp_prim_renderer_desc pd = {.options = d->prim};
-            pd.options.method = ASP_PRIM_RENDER_NORMALIZED;
-            pd.options.transparency = 0;
-            pd.options.flags &= ~(unsigned)(ASP_PRIM_RENDER_OUTLINE | ASP_PRIM_RENDER_COLOR_BY_DOMAIN);
-            memcpy(pd.origin, d->origin, sizeof pd.origin);
-            rc = asp_prim_renderer_create(gl, &kept, &pd, &h->prims, err);
-            asp_free(ctx, map);
-            asp_free(ctx, kept.prims);
-            asp_free(ctx, kept.neighbours);
-        }
+        // the whole level goes up, so kept primitives keep the crease planes of replaced neighbours
+        asp_prim_renderer_desc pd = {.options = d->prim};
+        pd.options.method = ASP_PRIM_RENDER_NORMALIZED;
+        pd.options.transparency = 0;
+        pd.options.flags &= ~(unsigned)(ASP_PRIM_RENDER_OUTLINE | ASP_PRIM_RENDER_COLOR_BY_DOMAIN);
+        memcpy(pd.origin, d->origin, sizeof pd.origin);
+        rc = asp_prim_renderer_create(gl, level, &pd, &h->prims, err);
+        if (!rc)
+            asp__prim_hybrid_keep((asp__prim_renderer *)h->prims, replaced);
     }
     /*
      * The points' splats end at sharp creases as the primitives do (same

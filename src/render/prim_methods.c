@@ -500,8 +500,22 @@ void asp__prim_hybrid_begin(asp__prim_renderer *r, const asp__frame *f)
     glProgramUniform1i(mp, r->uniforms[ASP__PROG_MAIN][PU_DOMAIN_COLORS], 0);
 }
 
-void asp__prim_hybrid_pass(asp__prim_renderer *r, int depth_only)
+size_t asp__prim_hybrid_keep(asp__prim_renderer *r, const uint8_t *replaced)
 {
+    size_t n = 0;
+    for (size_t i = 0; i < r->count; i++)
+        if (!replaced[i])
+            r->order[n++] = (uint32_t)i;
+    // the hybrid always draws the normalised sums, which never rewrite the order buffer
+    if (n)
+        glNamedBufferSubData(r->order_buffer.id, 0, (GLsizeiptr)(n * sizeof(uint32_t)), r->order);
+    return n;
+}
+
+void asp__prim_hybrid_pass(asp__prim_renderer *r, size_t kept, int depth_only)
+{
+    if (kept == 0)
+        return;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_PRIMS, r->prim_buffer.id);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_NEIGHBOURS, r->neighbour_buffer.id);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_CLIPS, r->clip_buffer.id);
@@ -514,7 +528,8 @@ void asp__prim_hybrid_pass(asp__prim_renderer *r, int depth_only)
         depth_pass(r, ASP__PROG_DEPTH, r->opt.depth_window, r->opt.alpha_ref);
     else
         main_pass(r, ASP__PASS_ADD);
-    draw_all(r);
+    glBindVertexArray(r->vao.id);
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)kept);
     glDisable(GL_CULL_FACE);
     glBindTextureUnit(ASP__PRIM_UNIT_ATLAS, 0);
     glBindTextureUnit(ASP__PRIM_UNIT_NORMALS, 0);
