@@ -698,8 +698,8 @@ int asp_prim_render_method_parse(const char *name, asp_prim_render_method *out, 
  * when the kept primitives near it (facing its way, within 2 error + 2
  * spacings of it) have Psi summing below COVERAGE_MIN.
  */
-#define ASP_HYBRID_ERROR_LIMIT 0.12f
-#define ASP_HYBRID_TURNED_LIMIT 0.25f
+#define ASP_HYBRID_ERROR_LIMIT 0.15f
+#define ASP_HYBRID_TURNED_LIMIT 0.4f
 #define ASP_HYBRID_COVERAGE_MIN 0.3f
 
 /** asp_hybrid_split's point_cover value of a point drawn as a point. */

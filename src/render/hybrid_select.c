@@ -8,8 +8,6 @@
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
-#include <stdlib.h> // DEVTUNE
-#include <stdio.h> // DEVTUNE
 
 #include "amgsplat/render.h"
 #include "util/banned.h"
@@ -79,12 +77,6 @@ int asp_hybrid_split(const asp_dps_level *level, const asp_cloud *points, const 
     float error_limit = d->error_limit > 0 ? d->error_limit : ASP_HYBRID_ERROR_LIMIT;
     float turned_limit = d->turned_limit > 0 ? d->turned_limit : ASP_HYBRID_TURNED_LIMIT;
     float coverage_min = d->coverage_min > 0 ? d->coverage_min : ASP_HYBRID_COVERAGE_MIN;
-    { // DEVTUNE
-        const char *e;
-        if ((e = getenv("HY_E"))) error_limit = (float)atof(e);
-        if ((e = getenv("HY_T"))) turned_limit = (float)atof(e);
-        if ((e = getenv("HY_C"))) coverage_min = (float)atof(e);
-    }
     if (!isfinite(error_limit) || !isfinite(turned_limit) || !isfinite(coverage_min))
         return asp_error_set(err, ASP_EINVAL, "hybrid thresholds must be finite (error %g, turned %g, coverage %g)",
                              (double)d->error_limit, (double)d->turned_limit, (double)d->coverage_min);
@@ -215,23 +207,6 @@ int asp_hybrid_split(const asp_dps_level *level, const asp_cloud *points, const 
             best_i = ASP_HYBRID_DRAWN;
         point_cover[j] = best_i;
         drawn += best_i == ASP_HYBRID_DRAWN;
-    }
-    if (getenv("HY_DEBUG")) { // DEVTUNE
-        size_t by_e = 0, by_t = 0, by_none = 0, cov_drawn = 0;
-        for (size_t i = 0; i < np; i++) {
-            by_none += !(sums[3 * i] > 0);
-            by_e += sums[3 * i + 1] / error_limit > 1;
-            by_t += sums[3 * i + 2] / turned_limit > 1;
-        }
-        for (size_t j = 0; j < n; j++) {
-            if (point_cover[j] != ASP_HYBRID_DRAWN) continue;
-            int inr = 0;
-            for (size_t i = 0; i < np && !inr; i++) { float h; if (prim_replaced[i] && membership(level, &level->prims[i], &fps[i], points->positions + 3*j, nrm ? nrm + 3*j : NULL, &h) > 0) inr = 1; }
-            cov_drawn += !inr;
-        }
-        for (size_t i = 0; i < np && getenv("HY_DEBUG")[0] == '2'; i++)
-            fprintf(stderr, "  prim %zu: w %.1f e %.3f t %.3f hu %.3f hv %.3f err %.4f pts %u curv %.4f\n", i, sums[3*i], sums[3*i+1], sums[3*i+2], level->prims[i].half_u, level->prims[i].half_v, level->prims[i].error, level->prims[i].points, level->prims[i].curvature);
-        fprintf(stderr, "HY %zu prims: replaced %zu (error %zu, turned %zu, empty %zu); drawn %zu (low coverage %zu)\n", np, replaced, by_e, by_t, by_none, drawn, cov_drawn);
     }
     asp_free(ctx, fps);
     asp_free(ctx, sums);
