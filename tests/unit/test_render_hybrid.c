@@ -296,6 +296,23 @@ static void hybrid_beats_primitives(void)
         // it draws the kept primitives and the legs' points, fewer than all points
         CHECK(hc.prims_kept > 0 && hc.points_drawn > 0 && hc.points_drawn < c->count);
         test_save_sheet(img, VIEWS, "ASP_TEST_SHEETS", "hybrid_ball_on_legs");
+        // the frame budget's hooks: the tolerance coarsens the point part only; stats report both parts
+        asp_renderer_stats st0, st1;
+        asp_renderer_stats_get(r, &st0);
+        CHECK(st0.count > hc.prims_kept); // the kept primitives and the last cut's splats
+        CHECK(st0.points == hc.points_drawn && st0.tolerance == 0);
+        CHECK_OK(asp_renderer_set_lod(r, 8.0f, 0, &err), ep(&err));
+        asp_image coarse = {0};
+        asp_camera cam;
+        asp_camera_init(&cam);
+        asp_camera_frame(&cam, &frame, NULL, 1.0f, 0.0f);
+        CHECK_OK(asp_render_to_image(gl, r, &cam, &(asp_render_desc){.width = SIZE, .height = SIZE}, &coarse, &err),
+                 ep(&err));
+        asp_renderer_stats_get(r, &st1);
+        CHECK_MSG(st1.count < st0.count && st1.count > hc.prims_kept, "count %zu at tau 8, %zu at 0", st1.count,
+                  st0.count);
+        CHECK(st1.tolerance == 8.0f && asp_renderer_count(r) == st1.count);
+        asp_image_release(&coarse);
     }
     asp_renderer_destroy(r);
     release_views(img);
