@@ -740,8 +740,8 @@ typedef struct asp_hybrid_counts {
  * error_limit, turned share / turned_limit), replaced when > 1 (INFINITY
  * for a primitive with no domain point). Coverage holds by construction:
  * every point is either drawn or in the domain of the kept primitive
- * point_cover names. counts may be NULL. Returns 0; ASP_EINVAL (a non-finite
- * threshold); ASP_EDEGENERATE (no primitives or points); ASP_EFORMAT (no
+ * point_cover names. counts may be NULL. Returns 0; ASP_EINVAL (a negative or
+ * non-finite threshold); ASP_EDEGENERATE (no primitives or points); ASP_EFORMAT (no
  * atlas, a texture rectangle outside it, an empty rectangle); ASP_ENOMEM.
  * Cost: primitives x points bounding-sphere tests; OpenMP threads of ctx.
  * Thread safe, no GL.

@@ -77,8 +77,11 @@ int asp_hybrid_split(const asp_dps_level *level, const asp_cloud *points, const 
     float error_limit = d->error_limit > 0 ? d->error_limit : ASP_HYBRID_ERROR_LIMIT;
     float turned_limit = d->turned_limit > 0 ? d->turned_limit : ASP_HYBRID_TURNED_LIMIT;
     float coverage_min = d->coverage_min > 0 ? d->coverage_min : ASP_HYBRID_COVERAGE_MIN;
-    if (!isfinite(error_limit) || !isfinite(turned_limit) || !isfinite(coverage_min))
-        return asp_error_set(err, ASP_EINVAL, "hybrid thresholds must be finite (error %g, turned %g, coverage %g)",
+    // 0 means the default; a negative or non-finite threshold is a caller's mistake, not a default
+    if (!(d->error_limit >= 0) || !(d->turned_limit >= 0) || !(d->coverage_min >= 0) || !isfinite(error_limit) ||
+        !isfinite(turned_limit) || !isfinite(coverage_min))
+        return asp_error_set(err, ASP_EINVAL,
+                             "hybrid thresholds must be finite and >= 0 (error %g, turned %g, coverage %g)",
                              (double)d->error_limit, (double)d->turned_limit, (double)d->coverage_min);
     size_t np = level->prim_count, n = points->count;
     if (np == 0 || n == 0)

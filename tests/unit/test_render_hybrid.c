@@ -200,6 +200,18 @@ static void split_covers_every_point(void)
         CHECK_MSG(top_drawn * 5 < top, "%zu of %zu points of the ball's upper half drawn", top_drawn, top);
         for (size_t i = 0; i < lv->prim_count; i++)
             CHECK(replaced[i] == (score[i] > 1));
+        // bad thresholds are refused, and the outputs stay as they were
+        memset(cover, 0xab, c->count * sizeof *cover);
+        CHECK(asp_hybrid_split(lv, c, &(asp_hybrid_desc){.error_limit = -1}, NULL, replaced, cover, NULL, NULL,
+                               &err) == ASP_EINVAL);
+        CHECK(asp_hybrid_split(lv, c, &(asp_hybrid_desc){.coverage_min = NAN}, NULL, replaced, cover, NULL, NULL,
+                               &err) == ASP_EINVAL);
+        CHECK(cover[0] == 0xabababab);
+        // a stricter error limit replaces at least as much
+        asp_hybrid_counts strict = {0};
+        CHECK_OK(asp_hybrid_split(lv, c, &(asp_hybrid_desc){.error_limit = 0.05f}, NULL, replaced, cover, NULL,
+                                  &strict, &err), ep(&err));
+        CHECK(strict.prims_replaced >= counts.prims_replaced && strict.points_drawn >= counts.points_drawn);
         free(replaced);
         free(cover);
         free(score);
