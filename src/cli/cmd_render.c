@@ -585,7 +585,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         status = cli_fail(env, &err);
     } else {
         cli_progress_end(env);
-        asp_hybrid_counts hc;
+        asp_hybrid_counts hc = {0};
         int hybrid = o.hybrid && asp_hybrid_renderer_counts(r, &hc, NULL) == 0;
         if (env->json)
             status = print_json(env, &o, count, &s, gl, kind->name, result, &vs, seconds, hybrid ? &hc : NULL);
@@ -599,6 +599,9 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                      vs.last_count,
                      1e3 * vs.seconds / (double)o.views, asp_gl_context_renderer(gl), o.output, result->width,
                      result->height, seconds);
+        if (!env->json && hybrid)
+            cli_info(env, "hybrid: %zu of %zu primitives kept, %zu of %zu points drawn as splats (docs/hybrid.md)",
+                     hc.prims_kept, hc.prims_kept + hc.prims_replaced, hc.points_drawn, hc.points_total);
     }
     asp_image_release(&sheet);
     for (size_t i = 0; i < o.views; i++)
