@@ -892,7 +892,7 @@ typedef struct asp_renderer_options {
 
 /** One row of the renderer table. */
 typedef struct asp_renderer_kind {
-    const char *name;   /* "disc", "splat", "square", "prim", "mesh" */
+    const char *name;   /* "disc", "splat", "square", "prim", "mesh", "hybrid" */
     const char *noun;   /* what asp_renderer_count counts: "points", "splats", "primitives", "triangles" */
     unsigned inputs;    /* asp_render_input_bits it draws */
     int has_lod;        /* draws a cut of the point hierarchy: tau and budgets apply (asp_renderer_set_lod) */
@@ -909,7 +909,7 @@ typedef struct asp_renderer_kind {
 
 /**
  * Row i of the renderer table, in the order "disc", "splat", "square",
- * "prim", "mesh" (the viewer's 1..9 keys follow it), or NULL past the end.
+ * "prim", "mesh", "hybrid" (the viewer's 1..9 keys follow it), or NULL past the end.
  * Thread safe.
  */
 const asp_renderer_kind *asp_renderer_kind_at(size_t i);

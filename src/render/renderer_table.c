@@ -3,7 +3,8 @@
  * by name here instead of each keeping a list. Rows: opaque discs (Pajarola
  * et al. 2003 section 5), blended splats and squares of the point hierarchy
  * (seed 001 section 5, seed 004 3.2.6), the domain primitives of a .dps level
- * (journal section 4), textured triangle meshes (seed 004 2.2-2.3).
+ * (journal section 4), textured triangle meshes (seed 004 2.2-2.3), and the hybrid of a
+ * level's primitives and its points (issue 18, docs/hybrid.md).
  */
 #include <stdio.h>
 #include <string.h>
@@ -89,8 +90,10 @@ static int make_hybrid(asp_gl_context *gl, const asp_render_source *src, const a
                              "renderer 'hybrid' draws domain primitives and their source points (a .dps input "
                              "with its point file)");
     asp_hybrid_desc d = o ? o->hybrid : (asp_hybrid_desc){0};
-    static const asp_prim_render_options zero_prim;
-    if (o && memcmp(&d.prim, &zero_prim, sizeof zero_prim) == 0)
+    const asp_prim_render_options *p = &d.prim;
+    // callers that set only the primitives' options (eval, the viewer) get them for the hybrid too
+    if (o && p->method == 0 && p->alpha_ref == 0 && p->transparency == 0 && p->depth_window == 0 && p->flags == 0 &&
+        p->crease_angle == 0)
         d.prim = o->prim;
     memcpy(d.origin, src->origin, sizeof d.origin);
     return asp_hybrid_renderer_create(gl, src->level, src->cloud, &d, ctx, out, err);
