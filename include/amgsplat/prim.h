@@ -38,6 +38,13 @@ typedef enum asp_prim_normalise {
     ASP_PRIM_NORM_GE1 = 1       /* divide by f only where f >= 1 (eq. 3.3): alpha fades at the border */
 } asp_prim_normalise;
 
+/** Which domains become primitives (asp_prim_desc.strict; thesis 2.5 and appendix C "Domain Set"). */
+typedef enum asp_prim_domain_set {
+    ASP_PRIM_DOMAINS_THRESHOLDED = 0, /* Psi > tau, overlapping (journal eq. 8); default */
+    ASP_PRIM_DOMAINS_STRICT = 1,      /* each point in the domain of its largest Psi (thesis eq. 2.5) */
+    ASP_PRIM_DOMAINS_BOTH = 2         /* both, so one file switches between them */
+} asp_prim_domain_set;
+
 /**
  * Build options; the zero value means the documented defaults, so
  * `&(asp_prim_desc){ .texel_size = 2 }` works.
@@ -65,8 +72,10 @@ typedef struct asp_prim_desc {
     int no_model_colors;     /* 1: every point light grey 200 (thesis appendix C "Use Model Colors" unchecked) */
     double brightness;       /* thesis appendix C "Adjust Brightness": added to each point colour's HSV value,
                                 in [-1, 1] (1 = full scale); hue and saturation kept; 0 = unchanged */
-    int strict;              /* 1: primitives of the strict domains (thesis eq. 2.5, asp_amg_strict_domain_rows),
-                                alpha 1 inside, for the no-blend method; 0: thresholded domains Psi > tau */
+    int strict;              /* asp_prim_domain_set: 1 (ASP_PRIM_DOMAINS_STRICT): primitives of the strict domains
+                                (thesis eq. 2.5, asp_amg_strict_domain_rows), alpha 1 inside, for the no-blend
+                                method; 0: thresholded domains Psi > tau; 2 (ASP_PRIM_DOMAINS_BOTH): both sets,
+                                each level twice, thresholded first (thesis appendix C "Domain Set") */
     double enlarge;          /* thesis appendix C "Enlarge Bounding Rectangle": > 0 grows the sides of the
                                 points' bounding rectangle by this percentage (at most 1000) instead of the
                                 default margin of one point footprint on every side (0) */
@@ -304,6 +313,28 @@ void asp_dps_level_name(const asp_dps *dps, size_t index, char name[16]);
  * name). *index is unchanged on failure. Thread-safe.
  */
 int asp_dps_level_parse(const asp_dps *dps, const char *text, size_t *index, asp_error *err);
+
+/**
+ * The index into dps->levels of the level of the other domain set (thesis
+ * appendix C "Domain Set"): the level with lv->strict == strict built from the
+ * same AMG level as dps->levels[from], else the finest level of that set.
+ * Returns 0, or ASP_EINVAL when from is out of range or the file holds no level
+ * of that set ("no strict levels in the file; build with --domains strict or
+ * both"). *index is unchanged on failure. Thread-safe.
+ */
+int asp_dps_domain_set_pick(const asp_dps *dps, size_t from, int strict, size_t *index, asp_error *err);
+
+/**
+ * Copies primitive prim of src into *out as a level of one primitive (the
+ * thesis viewer's "one picked domain only", appendix C): same geometry, the
+ * primitive's texture cropped to an atlas of its own (and its normal map when
+ * src has one), no neighbours; the level's figures (level, strict, error) are
+ * src's. Release with asp_dps_level_release (ctx as given here). Returns 0,
+ * ASP_EINVAL ("no domain N: level L has domains 0..M"), ASP_EFORMAT (texture
+ * outside the atlas), ASP_ENOMEM; *out is unchanged on failure. Thread-safe.
+ */
+int asp_dps_level_pick(const asp_dps_level *src, size_t prim, const asp_context *ctx, asp_dps_level *out,
+                       asp_error *err);
 
 /** Option names: "affine"/"radial", "linear"/"constant"/"gaussian", "positive"/"ge1". 0 or ASP_EINVAL. */
 int asp_prim_method_parse(const char *name, asp_prim_method *out, asp_error *err);

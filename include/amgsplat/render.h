@@ -594,8 +594,20 @@ enum asp_prim_render_flags {
     /* overlap method as the pseudocode of journal Fig. 10 / thesis 4.4.4 reads: the neighbours a
      * front-facing primitive adds are drawn even when they face away (default: back faces culled,
      * thesis 5.3.1) */
-    ASP_PRIM_RENDER_OVERLAP_BACKFACES = 1 << 3
+    ASP_PRIM_RENDER_OVERLAP_BACKFACES = 1 << 3,
+    /* Debug drawings of the thesis viewer (appendix C), drawn over the image without depth test: each
+     * primitive's PCA axes from its centre, axis_u red (half_u long), axis_v green (half_v), the normal
+     * blue (the shorter half extent) */
+    ASP_PRIM_RENDER_DEBUG_EIGENVECTORS = 1 << 4,
+    /* ... and the midpoints of the texels with alpha > 0 as one-pixel magenta dots */
+    ASP_PRIM_RENDER_DEBUG_TEXELS = 1 << 5
 };
+
+/** The sRGB colours of the debug drawings (ASP_PRIM_RENDER_DEBUG_*). */
+#define ASP_PRIM_DEBUG_AXIS_U_RGB 255, 0, 0
+#define ASP_PRIM_DEBUG_AXIS_V_RGB 0, 255, 0
+#define ASP_PRIM_DEBUG_NORMAL_RGB 0, 0, 255
+#define ASP_PRIM_DEBUG_TEXEL_RGB 255, 0, 255
 
 /**
  * Rendering options of a domain-primitive renderer; the zero value means

@@ -27,6 +27,8 @@ static const char usage[] =
     "       amgsplat render MESH -o OUT.png [--flat] [--texture IMG] [--renderer mesh|disc] ...\n"
     "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
     "                      dark-backface-soft|blend-all|no-blend|polygons] [--level L] [--alpha-ref X]\n"
+    "                      [--domains thresholded|strict] [--debug eigenvectors,texels,triangulation]\n"
+    "                      [--only-domain N] [--no-overlap-backfaces]\n"
     "                      [--transparency X] [--depth-window X] [--crease-angle DEG|off] [--outline]\n"
     "                      [--color-by domain] [--overlap-backfaces] ...\n"
     "\n"
@@ -85,6 +87,10 @@ struct render_opts {
     int outline;
     int no_normal_map;
     int overlap_backfaces;
+    int no_overlap_backfaces; /* switches off a preset's --overlap-backfaces (issue 17) */
+    const char *domains;      /* .dps: thresholded | strict (thesis appendix C "Domain Set") */
+    const char *debug;        /* .dps: eigenvectors,texels (thesis appendix C debug drawings) */
+    size_t only_domain;       /* .dps: draw this primitive only; SIZE_MAX = all */
     /* parsed */
     unsigned width, height;
     double az, el, dist; /* dist 0 = fit */
@@ -142,6 +148,33 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
         r->splat.tolerance = r->square.tolerance = asp_render_tolerance_from_area(o->tolerance_area, o->width, o->height);
     r->prim = o->prim;
     r->mesh.flags = o->flat ? ASP_MESH_RENDER_FLAT : 0u;
+}
+
+/*
+ * Domain Set (thesis appendix C): the level of the asked set built from the same AMG level as the one
+ * --level names; a level of the other set given by hand is switched, and strict levels are drawn with
+ * the thesis's no-blend method unless --method says otherwise.
+ */
+static int pick_domain_set(struct render_opts *o, asp_scene *s, asp_renderer_options *ropts, asp_error *err)
+{
+    int strict = o->domains && strcmp(o->domains, "strict") == 0;
+    if ((s->dps->levels[s->dps_level].strict != 0) != strict) {
+        int rc = asp_dps_domain_set_pick(s->dps, s->dps_level, strict, &s->dps_level, err);
+        if (rc)
+            return rc;
+    }
+    if (s->dps->levels[s->dps_level].strict && !o->method)
+        ropts->prim.method = o->prim.method = ASP_PRIM_RENDER_NO_BLEND;
+    if (o->only_domain == SIZE_MAX)
+        return 0;
+    // the picked primitive replaces its level in the scene, so every method draws it alone
+    asp_dps_level *lv = &s->dps->levels[s->dps_level], one;
+    int rc = asp_dps_level_pick(lv, o->only_domain, &s->dps->ctx, &one, err);
+    if (rc)
+        return rc;
+    asp_dps_level_release(lv, &s->dps->ctx);
+    *lv = one;
+    return 0;
 }
 
 /* The library records textures it could not find; saying so is the command's job (STYLE.md 4). */
@@ -248,11 +281,11 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
 static int parse_prim_options(struct cli_env *env, struct render_opts *o)
 {
     // NaN marks "not given": the option parser refuses non-finite values, so no user value collides with it
-    int given = o->method || !isnan(o->alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
+    int given = o->method || o->domains || o->debug || o->only_domain != SIZE_MAX || !isnan(o->alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
                 o->no_normal_map || o->overlap_backfaces;
     if (!o->dps_input) {
         if (given)
-            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline, --overlap-backfaces and "
+            return cli_usage_error(env, "--method, --domains, --debug, --only-domain, --alpha-ref, --transparency, --depth-window, --outline, --overlap-backfaces and "
                                         "--no-normal-map need a .dps input (amgsplat build makes one)");
         double deg = 0;
         if (!o->crease_angle) {
@@ -280,6 +313,19 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
     asp_error err = {0, ""};
     if (o->method && asp_prim_render_method_parse(o->method, &p->method, &err))
         return cli_usage_error(env, "--method: %s", err.msg);
+    for (const char *d = o->debug; d && *d;) {
+        size_t len = strcspn(d, ",");
+        if (len == strlen("eigenvectors") && strncmp(d, "eigenvectors", len) == 0)
+            p->flags |= ASP_PRIM_RENDER_DEBUG_EIGENVECTORS;
+        else if (len == strlen("texels") && strncmp(d, "texels", len) == 0)
+            p->flags |= ASP_PRIM_RENDER_DEBUG_TEXELS;
+        else
+            return cli_usage_error(env, "--debug expects eigenvectors, texels or both comma-separated, got '%.*s'",
+                                   (int)len, d);
+        d += len + (d[len] == ',');
+    }
+    if (o->domains && strcmp(o->domains, "thresholded") != 0 && strcmp(o->domains, "strict") != 0)
+        return cli_usage_error(env, "--domains expects thresholded or strict, got '%s'", o->domains);
     if (!isnan(o->alpha_ref)) {
         if (!(o->alpha_ref >= 0 && o->alpha_ref <= 1))
             return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
@@ -305,7 +351,7 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
             return cli_usage_error(env, "--crease-angle expects degrees in (0, 180) or 'off', got '%s'",
                                    o->crease_angle);
     }
-    p->flags = (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
+    p->flags |= (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
                (o->no_normal_map ? ASP_PRIM_RENDER_NO_NORMAL_MAP : 0u) |
                (o->overlap_backfaces ? ASP_PRIM_RENDER_OVERLAP_BACKFACES : 0u);
     return 0;
@@ -405,6 +451,7 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     cJSON_AddStringToObject(j, "renderer", renderer);
     if (o->dps_input) {
         cJSON_AddStringToObject(j, "method", asp_prim_render_method_name(o->prim.method));
+        cJSON_AddStringToObject(j, "domains", asp_scene_dps_level(s)->strict ? "strict" : "thresholded");
         cJSON_AddNumberToObject(j, "level", asp_scene_dps_level(s)->level);
     }
     cJSON_AddStringToObject(j, "gl_renderer", asp_gl_context_renderer(gl));
@@ -431,7 +478,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .width = 512, .height = 512,
                             .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0, .alpha_ref = NAN,
                             .sigma = NAN, .epsilon_uniform = NAN, .tolerance_area = NAN,
-                            .transparency = NAN, .depth_window = NAN, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
+                            .transparency = NAN, .depth_window = NAN, .only_domain = SIZE_MAX, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
         {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
@@ -464,7 +511,11 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", "cut at creases sharper than DEG (default 60; off = as the seeds): .dps primitives; points with normals: discs, splats"},
         {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
+        {"domains", 0, CLI_STRING, &o.domains, "SET", ".dps built with --domains both: thresholded (default) or strict (drawn no-blend unless --method)"},
+        {"debug", 0, CLI_STRING, &o.debug, "LIST", ".dps: debug drawings (thesis app. C): eigenvectors, texels, or both comma-separated"},
+        {"only-domain", 0, CLI_SIZE, &o.only_domain, "N", ".dps: draw primitive N of the level only (thesis app. C)"},
         {"overlap-backfaces", 0, CLI_FLAG, &o.overlap_backfaces, NULL, ".dps, overlap: also draw back-facing neighbours, as journal Fig. 10's pseudocode"},
+        {"no-overlap-backfaces", 0, CLI_FLAG, &o.no_overlap_backfaces, NULL, ".dps, overlap: cull back faces (the default; turns off a preset's --overlap-backfaces)"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
         {"transparent", 0, CLI_FLAG, &o.transparent, NULL, "transparent background"},
         {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
@@ -492,6 +543,10 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     if (!o.dps_input && cli_from_preset(env, &o.method))
         o.method = NULL;
     if (!o.dps_input && cli_from_preset(env, &o.overlap_backfaces))
+        o.overlap_backfaces = 0;
+    if (o.no_overlap_backfaces && o.overlap_backfaces && !cli_from_preset(env, &o.overlap_backfaces))
+        return cli_usage_error(env, "--overlap-backfaces and --no-overlap-backfaces exclude each other");
+    if (o.no_overlap_backfaces)
         o.overlap_backfaces = 0;
     if ((o.dps_input || type.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.renderer))
         o.renderer = NULL;
@@ -539,6 +594,10 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     int rc = load_scene(argv[0], &o, env, &s, &err);
     if (!rc)
         warn_missing_textures(&s);
+    if (!rc && s.dps && (rc = pick_domain_set(&o, &s, &ropts, &err)) != 0) {
+        asp_error e = err;
+        asp_error_set(&err, e.code, "'%s': %s", argv[0], e.msg);
+    }
     if (!rc)
         rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err);
     if (!rc) {

@@ -81,6 +81,9 @@ static int check_desc(const asp_prim_desc *d, asp_error *err)
                              d->enlarge);
     if (d->padding > 64)
         return asp_error_set(err, ASP_EINVAL, "atlas padding must be at most 64 texels, got %u", d->padding);
+    if ((unsigned)d->strict > ASP_PRIM_DOMAINS_BOTH)
+        return asp_error_set(err, ASP_EINVAL, "unknown domain set %d (expected 0 thresholded, 1 strict, 2 both)",
+                             d->strict);
     if ((unsigned)d->method > ASP_PRIM_RADIAL || (unsigned)d->shape > ASP_PRIM_GAUSSIAN ||
         (unsigned)d->normalise > ASP_PRIM_NORM_GE1)
         return asp_error_set(err, ASP_EINVAL, "unknown texture method, shape or normalisation");
@@ -359,11 +362,12 @@ static int build_level(const asp_amg *amg, const build_src *src, size_t level, c
     uint32_t *bfirst = NULL, *bcount = NULL;
     int rc = asp_amg_basis(amg, level, ctx, &psi, err);
     if (!rc)
-        rc = d->strict ? asp_amg_strict_domain_rows(psi, ctx, &dom, err) : asp_amg_domains(psi, d->tau, ctx, &dom, err);
+        rc = d->strict == ASP_PRIM_DOMAINS_STRICT ? asp_amg_strict_domain_rows(psi, ctx, &dom, err) : asp_amg_domains(psi, d->tau, ctx, &dom, err);
     asp_amg_csr_destroy(psi);
     if (rc)
         return rc;
     lv->level = (uint32_t)level;
+    lv->strict = d->strict == ASP_PRIM_DOMAINS_STRICT;
     lv->basis_count = (uint32_t)dom->rows;
     lv->t_basis = asp_time_now() - t0;
     double t1 = asp_time_now();
@@ -446,6 +450,7 @@ int asp_prim_build_level(const asp_cloud *cloud, const asp_amg_csr *dom, const a
     rc = prepare_src(&src, ctx, &own, err);
     if (!rc) {
         lv.basis_count = (uint32_t)dom->rows;
+        lv.strict = d.strict == ASP_PRIM_DOMAINS_STRICT;
         rc = construct(&src, dom, NULL, NULL, &d, "of explicit domains", ctx, &lv, err);
         lv.t_construct = asp_time_now() - t0;
     }
@@ -510,17 +515,22 @@ int asp_prim_build(const asp_amg *amg, const asp_cloud *attrs, const size_t *lev
     src.radii = attrs && attrs->radii ? attrs->radii : cloud->radii;
     if ((rc = prepare_src(&src, ctx, &own_radii, err)))
         goto fail;
-    dps->levels = asp_calloc(ctx, nu, sizeof *dps->levels);
+    // Domain Set both (thesis appendix C): each level twice, thresholded then strict
+    const size_t sets = d.strict == ASP_PRIM_DOMAINS_BOTH ? 2 : 1;
+    dps->levels = asp_calloc(ctx, nu * sets, sizeof *dps->levels);
     if (!dps->levels) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory");
         goto fail;
     }
-    for (size_t i = 0; i < nu; i++) {
-        if ((rc = asp_progress(ctx, "primitives", (double)i / (double)nu))) {
+    for (size_t i = 0; i < nu * sets; i++) {
+        if ((rc = asp_progress(ctx, "primitives", (double)i / (double)(nu * sets)))) {
             asp_error_set(err, rc, "primitive construction canceled");
             goto fail;
         }
-        rc = build_level(amg, &src, lv_sorted[i], &d, ctx, &dps->levels[dps->level_count], err);
+        asp_prim_desc di = d;
+        if (sets == 2)
+            di.strict = (int)(i % 2);
+        rc = build_level(amg, &src, lv_sorted[i / sets], &di, ctx, &dps->levels[dps->level_count], err);
         if (rc == ASP_EDEGENERATE) {
             dps->skipped_levels++;
             continue;
