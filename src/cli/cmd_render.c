@@ -158,7 +158,7 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
 static int pick_domain_set(struct render_opts *o, asp_scene *s, asp_renderer_options *ropts, asp_error *err)
 {
     int strict = o->domains && strcmp(o->domains, "strict") == 0;
-    if ((s->dps->levels[s->dps_level].strict != 0) != strict) {
+    if (o->domains && (s->dps->levels[s->dps_level].strict != 0) != strict) {
         int rc = asp_dps_domain_set_pick(s->dps, s->dps_level, strict, &s->dps_level, err);
         if (rc)
             return rc;
