@@ -46,6 +46,38 @@ typedef enum asp_prim_domain_set {
 } asp_prim_domain_set;
 
 /**
+ * The texture fills of a batch of primitives, for a texture builder outside
+ * the library's CPU path (thesis 3.6: on the graphics hardware,
+ * asp_prim_gpu_fill in render.h). Primitive k has samples
+ * sample_first[k] .. sample_first[k + 1] - 1 and a w[k] x h[k] texel grid
+ * stored from texel texel_first[k] on, row by row; sample s lies at (x[s],
+ * y[s]) in texel units (texel i spans [i, i + 1)), footprint radius r[s]
+ * texels, attributes attr[4 s ..] = r, g, b (0..255), Psi. Affine: the kept
+ * Delaunay triangles tri[3 t ..] (global sample indices), tri_first[k] ..
+ * tri_first[k + 1] - 1 per primitive.
+ */
+typedef struct asp_prim_fill_batch {
+    size_t prim_count;
+    const size_t *sample_first, *texel_first, *tri_first; /* prim_count + 1 entries each */
+    const uint32_t *w, *h;
+    const float *x, *y, *r, *attr;
+    const uint32_t *tri;
+    int method;          /* asp_prim_method */
+    int shape;           /* asp_prim_shape (radial) */
+} asp_prim_fill_batch;
+
+/**
+ * A texture fill (asp_prim_desc.fill): writes per texel t < texel_first[prim_count]
+ * acc[4 t ..] (the sum of phi times the attributes, or for affine the
+ * barycentric interpolation where covered[t] = 1), f[t] (the sum of phi) and
+ * covered[t], exactly as the CPU path's first half does (texture.c); the
+ * library then normalises, extends colour and encodes. Buffers arrive
+ * zeroed. Returns 0 or an ASP_E* code with err filled.
+ */
+typedef int (*asp_prim_fill_fn)(void *user, const asp_prim_fill_batch *batch, float *acc, float *f, uint8_t *covered,
+                                asp_error *err);
+
+/**
  * Build options; the zero value means the documented defaults, so
  * `&(asp_prim_desc){ .texel_size = 2 }` works.
  */
@@ -79,6 +111,9 @@ typedef struct asp_prim_desc {
     double enlarge;          /* thesis appendix C "Enlarge Bounding Rectangle": > 0 grows the sides of the
                                 points' bounding rectangle by this percentage (at most 1000) instead of the
                                 default margin of one point footprint on every side (0) */
+    asp_prim_fill_fn fill;   /* NULL: textures on the CPU; else the fills go to fill(fill_user, ...) in batches
+                                (thesis 3.6; render.h asp_prim_gpu_fill); not with normal_map */
+    void *fill_user;
 } asp_prim_desc;
 
 /* ---- one primitive ---- */

@@ -633,6 +633,21 @@ typedef struct asp_prim_render_options {
                             < 0 or >= 180 = never clip, exactly the seeds' methods */
 } asp_prim_render_options;
 
+/**
+ * The texture fills of asp_prim_build on the GPU (thesis 3.6): an
+ * asp_prim_fill_fn for asp_prim_desc.fill with fill_user = an
+ * asp_gl_context (made current; use it from its thread only). A GL 4.5
+ * compute shader computes per texel what the CPU's fill computes (the radial
+ * sums of 3.3.2; the affine interpolation of 3.3.3 in the kept triangles and
+ * the radial fringe outside), over the samples and triangles binned to the
+ * texel's 8 x 8 cell, in the CPU's order and in double precision; the
+ * library reads f back and finishes on the CPU as the thesis proposes.
+ * Batches hold at most 4,194,240 texels. Returns 0, ASP_EGL (the shader or
+ * a GL call failed), ASP_EUNSUPPORTED (a batch too large), ASP_ENOMEM.
+ */
+int asp_prim_gpu_fill(void *gl_context, const asp_prim_fill_batch *batch, float *acc, float *f, uint8_t *covered,
+                      asp_error *err);
+
 /** Default crease angle (degrees) of asp_prim_render_options.crease_angle. */
 #define ASP_PRIM_CREASE_ANGLE_DEFAULT 60.0f
 

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "amgsplat/prim.h"
+#include "amgsplat/render.h"
 #include "cli/cli.h"
 #include "cli/commands.h"
 #include "util/banned.h"
@@ -16,7 +17,7 @@ static const char usage[] =
     "                      [--texel-size X] [--method affine|radial] [--shape linear|constant|gaussian]\n"
     "                      [--width W] [--normalise positive|ge1] [--merge] [--normals] [--atlas X.png]\n"
     "                      [--preset thesis|journal] [--domains thresholded|strict|both] [--enlarge PCT]\n"
-    "                      [--normalise-color | --no-normalise-color] [--no-model-colors] [--brightness X]\n"
+    "                      [--normalise-color | --no-normalise-color] [--no-model-colors] [--brightness X] [--gpu]\n"
     "\n"
     "Turns every domain of the chosen AMG level(s) into one planar rectangle (weighted PCA of\n"
     "its points) with a texture: colour = the points' colours, alpha = the domain's basis\n"
@@ -92,7 +93,7 @@ static void print_table(const asp_dps *dps, const asp_dps_summary *rows)
 }
 
 static int print_json(const struct cli_env *env, const char *input, const char *output, const asp_dps *dps,
-                      const asp_dps_summary *rows, double t_decompose, double t_total)
+                      const asp_dps_summary *rows, double t_decompose, double t_total, int gpu)
 {
     cJSON *o = cJSON_CreateObject(), *levels = cJSON_CreateArray();
     cJSON_AddStringToObject(o, "input", input);
@@ -101,6 +102,7 @@ static int print_json(const struct cli_env *env, const char *input, const char *
     cJSON_AddItemToObject(o, "mean_radius", cli_json_number("%.9g", dps->mean_radius));
     cJSON_AddStringToObject(o, "method", asp_prim_method_name(dps->desc.method));
     cJSON_AddItemToObject(o, "texel_size", cli_json_number("%g", dps->desc.texel_size));
+    cJSON_AddBoolToObject(o, "gpu", gpu);
     cJSON_AddItemToObject(o, "decompose_seconds", cli_json_number("%.4f", t_decompose));
     cJSON_AddItemToObject(o, "total_seconds", cli_json_number("%.4f", t_total));
     for (size_t i = 0; i < dps->level_count; i++) {
@@ -159,7 +161,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     const char *atlas = NULL;
     size_t budget = SIZE_MAX, max_texture = 0, padding = 0; // SIZE_MAX: not given, so a given 0 is refused
     double texel = 0, width = 0, tau = 0, fraction = 0, flat = 0, angle = 0, enlarge = 0;
-    int unweighted = 0, project = 0, no_extend = 0, normals = 0, merge = 0;
+    int unweighted = 0, project = 0, no_extend = 0, normals = 0, merge = 0, gpu = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output primitives (.dps)"},
         {"preset", 0, CLI_STRING, &preset, "SEED", "the seed's options: thesis, journal (docs/seeds.md)"},
@@ -187,6 +189,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         {"brightness", 0, CLI_DOUBLE, &brightness, "X", "add X (-1..1) to each point colour's HSV value (thesis app. C)"},
         {"domains", 0, CLI_STRING, &domain_set, "SET", "thresholded (default, Psi > tau), strict (thesis eq. 2.5; drawn with --method no-blend) or both (render/view --domains picks)"},
         {"enlarge", 0, CLI_DOUBLE, &enlarge, "PCT", "grow the points' rectangle by PCT % (thesis app. C; default: one footprint margin)"},
+        {"gpu", 0, CLI_FLAG, &gpu, NULL, "fill the textures with a GL 4.5 compute shader (thesis 3.6; not with --normals)"},
         {"atlas", 0, CLI_STRING, &atlas, "X.png", "also write each level's atlas as PNG"},
         {0},
     };
@@ -247,6 +250,12 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
                                               : "merge-angle",
                                texel < 0 ? texel : width < 0 ? width : tau < 0 ? tau : fraction < 0 ? fraction : flat < 0 ? flat : angle);
 
+#ifndef ASP_HAVE_GL
+    if (gpu)
+        return cli_usage_error(env, "--gpu needs OpenGL 4.5, and this amgsplat was built without it (ASP_WITH_GL=OFF)");
+#endif
+    if (gpu && normals)
+        return cli_usage_error(env, "--gpu makes no normal maps: leave out --normals or --gpu");
     double t0 = asp_time_now(), t_dec = 0;
     asp_amg *amg = NULL;
     asp_cloud *cloud = NULL;
@@ -267,6 +276,13 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     else if (!rc)
         rc = parse_levels(amg, level_text ? level_text : "L-3", levels, &nlevels, 64, &err);
     asp_dps *dps = NULL;
+#ifdef ASP_HAVE_GL
+    asp_gl_context *gl = NULL;
+    if (!rc && gpu && (rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err)) == 0) {
+        desc.fill = asp_prim_gpu_fill; // thesis 3.6: the fills on the graphics hardware
+        desc.fill_user = gl;
+    }
+#endif
     if (!rc)
         rc = asp_prim_build(amg, cloud, levels, nlevels, &desc, argv[0], &env->ctx, &dps, &err);
     // the .dps and its atlases appear all or none (issue #13): a failed atlas leaves the old .dps as it was
@@ -283,6 +299,9 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     else
         rc = asp_output_batch_commit(&err);
     double t_total = asp_time_now() - t0;
+#ifdef ASP_HAVE_GL
+    asp_gl_context_destroy(gl);
+#endif
     asp_amg_destroy(amg);
     asp_cloud_destroy(cloud);
     asp_amg_shutdown();
@@ -297,7 +316,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
                      rows[i].name, rows[i].capped, rows[i].primitives, dps->desc.max_texture);
     int status = 0;
     if (env->json) {
-        status = print_json(env, argv[0], output, dps, rows, t_dec, t_total);
+        status = print_json(env, argv[0], output, dps, rows, t_dec, t_total, gpu);
     } else {
         if (!env->quiet)
             printf("%s: %llu points, %zu level(s), mean radius %.4g, %s textures, texel size %g%s, %.2f s\n", output,
