@@ -1,5 +1,6 @@
 /*
- * GPU texture construction (thesis 3.6, issue 17): asp_prim_build with the
+ * GPU texture construction (thesis 3.6, issue 17; "_prim" in the name: it decomposes, so ASan builds
+ * unwind it fully for the MPI suppressions, CMakeLists.txt): asp_prim_build with the
  * compute-shader fill (asp_prim_gpu_fill) makes the CPU build's atlases, texel
  * for texel, for the affine method and every radial shape and criterion; a
  * fill's error reaches the caller; normal maps are refused.
