@@ -371,6 +371,21 @@ int asp_dps_domain_set_pick(const asp_dps *dps, size_t from, int strict, size_t 
 int asp_dps_level_pick(const asp_dps_level *src, size_t prim, const asp_context *ctx, asp_dps_level *out,
                        asp_error *err);
 
+/**
+ * The kept Delaunay triangles of the affine method (thesis 3.3.3, Fig. 3.8)
+ * of every primitive of dps->levels[index], for the thesis viewer's
+ * triangulation drawing (appendix C). The triangles are not stored in a
+ * .dps, so the level's domains are made again from amg (the decomposition the
+ * file was built from, asp_dps.source) and each domain's points projected to
+ * its primitive's plane. Writes 6 floats per edge (two points, world minus
+ * origin; origin NULL = 0) to *lines, allocated through ctx (free with
+ * asp_free), and the edge count to *segments. Merged primitives are left out.
+ * Returns 0, ASP_EINVAL (index out of range, amg of another point count or
+ * without the level), ASP_ENOMEM; outputs unchanged on failure. Thread-safe.
+ */
+int asp_prim_level_triangles(const asp_amg *amg, const asp_dps *dps, size_t index, const double origin[3],
+                             const asp_context *ctx, float **lines, size_t *segments, asp_error *err);
+
 /** Option names: "affine"/"radial", "linear"/"constant"/"gaussian", "positive"/"ge1". 0 or ASP_EINVAL. */
 int asp_prim_method_parse(const char *name, asp_prim_method *out, asp_error *err);
 int asp_prim_shape_parse(const char *name, asp_prim_shape *out, asp_error *err);

@@ -600,7 +600,9 @@ enum asp_prim_render_flags {
      * blue (the shorter half extent) */
     ASP_PRIM_RENDER_DEBUG_EIGENVECTORS = 1 << 4,
     /* ... and the midpoints of the texels with alpha > 0 as one-pixel magenta dots */
-    ASP_PRIM_RENDER_DEBUG_TEXELS = 1 << 5
+    ASP_PRIM_RENDER_DEBUG_TEXELS = 1 << 5,
+    /* ... and the affine triangulation given by asp_prim_renderer_set_debug_lines as cyan lines */
+    ASP_PRIM_RENDER_DEBUG_TRIANGULATION = 1 << 6
 };
 
 /** The sRGB colours of the debug drawings (ASP_PRIM_RENDER_DEBUG_*). */
@@ -608,6 +610,7 @@ enum asp_prim_render_flags {
 #define ASP_PRIM_DEBUG_AXIS_V_RGB 0, 255, 0
 #define ASP_PRIM_DEBUG_NORMAL_RGB 0, 0, 255
 #define ASP_PRIM_DEBUG_TEXEL_RGB 255, 0, 255
+#define ASP_PRIM_DEBUG_TRIANGLE_RGB 0, 255, 255
 
 /**
  * Rendering options of a domain-primitive renderer; the zero value means
@@ -632,6 +635,17 @@ typedef struct asp_prim_render_options {
                             seeds, docs/render-methods.md); 0 = ASP_PRIM_CREASE_ANGLE_DEFAULT;
                             < 0 or >= 180 = never clip, exactly the seeds' methods */
 } asp_prim_render_options;
+
+/**
+ * Gives a domain-primitive renderer the line segments its
+ * ASP_PRIM_RENDER_DEBUG_TRIANGULATION drawing shows (6 floats per segment in
+ * the renderer's frame, as asp_prim_level_triangles writes them with the
+ * renderer's origin; copied, replacing earlier ones; segments 0 clears).
+ * Makes r's context current. Returns 0, ASP_EUNSUPPORTED (not a
+ * domain-primitive renderer), ASP_EINVAL (NULL lines with segments > 0),
+ * ASP_ENOMEM, ASP_EGL.
+ */
+int asp_prim_renderer_set_debug_lines(asp_renderer *r, const float *lines, size_t segments, asp_error *err);
 
 /**
  * The texture fills of asp_prim_build on the GPU (thesis 3.6): an

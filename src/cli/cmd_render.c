@@ -177,6 +177,42 @@ static int pick_domain_set(struct render_opts *o, asp_scene *s, asp_renderer_opt
     return 0;
 }
 
+/*
+ * --debug triangulation (thesis appendix C): the affine triangles are not stored in the .dps, so the
+ * library makes them again from the decomposition the file names (asp_dps.source, tried as stored and
+ * next to the .dps).
+ */
+static int debug_triangles(const char *path, const asp_scene *s, asp_renderer *r, const struct cli_env *env,
+                           asp_error *err)
+{
+    const char *src = s->dps->source, *slash = strrchr(path, '/');
+    char alt[4096] = "";
+    if (src[0] && src[0] != '/' && slash)
+        snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - path), path, src);
+    const char *use = NULL;
+    asp_file_type t;
+    for (int k = 0; k < 2 && !use; k++) {
+        const char *c = k ? alt : src;
+        if (c[0] && asp_file_recognise(c, &t, NULL) == 0 && t.kind == ASP_FILE_AMG)
+            use = c;
+    }
+    if (!use)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "--debug triangulation needs the .amg '%s' was built from; it "
+                             "names '%s' (build from an .amg: amgsplat decompose, then build)", path, src);
+    asp_amg *amg = NULL;
+    float *lines = NULL;
+    size_t n = 0;
+    int rc = asp_amg_load(use, &env->ctx, &amg, err);
+    if (!rc)
+        rc = asp_prim_level_triangles(amg, s->dps, s->dps_level, s->origin, &env->ctx, &lines, &n, err);
+    if (!rc)
+        rc = asp_prim_renderer_set_debug_lines(r, lines, n, err);
+    asp_free(&env->ctx, lines);
+    asp_amg_destroy(amg);
+    asp_amg_shutdown();
+    return rc;
+}
+
 /* The library records textures it could not find; saying so is the command's job (STYLE.md 4). */
 static void warn_missing_textures(const asp_scene *s)
 {
@@ -319,8 +355,10 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
             p->flags |= ASP_PRIM_RENDER_DEBUG_EIGENVECTORS;
         else if (len == strlen("texels") && strncmp(d, "texels", len) == 0)
             p->flags |= ASP_PRIM_RENDER_DEBUG_TEXELS;
+        else if (len == strlen("triangulation") && strncmp(d, "triangulation", len) == 0)
+            p->flags |= ASP_PRIM_RENDER_DEBUG_TRIANGULATION;
         else
-            return cli_usage_error(env, "--debug expects eigenvectors, texels or both comma-separated, got '%.*s'",
+            return cli_usage_error(env, "--debug expects eigenvectors, texels, triangulation or several comma-separated, got '%.*s'",
                                    (int)len, d);
         d += len + (d[len] == ',');
     }
@@ -512,7 +550,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
         {"domains", 0, CLI_STRING, &o.domains, "SET", ".dps built with --domains both: thresholded (default) or strict (drawn no-blend unless --method)"},
-        {"debug", 0, CLI_STRING, &o.debug, "LIST", ".dps: debug drawings (thesis app. C): eigenvectors, texels, or both comma-separated"},
+        {"debug", 0, CLI_STRING, &o.debug, "LIST", ".dps: debug drawings (thesis app. C): eigenvectors, texels, triangulation (needs the source .amg), comma-separated"},
         {"only-domain", 0, CLI_SIZE, &o.only_domain, "N", ".dps: draw primitive N of the level only (thesis app. C)"},
         {"overlap-backfaces", 0, CLI_FLAG, &o.overlap_backfaces, NULL, ".dps, overlap: also draw back-facing neighbours, as journal Fig. 10's pseudocode"},
         {"no-overlap-backfaces", 0, CLI_FLAG, &o.no_overlap_backfaces, NULL, ".dps, overlap: cull back faces (the default; turns off a preset's --overlap-backfaces)"},
@@ -604,6 +642,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         asp_scene_render_source(&s, &src);
         rc = kind->create(gl, &src, &ropts, &env->ctx, &r, &err);
     }
+    if (!rc && (o.prim.flags & ASP_PRIM_RENDER_DEBUG_TRIANGULATION))
+        rc = debug_triangles(argv[0], &s, r, env, &err);
     if (!rc && o.budget)
         rc = asp_renderer_set_budget(r, o.budget, &err);
     if (!rc && o.depth_limit)

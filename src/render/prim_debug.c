@@ -2,8 +2,9 @@
  * Debug drawings of the thesis's viewer (Reniers 2004, appendix C) over a
  * domain-primitive image: the eigenvectors of each support plane (the PCA
  * axes, thesis 3.1) and the midpoints of the texels a primitive's texture
- * covers (alpha > 0, thesis 3.3). Both are generated in the vertex shader
- * from the renderer's primitive buffer, so they cost no upload.
+ * covers (alpha > 0, thesis 3.3), generated in the vertex shader from the
+ * renderer's primitive buffer (no upload), and the affine triangulation
+ * (3.3.3) as lines the caller gives (asp_prim_level_triangles).
  */
 #include <math.h>
 #include <string.h>
@@ -12,8 +13,10 @@
 #include "util/banned.h"
 
 struct asp__prim_debug {
-    asp__gl_program axes, texels;
-    GLint axes_view, axes_proj, texels_view, texels_proj, texels_size;
+    asp__gl_program axes, texels, lines;
+    GLint axes_view, axes_proj, texels_view, texels_proj, texels_size, lines_view, lines_proj;
+    GLuint line_buffer;  /* 6 floats per segment */
+    size_t segments;
     GLsizei max_texels; /* the largest texture's texel count: vertices per primitive of the texel draw */
     GLint atlas_w, atlas_h;
 };
@@ -63,6 +66,19 @@ static const char texels_vs[] =
     "    gl_Position = u_proj * (u_view * vec4(w, 1.0));\n"
     "}\n";
 
+/* Vertex gl_VertexID of the caller's segments (asp_prim_renderer_set_debug_lines). */
+static const char lines_vs[] =
+    "#version 450 core\n"
+    "layout(std430, binding = 3) readonly buffer Lines { float lp[]; };\n"
+    "uniform mat4 u_view;\n"
+    "uniform mat4 u_proj;\n"
+    "out vec3 v_color;\n"
+    "void main() {\n"
+    "    int k = 3 * gl_VertexID;\n"
+    "    v_color = vec3(0.0, 1.0, 1.0);\n"
+    "    gl_Position = u_proj * (u_view * vec4(lp[k], lp[k + 1], lp[k + 2], 1.0));\n"
+    "}\n";
+
 static const char debug_fs[] = "#version 450 core\n"
                                "in vec3 v_color;\n"
                                "out vec4 o_color;\n"
@@ -91,6 +107,8 @@ static int debug_init(asp__prim_renderer *r, asp_error *err)
     int rc = asp__gl_program_create(gl, "primitive debug axes", axes_vs, debug_fs, &d->axes, err);
     if (!rc)
         rc = asp__gl_program_create(gl, "primitive debug texels", texels_vs, debug_fs, &d->texels, err);
+    if (!rc)
+        rc = asp__gl_program_create(gl, "primitive debug lines", lines_vs, debug_fs, &d->lines, err);
     if (rc)
         return rc;
     d->axes_view = glGetUniformLocation(d->axes.id, "u_view");
@@ -98,6 +116,8 @@ static int debug_init(asp__prim_renderer *r, asp_error *err)
     d->texels_view = glGetUniformLocation(d->texels.id, "u_view");
     d->texels_proj = glGetUniformLocation(d->texels.id, "u_proj");
     d->texels_size = glGetUniformLocation(d->texels.id, "u_atlas_size");
+    d->lines_view = glGetUniformLocation(d->lines.id, "u_view");
+    d->lines_proj = glGetUniformLocation(d->lines.id, "u_proj");
     return asp__gl_check(gl, "create the primitive debug drawings", err);
 }
 
@@ -109,7 +129,7 @@ int asp__prim_debug_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *
             return rc;
     }
     struct asp__prim_debug *d = r->debug;
-    if (!d->axes.id || !d->texels.id)
+    if (!d->axes.id || !d->texels.id || !d->lines.id)
         return asp_error_set(err, ASP_EGL, "the primitive debug drawings failed to build before");
     // drawn on top, as the thesis's viewer overlays them: no depth test, no blending
     glDisable(GL_DEPTH_TEST);
@@ -131,6 +151,14 @@ int asp__prim_debug_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *
         glUseProgram(d->axes.id);
         glDrawArraysInstanced(GL_LINES, 0, 6, (GLsizei)r->count);
     }
+    if (r->opt.flags & ASP_PRIM_RENDER_DEBUG_TRIANGULATION && d->segments > 0) {
+        glProgramUniformMatrix4fv(d->lines.id, d->lines_view, 1, GL_FALSE, f->view);
+        glProgramUniformMatrix4fv(d->lines.id, d->lines_proj, 1, GL_FALSE, f->proj);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, d->line_buffer);
+        glUseProgram(d->lines.id);
+        glDrawArrays(GL_LINES, 0, (GLsizei)(2 * d->segments));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, 0);
+    }
     glBindVertexArray(0);
     glUseProgram(0);
     glEnable(GL_DEPTH_TEST);
@@ -143,6 +171,37 @@ void asp__prim_debug_destroy(asp__prim_renderer *r)
         return;
     asp__gl_program_destroy(&r->debug->axes);
     asp__gl_program_destroy(&r->debug->texels);
+    asp__gl_program_destroy(&r->debug->lines);
+    if (r->debug->line_buffer)
+        glDeleteBuffers(1, &r->debug->line_buffer);
     asp_free(&r->base.gl->actx, r->debug);
     r->debug = NULL;
+}
+
+int asp_prim_renderer_set_debug_lines(asp_renderer *base, const float *lines, size_t segments, asp_error *err)
+{
+    if (!base || base->vt != &asp__prim_vtable)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "the %s renderer draws no triangulation",
+                             base ? asp_renderer_name(base) : "(null)");
+    if (!lines && segments)
+        return asp_error_set(err, ASP_EINVAL, "no lines for %zu segments", segments);
+    if (segments > (size_t)INT32_MAX / 2)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot draw %zu segments in one call", segments);
+    asp__prim_renderer *r = (asp__prim_renderer *)base;
+    int rc = asp__gl_ensure_current(base->gl, err);
+    if (!rc && !r->debug)
+        rc = debug_init(r, err);
+    if (rc)
+        return rc;
+    struct asp__prim_debug *d = r->debug;
+    if (d->line_buffer)
+        glDeleteBuffers(1, &d->line_buffer);
+    d->line_buffer = 0;
+    d->segments = 0;
+    if (segments) {
+        glCreateBuffers(1, &d->line_buffer);
+        glNamedBufferStorage(d->line_buffer, (GLsizeiptr)(6 * segments * sizeof(float)), lines, 0);
+        d->segments = segments;
+    }
+    return asp__gl_check(base->gl, "upload the triangulation lines", err);
 }

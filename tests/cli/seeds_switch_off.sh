@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Issue 17, the rest: a preset's flags can be switched off by hand (--no-overlap-backfaces,
 # --no-normalise-color), and render's debug drawings of the thesis viewer (appendix C: eigenvectors,
-# texel midpoints, one picked domain only) draw their colours where expected.
+# texel midpoints, the affine triangulation, one picked domain only) draw their colours where expected.
 source "$(dirname "$0")/common.sh"
 A="$AMGSPLAT"
 mpi_asan="${ASAN_OPTIONS:-}:fast_unwind_on_malloc=0" # decompose/build start MPI (see seeds_render.sh)
@@ -65,6 +65,12 @@ has "$T/ge.png" 255,0,0 50 && has "$T/ge.png" 0,255,0 50 || fail "no eigenvector
 has "$T/ge.png" 255,0,255 0 || fail "texel dots without --debug texels"
 has "$T/gt.png" 255,0,255 500 || fail "no texel midpoints"
 has "$T/gb.png" 255,0,255 500 && has "$T/gb.png" 255,0,0 50 || fail "--debug texels,eigenvectors"
+# the affine triangulation (made again from the .amg the file names), cyan
+ASAN_OPTIONS="$mpi_asan" "$A" render "$T/g.dps" -o "$T/gd.png" --debug triangulation "${R[@]}"
+has "$T/gd.png" 0,255,255 200 || fail "no triangulation lines"
+has "$T/g0.png" 0,255,255 0 && has "$T/gd.png" 255,0,255 0 || fail "cyan without --debug triangulation, or texels with it"
+ASAN_OPTIONS="$mpi_asan" "$A" build "$T/s.ply" -o "$T/p.dps" --level L-2 -q >/dev/null
+ASAN_OPTIONS="$mpi_asan" expect_fail 1 "needs the .amg" "$A" render "$T/p.dps" -o "$T/x.png" --debug triangulation
 expect_fail 2 "--debug expects eigenvectors, texels" "$A" render "$T/g.dps" -o "$T/x.png" --debug normals
 expect_fail 2 "need a .dps input" "$A" render "$T/s.ply" -o "$T/x.png" --debug texels
 # one picked domain: every domain's pixels lie inside the full silhouette (those facing away draw

@@ -231,6 +231,41 @@ static void test_domain_set_both(void)
                       memcmp(lv->atlas.pixels, p->atlas.pixels, 4 * (size_t)p->atlas.width * p->atlas.height) == 0);
             }
         }
+        // the affine triangulation of the thresholded level L-3 (thesis appendix C), drawn in cyan
+        float *lines = NULL;
+        size_t segs = 0;
+        CHECK(asp_prim_level_triangles(amg, dps, 9, NULL, NULL, &lines, &segs, &err) == ASP_EINVAL);
+        CHECK_OK(asp_prim_level_triangles(amg, dps, 0, NULL, NULL, &lines, &segs, &err), ep(&err));
+        size_t pts = 0;
+        for (size_t k = 0; k < dps->levels[0].prim_count; k++)
+            pts += dps->levels[0].prims[k].points;
+        // a Delaunay triangulation of n points has at most 2n triangles, 3 edges each; the cut ones go
+        CHECK_MSG(segs > pts / 2 && segs <= 6 * pts, "%zu segments for %zu domain points", segs, pts);
+        if (gl && lines) {
+            asp_renderer *r = NULL;
+            CHECK_OK(asp_prim_renderer_create(gl, &dps->levels[0], NULL, &r, &err), ep(&err));
+            if (r) {
+                CHECK_OK(asp_prim_renderer_set_debug_lines(r, lines, segs, &err), ep(&err));
+                float c[3], rad;
+                asp_camera cam;
+                asp_prim_level_bounding_sphere(&dps->levels[0], NULL, c, &rad, &err);
+                asp_camera_init(&cam);
+                asp_camera_fit(&cam, c, rad, 1.0f);
+                asp_render_desc rd = {.width = SIZE, .height = SIZE, .flags = ASP_RENDER_UNLIT, .samples = 1};
+                asp_image off = {0}, on = {0};
+                CHECK_OK(asp_render_to_image(gl, r, &cam, &rd, &off, &err), ep(&err));
+                asp_prim_renderer_set_options(r, &(asp_prim_render_options){.flags = ASP_PRIM_RENDER_DEBUG_TRIANGULATION}, &err);
+                CHECK_OK(asp_render_to_image(gl, r, &cam, &rd, &on, &err), ep(&err));
+                if (off.pixels && on.pixels) {
+                    size_t a0 = count_rgb(&off, 0, 255, 255, 0, off.width), a1 = count_rgb(&on, 0, 255, 255, 0, on.width);
+                    CHECK_MSG(a0 == 0 && a1 > 200, "cyan pixels %zu without, %zu with the triangulation", a0, a1);
+                }
+                test_save_sheet((asp_image[]){off, on}, 2, "ASP_TEST_IMAGES", "prim_triangulation");
+                asp_image_release(&off), asp_image_release(&on);
+                asp_renderer_destroy(r);
+            }
+        }
+        asp_free(NULL, lines);
         // the switch: level by level to the other set and back
         size_t idx = 99;
         CHECK_OK(asp_dps_domain_set_pick(dps, 2, 1, &idx, &err), ep(&err));
