@@ -656,8 +656,8 @@ int asp_prim_renderer_set_debug_lines(asp_renderer *r, const float *lines, size_
  * the radial fringe outside), over the samples and triangles binned to the
  * texel's 8 x 8 cell, in the CPU's order and in double precision; the
  * library reads f back and finishes on the CPU as the thesis proposes.
- * Batches hold at most 4,194,240 texels. Returns 0, ASP_EGL (the shader or
- * a GL call failed), ASP_EUNSUPPORTED (a batch too large), ASP_ENOMEM.
+ * Returns 0, ASP_EGL (the shader or a GL call failed), ASP_EUNSUPPORTED (a
+ * batch of 2^31 texels or more), ASP_ENOMEM.
  */
 int asp_prim_gpu_fill(void *gl_context, const asp_prim_fill_batch *batch, float *acc, float *f, uint8_t *covered,
                       asp_error *err);

@@ -292,11 +292,12 @@ done:
     return rc;
 }
 
-/* The level's textures through desc->fill, in batches of at most 4,194,240 texels (one GPU dispatch). */
+/* The level's textures through desc->fill, in batches of about 4 M texels (a primitive larger than that
+ * alone), which bounds the batch's buffers here and on the device. */
 static int fill_external(const build_src *src, const asp_amg_csr *dom, const asp_prim_desc *d, const layout *L,
                          asp_dps_level *lv, size_t np, const asp_context *ctx, asp_error *err)
 {
-    enum { BATCH_TEXELS = 65535 * 64 }; // one compute dispatch of asp_prim_gpu_fill
+    enum { BATCH_TEXELS = 1 << 22 };
     int rc = 0;
     for (size_t k0 = 0, k1; k0 < np && !rc; k0 = k1) {
         size_t texels = 0;

@@ -36,7 +36,7 @@ static const char fill_cs[] =
     "uniform int u_affine;\n"
     "uniform int u_shape;\n" /* 0 linear, 1 constant, 2 gaussian */
     "void main() {\n"
-    "    uint g = gl_GlobalInvocationID.x;\n"
+    "    uint g = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 64u;\n"
     "    if (g >= u_texels) return;\n"
     "    uint lo = 0u, hi = u_prims - 1u;\n" /* the last primitive whose first texel is <= g */
     "    while (lo < hi) { uint mid = (lo + hi + 1u) / 2u; if (prims[mid].a.x <= g) lo = mid; else hi = mid - 1u; }\n"
@@ -245,14 +245,9 @@ int asp_prim_gpu_fill(void *gl_context, const asp_prim_fill_batch *b, float *acc
     glProgramUniform1i(prog, glGetUniformLocation(prog, "u_affine"), b->method == ASP_PRIM_AFFINE);
     glProgramUniform1i(prog, glGetUniformLocation(prog, "u_shape"), b->shape);
     glUseProgram(prog);
-    // at most 65535 groups a row: a 2D grid would need the row in the shader; 65535 x 64 texels per dispatch
-    // call is 4 M, the batch size the library sends (asp_prim_build's fill_external)
-    size_t groups = (T + GROUP - 1) / GROUP;
-    if (groups > 65535) {
-        rc = asp_error_set(err, ASP_EUNSUPPORTED, "texture batch of %zu texels exceeds one dispatch", T);
-        goto done;
-    }
-    glDispatchCompute((GLuint)groups, 1, 1);
+    // at most 65535 groups a row (the GL minimum): rows of groups beyond, the shader folds y into its index
+    size_t groups = (T + GROUP - 1) / GROUP, gx = groups < 65535 ? groups : 65535, gy = (groups + gx - 1) / gx;
+    glDispatchCompute((GLuint)gx, (GLuint)gy, 1);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     glGetNamedBufferSubData(bufs[6], 0, (GLsizeiptr)(8 * T * sizeof(float)), out);
     glUseProgram(0);
