@@ -594,8 +594,23 @@ enum asp_prim_render_flags {
     /* overlap method as the pseudocode of journal Fig. 10 / thesis 4.4.4 reads: the neighbours a
      * front-facing primitive adds are drawn even when they face away (default: back faces culled,
      * thesis 5.3.1) */
-    ASP_PRIM_RENDER_OVERLAP_BACKFACES = 1 << 3
+    ASP_PRIM_RENDER_OVERLAP_BACKFACES = 1 << 3,
+    /* Debug drawings of the thesis viewer (appendix C), drawn over the image without depth test: each
+     * primitive's PCA axes from its centre, axis_u red (half_u long), axis_v green (half_v), the normal
+     * blue (the shorter half extent) */
+    ASP_PRIM_RENDER_DEBUG_EIGENVECTORS = 1 << 4,
+    /* ... and the midpoints of the texels with alpha > 0 as one-pixel magenta dots */
+    ASP_PRIM_RENDER_DEBUG_TEXELS = 1 << 5,
+    /* ... and the affine triangulation given by asp_prim_renderer_set_debug_lines as cyan lines */
+    ASP_PRIM_RENDER_DEBUG_TRIANGULATION = 1 << 6
 };
+
+/** The sRGB colours of the debug drawings (ASP_PRIM_RENDER_DEBUG_*). */
+#define ASP_PRIM_DEBUG_AXIS_U_RGB 255, 0, 0
+#define ASP_PRIM_DEBUG_AXIS_V_RGB 0, 255, 0
+#define ASP_PRIM_DEBUG_NORMAL_RGB 0, 0, 255
+#define ASP_PRIM_DEBUG_TEXEL_RGB 255, 0, 255
+#define ASP_PRIM_DEBUG_TRIANGLE_RGB 0, 255, 255
 
 /**
  * Rendering options of a domain-primitive renderer; the zero value means
@@ -620,6 +635,32 @@ typedef struct asp_prim_render_options {
                             seeds, docs/render-methods.md); 0 = ASP_PRIM_CREASE_ANGLE_DEFAULT;
                             < 0 or >= 180 = never clip, exactly the seeds' methods */
 } asp_prim_render_options;
+
+/**
+ * Gives a domain-primitive renderer the line segments its
+ * ASP_PRIM_RENDER_DEBUG_TRIANGULATION drawing shows (6 floats per segment in
+ * the renderer's frame, as asp_prim_level_triangles writes them with the
+ * renderer's origin; copied, replacing earlier ones; segments 0 clears).
+ * Makes r's context current. Returns 0, ASP_EUNSUPPORTED (not a
+ * domain-primitive renderer), ASP_EINVAL (NULL lines with segments > 0),
+ * ASP_ENOMEM, ASP_EGL.
+ */
+int asp_prim_renderer_set_debug_lines(asp_renderer *r, const float *lines, size_t segments, asp_error *err);
+
+/**
+ * The texture fills of asp_prim_build on the GPU (thesis 3.6): an
+ * asp_prim_fill_fn for asp_prim_desc.fill with fill_user = an
+ * asp_gl_context (made current; use it from its thread only). A GL 4.5
+ * compute shader computes per texel what the CPU's fill computes (the radial
+ * sums of 3.3.2; the affine interpolation of 3.3.3 in the kept triangles and
+ * the radial fringe outside), over the samples and triangles binned to the
+ * texel's 8 x 8 cell, in the CPU's order and in double precision; the
+ * library reads f back and finishes on the CPU as the thesis proposes.
+ * Returns 0, ASP_EGL (the shader or a GL call failed), ASP_EUNSUPPORTED (a
+ * batch of 2^31 texels or more), ASP_ENOMEM.
+ */
+int asp_prim_gpu_fill(void *gl_context, const asp_prim_fill_batch *batch, float *acc, float *f, uint8_t *covered,
+                      asp_error *err);
 
 /** Default crease angle (degrees) of asp_prim_render_options.crease_angle. */
 #define ASP_PRIM_CREASE_ANGLE_DEFAULT 60.0f

@@ -27,6 +27,8 @@ static const char usage[] =
     "       amgsplat render MESH -o OUT.png [--flat] [--texture IMG] [--renderer mesh|disc] ...\n"
     "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
     "                      dark-backface-soft|blend-all|no-blend|polygons] [--level L] [--alpha-ref X]\n"
+    "                      [--domains thresholded|strict] [--debug eigenvectors,texels,triangulation]\n"
+    "                      [--only-domain N] [--no-overlap-backfaces]\n"
     "                      [--transparency X] [--depth-window X] [--crease-angle DEG|off] [--outline]\n"
     "                      [--color-by domain] [--overlap-backfaces] [--hybrid] [--hybrid-points POINTS] ...\n"
     "\n"
@@ -88,6 +90,10 @@ struct render_opts {
     int overlap_backfaces;
     int hybrid;                /* --hybrid: primitives and points (docs/hybrid.md) */
     const char *hybrid_points; /* --hybrid-points: the points instead of the .dps's source */
+    int no_overlap_backfaces; /* switches off a preset's --overlap-backfaces (issue 17) */
+    const char *domains;      /* .dps: thresholded | strict (thesis appendix C "Domain Set") */
+    const char *debug;        /* .dps: eigenvectors,texels (thesis appendix C debug drawings) */
+    size_t only_domain;       /* .dps: draw this primitive only; SIZE_MAX = all */
     /* parsed */
     unsigned width, height;
     double az, el, dist; /* dist 0 = fit */
@@ -146,6 +152,69 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
     r->prim = o->prim;
     r->hybrid = (asp_hybrid_desc){.prim = o->prim, .splat = r->splat};
     r->mesh.flags = o->flat ? ASP_MESH_RENDER_FLAT : 0u;
+}
+
+/*
+ * Domain Set (thesis appendix C): the level of the asked set built from the same AMG level as the one
+ * --level names; a level of the other set given by hand is switched, and strict levels are drawn with
+ * the thesis's no-blend method unless --method says otherwise.
+ */
+static int pick_domain_set(struct render_opts *o, asp_scene *s, asp_renderer_options *ropts, asp_error *err)
+{
+    int strict = o->domains && strcmp(o->domains, "strict") == 0;
+    if (o->domains && (s->dps->levels[s->dps_level].strict != 0) != strict) {
+        int rc = asp_dps_domain_set_pick(s->dps, s->dps_level, strict, &s->dps_level, err);
+        if (rc)
+            return rc;
+    }
+    if (s->dps->levels[s->dps_level].strict && !o->method)
+        ropts->prim.method = o->prim.method = ASP_PRIM_RENDER_NO_BLEND;
+    if (o->only_domain == SIZE_MAX)
+        return 0;
+    // the picked primitive replaces its level in the scene, so every method draws it alone
+    asp_dps_level *lv = &s->dps->levels[s->dps_level], one;
+    int rc = asp_dps_level_pick(lv, o->only_domain, &s->dps->ctx, &one, err);
+    if (rc)
+        return rc;
+    asp_dps_level_release(lv, &s->dps->ctx);
+    *lv = one;
+    return 0;
+}
+
+/*
+ * --debug triangulation (thesis appendix C): the affine triangles are not stored in the .dps, so the
+ * library makes them again from the decomposition the file names (asp_dps.source, tried as stored and
+ * next to the .dps).
+ */
+static int debug_triangles(const char *path, const asp_scene *s, asp_renderer *r, const struct cli_env *env,
+                           asp_error *err)
+{
+    const char *src = s->dps->source, *slash = strrchr(path, '/');
+    char alt[4096] = "";
+    if (src[0] && src[0] != '/' && slash)
+        snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - path), path, src);
+    const char *use = NULL;
+    asp_file_type t;
+    for (int k = 0; k < 2 && !use; k++) {
+        const char *c = k ? alt : src;
+        if (c[0] && asp_file_recognise(c, &t, NULL) == 0 && t.kind == ASP_FILE_AMG)
+            use = c;
+    }
+    if (!use)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "--debug triangulation needs the .amg '%s' was built from; it "
+                             "names '%s' (build from an .amg: amgsplat decompose, then build)", path, src);
+    asp_amg *amg = NULL;
+    float *lines = NULL;
+    size_t n = 0;
+    int rc = asp_amg_load(use, &env->ctx, &amg, err);
+    if (!rc)
+        rc = asp_prim_level_triangles(amg, s->dps, s->dps_level, s->origin, &env->ctx, &lines, &n, err);
+    if (!rc)
+        rc = asp_prim_renderer_set_debug_lines(r, lines, n, err);
+    asp_free(&env->ctx, lines);
+    asp_amg_destroy(amg);
+    asp_amg_shutdown();
+    return rc;
 }
 
 /* The library records textures it could not find; saying so is the command's job (STYLE.md 4). */
@@ -252,11 +321,11 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
 static int parse_prim_options(struct cli_env *env, struct render_opts *o)
 {
     // NaN marks "not given": the option parser refuses non-finite values, so no user value collides with it
-    int given = o->method || !isnan(o->alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
+    int given = o->method || o->domains || o->debug || o->only_domain != SIZE_MAX || !isnan(o->alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
                 o->no_normal_map || o->overlap_backfaces;
     if (!o->dps_input) {
         if (given)
-            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline, --overlap-backfaces and "
+            return cli_usage_error(env, "--method, --domains, --debug, --only-domain, --alpha-ref, --transparency, --depth-window, --outline, --overlap-backfaces and "
                                         "--no-normal-map need a .dps input (amgsplat build makes one)");
         double deg = 0;
         if (!o->crease_angle) {
@@ -284,6 +353,21 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
     asp_error err = {0, ""};
     if (o->method && asp_prim_render_method_parse(o->method, &p->method, &err))
         return cli_usage_error(env, "--method: %s", err.msg);
+    for (const char *d = o->debug; d && *d;) {
+        size_t len = strcspn(d, ",");
+        if (len == strlen("eigenvectors") && strncmp(d, "eigenvectors", len) == 0)
+            p->flags |= ASP_PRIM_RENDER_DEBUG_EIGENVECTORS;
+        else if (len == strlen("texels") && strncmp(d, "texels", len) == 0)
+            p->flags |= ASP_PRIM_RENDER_DEBUG_TEXELS;
+        else if (len == strlen("triangulation") && strncmp(d, "triangulation", len) == 0)
+            p->flags |= ASP_PRIM_RENDER_DEBUG_TRIANGULATION;
+        else
+            return cli_usage_error(env, "--debug expects eigenvectors, texels, triangulation or several comma-separated, got '%.*s'",
+                                   (int)len, d);
+        d += len + (d[len] == ',');
+    }
+    if (o->domains && strcmp(o->domains, "thresholded") != 0 && strcmp(o->domains, "strict") != 0)
+        return cli_usage_error(env, "--domains expects thresholded or strict, got '%s'", o->domains);
     if (!isnan(o->alpha_ref)) {
         if (!(o->alpha_ref >= 0 && o->alpha_ref <= 1))
             return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
@@ -309,7 +393,7 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
             return cli_usage_error(env, "--crease-angle expects degrees in (0, 180) or 'off', got '%s'",
                                    o->crease_angle);
     }
-    p->flags = (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
+    p->flags |= (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
                (o->no_normal_map ? ASP_PRIM_RENDER_NO_NORMAL_MAP : 0u) |
                (o->overlap_backfaces ? ASP_PRIM_RENDER_OVERLAP_BACKFACES : 0u);
     return 0;
@@ -409,6 +493,7 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     cJSON_AddStringToObject(j, "renderer", renderer);
     if (o->dps_input) {
         cJSON_AddStringToObject(j, "method", o->hybrid ? "hybrid" : asp_prim_render_method_name(o->prim.method));
+        cJSON_AddStringToObject(j, "domains", asp_scene_dps_level(s)->strict ? "strict" : "thresholded");
         cJSON_AddNumberToObject(j, "level", asp_scene_dps_level(s)->level);
     }
     cJSON_AddStringToObject(j, "gl_renderer", asp_gl_context_renderer(gl));
@@ -442,7 +527,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .width = 512, .height = 512,
                             .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0, .alpha_ref = NAN,
                             .sigma = NAN, .epsilon_uniform = NAN, .tolerance_area = NAN,
-                            .transparency = NAN, .depth_window = NAN, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
+                            .transparency = NAN, .depth_window = NAN, .only_domain = SIZE_MAX, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
         {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
@@ -477,7 +562,11 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
         {"hybrid", 0, CLI_FLAG, &o.hybrid, NULL, ".dps: the source points (seed 001 splats) where a primitive fails (docs/hybrid.md)"},
         {"hybrid-points", 0, CLI_STRING, &o.hybrid_points, "POINTS", ".dps: --hybrid with these points (point file or .amg) instead of the file's source"},
+        {"domains", 0, CLI_STRING, &o.domains, "SET", ".dps built with --domains both: thresholded (default) or strict (drawn no-blend unless --method)"},
+        {"debug", 0, CLI_STRING, &o.debug, "LIST", ".dps: debug drawings (thesis app. C): eigenvectors, texels, triangulation (needs the source .amg), comma-separated"},
+        {"only-domain", 0, CLI_SIZE, &o.only_domain, "N", ".dps: draw primitive N of the level only (thesis app. C)"},
         {"overlap-backfaces", 0, CLI_FLAG, &o.overlap_backfaces, NULL, ".dps, overlap: also draw back-facing neighbours, as journal Fig. 10's pseudocode"},
+        {"no-overlap-backfaces", 0, CLI_FLAG, &o.no_overlap_backfaces, NULL, ".dps, overlap: cull back faces (the default; turns off a preset's --overlap-backfaces)"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
         {"transparent", 0, CLI_FLAG, &o.transparent, NULL, "transparent background"},
         {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
@@ -505,6 +594,10 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     if (!o.dps_input && cli_from_preset(env, &o.method))
         o.method = NULL;
     if (!o.dps_input && cli_from_preset(env, &o.overlap_backfaces))
+        o.overlap_backfaces = 0;
+    if (o.no_overlap_backfaces && o.overlap_backfaces && !cli_from_preset(env, &o.overlap_backfaces))
+        return cli_usage_error(env, "--overlap-backfaces and --no-overlap-backfaces exclude each other");
+    if (o.no_overlap_backfaces)
         o.overlap_backfaces = 0;
     if ((o.dps_input || type.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.renderer))
         o.renderer = NULL;
@@ -558,12 +651,18 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         warn_missing_textures(&s);
     if (!rc && o.hybrid)
         rc = asp_scene_load_source_from(&s, o.hybrid_points, &err);
+    if (!rc && s.dps && (rc = pick_domain_set(&o, &s, &ropts, &err)) != 0) {
+        asp_error e = err;
+        asp_error_set(&err, e.code, "'%s': %s", argv[0], e.msg);
+    }
     if (!rc)
         rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err);
     if (!rc) {
         asp_scene_render_source(&s, &src);
         rc = kind->create(gl, &src, &ropts, &env->ctx, &r, &err);
     }
+    if (!rc && (o.prim.flags & ASP_PRIM_RENDER_DEBUG_TRIANGULATION))
+        rc = debug_triangles(argv[0], &s, r, env, &err);
     if (!rc && o.budget)
         rc = asp_renderer_set_budget(r, o.budget, &err);
     if (!rc && o.depth_limit)

@@ -106,6 +106,7 @@ typedef struct asp__prim_renderer {
     asp__gl_vertex_array empty_vao;    /* the resolve triangle */
     GLuint atlas, normal_atlas;  /* textures */
     asp__prim_targets t;
+    struct asp__prim_debug *debug; /* debug drawings (prim_debug.c), made on first use */
 } asp__prim_renderer;
 
 extern const asp__renderer_vtable asp__prim_vtable;
@@ -144,5 +145,9 @@ void asp__prim_hybrid_pass(asp__prim_renderer *r, size_t kept, int depth_only);
 
 /* Frees the offscreen targets. */
 void asp__prim_targets_release(asp__prim_targets *t);
+
+/* Thesis appendix C debug drawings (ASP_PRIM_RENDER_DEBUG_*) over the current draw framebuffer; prim_debug.c. */
+int asp__prim_debug_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err);
+void asp__prim_debug_destroy(asp__prim_renderer *r);
 
 #endif
