@@ -202,6 +202,13 @@ typedef struct asp_eval_desc {
      * against asp_mesh_gpu_bytes). Borrowed for the call.
      */
     const asp_mesh *mesh;
+    /*
+     * 1: every level also gets a "hybrid" row (asp_hybrid_renderer_create, issue
+     * 18 item 3): the level's primitives where they hold, the cloud's points
+     * where they fail, in one normalised accumulation; drawn counts its
+     * primitives and splats, bytes the level's plus 32 per point drawn.
+     */
+    int hybrid;
 } asp_eval_desc;
 
 /** Figures of one representation at one level and image size, over all views. */

@@ -38,6 +38,45 @@ typedef enum asp_prim_normalise {
     ASP_PRIM_NORM_GE1 = 1       /* divide by f only where f >= 1 (eq. 3.3): alpha fades at the border */
 } asp_prim_normalise;
 
+/** Which domains become primitives (asp_prim_desc.strict; thesis 2.5 and appendix C "Domain Set"). */
+typedef enum asp_prim_domain_set {
+    ASP_PRIM_DOMAINS_THRESHOLDED = 0, /* Psi > tau, overlapping (journal eq. 8); default */
+    ASP_PRIM_DOMAINS_STRICT = 1,      /* each point in the domain of its largest Psi (thesis eq. 2.5) */
+    ASP_PRIM_DOMAINS_BOTH = 2         /* both, so one file switches between them */
+} asp_prim_domain_set;
+
+/**
+ * The texture fills of a batch of primitives, for a texture builder outside
+ * the library's CPU path (thesis 3.6: on the graphics hardware,
+ * asp_prim_gpu_fill in render.h). Primitive k has samples
+ * sample_first[k] .. sample_first[k + 1] - 1 and a w[k] x h[k] texel grid
+ * stored from texel texel_first[k] on, row by row; sample s lies at (x[s],
+ * y[s]) in texel units (texel i spans [i, i + 1)), footprint radius r[s]
+ * texels, attributes attr[4 s ..] = r, g, b (0..255), Psi. Affine: the kept
+ * Delaunay triangles tri[3 t ..] (global sample indices), tri_first[k] ..
+ * tri_first[k + 1] - 1 per primitive.
+ */
+typedef struct asp_prim_fill_batch {
+    size_t prim_count;
+    const size_t *sample_first, *texel_first, *tri_first; /* prim_count + 1 entries each */
+    const uint32_t *w, *h;
+    const float *x, *y, *r, *attr;
+    const uint32_t *tri;
+    int method;          /* asp_prim_method */
+    int shape;           /* asp_prim_shape (radial) */
+} asp_prim_fill_batch;
+
+/**
+ * A texture fill (asp_prim_desc.fill): writes per texel t < texel_first[prim_count]
+ * acc[4 t ..] (the sum of phi times the attributes, or for affine the
+ * barycentric interpolation where covered[t] = 1), f[t] (the sum of phi) and
+ * covered[t], exactly as the CPU path's first half does (texture.c); the
+ * library then normalises, extends colour and encodes. Buffers arrive
+ * zeroed. Returns 0 or an ASP_E* code with err filled.
+ */
+typedef int (*asp_prim_fill_fn)(void *user, const asp_prim_fill_batch *batch, float *acc, float *f, uint8_t *covered,
+                                asp_error *err);
+
 /**
  * Build options; the zero value means the documented defaults, so
  * `&(asp_prim_desc){ .texel_size = 2 }` works.
@@ -65,11 +104,16 @@ typedef struct asp_prim_desc {
     int no_model_colors;     /* 1: every point light grey 200 (thesis appendix C "Use Model Colors" unchecked) */
     double brightness;       /* thesis appendix C "Adjust Brightness": added to each point colour's HSV value,
                                 in [-1, 1] (1 = full scale); hue and saturation kept; 0 = unchanged */
-    int strict;              /* 1: primitives of the strict domains (thesis eq. 2.5, asp_amg_strict_domain_rows),
-                                alpha 1 inside, for the no-blend method; 0: thresholded domains Psi > tau */
+    int strict;              /* asp_prim_domain_set: 1 (ASP_PRIM_DOMAINS_STRICT): primitives of the strict domains
+                                (thesis eq. 2.5, asp_amg_strict_domain_rows), alpha 1 inside, for the no-blend
+                                method; 0: thresholded domains Psi > tau; 2 (ASP_PRIM_DOMAINS_BOTH): both sets,
+                                each level twice, thresholded first (thesis appendix C "Domain Set") */
     double enlarge;          /* thesis appendix C "Enlarge Bounding Rectangle": > 0 grows the sides of the
                                 points' bounding rectangle by this percentage (at most 1000) instead of the
                                 default margin of one point footprint on every side (0) */
+    asp_prim_fill_fn fill;   /* NULL: textures on the CPU; else the fills go to fill(fill_user, ...) in batches
+                                (thesis 3.6; render.h asp_prim_gpu_fill); not with normal_map */
+    void *fill_user;
 } asp_prim_desc;
 
 /* ---- one primitive ---- */
@@ -304,6 +348,43 @@ void asp_dps_level_name(const asp_dps *dps, size_t index, char name[16]);
  * name). *index is unchanged on failure. Thread-safe.
  */
 int asp_dps_level_parse(const asp_dps *dps, const char *text, size_t *index, asp_error *err);
+
+/**
+ * The index into dps->levels of the level of the other domain set (thesis
+ * appendix C "Domain Set"): the level with lv->strict == strict built from the
+ * same AMG level as dps->levels[from], else the finest level of that set.
+ * Returns 0, or ASP_EINVAL when from is out of range or the file holds no level
+ * of that set ("no strict levels in the file; build with --domains strict or
+ * both"). *index is unchanged on failure. Thread-safe.
+ */
+int asp_dps_domain_set_pick(const asp_dps *dps, size_t from, int strict, size_t *index, asp_error *err);
+
+/**
+ * Copies primitive prim of src into *out as a level of one primitive (the
+ * thesis viewer's "one picked domain only", appendix C): same geometry, the
+ * primitive's texture cropped to an atlas of its own (and its normal map when
+ * src has one), no neighbours; the level's figures (level, strict, error) are
+ * src's. Release with asp_dps_level_release (ctx as given here). Returns 0,
+ * ASP_EINVAL ("no domain N: level L has domains 0..M"), ASP_EFORMAT (texture
+ * outside the atlas), ASP_ENOMEM; *out is unchanged on failure. Thread-safe.
+ */
+int asp_dps_level_pick(const asp_dps_level *src, size_t prim, const asp_context *ctx, asp_dps_level *out,
+                       asp_error *err);
+
+/**
+ * The kept Delaunay triangles of the affine method (thesis 3.3.3, Fig. 3.8)
+ * of every primitive of dps->levels[index], for the thesis viewer's
+ * triangulation drawing (appendix C). The triangles are not stored in a
+ * .dps, so the level's domains are made again from amg (the decomposition the
+ * file was built from, asp_dps.source) and each domain's points projected to
+ * its primitive's plane. Writes 6 floats per edge (two points, world minus
+ * origin; origin NULL = 0) to *lines, allocated through ctx (free with
+ * asp_free), and the edge count to *segments. Merged primitives are left out.
+ * Returns 0, ASP_EINVAL (index out of range, amg of another point count or
+ * without the level), ASP_ENOMEM; outputs unchanged on failure. Thread-safe.
+ */
+int asp_prim_level_triangles(const asp_amg *amg, const asp_dps *dps, size_t index, const double origin[3],
+                             const asp_context *ctx, float **lines, size_t *segments, asp_error *err);
 
 /** Option names: "affine"/"radial", "linear"/"constant"/"gaussian", "positive"/"ge1". 0 or ASP_EINVAL. */
 int asp_prim_method_parse(const char *name, asp_prim_method *out, asp_error *err);

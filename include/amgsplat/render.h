@@ -594,8 +594,23 @@ enum asp_prim_render_flags {
     /* overlap method as the pseudocode of journal Fig. 10 / thesis 4.4.4 reads: the neighbours a
      * front-facing primitive adds are drawn even when they face away (default: back faces culled,
      * thesis 5.3.1) */
-    ASP_PRIM_RENDER_OVERLAP_BACKFACES = 1 << 3
+    ASP_PRIM_RENDER_OVERLAP_BACKFACES = 1 << 3,
+    /* Debug drawings of the thesis viewer (appendix C), drawn over the image without depth test: each
+     * primitive's PCA axes from its centre, axis_u red (half_u long), axis_v green (half_v), the normal
+     * blue (the shorter half extent) */
+    ASP_PRIM_RENDER_DEBUG_EIGENVECTORS = 1 << 4,
+    /* ... and the midpoints of the texels with alpha > 0 as one-pixel magenta dots */
+    ASP_PRIM_RENDER_DEBUG_TEXELS = 1 << 5,
+    /* ... and the affine triangulation given by asp_prim_renderer_set_debug_lines as cyan lines */
+    ASP_PRIM_RENDER_DEBUG_TRIANGULATION = 1 << 6
 };
+
+/** The sRGB colours of the debug drawings (ASP_PRIM_RENDER_DEBUG_*). */
+#define ASP_PRIM_DEBUG_AXIS_U_RGB 255, 0, 0
+#define ASP_PRIM_DEBUG_AXIS_V_RGB 0, 255, 0
+#define ASP_PRIM_DEBUG_NORMAL_RGB 0, 0, 255
+#define ASP_PRIM_DEBUG_TEXEL_RGB 255, 0, 255
+#define ASP_PRIM_DEBUG_TRIANGLE_RGB 0, 255, 255
 
 /**
  * Rendering options of a domain-primitive renderer; the zero value means
@@ -620,6 +635,32 @@ typedef struct asp_prim_render_options {
                             seeds, docs/render-methods.md); 0 = ASP_PRIM_CREASE_ANGLE_DEFAULT;
                             < 0 or >= 180 = never clip, exactly the seeds' methods */
 } asp_prim_render_options;
+
+/**
+ * Gives a domain-primitive renderer the line segments its
+ * ASP_PRIM_RENDER_DEBUG_TRIANGULATION drawing shows (6 floats per segment in
+ * the renderer's frame, as asp_prim_level_triangles writes them with the
+ * renderer's origin; copied, replacing earlier ones; segments 0 clears).
+ * Makes r's context current. Returns 0, ASP_EUNSUPPORTED (not a
+ * domain-primitive renderer), ASP_EINVAL (NULL lines with segments > 0),
+ * ASP_ENOMEM, ASP_EGL.
+ */
+int asp_prim_renderer_set_debug_lines(asp_renderer *r, const float *lines, size_t segments, asp_error *err);
+
+/**
+ * The texture fills of asp_prim_build on the GPU (thesis 3.6): an
+ * asp_prim_fill_fn for asp_prim_desc.fill with fill_user = an
+ * asp_gl_context (made current; use it from its thread only). A GL 4.5
+ * compute shader computes per texel what the CPU's fill computes (the radial
+ * sums of 3.3.2; the affine interpolation of 3.3.3 in the kept triangles and
+ * the radial fringe outside), over the samples and triangles binned to the
+ * texel's 8 x 8 cell, in the CPU's order and in double precision; the
+ * library reads f back and finishes on the CPU as the thesis proposes.
+ * Returns 0, ASP_EGL (the shader or a GL call failed), ASP_EUNSUPPORTED (a
+ * batch of 2^31 texels or more), ASP_ENOMEM.
+ */
+int asp_prim_gpu_fill(void *gl_context, const asp_prim_fill_batch *batch, float *acc, float *f, uint8_t *covered,
+                      asp_error *err);
 
 /** Default crease angle (degrees) of asp_prim_render_options.crease_angle. */
 #define ASP_PRIM_CREASE_ANGLE_DEFAULT 60.0f
@@ -684,6 +725,105 @@ int asp_prim_level_bounding_sphere(const asp_dps_level *level, const double orig
  */
 const char *asp_prim_render_method_name(asp_prim_render_method m);
 int asp_prim_render_method_parse(const char *name, asp_prim_render_method *out, asp_error *err);
+
+/* ------------------------------------------------------------------------ */
+/* Hybrid: primitives where they hold, points where they fail (issue 18)    */
+/* ------------------------------------------------------------------------ */
+
+/*
+ * Defaults of asp_hybrid_desc, chosen by measurement (docs/hybrid.md): a
+ * primitive is replaced by its domain's points when the Psi-weighted RMS
+ * distance of those points to its plane exceeds ERROR_LIMIT times its radius
+ * sqrt(half_u half_v), or when more than TURNED_LIMIT of its domain (Psi
+ * weighted) has normals more than 45 degrees from its own; a point is drawn
+ * when the kept primitives near it (facing its way, within 2 error + 2
+ * spacings of it) have Psi summing below COVERAGE_MIN.
+ */
+#define ASP_HYBRID_ERROR_LIMIT 0.15f
+#define ASP_HYBRID_TURNED_LIMIT 0.4f
+#define ASP_HYBRID_COVERAGE_MIN 0.3f
+
+/** asp_hybrid_split's point_cover value of a point drawn as a point. */
+#define ASP_HYBRID_DRAWN UINT32_MAX
+
+/** Options of the hybrid renderer; the zero value means defaults. */
+typedef struct asp_hybrid_desc {
+    asp_prim_render_options prim;   /* alpha_ref, depth_window, crease_angle, flags (outline and colour by domain
+                                       excepted); method and transparency are not used: the hybrid has its own
+                                       normalised passes */
+    asp_splat_renderer_desc splat;  /* kernel, epsilon, tolerance (the point part's tau, asp_renderer_set_lod),
+                                       hierarchy options, default colour; mode, lighting PIXEL and clip_planes
+                                       are not used */
+    double origin[3];               /* as asp_prim_renderer_desc.origin; the points must be in this frame too
+                                       (cloud->origin equal to it) */
+    float error_limit;              /* 0 = ASP_HYBRID_ERROR_LIMIT; else > 0 */
+    float turned_limit;             /* 0 = ASP_HYBRID_TURNED_LIMIT; else > 0 */
+    float coverage_min;             /* 0 = ASP_HYBRID_COVERAGE_MIN; else > 0 */
+} asp_hybrid_desc;
+
+/** What asp_hybrid_split decided. */
+typedef struct asp_hybrid_counts {
+    size_t prims_kept, prims_replaced;
+    size_t points_drawn, points_total;
+} asp_hybrid_counts;
+
+/**
+ * Decides per primitive of level whether it is kept or replaced by points,
+ * and per point of points (the level's source points, in their local frame
+ * centred on points->origin) whether a kept primitive stands for it. The
+ * domain of primitive i is the points projecting onto texels of its texture
+ * with alpha (= Psi_i) > tau = 0.05 (journal eq. 8), within half the
+ * primitive's radius of its plane and not facing away from it (normal dot >
+ * -0.1, when points has normals). Writes prim_replaced[i] (1 = replaced;
+ * level->prim_count entries), point_cover[j] (points->count entries): the
+ * kept primitive of largest Psi standing for point j, or ASP_HYBRID_DRAWN;
+ * prim_score[i] (optional, NULL = not wanted): max(relative error /
+ * error_limit, turned share / turned_limit), replaced when > 1 (INFINITY
+ * for a primitive with no domain point). Coverage holds by construction:
+ * every point is either drawn or in the domain of the kept primitive
+ * point_cover names. counts may be NULL. Returns 0; ASP_EINVAL (a negative or
+ * non-finite threshold); ASP_EDEGENERATE (no primitives or points); ASP_EFORMAT (no
+ * atlas, a texture rectangle outside it, an empty rectangle); ASP_ENOMEM.
+ * Cost: primitives x points bounding-sphere tests; OpenMP threads of ctx.
+ * Thread safe, no GL.
+ */
+int asp_hybrid_split(const asp_dps_level *level, const asp_cloud *points, const asp_hybrid_desc *desc,
+                     const asp_context *ctx, uint8_t *restrict prim_replaced, uint32_t *restrict point_cover,
+                     float *restrict prim_score, asp_hybrid_counts *counts, asp_error *err);
+
+/**
+ * Psi of primitive prim of level at point x (frame centred on origin, NULL =
+ * world origin) with normal (NULL = any) as asp_hybrid_split reads it: the
+ * alpha of the texel under x's projection when x is in the primitive's
+ * domain, else 0. For tests and tools. Thread safe, no GL.
+ */
+float asp_hybrid_domain_weight(const asp_dps_level *level, size_t prim, const double origin[3], const float x[3],
+                               const float normal[3]);
+
+/**
+ * A renderer drawing level's kept primitives (asp_hybrid_split) and, in
+ * place of the others, their domains' points (and any point the kept
+ * primitives leave uncovered) as the blended splats of seed 001, from a point
+ * hierarchy of those points cut per frame by the splat tolerance. Both add
+ * (colour x weight, weight) into one float target after one shared
+ * visibility pass (the primitives' alpha-tested depth pushed back by the depth
+ * window, the splats' pushed back by epsilon), and one resolve divides by
+ * the weight (Pajarola et al. 2003 5.4), so there is no seam where they meet.
+ * Back-facing primitives are culled as in the normalized method. points:
+ * the level's source points, in the frame of desc->origin; without radii
+ * each point gets the distance to its 8th neighbour. asp_renderer_set_lod
+ * sets the point part's tolerance; asp_renderer_stats_get reports primitives
+ * + splats drawn (count) and the points part (points, nodes, tolerance).
+ * Makes gl current. Returns 0; the errors of asp_hybrid_split,
+ * asp_prim_renderer_create and asp_splat_renderer_create; ASP_ENOMEM.
+ * *out is unchanged on failure; free it with asp_renderer_destroy.
+ */
+int asp_hybrid_renderer_create(asp_gl_context *gl, const asp_dps_level *level, const asp_cloud *points,
+                               const asp_hybrid_desc *desc, const asp_context *ctx, asp_renderer **out,
+                               asp_error *err);
+
+/** Fills *out with the split a hybrid renderer made. Returns 0 or ASP_EUNSUPPORTED for another kind. */
+int asp_hybrid_renderer_counts(const asp_renderer *r, asp_hybrid_counts *out, asp_error *err);
 
 /* ------------------------------------------------------------------------ */
 /* Triangle meshes (issue 14: the textured-mesh baseline of seed 004 2.2-2.3) */
@@ -788,11 +928,12 @@ typedef struct asp_renderer_options {
     asp_square_renderer_desc square;
     asp_prim_render_options prim;
     asp_mesh_renderer_desc mesh;     /* origin comes from the source */
+    asp_hybrid_desc hybrid;          /* origin comes from the source; prim: these options' prim when zero */
 } asp_renderer_options;
 
 /** One row of the renderer table. */
 typedef struct asp_renderer_kind {
-    const char *name;   /* "disc", "splat", "square", "prim", "mesh" */
+    const char *name;   /* "disc", "splat", "square", "prim", "mesh", "hybrid" */
     const char *noun;   /* what asp_renderer_count counts: "points", "splats", "primitives", "triangles" */
     unsigned inputs;    /* asp_render_input_bits it draws */
     int has_lod;        /* draws a cut of the point hierarchy: tau and budgets apply (asp_renderer_set_lod) */
@@ -809,7 +950,7 @@ typedef struct asp_renderer_kind {
 
 /**
  * Row i of the renderer table, in the order "disc", "splat", "square",
- * "prim", "mesh" (the viewer's 1..9 keys follow it), or NULL past the end.
+ * "prim", "mesh", "hybrid" (the viewer's 1..9 keys follow it), or NULL past the end.
  * Thread safe.
  */
 const asp_renderer_kind *asp_renderer_kind_at(size_t i);

@@ -119,6 +119,14 @@ int asp_scene_recolor(asp_scene *s, asp_scene_amg_color color, size_t level, asp
  */
 int asp_scene_load_source(asp_scene *s, asp_error *err);
 
+/**
+ * As asp_scene_load_source, for .dps scenes from path (a point file or .amg,
+ * e.g. `render --hybrid-points`) instead of the source the file names; path
+ * NULL is asp_scene_load_source. Returns its errors, or ASP_EINVAL when path
+ * is given for a scene that is not a .dps.
+ */
+int asp_scene_load_source_from(asp_scene *s, const char *path, asp_error *err);
+
 /** The .dps level drawn (s->dps_level), or NULL for other kinds. */
 const asp_dps_level *asp_scene_dps_level(const asp_scene *s);
 

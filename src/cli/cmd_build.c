@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "amgsplat/prim.h"
+#include "amgsplat/render.h"
 #include "cli/cli.h"
 #include "cli/commands.h"
 #include "util/banned.h"
@@ -15,8 +16,8 @@ static const char usage[] =
     "usage: amgsplat build IN.amg|IN.ply -o OUT.dps [--level L-5 | --level L-6..L | --primitives 400]\n"
     "                      [--texel-size X] [--method affine|radial] [--shape linear|constant|gaussian]\n"
     "                      [--width W] [--normalise positive|ge1] [--merge] [--normals] [--atlas X.png]\n"
-    "                      [--preset thesis|journal] [--domains thresholded|strict] [--enlarge PCT]\n"
-    "                      [--normalise-color] [--no-model-colors] [--brightness X]\n"
+    "                      [--preset thesis|journal] [--domains thresholded|strict|both] [--enlarge PCT]\n"
+    "                      [--normalise-color | --no-normalise-color] [--no-model-colors] [--brightness X] [--gpu]\n"
     "\n"
     "Turns every domain of the chosen AMG level(s) into one planar rectangle (weighted PCA of\n"
     "its points) with a texture: colour = the points' colours, alpha = the domain's basis\n"
@@ -81,17 +82,18 @@ static int parse_levels(const asp_amg *amg, const char *text, size_t *levels, si
 
 static void print_table(const asp_dps *dps, const asp_dps_summary *rows)
 {
-    printf("level  name   primitives    texels        error  normalised   cb (s)  dpc (s)  skipped  degenerate\n");
+    printf("level  name   domains      primitives    texels        error  normalised   cb (s)  dpc (s)  skipped  degenerate\n");
     for (size_t i = 0; i < dps->level_count; i++) {
         const asp_dps_summary *s = &rows[i];
-        printf("%5u  %-5s %11zu %9llu  %11.6g  %10.3f  %7.3f  %7.3f  %7u  %10u\n", s->level, s->name, s->primitives,
+        printf("%5u  %-5s  %-11s %11zu %9llu  %11.6g  %10.3f  %7.3f  %7.3f  %7u  %10u\n", s->level, s->name,
+               dps->levels[i].strict ? "strict" : "thresholded", s->primitives,
                (unsigned long long)s->texels, s->error, s->error_norm, s->t_basis, s->t_construct, s->skipped,
                s->degenerate);
     }
 }
 
 static int print_json(const struct cli_env *env, const char *input, const char *output, const asp_dps *dps,
-                      const asp_dps_summary *rows, double t_decompose, double t_total)
+                      const asp_dps_summary *rows, double t_decompose, double t_total, int gpu)
 {
     cJSON *o = cJSON_CreateObject(), *levels = cJSON_CreateArray();
     cJSON_AddStringToObject(o, "input", input);
@@ -100,6 +102,7 @@ static int print_json(const struct cli_env *env, const char *input, const char *
     cJSON_AddItemToObject(o, "mean_radius", cli_json_number("%.9g", dps->mean_radius));
     cJSON_AddStringToObject(o, "method", asp_prim_method_name(dps->desc.method));
     cJSON_AddItemToObject(o, "texel_size", cli_json_number("%g", dps->desc.texel_size));
+    cJSON_AddBoolToObject(o, "gpu", gpu);
     cJSON_AddItemToObject(o, "decompose_seconds", cli_json_number("%.4f", t_decompose));
     cJSON_AddItemToObject(o, "total_seconds", cli_json_number("%.4f", t_total));
     for (size_t i = 0; i < dps->level_count; i++) {
@@ -107,6 +110,7 @@ static int print_json(const struct cli_env *env, const char *input, const char *
         cJSON *l = cJSON_CreateObject();
         cJSON_AddNumberToObject(l, "level", s->level);
         cJSON_AddStringToObject(l, "name", s->name);
+        cJSON_AddStringToObject(l, "domains", dps->levels[i].strict ? "strict" : "thresholded");
         cJSON_AddNumberToObject(l, "primitives", (double)s->primitives);
         cJSON_AddNumberToObject(l, "texels", (double)s->texels);
         cJSON_AddItemToObject(l, "error", cli_json_number("%.9g", s->error));
@@ -133,12 +137,13 @@ static int save_atlases(const char *path, const asp_dps *dps, const asp_dps_summ
     for (size_t i = 0; i < dps->level_count; i++) {
         char name[4096];
         size_t n = strlen(path);
+        const char *set = dps->levels[i].strict ? "-strict" : ""; // --domains both: one level in two sets
         if (dps->level_count == 1)
             snprintf(name, sizeof name, "%s", path);
         else if (png)
-            snprintf(name, sizeof name, "%.*s-%s.png", (int)(n - 4), path, rows[i].name);
+            snprintf(name, sizeof name, "%.*s-%s%s.png", (int)(n - 4), path, rows[i].name, set);
         else
-            snprintf(name, sizeof name, "%s-%s.png", path, rows[i].name);
+            snprintf(name, sizeof name, "%s-%s%s.png", path, rows[i].name, set);
         int rc = asp_image_save_png(&dps->levels[i].atlas, name, err);
         if (rc)
             return rc;
@@ -149,14 +154,14 @@ static int save_atlases(const char *path, const asp_dps *dps, const asp_dps_summ
 int cmd_build(int argc, char **argv, struct cli_env *env)
 {
     const char *preset = NULL; /* applied by cli_parse */
-    int norm_color = 0, no_colors = 0;
+    int norm_color = 0, no_norm_color = 0, no_colors = 0;
     double brightness = 0;
     const char *domain_set = "thresholded";
     const char *output = NULL, *level_text = NULL, *method = "affine", *shape = "linear", *norm = "positive";
     const char *atlas = NULL;
     size_t budget = SIZE_MAX, max_texture = 0, padding = 0; // SIZE_MAX: not given, so a given 0 is refused
     double texel = 0, width = 0, tau = 0, fraction = 0, flat = 0, angle = 0, enlarge = 0;
-    int unweighted = 0, project = 0, no_extend = 0, normals = 0, merge = 0;
+    int unweighted = 0, project = 0, no_extend = 0, normals = 0, merge = 0, gpu = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output primitives (.dps)"},
         {"preset", 0, CLI_STRING, &preset, "SEED", "the seed's options: thesis, journal (docs/seeds.md)"},
@@ -179,10 +184,12 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         {"merge-angle", 0, CLI_DOUBLE, &angle, "DEG", "and normals within DEG degrees (default 15)"},
         {"padding", 0, CLI_SIZE, &padding, "N", "atlas padding in texels (default 2)"},
         {"normalise-color", 0, CLI_FLAG, &norm_color, NULL, "radial: the --normalise criterion for colour too (thesis eq. 3.3 as written)"},
+        {"no-normalise-color", 0, CLI_FLAG, &no_norm_color, NULL, "colour always divided by f (the default; turns off a preset's --normalise-color)"},
         {"no-model-colors", 0, CLI_FLAG, &no_colors, NULL, "grey points instead of the model's colours (thesis app. C)"},
         {"brightness", 0, CLI_DOUBLE, &brightness, "X", "add X (-1..1) to each point colour's HSV value (thesis app. C)"},
-        {"domains", 0, CLI_STRING, &domain_set, "SET", "thresholded (default, Psi > tau) or strict (thesis eq. 2.5; draw with --method no-blend)"},
+        {"domains", 0, CLI_STRING, &domain_set, "SET", "thresholded (default, Psi > tau), strict (thesis eq. 2.5; drawn with --method no-blend) or both (render/view --domains picks)"},
         {"enlarge", 0, CLI_DOUBLE, &enlarge, "PCT", "grow the points' rectangle by PCT % (thesis app. C; default: one footprint margin)"},
+        {"gpu", 0, CLI_FLAG, &gpu, NULL, "fill the textures with a GL 4.5 compute shader (thesis 3.6; not with --normals)"},
         {"atlas", 0, CLI_STRING, &atlas, "X.png", "also write each level's atlas as PNG"},
         {0},
     };
@@ -208,8 +215,18 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--max-texture must be at most 8192 and --padding at most 64");
     if (!(brightness >= -1 && brightness <= 1))
         return cli_usage_error(env, "--brightness expects -1..1, got %g", brightness);
-    if (strcmp(domain_set, "thresholded") != 0 && strcmp(domain_set, "strict") != 0)
-        return cli_usage_error(env, "--domains expects thresholded or strict, got '%s'", domain_set);
+    static const char *const sets[] = {"thresholded", "strict", "both"}; // asp_prim_domain_set order
+    int set = -1;
+    for (int i = 0; i < 3; i++)
+        if (strcmp(domain_set, sets[i]) == 0)
+            set = i;
+    if (set < 0)
+        return cli_usage_error(env, "--domains expects thresholded, strict or both, got '%s'", domain_set);
+    // a preset's flag can be switched off by hand (issue 17); both by hand contradict each other
+    if (no_norm_color && norm_color && !cli_from_preset(env, &norm_color))
+        return cli_usage_error(env, "--normalise-color and --no-normalise-color exclude each other");
+    if (no_norm_color)
+        norm_color = 0;
     if (!(enlarge >= 0 && enlarge <= 1000))
         return cli_usage_error(env, "--enlarge expects a percentage in 0..1000, got %g", enlarge);
     asp_error err = {0};
@@ -218,7 +235,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
                           .normal_map = normals, .neighbour_fraction = fraction, .merge = merge,
                           .merge_flatness = flat, .merge_angle = angle, .padding = (uint32_t)padding,
                           .enlarge = enlarge, .normalise_color = norm_color,
-                          .strict = strcmp(domain_set, "strict") == 0, .no_model_colors = no_colors,
+                          .strict = set, .no_model_colors = no_colors,
                           .brightness = brightness};
     if (asp_prim_method_parse(method, &desc.method, &err) || asp_prim_shape_parse(shape, &desc.shape, &err) ||
         asp_prim_normalise_parse(norm, &desc.normalise, &err))
@@ -233,6 +250,12 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
                                               : "merge-angle",
                                texel < 0 ? texel : width < 0 ? width : tau < 0 ? tau : fraction < 0 ? fraction : flat < 0 ? flat : angle);
 
+#ifndef ASP_HAVE_GL
+    if (gpu)
+        return cli_usage_error(env, "--gpu needs OpenGL 4.5, and this amgsplat was built without it (ASP_WITH_GL=OFF)");
+#endif
+    if (gpu && normals)
+        return cli_usage_error(env, "--gpu makes no normal maps: leave out --normals or --gpu");
     double t0 = asp_time_now(), t_dec = 0;
     asp_amg *amg = NULL;
     asp_cloud *cloud = NULL;
@@ -253,6 +276,13 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     else if (!rc)
         rc = parse_levels(amg, level_text ? level_text : "L-3", levels, &nlevels, 64, &err);
     asp_dps *dps = NULL;
+#ifdef ASP_HAVE_GL
+    asp_gl_context *gl = NULL;
+    if (!rc && gpu && (rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err)) == 0) {
+        desc.fill = asp_prim_gpu_fill; // thesis 3.6: the fills on the graphics hardware
+        desc.fill_user = gl;
+    }
+#endif
     if (!rc)
         rc = asp_prim_build(amg, cloud, levels, nlevels, &desc, argv[0], &env->ctx, &dps, &err);
     // the .dps and its atlases appear all or none (issue #13): a failed atlas leaves the old .dps as it was
@@ -269,6 +299,9 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
     else
         rc = asp_output_batch_commit(&err);
     double t_total = asp_time_now() - t0;
+#ifdef ASP_HAVE_GL
+    asp_gl_context_destroy(gl);
+#endif
     asp_amg_destroy(amg);
     asp_cloud_destroy(cloud);
     asp_amg_shutdown();
@@ -283,7 +316,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
                      rows[i].name, rows[i].capped, rows[i].primitives, dps->desc.max_texture);
     int status = 0;
     if (env->json) {
-        status = print_json(env, argv[0], output, dps, rows, t_dec, t_total);
+        status = print_json(env, argv[0], output, dps, rows, t_dec, t_total, gpu);
     } else {
         if (!env->quiet)
             printf("%s: %llu points, %zu level(s), mean radius %.4g, %s textures, texel size %g%s, %.2f s\n", output,

@@ -61,7 +61,7 @@ static int parse_sizes(struct cli_env *env, const char *text, uint32_t *sizes, s
     return 0;
 }
 
-static int parse_methods(struct cli_env *env, const char *text, asp_prim_render_method *m, size_t *n)
+static int parse_methods(struct cli_env *env, const char *text, asp_prim_render_method *m, size_t *n, int *hybrid)
 {
     *n = 0;
     if (strcmp(text, "none") == 0)
@@ -80,6 +80,11 @@ static int parse_methods(struct cli_env *env, const char *text, asp_prim_render_
         if (comma)
             *comma = 0;
         asp_error err = {0};
+        if (strcmp(item, "hybrid") == 0) { // issue 18 item 3: not a primitive method but a row of its own
+            *hybrid = 1;
+            item = comma ? comma + 1 : NULL;
+            continue;
+        }
         if (*n >= MAX_METHODS || asp_prim_render_method_parse(item, &m[*n], &err))
             return cli_usage_error(env, "--methods: %s", *n >= MAX_METHODS ? "too many methods" : err.msg);
         (*n)++;
@@ -175,6 +180,11 @@ static cJSON *claim_json(const asp_eval_result *res)
             cJSON_AddItemToObject(o, "mesh_bytes_ssim", cli_json_number("%.6f", res->rows[mb].ssim_mean));
             cJSON_AddNumberToObject(o, "wins_mesh_bytes", (double)asp_eval_ssim_wins(res, best, mb));
         }
+        size_t hy = find_row(res, pt, "hybrid");
+        if (hy != SIZE_MAX) { // issue 18: the hybrid against the best pure-primitive method
+            cJSON_AddItemToObject(o, "hybrid_ssim", cli_json_number("%.6f", res->rows[hy].ssim_mean));
+            cJSON_AddNumberToObject(o, "hybrid_wins", (double)asp_eval_ssim_wins(res, hy, best));
+        }
         cJSON_AddItemToArray(a, o);
     }
     return a;
@@ -205,6 +215,10 @@ static void print_claim(const asp_eval_result *res, FILE *fp)
                 fprintf(fp, " %10.4f %5zu/%zu", res->rows[other[k]].ssim_mean,
                         asp_eval_ssim_wins(res, best, other[k]), res->views);
         }
+        size_t hy = find_row(res, pt, "hybrid");
+        if (hy != SIZE_MAX)
+            fprintf(fp, "  hybrid %.4f wins %zu/%zu", res->rows[hy].ssim_mean, asp_eval_ssim_wins(res, hy, best),
+                    res->views);
         fputc('\n', fp);
         first = 0;
     }
@@ -416,7 +430,8 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
         return 2;
     asp_prim_render_method methods[MAX_METHODS];
     size_t nmethods = 0;
-    if (methods_text && parse_methods(env, methods_text, methods, &nmethods))
+    int hybrid = 0;
+    if (methods_text && parse_methods(env, methods_text, methods, &nmethods, &hybrid))
         return 2;
     char dir[4000];
     if (out_dir && strlen(out_dir) >= sizeof dir)
@@ -447,7 +462,8 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
     }
     asp_eval_desc desc = {.views = views, .sizes = sizes, .size_count = nsizes, .max_primitives = max_prims,
                           .frames = frames, .elevation = (float)elevation, .crease_angle = (float)crease,
-                          .methods = methods_text ? methods : NULL, .method_count = nmethods, .mesh = mesh};
+                          .methods = methods_text ? methods : NULL, .method_count = nmethods, .mesh = mesh,
+                          .hybrid = hybrid};
     double t0 = asp_time_now();
     asp_eval_result *res = NULL;
     rc = asp_eval_run(cloud, &desc, &env->ctx, &res, &err);

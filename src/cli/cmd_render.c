@@ -29,8 +29,10 @@ static const char usage[] =
     "       amgsplat render MESH -o OUT.png [--flat] [--texture IMG] [--renderer mesh|disc] ...\n"
     "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
     "                      dark-backface-soft|blend-all|no-blend|polygons] [--level L] [--alpha-ref X]\n"
+    "                      [--domains thresholded|strict] [--debug eigenvectors,texels,triangulation]\n"
+    "                      [--only-domain N] [--no-overlap-backfaces]\n"
     "                      [--transparency X] [--depth-window X] [--crease-angle DEG|off] [--outline]\n"
-    "                      [--color-by domain] [--overlap-backfaces] ...\n"
+    "                      [--color-by domain] [--overlap-backfaces] [--hybrid] [--hybrid-points POINTS] ...\n"
     "       amgsplat render SCENE.json -o OUT.png [--renderer disc|splat|square] [--method M] ...\n"
     "\n"
     "Renders a point set (PLY, XYZ) or the points of an AMG decomposition (.amg) headlessly through\n"
@@ -41,7 +43,8 @@ static const char usage[] =
     "angle above the horizon, both in degrees; DIST is the eye distance in bounding-sphere radii\n"
     "(default: the sphere fills the view). --views N renders N views at azimuths AZ + 360 i / N,\n"
     "elevation alternating +EL and -EL, into one contact sheet. A .dps input (amgsplat build) draws\n"
-    "the textured domain primitives of one level, blended by --method (docs/render-methods.md).\n"
+    "the textured domain primitives of one level, blended by --method (docs/render-methods.md);\n"
+    "with --hybrid, its source points (or POINTS) stand in where a primitive fails (docs/hybrid.md).\n"
     "A mesh (OBJ+MTL, PLY with faces, OFF, STL, glTF/GLB, 3DS) is drawn as textured triangles with\n"
     "the same lighting and framing as the points sampled from it (amgsplat sample); a texture that\n"
     "cannot be found is drawn in its material colour, with a warning. A scene file of instances\n"
@@ -89,6 +92,12 @@ struct render_opts {
     int outline;
     int no_normal_map;
     int overlap_backfaces;
+    int hybrid;                /* --hybrid: primitives and points (docs/hybrid.md) */
+    const char *hybrid_points; /* --hybrid-points: the points instead of the .dps's source */
+    int no_overlap_backfaces; /* switches off a preset's --overlap-backfaces (issue 17) */
+    const char *domains;      /* .dps: thresholded | strict (thesis appendix C "Domain Set") */
+    const char *debug;        /* .dps: eigenvectors,texels (thesis appendix C debug drawings) */
+    size_t only_domain;       /* .dps: draw this primitive only; SIZE_MAX = all */
     /* parsed */
     unsigned width, height;
     double az, el, dist; /* dist 0 = fit */
@@ -145,7 +154,71 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
     if (!isnan(o->tolerance_area)) // seed 001 5.1: tau in percent of the window (one view's) area
         r->splat.tolerance = r->square.tolerance = asp_render_tolerance_from_area(o->tolerance_area, o->width, o->height);
     r->prim = o->prim;
+    r->hybrid = (asp_hybrid_desc){.prim = o->prim, .splat = r->splat};
     r->mesh.flags = o->flat ? ASP_MESH_RENDER_FLAT : 0u;
+}
+
+/*
+ * Domain Set (thesis appendix C): the level of the asked set built from the same AMG level as the one
+ * --level names; a level of the other set given by hand is switched, and strict levels are drawn with
+ * the thesis's no-blend method unless --method says otherwise.
+ */
+static int pick_domain_set(struct render_opts *o, asp_scene *s, asp_renderer_options *ropts, asp_error *err)
+{
+    int strict = o->domains && strcmp(o->domains, "strict") == 0;
+    if (o->domains && (s->dps->levels[s->dps_level].strict != 0) != strict) {
+        int rc = asp_dps_domain_set_pick(s->dps, s->dps_level, strict, &s->dps_level, err);
+        if (rc)
+            return rc;
+    }
+    if (s->dps->levels[s->dps_level].strict && !o->method)
+        ropts->prim.method = o->prim.method = ASP_PRIM_RENDER_NO_BLEND;
+    if (o->only_domain == SIZE_MAX)
+        return 0;
+    // the picked primitive replaces its level in the scene, so every method draws it alone
+    asp_dps_level *lv = &s->dps->levels[s->dps_level], one;
+    int rc = asp_dps_level_pick(lv, o->only_domain, &s->dps->ctx, &one, err);
+    if (rc)
+        return rc;
+    asp_dps_level_release(lv, &s->dps->ctx);
+    *lv = one;
+    return 0;
+}
+
+/*
+ * --debug triangulation (thesis appendix C): the affine triangles are not stored in the .dps, so the
+ * library makes them again from the decomposition the file names (asp_dps.source, tried as stored and
+ * next to the .dps).
+ */
+static int debug_triangles(const char *path, const asp_scene *s, asp_renderer *r, const struct cli_env *env,
+                           asp_error *err)
+{
+    const char *src = s->dps->source, *slash = strrchr(path, '/');
+    char alt[4096] = "";
+    if (src[0] && src[0] != '/' && slash)
+        snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - path), path, src);
+    const char *use = NULL;
+    asp_file_type t;
+    for (int k = 0; k < 2 && !use; k++) {
+        const char *c = k ? alt : src;
+        if (c[0] && asp_file_recognise(c, &t, NULL) == 0 && t.kind == ASP_FILE_AMG)
+            use = c;
+    }
+    if (!use)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "--debug triangulation needs the .amg '%s' was built from; it "
+                             "names '%s' (build from an .amg: amgsplat decompose, then build)", path, src);
+    asp_amg *amg = NULL;
+    float *lines = NULL;
+    size_t n = 0;
+    int rc = asp_amg_load(use, &env->ctx, &amg, err);
+    if (!rc)
+        rc = asp_prim_level_triangles(amg, s->dps, s->dps_level, s->origin, &env->ctx, &lines, &n, err);
+    if (!rc)
+        rc = asp_prim_renderer_set_debug_lines(r, lines, n, err);
+    asp_free(&env->ctx, lines);
+    asp_amg_destroy(amg);
+    asp_amg_shutdown();
+    return rc;
 }
 
 /* The library records textures it could not find; saying so is the command's job (STYLE.md 4). */
@@ -252,11 +325,11 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
 static int parse_prim_options(struct cli_env *env, struct render_opts *o)
 {
     // NaN marks "not given": the option parser refuses non-finite values, so no user value collides with it
-    int given = o->method || !isnan(o->alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
+    int given = o->method || o->domains || o->debug || o->only_domain != SIZE_MAX || !isnan(o->alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
                 o->no_normal_map || o->overlap_backfaces;
     if (!o->dps_input) {
         if (given)
-            return cli_usage_error(env, "--method, --alpha-ref, --transparency, --depth-window, --outline, --overlap-backfaces and "
+            return cli_usage_error(env, "--method, --domains, --debug, --only-domain, --alpha-ref, --transparency, --depth-window, --outline, --overlap-backfaces and "
                                         "--no-normal-map need a .dps input (amgsplat build makes one)");
         double deg = 0;
         if (!o->crease_angle) {
@@ -284,6 +357,21 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
     asp_error err = {0, ""};
     if (o->method && asp_prim_render_method_parse(o->method, &p->method, &err))
         return cli_usage_error(env, "--method: %s", err.msg);
+    for (const char *d = o->debug; d && *d;) {
+        size_t len = strcspn(d, ",");
+        if (len == strlen("eigenvectors") && strncmp(d, "eigenvectors", len) == 0)
+            p->flags |= ASP_PRIM_RENDER_DEBUG_EIGENVECTORS;
+        else if (len == strlen("texels") && strncmp(d, "texels", len) == 0)
+            p->flags |= ASP_PRIM_RENDER_DEBUG_TEXELS;
+        else if (len == strlen("triangulation") && strncmp(d, "triangulation", len) == 0)
+            p->flags |= ASP_PRIM_RENDER_DEBUG_TRIANGULATION;
+        else
+            return cli_usage_error(env, "--debug expects eigenvectors, texels, triangulation or several comma-separated, got '%.*s'",
+                                   (int)len, d);
+        d += len + (d[len] == ',');
+    }
+    if (o->domains && strcmp(o->domains, "thresholded") != 0 && strcmp(o->domains, "strict") != 0)
+        return cli_usage_error(env, "--domains expects thresholded or strict, got '%s'", o->domains);
     if (!isnan(o->alpha_ref)) {
         if (!(o->alpha_ref >= 0 && o->alpha_ref <= 1))
             return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
@@ -309,7 +397,7 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
             return cli_usage_error(env, "--crease-angle expects degrees in (0, 180) or 'off', got '%s'",
                                    o->crease_angle);
     }
-    p->flags = (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
+    p->flags |= (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
                (o->no_normal_map ? ASP_PRIM_RENDER_NO_NORMAL_MAP : 0u) |
                (o->overlap_backfaces ? ASP_PRIM_RENDER_OVERLAP_BACKFACES : 0u);
     return 0;
@@ -396,7 +484,7 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
 
 static int print_json(const struct cli_env *env, const struct render_opts *o, size_t count, const asp_scene *s,
                       asp_gl_context *gl, const char *renderer, const asp_image *img, const struct view_stats *vs,
-                      double seconds)
+                      double seconds, const asp_hybrid_counts *hc)
 {
     cJSON *j = cJSON_CreateObject(), *frame = cJSON_CreateArray();
     cJSON_AddStringToObject(j, "output", o->output);
@@ -408,7 +496,8 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     cJSON_AddNumberToObject(j, "points", (double)count);
     cJSON_AddStringToObject(j, "renderer", renderer);
     if (o->dps_input) {
-        cJSON_AddStringToObject(j, "method", asp_prim_render_method_name(o->prim.method));
+        cJSON_AddStringToObject(j, "method", o->hybrid ? "hybrid" : asp_prim_render_method_name(o->prim.method));
+        cJSON_AddStringToObject(j, "domains", asp_scene_dps_level(s)->strict ? "strict" : "thresholded");
         cJSON_AddNumberToObject(j, "level", asp_scene_dps_level(s)->level);
     }
     cJSON_AddStringToObject(j, "gl_renderer", asp_gl_context_renderer(gl));
@@ -426,6 +515,13 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     cJSON_AddItemToArray(frame, cli_json_number("%.9g", s->frame.radius));
     cJSON_AddItemToObject(j, "frame", frame);
     cJSON_AddItemToObject(j, "seconds", cli_json_number("%.3f", seconds));
+    if (hc) {
+        cJSON *h = cJSON_AddObjectToObject(j, "hybrid");
+        cJSON_AddNumberToObject(h, "primitives_kept", (double)hc->prims_kept);
+        cJSON_AddNumberToObject(h, "primitives_replaced", (double)hc->prims_replaced);
+        cJSON_AddNumberToObject(h, "points_drawn", (double)hc->points_drawn);
+        cJSON_AddNumberToObject(h, "points_total", (double)hc->points_total);
+    }
     return cli_json_print(env, j);
 }
 
@@ -469,6 +565,8 @@ static int render_instance_scene(const char *path, struct render_opts *o, struct
 {
     if (o->budget)
         return cli_usage_error(env, "--budget is per model; a scene takes --tolerance (every instance's cut)");
+    if (o->hybrid || o->hybrid_points)
+        return cli_usage_error(env, "--hybrid draws one .dps with its points; a scene's sources are drawn one by one");
     const asp_renderer_kind *kind = NULL;
     asp_error err = {0, ""};
     if (o->renderer && asp_renderer_kind_find(o->renderer, ASP_RENDER_INPUT_POINTS, &kind, &err))
@@ -552,7 +650,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .width = 512, .height = 512,
                             .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0, .alpha_ref = NAN,
                             .sigma = NAN, .epsilon_uniform = NAN, .tolerance_area = NAN,
-                            .transparency = NAN, .depth_window = NAN, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
+                            .transparency = NAN, .depth_window = NAN, .only_domain = SIZE_MAX, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
         {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
@@ -585,7 +683,13 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", "cut at creases sharper than DEG (default 60; off = as the seeds): .dps primitives; points with normals: discs, splats"},
         {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
+        {"hybrid", 0, CLI_FLAG, &o.hybrid, NULL, ".dps: the source points (seed 001 splats) where a primitive fails (docs/hybrid.md)"},
+        {"hybrid-points", 0, CLI_STRING, &o.hybrid_points, "POINTS", ".dps: --hybrid with these points (point file or .amg) instead of the file's source"},
+        {"domains", 0, CLI_STRING, &o.domains, "SET", ".dps built with --domains both: thresholded (default) or strict (drawn no-blend unless --method)"},
+        {"debug", 0, CLI_STRING, &o.debug, "LIST", ".dps: debug drawings (thesis app. C): eigenvectors, texels, triangulation (needs the source .amg), comma-separated"},
+        {"only-domain", 0, CLI_SIZE, &o.only_domain, "N", ".dps: draw primitive N of the level only (thesis app. C)"},
         {"overlap-backfaces", 0, CLI_FLAG, &o.overlap_backfaces, NULL, ".dps, overlap: also draw back-facing neighbours, as journal Fig. 10's pseudocode"},
+        {"no-overlap-backfaces", 0, CLI_FLAG, &o.no_overlap_backfaces, NULL, ".dps, overlap: cull back faces (the default; turns off a preset's --overlap-backfaces)"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
         {"transparent", 0, CLI_FLAG, &o.transparent, NULL, "transparent background"},
         {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
@@ -615,12 +719,20 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         o.method = NULL;
     if (!o.dps_input && cli_from_preset(env, &o.overlap_backfaces))
         o.overlap_backfaces = 0;
+    if (o.no_overlap_backfaces && o.overlap_backfaces && !cli_from_preset(env, &o.overlap_backfaces))
+        return cli_usage_error(env, "--overlap-backfaces and --no-overlap-backfaces exclude each other");
+    if (o.no_overlap_backfaces)
+        o.overlap_backfaces = 0;
     if ((o.dps_input || type.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.renderer))
         o.renderer = NULL;
     if (parse_options(env, &o))
         return 2;
     if (type.kind == ASP_FILE_SCENE)
         return render_instance_scene(argv[0], &o, env);
+    if (o.hybrid_points)
+        o.hybrid = 1;
+    if (o.hybrid && !o.dps_input)
+        return cli_usage_error(env, "--hybrid needs a .dps input (amgsplat build makes one)");
     if (o.dps_input && o.renderer)
         return cli_usage_error(env, "--renderer is for point inputs; a .dps input is drawn with --method");
     o.mesh_input = type.kind == ASP_FILE_MESH;
@@ -633,7 +745,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     unsigned inputs = o.dps_input    ? (unsigned)ASP_RENDER_INPUT_PRIMS
                       : o.mesh_input ? (unsigned)(ASP_RENDER_INPUT_MESH | ASP_RENDER_INPUT_POINTS)
                                      : (unsigned)ASP_RENDER_INPUT_POINTS;
-    if (asp_renderer_kind_find(o.dps_input ? "prim" : o.renderer ? o.renderer : dflt, inputs, &kind, &err))
+    if (asp_renderer_kind_find(o.hybrid ? "hybrid" : o.dps_input ? "prim" : o.renderer ? o.renderer : dflt, inputs, &kind, &err))
         return cli_usage_error(env, "%s", err.msg);
     // a PLY with faces holds its vertices as points; other meshes hold triangles only
     if (o.mesh_input && !(kind->inputs & ASP_RENDER_INPUT_MESH) && strcmp(type.format, "ply") != 0)
@@ -663,12 +775,20 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     int rc = load_scene(argv[0], &o, env, &s, &err);
     if (!rc)
         warn_missing_textures(&s);
+    if (!rc && o.hybrid)
+        rc = asp_scene_load_source_from(&s, o.hybrid_points, &err);
+    if (!rc && s.dps && (rc = pick_domain_set(&o, &s, &ropts, &err)) != 0) {
+        asp_error e = err;
+        asp_error_set(&err, e.code, "'%s': %s", argv[0], e.msg);
+    }
     if (!rc)
         rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err);
     if (!rc) {
         asp_scene_render_source(&s, &src);
         rc = kind->create(gl, &src, &ropts, &env->ctx, &r, &err);
     }
+    if (!rc && (o.prim.flags & ASP_PRIM_RENDER_DEBUG_TRIANGULATION))
+        rc = debug_triangles(argv[0], &s, r, env, &err);
     if (!rc && o.budget)
         rc = asp_renderer_set_budget(r, o.budget, &err);
     if (!rc && o.depth_limit)
@@ -690,17 +810,23 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         status = cli_fail(env, &err);
     } else {
         cli_progress_end(env);
+        asp_hybrid_counts hc = {0};
+        int hybrid = o.hybrid && asp_hybrid_renderer_counts(r, &hc, NULL) == 0;
         if (env->json)
-            status = print_json(env, &o, count, &s, gl, kind->name, result, &vs, seconds);
+            status = print_json(env, &o, count, &s, gl, kind->name, result, &vs, seconds, hybrid ? &hc : NULL);
         else
             cli_info(env,
                      "rendered %zu view%s of %zu %s (%s, %zu primitives in the last view, %.1f ms per view, %s) "
                      "to '%s' (%ux%u) in %.2f s\n",
                      o.views, o.views > 1 ? "s" : "", count,
                      o.dps_input ? "domain primitives" : mesh_drawn ? "triangles" : "points",
-                     o.dps_input ? asp_prim_render_method_name(o.prim.method) : kind->name, vs.last_count,
+                     o.hybrid ? "hybrid" : o.dps_input ? asp_prim_render_method_name(o.prim.method) : kind->name,
+                     vs.last_count,
                      1e3 * vs.seconds / (double)o.views, asp_gl_context_renderer(gl), o.output, result->width,
                      result->height, seconds);
+        if (!env->json && hybrid)
+            cli_info(env, "hybrid: %zu of %zu primitives kept, %zu of %zu points drawn as splats (docs/hybrid.md)",
+                     hc.prims_kept, hc.prims_kept + hc.prims_replaced, hc.points_drawn, hc.points_total);
     }
     asp_image_release(&sheet);
     for (size_t i = 0; i < o.views; i++)

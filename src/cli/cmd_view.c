@@ -14,7 +14,7 @@
 static const char usage[] =
     "usage: amgsplat view FILE [--size WxH] [--view AZ,EL[,DIST]] [--renderer NAME] [--tau PX]\n"
     "                     [--color MODE] [--level L] [--method NAME] [--alpha-ref X] [--unlit]\n"
-    "                     [--background R,G,B] [--texture IMG] [--verbose]\n"
+    "                     [--background R,G,B] [--texture IMG] [--hybrid] [--verbose]\n"
     "                     [--preset thesis|journal|pajarola|schwarz]\n"
     "       amgsplat view FILE --frames N [--screenshot OUT.png] [--keys KEYS] [options above]\n"
     "\n"
@@ -42,6 +42,7 @@ struct view_opts {
     const char *keys;
     const char *method;
     const char *preset; /* --preset: applied by cli_parse (docs/seeds.md) */
+    int hybrid;         /* .dps: primitives and their source points (docs/hybrid.md) */
     int cull_backfaces; /* seed 004 3.2.2 */
     size_t depth_limit; /* seed 004 3.2.5 */
     double alpha_ref;
@@ -101,6 +102,10 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
     if (asp_file_recognise(path, &type, NULL) != 0)
         asp_file_type_of_name(path, &type, NULL);
     int dps = type.kind == ASP_FILE_DPS || type.kind == ASP_FILE_SCENE; // a scene's .dps sources take them
+    if (o->hybrid && type.kind == ASP_FILE_SCENE)
+        return cli_usage_error(env, "--hybrid draws one .dps with its points, not a scene");
+    if (o->hybrid && (!dps || o->renderer))
+        return cli_usage_error(env, "--hybrid needs a .dps input and no --renderer (it is the renderer)");
     if ((o->method || !isnan(o->alpha_ref)) && !dps)
         return cli_usage_error(env, "--method and --alpha-ref need a .dps input (amgsplat build makes one)");
     if (o->method) {
@@ -119,7 +124,7 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
         return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o->depth_limit);
     d->lod_flags = o->cull_backfaces ? ASP_SPLAT_CULL_BACKFACES : 0u;
     d->depth_limit = (uint32_t)o->depth_limit;
-    d->renderer = o->renderer;
+    d->renderer = o->hybrid ? "hybrid" : o->renderer;
     d->amg_level = o->level;
     d->texture = o->texture;
     d->frames = o->frames;
@@ -179,6 +184,7 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         {"color", 0, CLI_STRING, &o.color, "MODE", ".amg: classifier (default), domains, strict or input"},
         {"level", 0, CLI_STRING, &o.level, "L", ".amg: level for domain colours: L, L-2 or an index (default L); .dps: level drawn (default the finest in the file)"},
         {"method", 0, CLI_STRING, &o.method, "NAME", ".dps: how primitives blend (default normalized; m cycles)"},
+        {"hybrid", 0, CLI_FLAG, &o.hybrid, NULL, ".dps: its source points where a primitive fails (docs/hybrid.md)"},
         {"alpha-ref", 0, CLI_DOUBLE, &o.alpha_ref, "X", ".dps: alpha reference, 0..1 (default 0.1; ',' '.' step it)"},
         {"texture", 0, CLI_STRING, &o.texture, "IMG", "mesh: texture of materials that name none or whose file is missing"},
         {"unlit", 0, CLI_FLAG, &o.unlit, NULL, "start with lighting off"},

@@ -53,7 +53,7 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_co
 
 #else
 
-enum { MAX_SIZES = 8, MAX_VIEWS = 256, MAX_FRAMES = 1000, MAX_REPS = 19, MAX_LEVELS = 64 };
+enum { MAX_SIZES = 8, MAX_VIEWS = 256, MAX_FRAMES = 1000, MAX_REPS = 20, MAX_LEVELS = 64 };
 
 /* asp_eval_row.bytes of a point: 12 position + 12 normal + 4 RGBA8 + 4 radius, as asp_cloud holds it */
 #define POINT_BYTES 32
@@ -66,7 +66,7 @@ enum { MAX_SIZES = 8, MAX_VIEWS = 256, MAX_FRAMES = 1000, MAX_REPS = 19, MAX_LEV
  * count (prim = 0, drawn by the shared splat renderer), or the level's domain
  * primitives drawn with one method (journal section 4, thesis 4.4).
  */
-enum rep_kind { REP_CUT, REP_PRIM, REP_MESH_TRIS, REP_MESH_BYTES, REP_FULL_DISCS, REP_FULL_SPLATS };
+enum rep_kind { REP_CUT, REP_PRIM, REP_MESH_TRIS, REP_MESH_BYTES, REP_FULL_DISCS, REP_FULL_SPLATS, REP_HYBRID };
 
 struct rep {
     char name[32];
@@ -109,6 +109,19 @@ static int create_prim(struct eval_state *s, const struct rep *rep, const asp_dp
     memcpy(src.origin, s->cloud->origin, sizeof src.origin);
     asp_renderer_options o = {.prim = {.method = rep->method, .crease_angle = s->crease_angle}};
     return prim->create(s->gl, &src, &o, s->ctx, out, err);
+}
+
+/* issue 18 item 3: the level's primitives where they hold, the cloud's points where they fail */
+static int create_hybrid(struct eval_state *s, const asp_dps_level *lv, asp_renderer **out, asp_error *err)
+{
+    const asp_renderer_kind *kind = NULL;
+    int rc = asp_renderer_kind_find("hybrid", 0, &kind, err);
+    if (rc)
+        return rc;
+    asp_render_source src = {.level = lv, .cloud = s->cloud};
+    memcpy(src.origin, s->cloud->origin, sizeof src.origin);
+    asp_renderer_options o = {.prim = {.crease_angle = s->crease_angle}};
+    return kind->create(s->gl, &src, &o, s->ctx, out, err);
 }
 
 static int create_mesh(struct eval_state *s, const asp_mesh *m, asp_renderer **out, asp_error *err)
@@ -220,8 +233,13 @@ static int measure(struct eval_state *s, const struct rep *rep, const asp_dps_le
         rc = create_prim(s, rep, lv, &r, err);
     else if (rep && rep->kind == REP_FULL_DISCS)
         r = s->disc;
+    else if (rep && rep->kind == REP_HYBRID)
+        rc = create_hybrid(s, lv, &r, err);
     if (rc)
         return rc;
+    asp_hybrid_counts hc = {0};
+    if (rep && rep->kind == REP_HYBRID)
+        (void)asp_hybrid_renderer_counts(r, &hc, NULL);
     int cut = r == s->splat;
     size_t target = lv ? lv->prim_count : mesh ? mesh->triangle_count : s->cloud->count;
     asp_render_desc rd = {.width = size, .height = size};
@@ -277,11 +295,14 @@ static int measure(struct eval_state *s, const struct rep *rep, const asp_dps_le
     row->primitives = target;
     row->drawn = drawn / (double)s->views;
     // splats have no texture
-    row->texels = mesh ? mesh_texels(mesh) : rep && rep->prim ? lv->texels : 0;
+    row->texels = mesh ? mesh_texels(mesh) : rep && (rep->prim || rep->kind == REP_HYBRID) ? lv->texels : 0;
     if (mesh)
         row->bytes = asp_mesh_gpu_bytes(mesh, NULL);
     else if (rep && rep->prim)
         row->bytes = asp_dps_level_gpu_bytes(lv, NULL);
+    else if (rep && rep->kind == REP_HYBRID)
+        // the whole level stays uploaded (its atlas is shared) plus every point drawn
+        row->bytes = asp_dps_level_gpu_bytes(lv, NULL) + (uint64_t)hc.points_drawn * POINT_BYTES;
     else
         row->bytes = (uint64_t)llround(row->drawn) * POINT_BYTES;
     row->psnr_mean = psnr_sum / (double)s->views;
@@ -315,8 +336,8 @@ static int check_desc(const asp_eval_desc *d, const uint32_t *sizes, size_t nsiz
         if (sizes[i] < 16 || sizes[i] > 2048)
             return asp_error_set(err, ASP_EINVAL, "image size %u is outside 16..2048", sizes[i]);
     // the reps: the point cut, the methods, and the two simplified meshes
-    if (d->methods && d->method_count > MAX_REPS - 3)
-        return asp_error_set(err, ASP_EINVAL, "at most %d rendering methods, got %zu", MAX_REPS - 3, d->method_count);
+    if (d->methods && d->method_count > MAX_REPS - 4)
+        return asp_error_set(err, ASP_EINVAL, "at most %d rendering methods, got %zu", MAX_REPS - 4, d->method_count);
     for (size_t i = 0; d->methods && i < d->method_count; i++)
         if (!asp_prim_render_method_name(d->methods[i]))
             return asp_error_set(err, ASP_EINVAL, "unknown rendering method %d", (int)d->methods[i]);
@@ -606,6 +627,8 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_co
         s.reps[s.nreps].kind = REP_PRIM;
         snprintf(s.reps[s.nreps].name, sizeof s.reps[s.nreps].name, "dp-%s", asp_prim_render_method_name(methods[i]));
     }
+    if (d.hybrid)
+        s.reps[s.nreps++] = (struct rep){.name = "hybrid", .kind = REP_HYBRID};
     if (d.mesh) {
         s.reps[s.nreps++] = (struct rep){.name = "mesh-tris", .kind = REP_MESH_TRIS};
         s.reps[s.nreps++] = (struct rep){.name = "mesh-bytes", .kind = REP_MESH_BYTES};

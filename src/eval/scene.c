@@ -114,14 +114,15 @@ static int load_amg(asp_scene *s, const asp_scene_desc *d, asp_error *err)
 }
 
 /* The source file a .dps names: as stored, then next to the .dps. Loads its points (world frame kept in origin). */
-static int load_dps_source_cloud(const asp_scene *s, asp_cloud **out, asp_error *err)
+/* given: a point file or .amg the caller names instead of the .dps's source (render --hybrid-points) */
+static int load_dps_source_cloud(const asp_scene *s, const char *given, asp_cloud **out, asp_error *err)
 {
-    const char *src = s->dps->source;
+    const char *src = given ? given : s->dps->source;
     if (!src[0])
         return asp_error_set(err, ASP_EUNSUPPORTED, "'%s' names no source file", s->path);
     char alt[1024] = "";
     const char *slash = strrchr(s->path, '/');
-    if (src[0] != '/' && slash)
+    if (!given && src[0] != '/' && slash)
         snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - s->path), s->path, src);
     const char *tries[2] = {src, alt};
     asp_error first = {0, ""};
@@ -157,7 +158,7 @@ static int load_dps_source_cloud(const asp_scene *s, asp_cloud **out, asp_error 
 static int frame_dps_fallback(asp_scene *s, asp_error *err)
 {
     asp_cloud *cloud = NULL;
-    if (load_dps_source_cloud(s, &cloud, NULL) == 0) {
+    if (load_dps_source_cloud(s, NULL, &cloud, NULL) == 0) {
         int rc = asp_cloud_frame(cloud, &s->frame, NULL);
         asp_cloud_destroy(cloud);
         if (!rc)
@@ -312,6 +313,14 @@ int asp_scene_load(const char *path, const asp_scene_desc *desc, const asp_conte
 
 int asp_scene_load_source(asp_scene *s, asp_error *err)
 {
+    return asp_scene_load_source_from(s, NULL, err);
+}
+
+int asp_scene_load_source_from(asp_scene *s, const char *path, asp_error *err)
+{
+    if (path && !s->dps)
+        return asp_error_set(err, ASP_EINVAL, "'%s' is not a .dps file: points '%s' have no primitives to join",
+                             s->path, path);
     if (!s->dps && !s->mesh)
         return asp_error_set(err, ASP_EINVAL, "'%s' is not a .dps file or a mesh: its points are drawn already",
                              s->path);
@@ -324,7 +333,7 @@ int asp_scene_load_source(asp_scene *s, asp_error *err)
         asp_sample_desc sd = {.method = ASP_SAMPLE_AREA, .points = ASP_SCENE_MESH_POINTS};
         rc = asp_sample_mesh(s->mesh, &sd, &s->ctx, &cloud, NULL, err);
     } else {
-        rc = load_dps_source_cloud(s, &cloud, err);
+        rc = load_dps_source_cloud(s, path, &cloud, err);
     }
     if (rc)
         return rc;

@@ -81,6 +81,12 @@ static int check_desc(const asp_prim_desc *d, asp_error *err)
                              d->enlarge);
     if (d->padding > 64)
         return asp_error_set(err, ASP_EINVAL, "atlas padding must be at most 64 texels, got %u", d->padding);
+    if (d->fill && d->normal_map)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "the texture fill of desc.fill (GPU) makes no normal maps; "
+                             "build the normal maps on the CPU");
+    if ((unsigned)d->strict > ASP_PRIM_DOMAINS_BOTH)
+        return asp_error_set(err, ASP_EINVAL, "unknown domain set %d (expected 0 thresholded, 1 strict, 2 both)",
+                             d->strict);
     if ((unsigned)d->method > ASP_PRIM_RADIAL || (unsigned)d->shape > ASP_PRIM_GAUSSIAN ||
         (unsigned)d->normalise > ASP_PRIM_NORM_GE1)
         return asp_error_set(err, ASP_EINVAL, "unknown texture method, shape or normalisation");
@@ -152,14 +158,11 @@ static void plan_one(const build_src *src, const asp_amg_csr *dom, const asp_pri
     L->t0 = mt - 0.5 * L->h * T;
 }
 
-/* Pass 2 for one domain: samples in texel units, then the texture into the atlas. */
-static void texture_one(const build_src *src, const asp_amg_csr *dom, const asp_prim_desc *d, const layout *L,
-                        const asp_prim *P, asp_image *atlas, asp_image *natlas, void *scratch)
+/* One domain's samples in texel units: x, y, footprint r and C attributes each (thesis 3.3). */
+static void project_samples(const build_src *src, const asp_amg_csr *dom, const asp_prim_desc *d, const layout *L,
+                            int C, float *x, float *y, float *r, float *attr)
 {
     size_t a = dom->row_ptr[L->row], n = dom->row_ptr[L->row + 1] - a;
-    int C = d->normal_map ? 7 : 4;
-    float *x = scratch, *y = x + n, *r = y + n, *attr = r + n;
-    size_t head = ((size_t)(3 + C) * n * sizeof(float) + 63) & ~(size_t)63;
     const asp_cloud *c = src->cloud;
     for (size_t k = 0; k < n; k++) {
         size_t p = dom->col[a + k];
@@ -177,13 +180,132 @@ static void texture_one(const build_src *src, const asp_amg_csr *dom, const asp_
             for (int j = 0; j < 3; j++)
                 o[4 + j] = c->normals ? c->normals[3 * p + (size_t)j] : (float)L->pl.n[j];
     }
-    asp__tex_input in = {.n = n, .x = x, .y = y, .r = r, .attr = attr, .channels = C, .w = L->w, .h = L->h,
-                         .method = d->method, .shape = d->shape, .normalise = d->normalise,
-                         .normalise_color = d->normalise_color,
-                         .extend_color = !d->no_extend_color};
+}
+
+static asp__tex_input tex_input(const asp_prim_desc *d, const layout *L, size_t n, int C, const float *x,
+                                const float *y, const float *r, const float *attr)
+{
+    return (asp__tex_input){.n = n, .x = x, .y = y, .r = r, .attr = attr, .channels = C, .w = L->w, .h = L->h,
+                            .method = d->method, .shape = d->shape, .normalise = d->normalise,
+                            .normalise_color = d->normalise_color, .extend_color = !d->no_extend_color};
+}
+
+/* Pass 2 for one domain: samples in texel units, then the texture into the atlas. */
+static void texture_one(const build_src *src, const asp_amg_csr *dom, const asp_prim_desc *d, const layout *L,
+                        const asp_prim *P, asp_image *atlas, asp_image *natlas, void *scratch)
+{
+    size_t n = dom->row_ptr[L->row + 1] - dom->row_ptr[L->row];
+    int C = d->normal_map ? 7 : 4;
+    float *x = scratch, *y = x + n, *r = y + n, *attr = r + n;
+    size_t head = ((size_t)(3 + C) * n * sizeof(float) + 63) & ~(size_t)63;
+    project_samples(src, dom, d, L, C, x, y, r, attr);
+    asp__tex_input in = tex_input(d, L, n, C, x, y, r, attr);
     size_t off = 4 * ((size_t)P->tex_y * atlas->width + P->tex_x);
     asp__prim_texture(&in, (uint8_t *)scratch + head, atlas->pixels + off, natlas ? natlas->pixels + off : NULL,
                       atlas->width);
+}
+
+/*
+ * Thesis 3.6: one batch of texture fills by an external builder (desc->fill, the GPU). The samples and
+ * the affine triangulation are made here as on the CPU path, the fill (the per-texel sums and the
+ * barycentric interpolation) there, and the normalisation, extend colour and encoding here again
+ * (asp__prim_texture_finish), so the two paths differ only in the fill.
+ */
+static int fill_batch(const build_src *src, const asp_amg_csr *dom, const asp_prim_desc *d, const layout *L,
+                      const asp_prim *P, size_t m, asp_image *atlas, const asp_context *ctx, asp_error *err)
+{
+    int threads = asp_context_threads(ctx), rc = 0;
+    size_t *sf = asp_calloc(ctx, 3 * (m + 1), sizeof *sf), *tf = sf ? sf + m + 1 : NULL, *trf = sf ? tf + m + 1 : NULL;
+    uint32_t *wh = asp_alloc(ctx, 2 * m * sizeof *wh);
+    if (!sf || !wh) {
+        asp_free(ctx, sf);
+        asp_free(ctx, wh);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for a texture batch of %zu primitives", m);
+    }
+    size_t max_n = 0;
+    for (size_t k = 0; k < m; k++) {
+        size_t n = dom->row_ptr[L[k].row + 1] - dom->row_ptr[L[k].row];
+        max_n = n > max_n ? n : max_n;
+        sf[k + 1] = sf[k] + n;
+        tf[k + 1] = tf[k] + (size_t)L[k].w * L[k].h;
+        wh[k] = L[k].w, wh[m + k] = L[k].h;
+    }
+    const size_t S = sf[m], T = tf[m];
+    size_t dscratch = (2 * max_n * sizeof(double) + (6 * max_n + 2) * sizeof(uint32_t) +
+                       asp_delaunay2d_scratch_size(max_n) + 63) & ~(size_t)63;
+    float *xyr = asp_alloc(ctx, 7 * S * sizeof *xyr), *acc = asp_calloc(ctx, 5 * T, sizeof *acc);
+    uint32_t *tri = d->method == ASP_PRIM_AFFINE ? asp_alloc(ctx, (6 * S + 1) * sizeof *tri) : NULL;
+    uint8_t *covered = asp_calloc(ctx, T, 1);
+    int32_t *seed = asp_alloc(ctx, T * sizeof *seed);
+    uint8_t *ds = d->method == ASP_PRIM_AFFINE ? asp_alloc(ctx, (size_t)threads * dscratch) : NULL;
+    if (!xyr || !acc || !covered || !seed || (d->method == ASP_PRIM_AFFINE && (!tri || !ds))) {
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for a texture batch of %zu texels", T);
+        goto done;
+    }
+    float *x = xyr, *y = x + S, *r = y + S, *attr = r + S, *f = acc + 4 * T;
+    long lm = (long)m;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long k = 0; k < lm; k++) {
+        size_t a = sf[k], n = sf[k + 1] - a;
+        project_samples(src, dom, d, &L[k], 4, x + a, y + a, r + a, attr + 4 * a);
+        if (d->method != ASP_PRIM_AFFINE)
+            continue;
+        int tid = 0;
+#ifdef _OPENMP
+        tid = omp_get_thread_num();
+#endif
+        asp__tex_input in = tex_input(d, &L[k], n, 4, x + a, y + a, r + a, attr + 4 * a);
+        uint32_t *kept = NULL;
+        size_t nt = asp__prim_affine_triangles(&in, ds + (size_t)tid * dscratch, &kept);
+        for (size_t q = 0; q < 3 * nt; q++)
+            tri[6 * a + q] = kept[q] + (uint32_t)a; // global sample indices
+        trf[k + 1] = nt;
+    }
+    if (d->method == ASP_PRIM_AFFINE)
+        for (size_t k = 0; k < m; k++) { // compact: each primitive's triangles start at 6 sf[k] >= 3 trf[k]
+            size_t nt = trf[k + 1];
+            trf[k + 1] = trf[k] + nt;
+            memmove(&tri[3 * trf[k]], &tri[6 * sf[k]], 3 * nt * sizeof *tri);
+        }
+    asp_prim_fill_batch b = {.prim_count = m, .sample_first = sf, .texel_first = tf, .tri_first = trf, .w = wh,
+                             .h = wh + m, .x = x, .y = y, .r = r, .attr = attr, .tri = tri, .method = (int)d->method,
+                             .shape = (int)d->shape};
+    if ((rc = d->fill(d->fill_user, &b, acc, f, covered, err)) != 0)
+        goto done;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long k = 0; k < lm; k++) {
+        size_t a = sf[k], t = tf[k];
+        asp__tex_input in = tex_input(d, &L[k], sf[k + 1] - a, 4, x + a, y + a, r + a, attr + 4 * a);
+        asp__prim_texture_finish(&in, acc + 4 * t, f + t, covered + t, seed + t,
+                                 atlas->pixels + 4 * ((size_t)P[k].tex_y * atlas->width + P[k].tex_x), NULL,
+                                 atlas->width);
+    }
+done:
+    asp_free(ctx, sf);
+    asp_free(ctx, wh);
+    asp_free(ctx, xyr);
+    asp_free(ctx, acc);
+    asp_free(ctx, tri);
+    asp_free(ctx, covered);
+    asp_free(ctx, seed);
+    asp_free(ctx, ds);
+    return rc;
+}
+
+/* The level's textures through desc->fill, in batches of about 4 M texels (a primitive larger than that
+ * alone), which bounds the batch's buffers here and on the device. */
+static int fill_external(const build_src *src, const asp_amg_csr *dom, const asp_prim_desc *d, const layout *L,
+                         asp_dps_level *lv, size_t np, const asp_context *ctx, asp_error *err)
+{
+    enum { BATCH_TEXELS = 1 << 22 };
+    int rc = 0;
+    for (size_t k0 = 0, k1; k0 < np && !rc; k0 = k1) {
+        size_t texels = 0;
+        for (k1 = k0; k1 < np && (k1 == k0 || texels + (size_t)L[k1].w * L[k1].h <= BATCH_TEXELS); k1++)
+            texels += (size_t)L[k1].w * L[k1].h;
+        rc = fill_batch(src, dom, d, L + k0, lv->prims + k0, k1 - k0, &lv->atlas, ctx, err);
+    }
+    return rc;
 }
 
 static size_t scratch_bytes(size_t n, size_t texels, int C)
@@ -294,13 +416,18 @@ static int construct(const build_src *src, const asp_amg_csr *dom, const uint32_
         P->tex_x = x[k], P->tex_y = y[k], P->tex_w = l->w, P->tex_h = l->h;
     }
     asp_image *natlas = d->normal_map ? &lv->normal_atlas : NULL;
+    if (d->fill) {
+        if ((rc = fill_external(src, dom, d, L, lv, np, ctx, err)) != 0)
+            goto done;
+    } else {
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (long k = 0; k < lnp; k++) {
-        int tid = 0;
+        for (long k = 0; k < lnp; k++) {
+            int tid = 0;
 #ifdef _OPENMP
-        tid = omp_get_thread_num();
+            tid = omp_get_thread_num();
 #endif
-        texture_one(src, dom, d, &L[k], &lv->prims[k], &lv->atlas, natlas, scratch + (size_t)tid * max_t);
+            texture_one(src, dom, d, &L[k], &lv->prims[k], &lv->atlas, natlas, scratch + (size_t)tid * max_t);
+        }
     }
     asp__atlas_pad(&lv->atlas, lv->prims, np, d->padding);
     if (natlas)
@@ -359,11 +486,12 @@ static int build_level(const asp_amg *amg, const build_src *src, size_t level, c
     uint32_t *bfirst = NULL, *bcount = NULL;
     int rc = asp_amg_basis(amg, level, ctx, &psi, err);
     if (!rc)
-        rc = d->strict ? asp_amg_strict_domain_rows(psi, ctx, &dom, err) : asp_amg_domains(psi, d->tau, ctx, &dom, err);
+        rc = d->strict == ASP_PRIM_DOMAINS_STRICT ? asp_amg_strict_domain_rows(psi, ctx, &dom, err) : asp_amg_domains(psi, d->tau, ctx, &dom, err);
     asp_amg_csr_destroy(psi);
     if (rc)
         return rc;
     lv->level = (uint32_t)level;
+    lv->strict = d->strict == ASP_PRIM_DOMAINS_STRICT;
     lv->basis_count = (uint32_t)dom->rows;
     lv->t_basis = asp_time_now() - t0;
     double t1 = asp_time_now();
@@ -446,6 +574,7 @@ int asp_prim_build_level(const asp_cloud *cloud, const asp_amg_csr *dom, const a
     rc = prepare_src(&src, ctx, &own, err);
     if (!rc) {
         lv.basis_count = (uint32_t)dom->rows;
+        lv.strict = d.strict == ASP_PRIM_DOMAINS_STRICT;
         rc = construct(&src, dom, NULL, NULL, &d, "of explicit domains", ctx, &lv, err);
         lv.t_construct = asp_time_now() - t0;
     }
@@ -510,17 +639,22 @@ int asp_prim_build(const asp_amg *amg, const asp_cloud *attrs, const size_t *lev
     src.radii = attrs && attrs->radii ? attrs->radii : cloud->radii;
     if ((rc = prepare_src(&src, ctx, &own_radii, err)))
         goto fail;
-    dps->levels = asp_calloc(ctx, nu, sizeof *dps->levels);
+    // Domain Set both (thesis appendix C): each level twice, thresholded then strict
+    const size_t sets = d.strict == ASP_PRIM_DOMAINS_BOTH ? 2 : 1;
+    dps->levels = asp_calloc(ctx, nu * sets, sizeof *dps->levels);
     if (!dps->levels) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory");
         goto fail;
     }
-    for (size_t i = 0; i < nu; i++) {
-        if ((rc = asp_progress(ctx, "primitives", (double)i / (double)nu))) {
+    for (size_t i = 0; i < nu * sets; i++) {
+        if ((rc = asp_progress(ctx, "primitives", (double)i / (double)(nu * sets)))) {
             asp_error_set(err, rc, "primitive construction canceled");
             goto fail;
         }
-        rc = build_level(amg, &src, lv_sorted[i], &d, ctx, &dps->levels[dps->level_count], err);
+        asp_prim_desc di = d;
+        if (sets == 2)
+            di.strict = (int)(i % 2);
+        rc = build_level(amg, &src, lv_sorted[i / sets], &di, ctx, &dps->levels[dps->level_count], err);
         if (rc == ASP_EDEGENERATE) {
             dps->skipped_levels++;
             continue;
@@ -538,6 +672,7 @@ int asp_prim_build(const asp_amg *amg, const asp_cloud *attrs, const size_t *lev
     dps->source_points = n;
     dps->mean_radius = src.mean_radius;
     dps->desc = d;
+    dps->desc.fill = NULL, dps->desc.fill_user = NULL; // the builder is the caller's, not a parameter of the file
     snprintf(dps->source, sizeof dps->source, "%s", source ? source : "");
     dps->frame = *asp_amg_frame(amg);
     *out = dps;

@@ -64,6 +64,15 @@ size_t asp__prim_texture_scratch(size_t n, size_t texels, int channels);
  */
 void asp__prim_texture(const asp__tex_input *in, void *scratch, uint8_t *rgba, uint8_t *nrm, size_t stride);
 
+/*
+ * The texture's second half, after the fill (affine interpolation into acc with covered[t] = 1, radial
+ * sums into acc and f): normalisation (eq. 3.3 / 3.4), extend colour (3.3.4, seed holds w*h int32) and
+ * the RGBA8 encoding. acc and f are changed. The GPU build fills acc, f, covered on the device (thesis
+ * 3.6) and finishes here, so both builds share this code.
+ */
+void asp__prim_texture_finish(const asp__tex_input *in, float *acc, float *f, const uint8_t *covered, int32_t *seed,
+                              uint8_t *rgba, uint8_t *nrm, size_t stride);
+
 /* Radial pass: adds phi-weighted attributes to acc (texels x channels) and phi to f, skipping texels with
  * skip[t] != 0 when skip is not NULL (thesis 3.3.2; 3.3.3 outside the triangulation). nearest: evaluate
  * phi at the texel's point nearest the sample, so the texel holding a point gets its full weight. */
@@ -72,6 +81,10 @@ void asp__prim_splat_radial(const asp__tex_input *in, asp_prim_shape shape, cons
 /* Affine pass: barycentric interpolation inside the kept Delaunay triangles; sets covered[t] = 1.
  * Returns 0, or -1 when there were too few distinct points for a triangle. */
 void asp__prim_affine(const asp__tex_input *in, void *scratch, float *acc, uint8_t *covered);
+/* The kept Delaunay triangles of the affine pass (edges no longer than their vertices' radii summed,
+ * thesis Fig. 3.8), as sample index triples in *tri (inside scratch); returns their number. scratch as for
+ * asp__prim_affine (the xy doubles stay at its start). */
+size_t asp__prim_affine_triangles(const asp__tex_input *in, void *scratch, uint32_t **tri);
 /* Extend colour (thesis 3.3.4): texels with f == 0 get the colour of the (approximately) nearest point. */
 void asp__prim_extend_color(const asp__tex_input *in, const float *f, int32_t *seed, float *acc);
 

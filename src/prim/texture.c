@@ -49,17 +49,27 @@ void asp__prim_texture(const asp__tex_input *in, void *scratch, uint8_t *rgba, u
     memset(f, 0, T * sizeof(float));
     memset(covered, 0, T);
 
-    asp_prim_normalise crit = in->normalise;
     if (in->method == ASP_PRIM_AFFINE) {
         asp__prim_affine(in, s, acc, covered);
         /* outside the triangulation: radial linear within a point's radius; alpha fades (eq. 3.3) */
         asp__prim_splat_radial(in, ASP_PRIM_LINEAR, covered, 1, acc, f);
+    } else {
+        asp__prim_splat_radial(in, in->shape, NULL, 0, acc, f);
+    }
+    asp__prim_texture_finish(in, acc, f, covered, seed, rgba, nrm, stride);
+}
+
+void asp__prim_texture_finish(const asp__tex_input *in, float *acc, float *f, const uint8_t *covered, int32_t *seed,
+                              uint8_t *rgba, uint8_t *nrm, size_t stride)
+{
+    const size_t T = (size_t)in->w * in->h;
+    const int C = in->channels;
+    asp_prim_normalise crit = in->normalise;
+    if (in->method == ASP_PRIM_AFFINE) {
         for (size_t t = 0; t < T; t++)
             if (covered[t])
                 f[t] = 1.0f; /* acc already holds the interpolated values */
         crit = ASP_PRIM_NORM_GE1;
-    } else {
-        asp__prim_splat_radial(in, in->shape, NULL, 0, acc, f);
     }
     for (size_t t = 0; t < T; t++) {
         if (!(f[t] > 0) || covered[t])

@@ -10,10 +10,9 @@
 #include "prim/internal.h"
 #include "util/banned.h"
 
-void asp__prim_affine(const asp__tex_input *in, void *scratch, float *acc, uint8_t *covered)
+size_t asp__prim_affine_triangles(const asp__tex_input *in, void *scratch, uint32_t **tri_out)
 {
     const size_t n = in->n;
-    const int C = in->channels;
     double *xy = scratch;
     uint32_t *tri = (uint32_t *)(xy + 2 * n);
     void *dts = tri + 3 * asp_delaunay2d_bound(n) + (3 * asp_delaunay2d_bound(n) & 1); /* keep 8-byte alignment */
@@ -21,10 +20,9 @@ void asp__prim_affine(const asp__tex_input *in, void *scratch, float *acc, uint8
         xy[2 * p] = in->x[p];
         xy[2 * p + 1] = in->y[p];
     }
-    size_t nt = n >= 3 ? asp_delaunay2d(xy, n, tri, dts) : 0;
+    size_t nt = n >= 3 ? asp_delaunay2d(xy, n, tri, dts) : 0, kept = 0;
     for (size_t t = 0; t < nt; t++) {
-        const uint32_t a = tri[3 * t], b = tri[3 * t + 1], c = tri[3 * t + 2];
-        const uint32_t v[3] = {a, b, c};
+        const uint32_t v[3] = {tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]};
         int keep = 1;
         for (int e = 0; e < 3 && keep; e++) {
             uint32_t p = v[e], q = v[(e + 1) % 3];
@@ -32,8 +30,23 @@ void asp__prim_affine(const asp__tex_input *in, void *scratch, float *acc, uint8
             double lim = (double)in->r[p] + (double)in->r[q];
             keep = dx * dx + dy * dy <= lim * lim;
         }
-        if (!keep)
-            continue;
+        if (keep)
+            for (int e = 0; e < 3; e++)
+                tri[3 * kept + (size_t)e] = v[e];
+        kept += (size_t)keep;
+    }
+    *tri_out = tri;
+    return kept;
+}
+
+void asp__prim_affine(const asp__tex_input *in, void *scratch, float *acc, uint8_t *covered)
+{
+    const int C = in->channels;
+    uint32_t *tri = NULL;
+    size_t nt = asp__prim_affine_triangles(in, scratch, &tri);
+    const double *xy = scratch;
+    for (size_t t = 0; t < nt; t++) {
+        const uint32_t a = tri[3 * t], b = tri[3 * t + 1], c = tri[3 * t + 2];
         double ax = xy[2 * a], ay = xy[2 * a + 1], bx = xy[2 * b], by = xy[2 * b + 1], cx = xy[2 * c],
                cy = xy[2 * c + 1];
         double area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);

@@ -106,6 +106,7 @@ typedef struct asp__prim_renderer {
     asp__gl_vertex_array empty_vao;    /* the resolve triangle */
     GLuint atlas, normal_atlas;  /* textures */
     asp__prim_targets t;
+    struct asp__prim_debug *debug; /* debug drawings (prim_debug.c), made on first use */
 } asp__prim_renderer;
 
 extern const asp__renderer_vtable asp__prim_vtable;
@@ -131,7 +132,26 @@ int asp__prim_draw_instances(asp__prim_renderer *r, const asp__frame *f, const f
 int asp__prim_creases(const asp_dps_level *lv, const double origin[3], const asp_context *ctx, uint32_t *first,
                       uint32_t *count, float **entries, size_t *total, asp_error *err);
 
+/*
+ * The hybrid renderer's access (hybrid_renderer.c). keep writes the ids of
+ * the primitives not replaced (replaced: count flags) to the draw order once
+ * and returns how many; the crease records stay those of the whole level, so
+ * a kept primitive is still cut by the plane of a replaced neighbour. begin
+ * sets the frame's uniforms (opacity 1, texture colours); pass binds r's
+ * buffers and textures and draws the kept front-facing primitives into the
+ * bound framebuffer with the caller's depth and blend state: depth_only 1
+ * writes the alpha-tested depth pushed back by the depth window along the eye
+ * rays, 0 adds (colour x alpha, alpha) of every fragment.
+ */
+size_t asp__prim_hybrid_keep(asp__prim_renderer *r, const uint8_t *replaced);
+void asp__prim_hybrid_begin(asp__prim_renderer *r, const asp__frame *f);
+void asp__prim_hybrid_pass(asp__prim_renderer *r, size_t kept, int depth_only);
+
 /* Frees the offscreen targets. */
 void asp__prim_targets_release(asp__prim_targets *t);
+
+/* Thesis appendix C debug drawings (ASP_PRIM_RENDER_DEBUG_*) over the current draw framebuffer; prim_debug.c. */
+int asp__prim_debug_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err);
+void asp__prim_debug_destroy(asp__prim_renderer *r);
 
 #endif

@@ -525,6 +525,56 @@ int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err)
     return asp__gl_check(gl, "draw domain primitives", err);
 }
 
+/*
+ * For the hybrid renderer (hybrid_renderer.c), which blends these primitives
+ * with point splats in its own normalised accumulation: the two passes of
+ * the normalised sum as the two-pass form (thesis 4.4.2) draws them, into
+ * whatever framebuffer and depth/blend state the caller set.
+ */
+void asp__prim_hybrid_begin(asp__prim_renderer *r, const asp__frame *f)
+{
+    set_uniforms(r, f);
+    GLuint mp = r->programs[ASP__PROG_MAIN].id;
+    // the weights are divided later, by the hybrid's resolve
+    glProgramUniform1f(mp, r->uniforms[ASP__PROG_MAIN][PU_TRANSPARENCY], 1.0f);
+    glProgramUniform1i(mp, r->uniforms[ASP__PROG_MAIN][PU_DOMAIN_COLORS], 0);
+}
+
+size_t asp__prim_hybrid_keep(asp__prim_renderer *r, const uint8_t *replaced)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < r->count; i++)
+        if (!replaced[i])
+            r->order[n++] = (uint32_t)i;
+    // the hybrid always draws the normalised sums, which never rewrite the order buffer
+    if (n)
+        glNamedBufferSubData(r->order_buffer.id, 0, (GLsizeiptr)(n * sizeof(uint32_t)), r->order);
+    return n;
+}
+
+void asp__prim_hybrid_pass(asp__prim_renderer *r, size_t kept, int depth_only)
+{
+    if (kept == 0)
+        return;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_PRIMS, r->prim_buffer.id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_NEIGHBOURS, r->neighbour_buffer.id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__PRIM_BIND_CLIPS, r->clip_buffer.id);
+    glBindTextureUnit(ASP__PRIM_UNIT_ATLAS, r->atlas);
+    glBindTextureUnit(ASP__PRIM_UNIT_NORMALS, r->normal_atlas ? r->normal_atlas : r->atlas);
+    // back faces culled, as in normalized (draw_normalized explains why)
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    if (depth_only)
+        depth_pass(r, ASP__PROG_DEPTH, r->opt.depth_window, r->opt.alpha_ref);
+    else
+        main_pass(r, ASP__PASS_ADD);
+    glBindVertexArray(r->vao.id);
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)kept);
+    glDisable(GL_CULL_FACE);
+    glBindTextureUnit(ASP__PRIM_UNIT_ATLAS, 0);
+    glBindTextureUnit(ASP__PRIM_UNIT_NORMALS, 0);
+}
+
 /* Sort key of an instance: its frame's origin distance from the eye (the model's translation). */
 typedef struct instance_key {
     float d2;

@@ -112,7 +112,8 @@ static int check_options(const asp_prim_render_options *o, asp_error *err)
         return asp_error_set(err, ASP_EINVAL, "unknown rendering method %d (expected 0..%d)", (int)o->method,
                              METHOD_COUNT - 1);
     unsigned known = ASP_PRIM_RENDER_OUTLINE | ASP_PRIM_RENDER_COLOR_BY_DOMAIN | ASP_PRIM_RENDER_NO_NORMAL_MAP |
-                     ASP_PRIM_RENDER_OVERLAP_BACKFACES;
+                     ASP_PRIM_RENDER_OVERLAP_BACKFACES | ASP_PRIM_RENDER_DEBUG_EIGENVECTORS | ASP_PRIM_RENDER_DEBUG_TEXELS |
+                     ASP_PRIM_RENDER_DEBUG_TRIANGULATION;
     if (o->flags & ~known)
         return asp_error_set(err, ASP_EINVAL, "unknown primitive rendering flags 0x%x", o->flags & ~known);
     if (isnan(o->alpha_ref) || o->alpha_ref > 1)
@@ -219,6 +220,7 @@ static void prim_destroy(asp_renderer *base)
 {
     asp__prim_renderer *r = (asp__prim_renderer *)base;
     asp__prim_targets_release(&r->t);
+    asp__prim_debug_destroy(r);
     for (int i = 0; i < ASP__PROG_COUNT; i++)
         asp__gl_program_destroy(&r->programs[i]);
     GLuint bufs[5] = {r->prim_buffer.id, r->neighbour_buffer.id, r->order_buffer.id, r->identity_buffer.id,
@@ -244,7 +246,12 @@ static void prim_destroy(asp_renderer *base)
 
 static int prim_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
 {
-    return asp__prim_draw((asp__prim_renderer *)base, f, err);
+    asp__prim_renderer *r = (asp__prim_renderer *)base;
+    int rc = asp__prim_draw(r, f, err);
+    if (!rc && (r->opt.flags & (ASP_PRIM_RENDER_DEBUG_EIGENVECTORS | ASP_PRIM_RENDER_DEBUG_TEXELS |
+                                ASP_PRIM_RENDER_DEBUG_TRIANGULATION)))
+        rc = asp__prim_debug_draw(r, f, err); // thesis appendix C: over the method's image
+    return rc;
 }
 
 static int prim_draw_instances(asp_renderer *base, const asp__frame *f, const float *models, size_t count,

@@ -3,7 +3,8 @@
  * by name here instead of each keeping a list. Rows: opaque discs (Pajarola
  * et al. 2003 section 5), blended splats and squares of the point hierarchy
  * (seed 001 section 5, seed 004 3.2.6), the domain primitives of a .dps level
- * (journal section 4), textured triangle meshes (seed 004 2.2-2.3).
+ * (journal section 4), textured triangle meshes (seed 004 2.2-2.3), and the hybrid of a
+ * level's primitives and its points (issue 18, docs/hybrid.md).
  */
 #include <stdio.h>
 #include <string.h>
@@ -80,12 +81,31 @@ static int make_mesh(asp_gl_context *gl, const asp_render_source *src, const asp
     return asp_mesh_renderer_create(gl, src->mesh, &d, out, err);
 }
 
+/* issue 18 item 3: the level's primitives where they hold, its source points where they fail */
+static int make_hybrid(asp_gl_context *gl, const asp_render_source *src, const asp_renderer_options *o,
+                       const asp_context *ctx, asp_renderer **out, asp_error *err)
+{
+    if (!src->level || !src->cloud)
+        return asp_error_set(err, ASP_EUNSUPPORTED,
+                             "renderer 'hybrid' draws domain primitives and their source points (a .dps input "
+                             "with its point file)");
+    asp_hybrid_desc d = o ? o->hybrid : (asp_hybrid_desc){0};
+    const asp_prim_render_options *p = &d.prim;
+    // callers that set only the primitives' options (eval, the viewer) get them for the hybrid too
+    if (o && p->method == 0 && p->alpha_ref == 0 && p->transparency == 0 && p->depth_window == 0 && p->flags == 0 &&
+        p->crease_angle == 0)
+        d.prim = o->prim;
+    memcpy(d.origin, src->origin, sizeof d.origin);
+    return asp_hybrid_renderer_create(gl, src->level, src->cloud, &d, ctx, out, err);
+}
+
 static const asp_renderer_kind kinds[] = {
     {"disc", "points", ASP_RENDER_INPUT_POINTS, 0, make_disc},
     {"splat", "splats", ASP_RENDER_INPUT_POINTS, 1, make_splat},
     {"square", "splats", ASP_RENDER_INPUT_POINTS, 1, make_square},
     {"prim", "primitives", ASP_RENDER_INPUT_PRIMS, 0, make_prim},
     {"mesh", "triangles", ASP_RENDER_INPUT_MESH, 0, make_mesh},
+    {"hybrid", "primitives and splats", ASP_RENDER_INPUT_PRIMS, 0, make_hybrid},
 };
 enum { N_KINDS = sizeof kinds / sizeof kinds[0] };
 

@@ -75,6 +75,15 @@ typedef struct asp__lod_renderer {
 extern const asp__renderer_vtable asp__splat_vtable;
 extern const asp__renderer_vtable asp__square_vtable;
 
+/*
+ * The hybrid renderer's access to a splat renderer r (hybrid_renderer.c):
+ * select cuts the hierarchy for f (asp__lod_select); pass draws the cut into
+ * the bound framebuffer with the caller's depth and blend state: depth_only 1
+ * the epsilon-offset depth (seed 001 5.3), 0 the sums (psi c, psi) of eq. 10.
+ */
+int asp__splat_hybrid_select(asp_renderer *r, const asp__frame *f, asp_error *err);
+void asp__splat_hybrid_pass(asp_renderer *r, const asp__frame *f, int depth_only);
+
 /* r as a hierarchy renderer, or NULL for other kinds. */
 asp__lod_renderer *asp__lod_renderer_of(asp_renderer *r);
 

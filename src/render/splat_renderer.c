@@ -807,3 +807,31 @@ int asp_splat_renderer_create_hier(asp_gl_context *gl, const asp_hier *hier, con
 {
     return create(gl, NULL, hier, NULL, desc, out, err);
 }
+
+/*
+ * For the hybrid renderer (hybrid_renderer.c): the first two passes of
+ * draw_blended into the caller's framebuffer and state, so its primitives
+ * and these splats share one accumulation and one division.
+ */
+int asp__splat_hybrid_select(asp_renderer *r, const asp__frame *f, asp_error *err)
+{
+    ASP_ASSERT(r->vt == &asp__splat_vtable);
+    return asp__lod_select((asp__lod_renderer *)r, f, err);
+}
+
+void asp__splat_hybrid_pass(asp_renderer *r, const asp__frame *f, int depth_only)
+{
+    splat_renderer *s = (splat_renderer *)r;
+    if (s->lod.count == 0)
+        return;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_SPLATS, s->lod.splats.id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_IDS, s->lod.ids.id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_CONES, s->lod.cones.id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_CLIPS, s->clips.id);
+    int prog = depth_only ? PROG_DEPTH : PROG_BLEND;
+    set_frame_uniforms(s, prog, f, depth_only ? s->epsilon : 0.0f, 0);
+    // the shared resolve lights nothing: per-pixel lighting falls back to Gouraud
+    if (lighting_code(s, f) == 1)
+        glProgramUniform1i(s->programs[prog].id, s->uniforms[prog][U_LIGHTING], 0);
+    draw_splats(s, prog);
+}

@@ -125,5 +125,8 @@ void asp__viewer_instances_status(const asp_instance_scene *is, char *status, si
 
 /* Title text for the scene, e.g. "domains, level 3 (L-2), 40 domains" or "level 2 (L-1)"; "" for points. */
 void asp__viewer_scene_status(const asp_scene *s, char *status, size_t cap);
+/* .dps: switches to the other domain set's level (thesis appendix C "Domain Set"; a file built with
+ * --domains both). Returns 1 when the level changed, 0 with a note. */
+int asp__viewer_scene_domain_set(asp_scene *s, char *note, size_t cap);
 
 #endif

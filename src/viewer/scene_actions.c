@@ -5,6 +5,7 @@
  * .dps domain primitives (journal section 4) one level at a time, with their
  * source points loaded on demand.
  */
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -40,7 +41,8 @@ void asp__viewer_scene_status(const asp_scene *s, char *status, size_t cap)
     } else if (s->dps) {
         char name[16];
         asp_dps_level_name(s->dps, s->dps_level, name);
-        snprintf(status, cap, "level %u (%s)", s->dps->levels[s->dps_level].level, name);
+        const asp_dps_level *lv = &s->dps->levels[s->dps_level];
+        snprintf(status, cap, "level %u (%s)%s", lv->level, name, lv->strict ? ", strict domains" : "");
     }
 }
 
@@ -107,22 +109,47 @@ static int amg_action(asp_scene *s, enum asp__viewer_action act, char *note, siz
     return rc ? rc : 1;
 }
 
+/* The next level of the same domain set (thesis appendix C "Domain Set") towards dir; SIZE_MAX if none. */
+static size_t step_in_set(const asp_dps *dps, size_t from, int dir)
+{
+    for (size_t i = from; dir < 0 ? i-- > 0 : ++i < dps->level_count;)
+        if ((dps->levels[i].strict != 0) == (dps->levels[from].strict != 0))
+            return i;
+    return SIZE_MAX;
+}
+
+int asp__viewer_scene_domain_set(asp_scene *s, char *note, size_t cap)
+{
+    if (!s->dps) {
+        snprintf(note, cap, "the domain set applies to .dps input only");
+        return 0;
+    }
+    asp_error e = {0, ""};
+    int strict = !s->dps->levels[s->dps_level].strict;
+    if (asp_dps_domain_set_pick(s->dps, s->dps_level, strict, &s->dps_level, &e)) {
+        snprintf(note, cap, "%s", e.msg);
+        return 0;
+    }
+    return 1;
+}
+
 static int dps_action(asp_scene *s, enum asp__viewer_action act, char *note, size_t cap, asp_error *err)
 {
+    size_t next;
     switch (act) {
     case ASP__VIEWER_LEVEL_FINER:
-        if (s->dps_level == 0) {
-            snprintf(note, cap, "already at the finest level in the file (%u)", s->dps->levels[0].level);
+        if ((next = step_in_set(s->dps, s->dps_level, -1)) == SIZE_MAX) {
+            snprintf(note, cap, "already at the finest level in the file (%u)", s->dps->levels[s->dps_level].level);
             return 0;
         }
-        s->dps_level--;
+        s->dps_level = next;
         return 1;
     case ASP__VIEWER_LEVEL_COARSER:
-        if (s->dps_level + 1 >= s->dps->level_count) {
+        if ((next = step_in_set(s->dps, s->dps_level, +1)) == SIZE_MAX) {
             snprintf(note, cap, "already at the coarsest level in the file (%u)", s->dps->levels[s->dps_level].level);
             return 0;
         }
-        s->dps_level++;
+        s->dps_level = next;
         return 1;
     case ASP__VIEWER_POINTS: {
         if (s->cloud)

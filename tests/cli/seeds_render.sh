@@ -58,7 +58,7 @@ ASAN_OPTIONS="$mpi_asan" "$A" build "$T/o.amg" -o "$T/s.dps" --level L-2 --domai
 "$A" render "$T/o.ply" -o "$T/sp.png" --renderer splat --tolerance 0 "${R[@]}"
 "$A" imgdiff "$T/sd.png" "$T/sp.png" --json | python3 -c "import json,sys; d=json.load(sys.stdin); assert d['iou'] > 0.9, d" \
   || fail "strict primitives do not cover the points' silhouette"
-ASAN_OPTIONS="$mpi_asan" expect_fail 2 "--domains expects thresholded or strict" "$A" build "$T/o.amg" -o "$T/x.dps" --domains fuzzy
+ASAN_OPTIONS="$mpi_asan" expect_fail 2 "--domains expects thresholded, strict or both" "$A" build "$T/o.amg" -o "$T/x.dps" --domains fuzzy
 
 # overlap with back-facing neighbours (journal Fig. 10's pseudocode): an open sheet folded at x = 0
 # (a face z = 0 and a face z = 2x rising towards the eye) seen from azimuth 40: the fold's second face
