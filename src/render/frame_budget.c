@@ -1,0 +1,105 @@
+/*
+ * A frame budget (issue 18 item 5): the screen tolerance tau that holds a
+ * target frame time, set each frame from the last frame's time by integral
+ * control on log tau (seed 001 5.1: tau decides how deep the hierarchy is
+ * traversed), with seed 004 section 3.2.5's adaptive traversal depth (Fig.
+ * 3.5) as the fallback once tau is as coarse as it may get. No GL.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "render/internal.h"
+#include "util/banned.h"
+
+/* Depth steps wait this many frames, so the frames after one step show its effect before the next. */
+enum { DEPTH_HOLD = 2 };
+
+int asp_frame_budget_init(asp_frame_budget *b, const asp_frame_budget_desc *desc, asp_error *err)
+{
+    ASP_ASSERT(b && desc);
+    asp_frame_budget_desc d = *desc;
+    if (!(d.target_ms > 0) || !isfinite(d.target_ms))
+        return asp_error_set(err, ASP_EINVAL, "frame budget %g ms is not a time > 0", d.target_ms);
+    d.tolerance_min = d.tolerance_min == 0 ? 0.25f : d.tolerance_min;
+    d.tolerance_max = d.tolerance_max == 0 ? 256.0f : d.tolerance_max;
+    d.tolerance = d.tolerance == 0 ? 4.0f : d.tolerance;
+    d.gain = d.gain == 0 ? 0.35f : d.gain;
+    d.deadband = d.deadband == 0 ? 0.05f : d.deadband < 0 ? 0.0f : d.deadband;
+    d.max_step = d.max_step == 0 ? 2.0f : d.max_step;
+    if (!(d.tolerance_min > 0) || !(d.tolerance_max >= d.tolerance_min) || !isfinite(d.tolerance_max))
+        return asp_error_set(err, ASP_EINVAL, "frame budget tolerance range [%g, %g] px is invalid (need 0 < min <= max)",
+                             (double)d.tolerance_min, (double)d.tolerance_max);
+    if (!(d.tolerance > 0) || !isfinite(d.tolerance))
+        return asp_error_set(err, ASP_EINVAL, "frame budget start tolerance %g px is not > 0", (double)d.tolerance);
+    if (!(d.gain > 0 && d.gain <= 1))
+        return asp_error_set(err, ASP_EINVAL, "frame budget gain %g is outside (0, 1]", (double)d.gain);
+    if (!(d.deadband < 1))
+        return asp_error_set(err, ASP_EINVAL, "frame budget dead band %g is not < 1", (double)d.deadband);
+    if (!(d.max_step > 1) || !isfinite(d.max_step))
+        return asp_error_set(err, ASP_EINVAL, "frame budget step %g is not a factor > 1", (double)d.max_step);
+    memset(b, 0, sizeof *b);
+    b->desc = d;
+    b->tolerance = fminf(fmaxf(d.tolerance, d.tolerance_min), d.tolerance_max);
+    return 0;
+}
+
+/* Too slow at the coarsest tau: one level shallower (seed 004 Fig. 3.5, "decrement k_0"). */
+static int depth_coarser(asp_frame_budget *b)
+{
+    uint32_t max = b->desc.depth_max;
+    if (max == 0 || b->hold > 0)
+        return 0;
+    uint32_t d = b->depth_limit ? b->depth_limit : max;
+    if (d <= 1)
+        return 0;
+    b->depth_limit = d - 1;
+    b->hold = DEPTH_HOLD;
+    return 1;
+}
+
+/* Fast with a depth limit on: one level deeper first (Fig. 3.5, "increment k_min"); at depth_max, none. */
+static int depth_finer(asp_frame_budget *b)
+{
+    if (b->depth_limit == 0 || b->hold > 0)
+        return 0;
+    b->depth_limit = b->depth_limit + 1 >= b->desc.depth_max ? 0 : b->depth_limit + 1;
+    b->hold = DEPTH_HOLD;
+    return 1;
+}
+
+int asp_frame_budget_update(asp_frame_budget *b, double frame_ms)
+{
+    if (!(frame_ms >= 0) || !isfinite(frame_ms))
+        return 0;
+    const asp_frame_budget_desc *d = &b->desc;
+    b->last_ms = frame_ms;
+    b->frames++;
+    if (b->hold > 0)
+        b->hold--;
+    // a frame of 0 ms (a timer too coarse) counts as very fast, not as -infinity
+    double e = log(fmax(frame_ms, 1e-3) / d->target_ms);
+    b->saturated = b->finest = 0;
+    if (fabs(e) <= d->deadband)
+        return 0;
+    float old_tau = b->tolerance;
+    uint32_t old_depth = b->depth_limit;
+    double step = d->gain * e, cap = log(d->max_step);
+    step = step > cap ? cap : step < -cap ? -cap : step;
+    if (e > 0) {
+        if (b->tolerance < d->tolerance_max)
+            b->tolerance = fminf((float)(b->tolerance * exp(step)), d->tolerance_max);
+        else if (!depth_coarser(b))
+            b->saturated = b->hold == 0; // nothing coarser left (a hold only delays the next depth step)
+    } else if (!depth_finer(b) && b->depth_limit == 0) {
+        if (b->tolerance > d->tolerance_min)
+            b->tolerance = fmaxf((float)(b->tolerance * exp(step)), d->tolerance_min);
+        else
+            b->finest = 1;
+    }
+    return b->tolerance != old_tau || b->depth_limit != old_depth;
+}
+
+int asp_frame_budget_apply(const asp_frame_budget *b, asp_renderer *r, asp_error *err)
+{
+    return asp_renderer_set_lod(r, b->tolerance, b->depth_limit, err);
+}
