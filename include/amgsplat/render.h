@@ -547,6 +547,14 @@ void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out);
  * fits); at tolerance_max, still too slow, it lowers the traversal depth limit
  * one level per settled step (seed 004 section 3.2.5's adaptive traversal
  * depth, Fig. 3.5) and raises it again before refining tau.
+ *
+ * Coarser is not always faster: blended splats cost fill, and a coarse cut's
+ * splats are large, so close up a cut of 2,000 splats takes as long as one of
+ * 7,000 (llvmpipe, 800x600). The controller measures the response of every
+ * move (slope = -d ln f / d ln tau, a depth step counting as 1) and, while
+ * too slow with a slope under 0.2, stops coarsening ("bound": the floor of
+ * this view is above T) instead of trading the picture for nothing; every
+ * 8th such frame it probes one step coarser, so a new view is noticed.
  */
 typedef struct asp_frame_budget_desc {
     double target_ms;     /* T, the frame time to hold, ms; > 0 and finite (required) */
@@ -570,6 +578,11 @@ typedef struct asp_frame_budget {
     uint32_t hold;              /* frames left before the depth limit may move again */
     int saturated;              /* coarsest setting reached and the last frame still over budget */
     int finest;                 /* finest setting reached and the last frame under budget */
+    int bound;                  /* over budget, but coarser settings stopped making frames faster */
+    float slope;                /* measured -d ln(frame time) / d ln tau (EMA over moves); starts at 1 */
+    double last_log_ms;         /* ln of the last frame time */
+    double last_move;           /* the move applied before the next frame: ln tau, or +-1 per depth step */
+    uint32_t since_probe;       /* bound frames since the last probing step */
 } asp_frame_budget;
 
 /**
@@ -599,7 +612,9 @@ int asp_frame_budget_apply(const asp_frame_budget *b, asp_renderer *r, asp_error
 /** What asp_frame_budget_settle reached. */
 typedef struct asp_frame_budget_result {
     size_t frames;         /* frames drawn */
-    int settled;           /* 1: the last `window` frames held T (median within the dead band or 10%) */
+    int settled;           /* 1: held T with tau steady, or the budget can do no better (finest or coarsest
+                              setting, or bound: coarser is not faster) */
+    int held;              /* the median of the last `window` frames is within max(10%, the dead band) of T */
     double median_ms;      /* median frame time of the last `window` frames */
     double p10_ms, p90_ms; /* their 10th and 90th percentiles */
     float tolerance;       /* tau reached */
@@ -613,7 +628,8 @@ typedef struct asp_frame_budget_result {
  * frame's time is the drawing finished) up to max_frames times (0 = 200),
  * feeding b after every frame and applying it before the next, and stops
  * once the median of the last window frames (0 = 9) is within max(10%, the
- * dead band) of T and tau moved less than 10% over them. b keeps the reached
+ * dead band) of T and tau moved less than 10% over them, or the budget can
+ * do no better (asp_frame_budget finest, saturated or bound). b keeps the reached
  * state, so the next view starts from it. Returns 0 and *out; the errors of
  * asp_frame_budget_apply and asp_render_frame; ASP_ENOMEM.
  */

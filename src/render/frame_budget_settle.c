@@ -68,17 +68,19 @@ int asp_frame_budget_settle(asp_gl_context *gl, asp_renderer *r, const asp_camer
             lo = fminf(lo, taus[k]);
             hi = fmaxf(hi, taus[k]);
         }
-        int held = fabs(log(res.median_ms / b->desc.target_ms)) <= log1p(band);
-        // at the finest or coarsest setting the budget cannot move further: that is settled too
-        int pinned = (b->finest || b->saturated) && hi <= lo * 1.1f;
-        if ((held && hi <= lo * 1.1f) || pinned) {
+        res.held = fabs(log(res.median_ms / b->desc.target_ms)) <= log1p(band);
+        // at the finest or coarsest setting, or where coarser is not faster, the budget cannot do better
+        int pinned = b->finest || b->saturated || b->bound;
+        if ((res.held && hi <= lo * 1.1f) || pinned) {
             res.settled = 1;
             i++;
             break;
         }
     }
-    if (!rc && i < window && i > 0)
+    if (!rc && i < window && i > 0) {
         window_quantiles(ms, window, i, i, ms + window, &res);
+        res.held = fabs(log(res.median_ms / b->desc.target_ms)) <= log1p(band);
+    }
     asp_free(&gl->actx, ms);
     asp_free(&gl->actx, taus);
     if (!rc) // the renderer keeps the reached state for the caller's final image

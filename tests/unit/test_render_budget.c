@@ -147,6 +147,25 @@ static void test_depth_fallback(void)
     CHECK(b.depth_limit == 0 && b.tolerance < tau_before);
 }
 
+/*
+ * Fill-bound (blended splats close up): a floor of 60 ms that no cut changes. The controller finds that
+ * coarser is not faster and stops there instead of dropping to the depth fallback; a later view
+ * where detail costs again is found by its probes.
+ */
+static void test_fill_bound(void)
+{
+    model m = {.fixed_ms = 60, .ms_per_splat = 1e-7, .points = 1e6, .splats_at_1px = 1e6, .noise = 0.05, .rng = 13};
+    asp_frame_budget b;
+    asp_error err = {0, ""};
+    CHECK_OK(asp_frame_budget_init(&b, &(asp_frame_budget_desc){.target_ms = 40, .depth_max = 8}, &err), &err);
+    run(&m, &b, 100, 0);
+    CHECK_MSG(b.bound && b.slope < 0.2 && b.depth_limit == 0 && b.tolerance < 128, "bound %d slope %g depth %u tau %g",
+              b.bound, (double)b.slope, b.depth_limit, (double)b.tolerance);
+    model v = {.fixed_ms = 10, .ms_per_splat = 1e-4, .points = 1e6, .splats_at_1px = 4e6, .noise = 0.05, .rng = 17};
+    double med = run(&v, &b, 200, 100);
+    CHECK_MSG(!b.bound && fabs(med / 40 - 1) < 0.1, "bound %d, median %g ms after the view changed", b.bound, med);
+}
+
 /* Spikes (another process takes the CPU) move tau by at most max_step, and the median holds. */
 static void test_spikes(void)
 {
@@ -243,5 +262,5 @@ static void test_renderers(void)
 }
 
 TEST_MAIN(TEST_CASE(test_holds_target), TEST_CASE(test_follows_cost_step), TEST_CASE(test_full_detail_fits),
-          TEST_CASE(test_depth_fallback), TEST_CASE(test_spikes), TEST_CASE(test_bad_options),
+          TEST_CASE(test_depth_fallback), TEST_CASE(test_fill_bound), TEST_CASE(test_spikes), TEST_CASE(test_bad_options),
           TEST_CASE(test_renderers))
