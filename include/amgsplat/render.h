@@ -551,7 +551,10 @@ void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out);
  * Coarser is not always faster: blended splats cost fill, and a coarse cut's
  * splats are large, so close up a cut of 2,000 splats takes as long as one of
  * 7,000 (llvmpipe, 800x600). The controller measures the response of every
- * move (slope = -d ln f / d ln tau, a depth step counting as 1) and, while
+ * move that changed the count drawn by more than 10% (slope = -d ln f /
+ * d ln tau, a depth step counting as 1; a move that changed nothing, e.g.
+ * below the leaves' size, says nothing about the cost, and the next move in
+ * that direction takes the largest step) and, while
  * too slow with a slope under 0.2, stops coarsening ("bound": the floor of
  * this view is above T) instead of trading the picture for nothing; every
  * 8th such frame it probes one step coarser, so a new view is noticed.
@@ -582,6 +585,8 @@ typedef struct asp_frame_budget {
     float slope;                /* measured -d ln(frame time) / d ln tau (EMA over moves); starts at 1 */
     double last_log_ms;         /* ln of the last frame time */
     double last_move;           /* the move applied before the next frame: ln tau, or +-1 per depth step */
+    size_t last_count;          /* primitives drawn in the last frame (0 = not told) */
+    double prev_move;           /* the move before the last frame (a sign for the next step) */
     uint32_t since_probe;       /* bound frames since the last probing step */
 } asp_frame_budget;
 
@@ -595,11 +600,11 @@ int asp_frame_budget_init(asp_frame_budget *b, const asp_frame_budget_desc *desc
 
 /**
  * Feeds the time of the frame just drawn (ms, everything the user waits for)
- * and computes tau and the depth limit for the next one. A negative or
- * non-finite time is ignored. Returns 1 if tau or the depth limit changed,
- * else 0.
+ * and the primitives it drew (asp_renderer_count; 0 = unknown), and computes
+ * tau and the depth limit for the next one. A negative or non-finite time is
+ * ignored. Returns 1 if tau or the depth limit changed, else 0.
  */
-int asp_frame_budget_update(asp_frame_budget *b, double frame_ms);
+int asp_frame_budget_update(asp_frame_budget *b, double frame_ms, size_t count);
 
 /**
  * asp_renderer_set_lod(r, b->tolerance, b->depth_limit): every renderer with

@@ -76,20 +76,24 @@ static int depth_finer(asp_frame_budget *b)
     return 1;
 }
 
-int asp_frame_budget_update(asp_frame_budget *b, double frame_ms)
+int asp_frame_budget_update(asp_frame_budget *b, double frame_ms, size_t count)
 {
     if (!(frame_ms >= 0) || !isfinite(frame_ms))
         return 0;
     const asp_frame_budget_desc *d = &b->desc;
     // a frame of 0 ms (a timer too coarse) counts as very fast, not as -infinity
     double lf = log(fmax(frame_ms, 1e-3));
-    if (b->frames > 0 && fabs(b->last_move) >= 0.05) {
+    // a move that left the cut as it was (tau below the leaves' size, a view with nothing to refine)
+    int cut_changed = count == 0 || b->last_count == 0 || fabs(log((double)count / (double)b->last_count)) > 0.1;
+    if (b->frames > 0 && fabs(b->last_move) >= 0.05 && cut_changed) {
         // the response of the last move; one frame's noise (~0.1 in ln f on llvmpipe) is damped by the EMA
         double s = -(lf - b->last_log_ms) / b->last_move;
         s = s < -1 ? -1 : s > 3 ? 3 : s;
         b->slope = (float)(0.7 * b->slope + 0.3 * s);
     }
     b->last_log_ms = lf;
+    b->last_count = count;
+    b->prev_move = b->last_move;
     b->last_move = 0;
     b->last_ms = frame_ms;
     b->frames++;
@@ -105,6 +109,10 @@ int asp_frame_budget_update(asp_frame_budget *b, double frame_ms)
     uint32_t old_depth = b->depth_limit;
     double step = d->gain * e, cap = log(d->max_step);
     step = step > cap ? cap : step < -cap ? -cap : step;
+    // the last move in this direction left the cut as it was (tau below the leaves' size): cross the
+    // range where tau changes nothing at the largest step instead of creeping through it
+    if (!cut_changed && b->frames > 1 && b->prev_move * e > 0)
+        step = e > 0 ? cap : -cap;
     if (e > 0) {
         b->bound = b->slope < futile_slope;
         if (b->bound && ++b->since_probe < PROBE_EVERY)

@@ -59,7 +59,7 @@ int asp_frame_budget_settle(asp_gl_context *gl, asp_renderer *r, const asp_camer
             break;
         double f = 1e3 * (asp_time_now() - t0);
         ms[i % window] = f;
-        asp_frame_budget_update(b, f);
+        asp_frame_budget_update(b, f, asp_renderer_count(r));
         if (i + 1 < window)
             continue;
         window_quantiles(ms, window, i + 1, window, ms + window, &res);

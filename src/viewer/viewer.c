@@ -698,11 +698,11 @@ static void budget_before_frame(viewer *v)
 }
 
 /* Feeds the whole frame's time; a changed tau asks for another frame, so an idle window settles too. */
-static void budget_after_frame(viewer *v, double frame_ms)
+static void budget_after_frame(viewer *v, double frame_ms, size_t count)
 {
     if (!v->budget_on || !v->budget_ok)
         return;
-    if (asp_frame_budget_update(&v->budget, frame_ms))
+    if (asp_frame_budget_update(&v->budget, frame_ms, count))
         v->dirty = 1;
 }
 
@@ -854,7 +854,7 @@ static int draw(viewer *v, int last, asp_error *err)
     rc = asp__viewer_frame_log_add(&v->flog, &v->ctx, &rec, err);
     if (rc)
         return rc;
-    budget_after_frame(v, rec.frame_ms);
+    budget_after_frame(v, rec.frame_ms, rec.count);
     return 0;
 }
 
