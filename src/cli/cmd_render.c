@@ -548,10 +548,10 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                                kind->name, o.dps_input ? "primitive" : "point");
     if (!(o.frame_ms >= 0 && o.frame_ms <= 1e6))
         return cli_usage_error(env, "--frame-ms expects milliseconds in 0..1e6 (0 = off), got %g", o.frame_ms);
-    if (o.frame_ms > 0 && (!kind->has_lod || o.budget))
-        return cli_usage_error(env, "--frame-ms needs a renderer with a level of detail (splat, square; not %s) and "
-                               "no --budget", kind->name);
+    if (o.frame_ms > 0 && o.budget)
+        return cli_usage_error(env, "--frame-ms sets the tolerance every frame: give no --budget");
     asp_frame_budget frame_budget;
+    int no_lod = 0; // --frame-ms on a renderer without a level of detail: a usage error, found once it exists
 
     double t0 = asp_time_now();
     asp_scene s;
@@ -580,6 +580,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         rc = asp_renderer_set_lod(r, kind->has_lod ? ropts.splat.tolerance : 0.0f, (uint32_t)o.depth_limit, &err);
     if (!rc && o.frame_ms > 0) {
         rc = asp_frame_budget_init(&frame_budget, &(asp_frame_budget_desc){.target_ms = o.frame_ms}, &err);
+        if (!rc && (rc = asp_frame_budget_apply(&frame_budget, r, &err)) == ASP_EUNSUPPORTED)
+            no_lod = 1;
         vs.budget = &frame_budget;
     }
     if (!rc)
@@ -595,7 +597,9 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                    : mesh_drawn && s.mesh ? s.mesh->triangle_count
                    : s.cloud ? s.cloud->count : 0;
     int status = 0;
-    if (rc) {
+    if (no_lod) {
+        status = cli_usage_error(env, "--frame-ms needs a renderer with a level of detail (splat, square): %s", err.msg);
+    } else if (rc) {
         status = cli_fail(env, &err);
     } else {
         cli_progress_end(env);

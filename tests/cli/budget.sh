@@ -22,7 +22,7 @@ expect_fail 2 "--fly 10 draws 10 frames" view "$T/s.ply" --fly 10 --frames 5
 expect_fail 2 "exclude each other" view "$T/s.ply" --overlay --no-overlay --frames 1
 expect_fail 2 "--frame-ms needs a renderer with a level of detail" \
   "$AMGSPLAT" render "$T/s.ply" -o "$T/x.png" --frame-ms 40
-expect_fail 2 "no --budget" "$AMGSPLAT" render "$T/s.ply" -o "$T/x.png" --renderer square --budget 100 --frame-ms 40
+expect_fail 2 "give no --budget" "$AMGSPLAT" render "$T/s.ply" -o "$T/x.png" --renderer square --budget 100 --frame-ms 40
 
 # This machine's full-detail frame time (square renderer, tau 0, every point), median of 6 frames.
 view "$T/s.ply" --renderer square --tau 0 --frames 6 --size 512x512 --json -q >"$T/full.json"
