@@ -557,7 +557,8 @@ void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out);
  * that direction takes the largest step) and, while
  * too slow with a slope under 0.2, stops coarsening ("bound": the floor of
  * this view is above T) instead of trading the picture for nothing; every
- * 8th such frame it probes one step coarser, so a new view is noticed.
+ * 8th such frame it probes one step coarser, kept if it helped and undone
+ * if not, so a new view is noticed and the picture never creeps to blobs.
  */
 typedef struct asp_frame_budget_desc {
     double target_ms;     /* T, the frame time to hold, ms; > 0 and finite (required) */
@@ -588,6 +589,9 @@ typedef struct asp_frame_budget {
     size_t last_count;          /* primitives drawn in the last frame (0 = not told) */
     double prev_move;           /* the move before the last frame (a sign for the next step) */
     uint32_t since_probe;       /* bound frames since the last probing step */
+    int probing;                /* the last move was a probe: undone if it did not help */
+    float probe_tau;            /* where the probe started */
+    uint32_t probe_depth;
 } asp_frame_budget;
 
 /**

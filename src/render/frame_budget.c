@@ -85,9 +85,10 @@ int asp_frame_budget_update(asp_frame_budget *b, double frame_ms, size_t count)
     double lf = log(fmax(frame_ms, 1e-3));
     // a move that left the cut as it was (tau below the leaves' size, a view with nothing to refine)
     int cut_changed = count == 0 || b->last_count == 0 || fabs(log((double)count / (double)b->last_count)) > 0.1;
+    double s = NAN;
     if (b->frames > 0 && fabs(b->last_move) >= 0.05 && cut_changed) {
         // the response of the last move; one frame's noise (~0.1 in ln f on llvmpipe) is damped by the EMA
-        double s = -(lf - b->last_log_ms) / b->last_move;
+        s = -(lf - b->last_log_ms) / b->last_move;
         s = s < -1 ? -1 : s > 3 ? 3 : s;
         b->slope = (float)(0.7 * b->slope + 0.3 * s);
     }
@@ -103,6 +104,18 @@ int asp_frame_budget_update(asp_frame_budget *b, double frame_ms, size_t count)
     b->saturated = b->finest = 0;
     if (e <= d->deadband)
         b->bound = 0;
+    if (b->probing) {
+        b->probing = 0;
+        // a probe that left the frame slow without helping is undone, so probes never creep to the blobs
+        // of depth 1; the way back says nothing new (last_move stays 0)
+        if (e > d->deadband && !(s >= futile_slope)) {
+            int changed = b->tolerance != b->probe_tau || b->depth_limit != b->probe_depth;
+            b->tolerance = b->probe_tau;
+            b->depth_limit = b->probe_depth;
+            b->bound = 1;
+            return changed;
+        }
+    }
     if (fabs(e) <= d->deadband)
         return 0;
     float old_tau = b->tolerance;
@@ -118,6 +131,11 @@ int asp_frame_budget_update(asp_frame_budget *b, double frame_ms, size_t count)
         if (b->bound && ++b->since_probe < PROBE_EVERY)
             return 0;
         b->since_probe = 0;
+        if (b->bound) {
+            b->probing = 1;
+            b->probe_tau = old_tau;
+            b->probe_depth = old_depth;
+        }
         if (b->tolerance < d->tolerance_max)
             b->tolerance = fminf((float)(b->tolerance * exp(step)), d->tolerance_max);
         else if (!depth_coarser(b))
@@ -130,6 +148,7 @@ int asp_frame_budget_update(asp_frame_budget *b, double frame_ms, size_t count)
     }
     if (b->tolerance != old_tau)
         b->last_move = log((double)b->tolerance / old_tau);
+    b->probing = b->probing && (b->tolerance != old_tau || b->depth_limit != old_depth);
     return b->tolerance != old_tau || b->depth_limit != old_depth;
 }
 
