@@ -86,10 +86,14 @@ int asp_frame_budget_update(asp_frame_budget *b, double frame_ms, size_t count)
     // a move that left the cut as it was (tau below the leaves' size, a view with nothing to refine)
     int cut_changed = count == 0 || b->last_count == 0 || fabs(log((double)count / (double)b->last_count)) > 0.1;
     double s = NAN;
-    if (b->frames > 0 && fabs(b->last_move) >= 0.05 && cut_changed) {
-        // the response of the last move; one frame's noise (~0.1 in ln f on llvmpipe) is damped by the EMA
+    if (b->frames > 0 && fabs(b->last_move) >= 0.1 && cut_changed) {
+        /*
+         * The response of the last move. One frame's noise (0.1 in ln f on llvmpipe, 0.3 under a load of
+         * 12 on two cores) over a move of 0.1-0.7 is large: moves under 0.1 are not used, the EMA damps
+         * the rest, and a clamp at -0.5 keeps a few noisy samples from passing for futility.
+         */
         s = -(lf - b->last_log_ms) / b->last_move;
-        s = s < -1 ? -1 : s > 3 ? 3 : s;
+        s = s < -0.5 ? -0.5 : s > 3 ? 3 : s;
         b->slope = (float)(0.7 * b->slope + 0.3 * s);
     }
     b->last_log_ms = lf;

@@ -47,7 +47,7 @@ int asp_frame_budget_settle(asp_gl_context *gl, asp_renderer *r, const asp_camer
     // tolerance band of "held": the dead band, but never tighter than 10% (llvmpipe's frame-to-frame noise)
     double band = fmax(0.10, (double)b->desc.deadband);
     int rc = 0;
-    size_t i = 0;
+    size_t i = 0, pinned_run = 0;
     for (; i < max_frames && !rc; i++) {
         rc = asp_frame_budget_apply(b, r, err);
         if (rc)
@@ -60,6 +60,9 @@ int asp_frame_budget_settle(asp_gl_context *gl, asp_renderer *r, const asp_camer
         double f = 1e3 * (asp_time_now() - t0);
         ms[i % window] = f;
         asp_frame_budget_update(b, f, asp_renderer_count(r));
+        // at the finest or coarsest setting, or where coarser is not faster, the budget cannot do better;
+        // believed once it lasted two windows (and two probes), not from one noisy frame
+        pinned_run = b->finest || b->saturated || b->bound ? pinned_run + 1 : 0;
         if (i + 1 < window)
             continue;
         window_quantiles(ms, window, i + 1, window, ms + window, &res);
@@ -69,8 +72,7 @@ int asp_frame_budget_settle(asp_gl_context *gl, asp_renderer *r, const asp_camer
             hi = fmaxf(hi, taus[k]);
         }
         res.held = fabs(log(res.median_ms / b->desc.target_ms)) <= log1p(band);
-        // at the finest or coarsest setting, or where coarser is not faster, the budget cannot do better
-        int pinned = b->finest || b->saturated || b->bound;
+        int pinned = pinned_run >= 2 * window && pinned_run >= 17;
         if ((res.held && hi <= lo * 1.1f) || pinned) {
             res.settled = 1;
             i++;
