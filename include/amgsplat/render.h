@@ -559,6 +559,7 @@ void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out);
  * this view is above T) instead of trading the picture for nothing; every
  * 8th such frame it probes one step coarser, kept if it helped and undone
  * if not, so a new view is noticed and the picture never creeps to blobs.
+ * Nor does it coarsen below min_count primitives: there it is saturated.
  */
 typedef struct asp_frame_budget_desc {
     double target_ms;     /* T, the frame time to hold, ms; > 0 and finite (required) */
@@ -570,6 +571,9 @@ typedef struct asp_frame_budget_desc {
     float deadband;       /* |ln(f / T)| below this leaves tau alone; 0 = 0.05, < 0 = none */
     float max_step;       /* largest factor tau may change by in one frame, > 1; 0 = 2 */
     uint32_t depth_max;   /* the depth limit that means "no limit" (asp_hier_depth + 1); 0 = no depth fallback */
+    size_t min_count;     /* no coarser cut than about this many primitives (a cut's count goes as tau^-2, a
+                             depth step divides it by up to 8): below ~1000 splats a model is blobs, as slow
+                             as it may be; 0 = 1000; 1 = none (seed 004 Fig. 3.5 goes down to depth 1) */
 } asp_frame_budget_desc;
 
 /** State of a frame budget; read its fields, change them only through the functions. */

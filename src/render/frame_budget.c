@@ -32,6 +32,7 @@ int asp_frame_budget_init(asp_frame_budget *b, const asp_frame_budget_desc *desc
     d.gain = d.gain == 0 ? 0.35f : d.gain;
     d.deadband = d.deadband == 0 ? 0.05f : d.deadband < 0 ? 0.0f : d.deadband;
     d.max_step = d.max_step == 0 ? 2.0f : d.max_step;
+    d.min_count = d.min_count == 0 ? 1000 : d.min_count;
     if (!(d.tolerance_min > 0) || !(d.tolerance_max >= d.tolerance_min) || !isfinite(d.tolerance_max))
         return asp_error_set(err, ASP_EINVAL, "frame budget tolerance range [%g, %g] px is invalid (need 0 < min <= max)",
                              (double)d.tolerance_min, (double)d.tolerance_max);
@@ -51,10 +52,12 @@ int asp_frame_budget_init(asp_frame_budget *b, const asp_frame_budget_desc *desc
 }
 
 /* Too slow at the coarsest tau: one level shallower (seed 004 Fig. 3.5, "decrement k_0"). */
-static int depth_coarser(asp_frame_budget *b)
+static int depth_coarser(asp_frame_budget *b, size_t count)
 {
     uint32_t max = b->desc.depth_max;
     if (max == 0 || b->hold > 0)
+        return 0;
+    if (count > 0 && count / 8 < b->desc.min_count) // one level shallower keeps an eighth at worst
         return 0;
     uint32_t d = b->depth_limit ? b->depth_limit : max;
     if (d <= 1)
@@ -130,6 +133,11 @@ int asp_frame_budget_update(asp_frame_budget *b, double frame_ms, size_t count)
     // range where tau changes nothing at the largest step instead of creeping through it
     if (!cut_changed && b->frames > 1 && b->prev_move * e > 0)
         step = e > 0 ? cap : -cap;
+    if (e > 0 && count > 0) {
+        // a cut's count goes as tau^-2: the largest step that keeps about min_count primitives
+        double room = 0.5 * log((double)count / (double)d->min_count);
+        step = step < room ? step : room;
+    }
     if (e > 0) {
         b->bound = b->slope < futile_slope;
         if (b->bound && ++b->since_probe < PROBE_EVERY)
@@ -140,9 +148,9 @@ int asp_frame_budget_update(asp_frame_budget *b, double frame_ms, size_t count)
             b->probe_tau = old_tau;
             b->probe_depth = old_depth;
         }
-        if (b->tolerance < d->tolerance_max)
+        if (b->tolerance < d->tolerance_max && step > 0.01)
             b->tolerance = fminf((float)(b->tolerance * exp(step)), d->tolerance_max);
-        else if (!depth_coarser(b))
+        else if ((b->tolerance < d->tolerance_max && step <= 0.01) || !depth_coarser(b, count))
             b->saturated = b->hold == 0; // nothing coarser left (a hold only delays the next depth step)
     } else if (!depth_finer(b) && b->depth_limit == 0) {
         if (b->tolerance > d->tolerance_min)

@@ -144,7 +144,8 @@ static void test_depth_fallback(void)
     model m = {.fixed_ms = 10, .ms_per_splat = 7.3e-3, .points = 1e6, .splats_at_1px = 1e8, .noise = 0.05, .rng = 5};
     asp_frame_budget b;
     asp_error err = {0, ""};
-    CHECK_OK(asp_frame_budget_init(&b, &(asp_frame_budget_desc){.target_ms = 40, .tolerance_max = 64, .depth_max = 8},
+    CHECK_OK(asp_frame_budget_init(&b, &(asp_frame_budget_desc){.target_ms = 40, .tolerance_max = 64, .depth_max = 8,
+                                                                 .min_count = 1},
                                    &err), &err);
     // at tau 64, 24414 splats take 188 ms; depth limit 5 keeps 8^4 = 4096 splats: 40 ms
     double med = run(&m, &b, 120, 60);
@@ -168,6 +169,18 @@ static void test_depth_fallback(void)
     }
     CHECK(depth_first);
     CHECK(b.depth_limit == 0 && b.tolerance < tau_before);
+    // with the default floor of 1000 primitives the same slow view stops at depth 5 (4096 splats):
+    // depth 4 would keep 512, blobs
+    CHECK_OK(asp_frame_budget_init(&b, &(asp_frame_budget_desc){.target_ms = 40, .tolerance_max = 64, .depth_max = 8},
+                                   &err), &err);
+    run(&slow, &b, 120, 0);
+    CHECK_MSG(b.depth_limit == 5 && b.saturated && splats(&slow, &b) >= 1000, "depth %u, %g splats",
+              b.depth_limit, splats(&slow, &b));
+    // and tau stops where the cut would fall under 1000 splats without a depth fallback
+    CHECK_OK(asp_frame_budget_init(&b, &(asp_frame_budget_desc){.target_ms = 40, .tolerance_max = 4096}, &err), &err);
+    run(&slow, &b, 120, 0);
+    CHECK_MSG(b.saturated && splats(&slow, &b) >= 990 && splats(&slow, &b) < 1100, "%g splats, tau %g",
+              splats(&slow, &b), (double)b.tolerance);
 }
 
 /*
