@@ -104,8 +104,9 @@ const char *asp_viewer_renderer_name(size_t i);
 
 /**
  * Checks desc without opening anything: sizes, renderer name, tolerance,
- * view, colour mode, .dps method and alpha reference, keys (each must be a viewer key), and that screenshot
- * ends in .png and is given only with frames > 0. Returns 0 or ASP_EINVAL
+ * view, colour mode, .dps method and alpha reference, keys (each must be a viewer key), that screenshot
+ * ends in .png and is given only with frames > 0, the frame budget (0..1e6 ms) and that a fly-through
+ * has frames. Returns 0 or ASP_EINVAL
  * naming the bad value, e.g. "unknown renderer 'x' (expected disc, splat)".
  * Thread safe.
  */
