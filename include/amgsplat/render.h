@@ -534,6 +534,154 @@ typedef struct asp_renderer_stats {
 void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out);
 
 /* ------------------------------------------------------------------------ */
+/* Frame budget: the tolerance that holds a frame time (issue 18 item 5)    */
+/* ------------------------------------------------------------------------ */
+
+/**
+ * Options of a frame budget; the zero value means defaults except target_ms.
+ * The controller works on log tau: a frame of f ms gives the error
+ * e = ln(f / T), ignored within the dead band, and tau is multiplied by
+ * exp(gain * e) (integral control, damped by gain < 1 and clamped to a factor
+ * max_step per frame), so tau settles where the frame time is T whatever the
+ * renderer's cost per splat. Below tolerance_min it stops (the finest cut
+ * fits); at tolerance_max, still too slow, it lowers the traversal depth limit
+ * one level per settled step (seed 004 section 3.2.5's adaptive traversal
+ * depth, Fig. 3.5) and raises it again before refining tau.
+ *
+ * Coarser is not always faster: blended splats cost fill, and a coarse cut's
+ * splats are large, so close up a cut of 2,000 splats takes as long as one of
+ * 7,000 (llvmpipe, 800x600). The controller measures the response of every
+ * move that changed the count drawn by more than 10% (slope = -d ln f /
+ * d ln tau, a depth step counting as 1; a move that changed nothing, e.g.
+ * below the leaves' size, says nothing about the cost, and the next move in
+ * that direction takes the largest step) and, while
+ * too slow with a slope under 0.2, stops coarsening ("bound": the floor of
+ * this view is above T) instead of trading the picture for nothing; every
+ * 8th such frame it probes one step coarser, kept if it helped and undone
+ * if not, so a new view is noticed and the picture never creeps to blobs.
+ * Nor does it coarsen below min_count primitives: there it is saturated.
+ */
+typedef struct asp_frame_budget_desc {
+    double target_ms;     /* T, the frame time to hold, ms; > 0 and finite (required) */
+    float tolerance;      /* tau of the first frame, pixels; 0 = 4 (coarse: a slow first frame costs most) */
+    float tolerance_min;  /* 0 = 0.25 px (every splat larger than a quarter pixel is refined: full detail) */
+    float tolerance_max;  /* 0 = 256 px */
+    float gain;           /* ln tau per unit of ln(f / T), in (0, 1]; 0 = 0.35 (frame time falls ~1.1-2.2 times
+                             as fast as tau rises on llvmpipe, so the loop gain stays below 1: no overshoot) */
+    float deadband;       /* |ln(f / T)| below this leaves tau alone; 0 = 0.05, < 0 = none */
+    float max_step;       /* largest factor tau may change by in one frame, > 1; 0 = 2 */
+    uint32_t depth_max;   /* the depth limit that means "no limit" (asp_hier_depth + 1); 0 = no depth fallback */
+    size_t min_count;     /* no coarser cut than about this many primitives (a cut's count goes as tau^-2, a
+                             depth step divides it by up to 8): below ~1000 splats a model is blobs, as slow
+                             as it may be; 0 = 1000; 1 = none (seed 004 Fig. 3.5 goes down to depth 1) */
+} asp_frame_budget_desc;
+
+/** State of a frame budget; read its fields, change them only through the functions. */
+typedef struct asp_frame_budget {
+    asp_frame_budget_desc desc; /* resolved options */
+    float tolerance;            /* tau for the next frame, pixels */
+    uint32_t depth_limit;       /* depth limit for the next frame; 0 = none */
+    double last_ms;             /* the last frame time fed */
+    size_t frames;              /* frame times fed */
+    uint32_t hold;              /* frames left before the depth limit may move again */
+    int saturated;              /* coarsest setting reached and the last frame still over budget */
+    int finest;                 /* finest setting reached and the last frame under budget */
+    int bound;                  /* over budget, but coarser settings stopped making frames faster */
+    float slope;                /* measured -d ln(frame time) / d ln tau (EMA over moves); starts at 1 */
+    double last_log_ms;         /* ln of the last frame time */
+    double last_move;           /* the move applied before the next frame: ln tau, or +-1 per depth step */
+    size_t last_count;          /* primitives drawn in the last frame (0 = not told) */
+    double prev_move;           /* the move before the last frame (a sign for the next step) */
+    uint32_t since_probe;       /* bound frames since the last probing step */
+    int probing;                /* the last move was a probe: undone if it did not help */
+    float probe_tau;            /* where the probe started */
+    uint32_t probe_depth;
+} asp_frame_budget;
+
+/**
+ * Initialises b from desc. Returns 0 or ASP_EINVAL naming the bad option
+ * (target_ms not > 0, a range with min > max, gain outside (0, 1], max_step
+ * <= 1, a non-finite value); b is unchanged on failure. No GL; thread safe
+ * on distinct b.
+ */
+int asp_frame_budget_init(asp_frame_budget *b, const asp_frame_budget_desc *desc, asp_error *err);
+
+/**
+ * Feeds the time of the frame just drawn (ms, everything the user waits for)
+ * and the primitives it drew (asp_renderer_count; 0 = unknown), and computes
+ * tau and the depth limit for the next one. A negative or non-finite time is
+ * ignored. Returns 1 if tau or the depth limit changed, else 0.
+ */
+int asp_frame_budget_update(asp_frame_budget *b, double frame_ms, size_t count);
+
+/**
+ * asp_renderer_set_lod(r, b->tolerance, b->depth_limit): every renderer with
+ * a level of detail (splat, square, and those implementing the set_lod hook)
+ * follows the budget. Returns 0, or ASP_EUNSUPPORTED for a renderer without
+ * one (disc, prim, mesh: the budget then has no effect).
+ */
+int asp_frame_budget_apply(const asp_frame_budget *b, asp_renderer *r, asp_error *err);
+
+/** What asp_frame_budget_settle reached. */
+typedef struct asp_frame_budget_result {
+    size_t frames;         /* frames drawn */
+    int settled;           /* 1: held T with tau steady, or the budget can do no better (finest or coarsest
+                              setting, or bound: coarser is not faster) */
+    int held;              /* the median of the last `window` frames is within max(10%, the dead band) of T */
+    double median_ms;      /* median frame time of the last `window` frames */
+    double p10_ms, p90_ms; /* their 10th and 90th percentiles */
+    float tolerance;       /* tau reached */
+    uint32_t depth_limit;  /* depth limit reached (0 = none) */
+    size_t count;          /* primitives drawn in the last frame */
+} asp_frame_budget_result;
+
+/**
+ * A simulated budget for offline renders (amgsplat render --frame-ms): draws
+ * r seen by cam with desc (asp_render_frame with ASP_RENDER_WAIT, so each
+ * frame's time is the drawing finished) up to max_frames times (0 = 200),
+ * feeding b after every frame and applying it before the next, and stops
+ * once the median of the last window frames (0 = 9) is within max(10%, the
+ * dead band) of T and tau moved less than 10% over them, or the budget can
+ * do no better (asp_frame_budget finest, saturated or bound). b keeps the reached
+ * state, so the next view starts from it. Returns 0 and *out; the errors of
+ * asp_frame_budget_apply and asp_render_frame; ASP_ENOMEM.
+ */
+int asp_frame_budget_settle(asp_gl_context *gl, asp_renderer *r, const asp_camera *cam,
+                            const asp_render_desc *desc, asp_frame_budget *b, size_t max_frames, size_t window,
+                            asp_frame_budget_result *out, asp_error *err);
+
+/* ------------------------------------------------------------------------ */
+/* Text over a frame (the viewer's figures)                                 */
+/* ------------------------------------------------------------------------ */
+
+/** Draws lines of text over what a frame drew. Opaque; made from a context, which must outlive it. */
+typedef struct asp_text_overlay asp_text_overlay;
+
+/** Where and how asp_text_overlay_draw writes; the zero value means defaults. */
+typedef struct asp_text_overlay_desc {
+    float x, y;           /* top-left corner of the text block, pixels from the target's top-left */
+    float scale;          /* pixels per font unit (stb_easy_font's glyphs are ~7 units tall); 0 = 2 */
+    uint8_t color[4];     /* sRGB text colour; all 0 = white */
+    uint8_t box[4];       /* sRGB colour of the box behind the text, alpha blended; all 0 = black, alpha 160 */
+} asp_text_overlay_desc;
+
+/** Creates the overlay's GL program and buffers. Returns 0, ASP_EGL or ASP_ENOMEM; *out unchanged on failure. */
+int asp_text_overlay_create(asp_gl_context *gl, asp_text_overlay **out, asp_error *err);
+
+/**
+ * Draws text ('\n' separates lines; stb_easy_font's ASCII glyphs) in a box
+ * over the window's back buffer (window context; after asp_render_frame,
+ * before asp_gl_context_read_window and the swap) or the headless context's
+ * offscreen target, without depth test and without clearing. Returns 0,
+ * ASP_EINVAL (text over 4096 characters), ASP_EGL or ASP_ENOMEM.
+ */
+int asp_text_overlay_draw(asp_text_overlay *o, const char *text, const asp_text_overlay_desc *desc,
+                          asp_error *err);
+
+/** Frees the overlay's GL objects (makes its context current). NULL is accepted. */
+void asp_text_overlay_destroy(asp_text_overlay *o);
+
+/* ------------------------------------------------------------------------ */
 /* Domain primitives (prim.h levels): journal section 4, thesis chapter 4   */
 /* ------------------------------------------------------------------------ */
 

@@ -21,7 +21,10 @@ extern "C" {
 /** Flags for asp_viewer_desc.flags; 0 is the default. */
 enum asp_viewer_flags {
     ASP_VIEWER_UNLIT = 1 << 0,  /* start with lighting off (the l key toggles it) */
-    ASP_VIEWER_VERBOSE = 1 << 1 /* log frame time and primitive count about once a second */
+    ASP_VIEWER_VERBOSE = 1 << 1, /* log frame time and primitive count about once a second */
+    ASP_VIEWER_OVERLAY = 1 << 2, /* start with the figures drawn over the frame (the i key toggles them; on by
+                                    default with a frame budget) */
+    ASP_VIEWER_NO_OVERLAY = 1 << 3 /* start without them, even with a frame budget */
 };
 
 /**
@@ -61,6 +64,14 @@ typedef struct asp_viewer_desc {
     uint32_t depth_limit;    /* splat and square renderers: traversal depth limit (seed 004 3.2.5); 0 = none */
     asp_viewer_log_fn log;   /* NULL = lines are dropped */
     void *log_user;
+    double frame_ms;         /* > 0: frame budget (issue 18 item 5): each frame sets tau (and, at the coarsest
+                                tau, the depth limit) of a renderer with a level of detail so the frame time
+                                holds this many ms (asp_frame_budget); 0 = off */
+    int fly;                 /* scripted: the camera flies around the model over the desc->frames frames
+                                (asp_viewer_desc.frames; a full turn, up and down, in to 0.35 times the
+                                first distance and out again), the same path every run */
+    const char *stats_json;  /* scripted or not: JSON file written at the end with every frame's time, tau,
+                                depth limit and count and their summary; NULL = none */
 } asp_viewer_desc;
 
 /** What a viewer run did, for scripts (amgsplat view --json). */
@@ -74,6 +85,12 @@ typedef struct asp_viewer_stats {
     size_t screenshots;       /* PNG files written (the s key and desc->screenshot) */
     char gl_renderer[128];    /* GL_RENDERER of the window's context */
     char title[320];          /* the window title at the end: file, renderer, count, frame time, tau, mode */
+    /* Frame times: the whole frame, input to swap, as the user waits for it (not only the drawing of
+     * mean_frame_ms), over every frame drawn */
+    double median_frame_ms, p10_frame_ms, p90_frame_ms;
+    float tolerance_min, tolerance_max; /* range of tau over the frames drawn by a level-of-detail renderer */
+    size_t count_min, count_max;        /* range of primitives drawn per frame */
+    int budget_applied;       /* desc->frame_ms > 0 and the last renderer took it (it has a level of detail) */
 } asp_viewer_stats;
 
 /**
@@ -87,8 +104,9 @@ const char *asp_viewer_renderer_name(size_t i);
 
 /**
  * Checks desc without opening anything: sizes, renderer name, tolerance,
- * view, colour mode, .dps method and alpha reference, keys (each must be a viewer key), and that screenshot
- * ends in .png and is given only with frames > 0. Returns 0 or ASP_EINVAL
+ * view, colour mode, .dps method and alpha reference, keys (each must be a viewer key), that screenshot
+ * ends in .png and is given only with frames > 0, the frame budget (0..1e6 ms) and that a fly-through
+ * has frames. Returns 0 or ASP_EINVAL
  * naming the bad value, e.g. "unknown renderer 'x' (expected disc, splat)".
  * Thread safe.
  */

@@ -24,7 +24,7 @@ static const char usage[] =
     "                      [--background R,G,B[,A] | --transparent] [--light AZ,EL]\n"
     "                      [--preset thesis|journal|pajarola|schwarz] [--kernel-rim 1|b] [--kernel-shape psi-e|psi-g]\n"
     "                      [--epsilon-uniform X] [--tolerance-area PCT] [--axes sqrt|lambda] [--cull-backfaces]\n"
-    "                      [--depth-limit N]\n"
+    "                      [--depth-limit N] [--frame-ms T]\n"
     "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict] [--level L-3] ...\n"
     "       amgsplat render MESH -o OUT.png [--flat] [--texture IMG] [--renderer mesh|disc] ...\n"
     "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
@@ -81,6 +81,7 @@ struct render_opts {
     unsigned splat_flags, hier_flags;
     int cull_backfaces;  /* seed 004 3.2.2: normal-cone culling of hierarchy nodes */
     size_t depth_limit;  /* seed 004 3.2.5: traversal depth limit (0 = none) */
+    double frame_ms;     /* simulated frame budget (issue 18 item 5): tau settled per view; 0 = off */
     asp_splat_kernel kernel_kind;
     double alpha_ref;
     double transparency;
@@ -448,6 +449,8 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
 struct view_stats {
     size_t min_count, max_count, last_count;
     double seconds; /* all asp_render_to_image calls, read-back included */
+    asp_frame_budget *budget;        /* --frame-ms: settled before each view, from the last view's state */
+    asp_frame_budget_result settled; /* the last view's */
 };
 
 /* Renders the views into tiles[0 .. views-1], every one framed by the scene's frame (asp_camera_frame). */
@@ -467,6 +470,11 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
         cam.azimuth = (float)(o->az + 360.0 * (double)i / (double)o->views);
         cam.elevation = (float)(i % 2 ? -o->el : o->el);
         asp_camera_frame(&cam, &s->frame, s->origin, (float)o->width / (float)o->height, (float)o->dist);
+        if (vs->budget) {
+            int brc = asp_frame_budget_settle(gl, r, &cam, &desc, vs->budget, 0, 0, &vs->settled, err);
+            if (brc)
+                return brc;
+        }
         double t0 = asp_time_now();
         int rc = asp_render_to_image(gl, r, &cam, &desc, &tiles[i], err);
         if (rc)
@@ -521,6 +529,20 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
         cJSON_AddNumberToObject(h, "primitives_replaced", (double)hc->prims_replaced);
         cJSON_AddNumberToObject(h, "points_drawn", (double)hc->points_drawn);
         cJSON_AddNumberToObject(h, "points_total", (double)hc->points_total);
+    }
+    if (vs->budget) { // the last view's simulated budget
+        cJSON *b = cJSON_CreateObject();
+        cJSON_AddNumberToObject(b, "target_ms", o->frame_ms);
+        cJSON_AddItemToObject(b, "median_ms", cli_json_number("%.3f", vs->settled.median_ms));
+        cJSON_AddItemToObject(b, "p10_ms", cli_json_number("%.3f", vs->settled.p10_ms));
+        cJSON_AddItemToObject(b, "p90_ms", cli_json_number("%.3f", vs->settled.p90_ms));
+        cJSON_AddItemToObject(b, "tolerance", cli_json_number("%g", vs->settled.tolerance));
+        cJSON_AddNumberToObject(b, "depth_limit", vs->settled.depth_limit);
+        cJSON_AddNumberToObject(b, "frames", (double)vs->settled.frames);
+        cJSON_AddBoolToObject(b, "settled", vs->settled.settled);
+        cJSON_AddBoolToObject(b, "held", vs->settled.held);
+        cJSON_AddNumberToObject(b, "count", (double)vs->settled.count);
+        cJSON_AddItemToObject(j, "frame_budget", b);
     }
     return cli_json_print(env, j);
 }
@@ -669,6 +691,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"tolerance-area", 0, CLI_DOUBLE, &o.tolerance_area, "PCT", "splat, square: tau in percent of the view's area (seed 001 5.1); replaces --tolerance"},
         {"cull-backfaces", 0, CLI_FLAG, &o.cull_backfaces, NULL, "splat, square: drop subtrees whose normal cone faces away (seed 004 3.2.2)"},
         {"depth-limit", 0, CLI_SIZE, &o.depth_limit, "N", "splat, square: traverse the hierarchy to depth N at most (seed 004 3.2.5; default 0: none)"},
+        {"frame-ms", 0, CLI_DOUBLE, &o.frame_ms, "T", "splat, square: simulated frame budget: redraw each view until tau holds T ms per frame, then render it"},
         {"axes", 0, CLI_STRING, &o.axes, "A", "splat, square: ellipse axis ratio sqrt (default) or lambda (seed 001 eq. 5-6)"},
         {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
         {"opaque", 0, CLI_FLAG, &o.opaque, NULL, "splat: opaque ellipses, no blending"},
@@ -759,6 +782,12 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     if (o.budget && !kind->has_lod)
         return cli_usage_error(env, "--budget needs --renderer splat or square (the %s renderer draws every %s)",
                                kind->name, o.dps_input ? "primitive" : "point");
+    if (!(o.frame_ms >= 0 && o.frame_ms <= 1e6))
+        return cli_usage_error(env, "--frame-ms expects milliseconds in 0..1e6 (0 = off), got %g", o.frame_ms);
+    if (o.frame_ms > 0 && o.budget)
+        return cli_usage_error(env, "--frame-ms sets the tolerance every frame: give no --budget");
+    asp_frame_budget frame_budget;
+    int no_lod = 0; // --frame-ms on a renderer without a level of detail: a usage error, found once it exists
 
     double t0 = asp_time_now();
     asp_scene s;
@@ -768,7 +797,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     asp_image tiles[MAX_VIEWS];
     asp_image sheet = {0, 0, NULL};
     memset(tiles, 0, sizeof tiles);
-    struct view_stats vs = {0, 0, 0, 0};
+    struct view_stats vs = {0, 0, 0, 0, NULL, {0}};
     asp_renderer_options ropts;
     renderer_options(&o, &ropts);
     asp_render_source src;
@@ -793,6 +822,12 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         rc = asp_renderer_set_budget(r, o.budget, &err);
     if (!rc && o.depth_limit)
         rc = asp_renderer_set_lod(r, kind->has_lod ? ropts.splat.tolerance : 0.0f, (uint32_t)o.depth_limit, &err);
+    if (!rc && o.frame_ms > 0) {
+        rc = asp_frame_budget_init(&frame_budget, &(asp_frame_budget_desc){.target_ms = o.frame_ms}, &err);
+        if (!rc && (rc = asp_frame_budget_apply(&frame_budget, r, &err)) == ASP_EUNSUPPORTED)
+            no_lod = 1;
+        vs.budget = &frame_budget;
+    }
     if (!rc)
         rc = render_views(gl, r, &s, &o, env, tiles, &vs, &err);
     if (!rc && o.views > 1)
@@ -806,7 +841,9 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                    : mesh_drawn && s.mesh ? s.mesh->triangle_count
                    : s.cloud ? s.cloud->count : 0;
     int status = 0;
-    if (rc) {
+    if (no_lod) {
+        status = cli_usage_error(env, "--frame-ms needs a renderer with a level of detail (splat, square): %s", err.msg);
+    } else if (rc) {
         status = cli_fail(env, &err);
     } else {
         cli_progress_end(env);
@@ -827,6 +864,15 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         if (!env->json && hybrid)
             cli_info(env, "hybrid: %zu of %zu primitives kept, %zu of %zu points drawn as splats (docs/hybrid.md)",
                      hc.prims_kept, hc.prims_kept + hc.prims_replaced, hc.points_drawn, hc.points_total);
+        if (!env->json && vs.budget)
+            cli_info(env, "frame budget %g ms%s: tau %g px, %zu primitives, median %.1f ms (p10 %.1f, p90 %.1f) over the "
+                          "last frames of %zu\n", o.frame_ms,
+                     !vs.settled.settled ? " (not settled)"
+                     : vs.settled.held   ? ""
+                     : frame_budget.finest ? " (full detail is faster)"
+                                           : " (not held: the coarsest useful cut is slower)",
+                     (double)vs.settled.tolerance, vs.settled.count, vs.settled.median_ms, vs.settled.p10_ms,
+                     vs.settled.p90_ms, vs.settled.frames);
     }
     asp_image_release(&sheet);
     for (size_t i = 0; i < o.views; i++)

@@ -16,7 +16,9 @@ static const char usage[] =
     "                     [--color MODE] [--level L] [--method NAME] [--alpha-ref X] [--unlit]\n"
     "                     [--background R,G,B] [--texture IMG] [--hybrid] [--verbose]\n"
     "                     [--preset thesis|journal|pajarola|schwarz]\n"
+    "                     [--frame-ms T] [--overlay | --no-overlay]\n"
     "       amgsplat view FILE --frames N [--screenshot OUT.png] [--keys KEYS] [options above]\n"
+    "       amgsplat view FILE --fly N [--frame-ms T] [--stats-json OUT.json] [options above]\n"
     "\n"
     "Opens a window on a point file (.ply, .xyz, .pts, .txt), an AMG decomposition (.amg,\n"
     "coloured by classifier or domains), domain primitives (.dps, one level at a time, blended\n"
@@ -25,7 +27,9 @@ static const char usage[] =
     "renderer keys pick how its point sources are drawn). Left drag orbits, the wheel or right drag zooms, middle\n"
     "drag or shift + left drag pans; press h in the window for the keys (docs/cli/view.md).\n"
     "With --frames N the viewer draws N frames, pressing KEYS one per frame, saves the last\n"
-    "frame to OUT.png and exits (needs a display: run under xvfb-run without one).";
+    "frame to OUT.png and exits (needs a display: run under xvfb-run without one). --frame-ms T\n"
+    "sets the screen tolerance every frame so a frame takes T ms (splat, square); --fly N draws\n"
+    "N frames on a fixed path around the model.";
 
 static const char *const color_modes[] = {"classifier", "domains", "strict", "input"};
 
@@ -47,6 +51,10 @@ struct view_opts {
     size_t depth_limit; /* seed 004 3.2.5 */
     double alpha_ref;
     size_t frames;
+    size_t fly;             /* --fly N: scripted fly-through of N frames */
+    double frame_ms;        /* --frame-ms: frame budget (issue 18 item 5) */
+    const char *stats_json;
+    int overlay, no_overlay;
     double tau;
     int unlit;
     int verbose;
@@ -130,7 +138,22 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
     d->frames = o->frames;
     d->screenshot = o->screenshot;
     d->keys = o->keys;
-    d->flags = (o->unlit ? ASP_VIEWER_UNLIT : 0u) | (o->verbose ? ASP_VIEWER_VERBOSE : 0u);
+    d->flags = (o->unlit ? ASP_VIEWER_UNLIT : 0u) | (o->verbose ? ASP_VIEWER_VERBOSE : 0u) |
+               (o->overlay ? ASP_VIEWER_OVERLAY : 0u) | (o->no_overlay ? ASP_VIEWER_NO_OVERLAY : 0u);
+    if (o->overlay && o->no_overlay)
+        return cli_usage_error(env, "--overlay and --no-overlay exclude each other");
+    if (o->fly) {
+        if (o->frames && o->frames != o->fly)
+            return cli_usage_error(env, "--fly %zu draws %zu frames; --frames %zu disagrees", o->fly, o->fly, o->frames);
+        d->frames = o->fly;
+        d->fly = 1;
+    }
+    if (!(o->frame_ms >= 0 && o->frame_ms <= 1e6))
+        return cli_usage_error(env, "--frame-ms expects milliseconds in 0..1e6 (0 = off), got %g", o->frame_ms);
+    d->frame_ms = o->frame_ms;
+    if (o->stats_json && cli_check_output(env, o->stats_json, NULL, 0, (const char *const[]){path}, 1))
+        return 2;
+    d->stats_json = o->stats_json;
     // what the library would refuse is a usage error too (renderer names, keys, screenshot)
     asp_error err = {0, ""};
     if (asp_viewer_desc_check(d, &err))
@@ -157,6 +180,18 @@ static int print_json(const struct cli_env *env, const char *path, const asp_vie
         cJSON_AddNullToObject(o, "screenshot");
     cJSON_AddStringToObject(o, "gl_renderer", s->gl_renderer);
     cJSON_AddStringToObject(o, "title", s->title);
+    cJSON_AddItemToObject(o, "median_frame_ms", cli_json_number("%.3f", s->median_frame_ms));
+    cJSON_AddItemToObject(o, "p10_frame_ms", cli_json_number("%.3f", s->p10_frame_ms));
+    cJSON_AddItemToObject(o, "p90_frame_ms", cli_json_number("%.3f", s->p90_frame_ms));
+    if (d->frame_ms > 0)
+        cJSON_AddNumberToObject(o, "budget_ms", d->frame_ms);
+    else
+        cJSON_AddNullToObject(o, "budget_ms");
+    cJSON_AddBoolToObject(o, "budget_applied", s->budget_applied);
+    cJSON_AddItemToObject(o, "tolerance_min", cli_json_number("%g", s->tolerance_min));
+    cJSON_AddItemToObject(o, "tolerance_max", cli_json_number("%g", s->tolerance_max));
+    cJSON_AddNumberToObject(o, "count_min", (double)s->count_min);
+    cJSON_AddNumberToObject(o, "count_max", (double)s->count_max);
     return cli_json_print(env, o);
 }
 
@@ -193,6 +228,11 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         {"frames", 0, CLI_SIZE, &o.frames, "N", "scripted: draw N frames, then exit"},
         {"screenshot", 0, CLI_STRING, &o.screenshot, "OUT.png", "scripted: save the last frame"},
         {"keys", 0, CLI_STRING, &o.keys, "KEYS", "press these keys, one per frame, from the first frame on"},
+        {"frame-ms", 0, CLI_DOUBLE, &o.frame_ms, "T", "frame budget: set tau (then the depth limit) every frame so a frame takes T ms"},
+        {"fly", 0, CLI_SIZE, &o.fly, "N", "scripted: N frames on a fixed path around and close to the model"},
+        {"stats-json", 0, CLI_STRING, &o.stats_json, "OUT.json", "write every frame's time, tau, depth limit and count, with median, p10, p90"},
+        {"overlay", 0, CLI_FLAG, &o.overlay, NULL, "start with the figures over the frame (i toggles; on with --frame-ms)"},
+        {"no-overlay", 0, CLI_FLAG, &o.no_overlay, NULL, "start without them"},
         {0},
     };
     int npos = 0;
@@ -220,6 +260,11 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         return print_json(env, argv[0], &desc, &stats);
     cli_info(env, "drew %zu frames of '%s' (%s, %zu %s, %.2f ms per frame)\n", stats.frames, argv[0], stats.renderer,
              stats.count, "primitives", stats.mean_frame_ms);
+    if (desc.frame_ms > 0)
+        cli_info(env, "frame budget %g ms%s: median %.1f ms (p10 %.1f, p90 %.1f), tau %g..%g px, %zu..%zu primitives\n",
+                 desc.frame_ms, stats.budget_applied ? "" : " (not applied: no level of detail)", stats.median_frame_ms,
+                 stats.p10_frame_ms, stats.p90_frame_ms, (double)stats.tolerance_min, (double)stats.tolerance_max,
+                 stats.count_min, stats.count_max);
     return 0;
 }
 #endif

@@ -34,6 +34,7 @@ const asp__viewer_key asp__viewer_keys[] = {
     {'p', ASP__VIEWER_POINTS, 0, ".dps: toggle the source points (disc renderer) and the primitives; mesh: its points and the mesh"},
     {'s', ASP__VIEWER_SCREENSHOT, 0, "screenshot to <input>-NNN.png in the current directory"},
     {'v', ASP__VIEWER_PRINT_VIEW, 0, "print the view as --view AZ,EL,DIST"},
+    {'i', ASP__VIEWER_OVERLAY, 0, "toggle the figures over the frame: frame time, tau, depth limit, counts"},
     {'h', ASP__VIEWER_HELP, 0, "print the keys (also ?)"},
     {'?', ASP__VIEWER_HELP, 0, NULL},
     {'a', ASP__VIEWER_ORBIT_LEFT, 0, "orbit left (also Left)"},

@@ -37,7 +37,8 @@ enum asp__viewer_action {
     ASP__VIEWER_ALPHA_UP,
     ASP__VIEWER_OUTLINE,
     ASP__VIEWER_CREASES,
-    ASP__VIEWER_POINTS
+    ASP__VIEWER_POINTS,
+    ASP__VIEWER_OVERLAY /* the figures over the frame (frame time, tau, depth limit, counts) */
 };
 
 /* One printable key of the viewer; the table ends with key 0. */
@@ -85,6 +86,41 @@ void asp__viewer_pan(asp_camera *cam, double dx, double dy, uint32_t height);
  * bottom), so every value is reachable and 0 (every leaf) is one key away.
  */
 float asp__viewer_tolerance_step(float tau, int dir);
+
+/*
+ * The scripted fly-through (fly.c; pure math): the camera at u in [0, 1] of
+ * the path from start: azimuth start + 360 u, elevation start + 25 sin(2 pi u)
+ * (within -89..89), distance start * (1 - 0.65 sin^2(pi u)), so the view
+ * turns once around the model, passes above and below it and comes in to
+ * 0.35 times the first distance half way, where the cut is largest.
+ */
+void asp__viewer_fly(const asp_camera *start, double u, asp_camera *cam);
+
+/* ---- per-frame figures (frame_log.c): what --stats-json writes and the quantiles of asp_viewer_stats ---- */
+
+typedef struct asp__viewer_frame {
+    double frame_ms;       /* the whole frame: input, drawing, overlay, swap */
+    double draw_ms;        /* asp_render_frame with glFinish only */
+    float tolerance;       /* tau of the frame; NaN for renderers without a level of detail */
+    uint32_t depth_limit;  /* 0 = none */
+    size_t count;          /* primitives drawn */
+    float azimuth, elevation, distance; /* the camera (distance in world units) */
+} asp__viewer_frame;
+
+typedef struct asp__viewer_frame_log {
+    asp__viewer_frame *frames;
+    size_t count, cap;
+} asp__viewer_frame_log;
+
+/* Appends f (growing the log). Returns 0 or ASP_ENOMEM (the log keeps what it had). */
+int asp__viewer_frame_log_add(asp__viewer_frame_log *log, const asp_context *ctx, const asp__viewer_frame *f,
+                              asp_error *err);
+/* Fills the quantiles and ranges of st from the log (zeros when it is empty); ctx: scratch. */
+void asp__viewer_frame_log_summary(const asp__viewer_frame_log *log, const asp_context *ctx, asp_viewer_stats *st);
+/* Writes the log, st and the budget of d as JSON to path (atomically). Returns 0, ASP_EIO or ASP_ENOMEM. */
+int asp__viewer_frame_log_save(const asp__viewer_frame_log *log, const asp_viewer_stats *st,
+                               const asp_viewer_desc *d, const char *input, const char *path, asp_error *err);
+void asp__viewer_frame_log_release(asp__viewer_frame_log *log, const asp_context *ctx);
 
 /* ---- what is shown (scene_actions.c, over the one scene loader of scene.h) ---- */
 

@@ -4,7 +4,8 @@
  * Pajarola et al. 2003 section 5; splats and squares, seed 004 3.2.6; the
  * textured domain primitives of a .dps level, journal section 4), the screen
  * tolerance, the .amg colouring, the .dps blending options, and a scripted
- * mode for tests.
+ * mode for tests; with a frame budget (issue 18 item 5) each frame sets the
+ * tolerance that holds the frame time, and the figures show over the frame.
  */
 #include <math.h>
 #include <stdarg.h>
@@ -88,6 +89,10 @@ int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err)
         return asp_error_set(err, ASP_EINVAL, "a screenshot file needs a number of frames (scripted mode)");
     if (desc->screenshot && !asp_file_name_is(desc->screenshot, "png"))
         return asp_error_set(err, ASP_EINVAL, "screenshot '%s' must end in .png", desc->screenshot);
+    if (!(desc->frame_ms >= 0 && desc->frame_ms <= 1e6))
+        return asp_error_set(err, ASP_EINVAL, "frame budget %g ms is outside 0..1e6", desc->frame_ms);
+    if (desc->fly && desc->frames == 0)
+        return asp_error_set(err, ASP_EINVAL, "a fly-through needs a number of frames (scripted mode)");
     return 0;
 }
 
@@ -136,9 +141,20 @@ struct viewer {
     size_t window_frames;
     double window_ms;
     double title_time;
+    double frame_last_ms;  /* the whole last frame (input to swap), what the budget holds */
     int title_stale;       /* the last frame's figures are not in the title yet */
     asp_viewer_stats stats;
     size_t kind_prim;      /* row of the "prim" renderer */
+    /* frame budget (desc->frame_ms > 0) and the figures over the frame */
+    int budget_on;
+    asp_frame_budget budget;
+    int budget_ok;            /* the current renderer took the budget's tau */
+    size_t budget_told;       /* 1 + the renderer kind the log was last told about (no level of detail) */
+    int overlay_on;
+    asp_text_overlay *overlay;
+    double frame_top;         /* when the current frame began (after any idle wait) */
+    asp_camera fly_start;     /* the first view: the fly-through's path starts there */
+    asp__viewer_frame_log flog;
 };
 
 static void vlog(const viewer *v, const char *fmt, ...)
@@ -422,6 +438,11 @@ static void print_view(const viewer *v)
 
 static void change_tolerance(viewer *v, int dir)
 {
+    if (v->budget_on) {
+        vlog(v, "tau is set by the frame budget of %g ms (--frame-ms): %g px now", v->desc->frame_ms,
+             (double)v->tolerance);
+        return;
+    }
     float old = v->tolerance;
     v->tolerance = asp__viewer_tolerance_step(old, dir);
     if (!K(v->kind)->has_lod) {
@@ -600,6 +621,7 @@ static void apply(viewer *v, const action *a)
     case ASP__VIEWER_CREASES: prim_action(v, a->what); break;
     case ASP__VIEWER_POINTS: toggle_points(v); break;
     case ASP__VIEWER_SCREENSHOT: v->screenshot_wanted = 1; break;
+    case ASP__VIEWER_OVERLAY: v->overlay_on = !v->overlay_on; break;
     case ASP__VIEWER_HELP: print_help(v); break;
     case ASP__VIEWER_PRINT_VIEW: print_view(v); break;
     case ASP__VIEWER_ORBIT_LEFT: asp__viewer_orbit(&v->cam, -step_px, 0); break;
@@ -647,6 +669,85 @@ static int next_screenshot_name(viewer *v, char *out, size_t cap)
     return -1;
 }
 
+/* ---- frame budget and the figures over the frame (issue 18 item 5) ---- */
+
+/* The budget starts from --tau when given (else its coarse default); the depth fallback needs a hierarchy. */
+static int budget_start(viewer *v, asp_error *err)
+{
+    const asp_hier *h = v->hier ? v->hier : v->scene.hier;
+    asp_frame_budget_desc bd = {.target_ms = v->desc->frame_ms, .tolerance = v->desc->tolerance,
+                                .depth_max = h ? asp_hier_depth(h) + 1 : 0};
+    int rc = asp_frame_budget_init(&v->budget, &bd, err);
+    if (rc)
+        return rc;
+    v->budget_on = 1;
+    v->budget_told = 0;
+    vlog(v, "frame budget %g ms: tau starts at %g px", v->desc->frame_ms, (double)v->budget.tolerance);
+    return 0;
+}
+
+/* Applies the budget's tau and depth limit to the current renderer; says once per renderer when it has none. */
+static void budget_before_frame(viewer *v)
+{
+    if (!v->budget_on)
+        return;
+    asp_error e = {0, ""};
+    int rc = asp_frame_budget_apply(&v->budget, v->r, &e);
+    v->budget_ok = rc == 0;
+    if (rc == 0) {
+        v->tolerance = v->budget.tolerance;
+        v->depth_limit = v->budget.depth_limit;
+        v->budget_told = 0;
+        return;
+    }
+    if (v->budget_told != v->kind + 1)
+        vlog(v, "frame budget: %s; --frame-ms has no effect on this renderer", e.msg);
+    v->budget_told = v->kind + 1;
+}
+
+/* Feeds the whole frame's time; a changed tau asks for another frame, so an idle window settles too. */
+static void budget_after_frame(viewer *v, double frame_ms, size_t count)
+{
+    if (!v->budget_on || !v->budget_ok)
+        return;
+    if (asp_frame_budget_update(&v->budget, frame_ms, count))
+        v->dirty = 1;
+}
+
+static int draw_overlay(viewer *v, asp_error *err)
+{
+    if (!v->overlay) {
+        int rc = asp_text_overlay_create(v->gl, &v->overlay, err);
+        if (rc)
+            return rc;
+    }
+    asp_renderer_stats rs;
+    asp_renderer_stats_get(v->r, &rs);
+    char text[512], line[160];
+    snprintf(text, sizeof text, "frame %.1f ms  draw %.1f ms", v->frame_last_ms, v->last_ms);
+    if (v->budget_on) {
+        snprintf(line, sizeof line, "\nbudget %g ms%s", v->desc->frame_ms,
+                 !v->budget_ok                    ? " (no level of detail here)"
+                 : v->budget.saturated            ? " (coarsest: cannot hold it)"
+                 : v->budget.bound                ? " (coarser is not faster here)"
+                 : v->budget.finest               ? " (full detail fits)"
+                                                  : "");
+        strncat(text, line, sizeof text - strlen(text) - 1);
+    }
+    if (K(v->kind)->has_lod || v->budget_ok) {
+        char depth[32] = "none";
+        if (v->depth_limit)
+            snprintf(depth, sizeof depth, "%u", v->depth_limit);
+        snprintf(line, sizeof line, "\ntau %.2f px  depth limit %s", (double)v->tolerance, depth);
+        strncat(text, line, sizeof text - strlen(text) - 1);
+    }
+    snprintf(line, sizeof line, "\n%zu / %zu %s (%s)", rs.count, rs.points ? rs.points : rs.count, K(v->kind)->noun,
+             K(v->kind)->name);
+    strncat(text, line, sizeof text - strlen(text) - 1);
+    asp_text_overlay_desc od = {.x = 8, .y = 8, .scale = 2};
+    return asp_text_overlay_draw(v->overlay, text, &od, err);
+}
+
 /* ---- the loop ---- */
 
 static void update_title(viewer *v, double now, int force)
@@ -667,11 +768,18 @@ static void update_title(viewer *v, double now, int force)
                  alpha_ref_of(&v->prim), v->prim.crease_angle < 0 ? ", no creases" : "",
                  v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? ", outline" : "",
                  v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? ", domain colours" : "");
+    char budget[96] = "";
+    if (v->budget_on)
+        snprintf(budget, sizeof budget, " | budget %g ms%s%s", v->desc->frame_ms,
+                 !v->budget_ok ? " (no level of detail)" : "",
+                 v->budget_ok && v->depth_limit ? ", depth limit" : "");
+    if (v->budget_on && v->budget_ok && v->depth_limit)
+        snprintf(budget + strlen(budget), sizeof budget - strlen(budget), " %u", v->depth_limit);
     char *title = v->stats.title;
-    snprintf(title, sizeof v->stats.title, "amgsplat view: %s | %s | %zu %s | %.1f ms (%.0f fps)%s | %s%s%s", base,
+    snprintf(title, sizeof v->stats.title, "amgsplat view: %s | %s | %zu %s | %.1f ms (%.0f fps)%s%s | %s%s%s", base,
              K(v->kind)->name, v->r ? asp_renderer_count(v->r) : 0,
              K(v->kind)->noun, v->last_ms,
-             v->last_ms > 0 ? 1000.0 / v->last_ms : 0.0, tau, v->unlit ? "unlit" : "lit",
+             v->last_ms > 0 ? 1000.0 / v->last_ms : 0.0, tau, budget, v->unlit ? "unlit" : "lit",
              v->status[0] ? " | " : "", v->status);
     glfwSetWindowTitle(v->window, title);
 }
@@ -712,12 +820,25 @@ static int draw(viewer *v, int last, asp_error *err)
         memcpy(rd.background, bg, 4);
     else
         memset(rd.background, 255, 4);
+    budget_before_frame(v);
+    asp__viewer_frame rec = {.tolerance = K(v->kind)->has_lod || v->budget_ok ? v->tolerance : NAN,
+                             .depth_limit = v->depth_limit, .azimuth = v->cam.azimuth,
+                             .elevation = v->cam.elevation, .distance = v->cam.distance};
     double t0 = asp_time_now();
     int rc = asp_render_frame(v->gl, v->r, &v->cam, &rd, err);
     if (rc)
         return rc;
     double now = asp_time_now();
-    account_frame(v, 1000.0 * (now - t0), now);
+    rec.draw_ms = 1000.0 * (now - t0);
+    rec.count = asp_renderer_count(v->r);
+    account_frame(v, rec.draw_ms, now);
+    if (v->overlay_on) {
+        asp_error e = {0, ""};
+        if (draw_overlay(v, &e)) {
+            vlog(v, "cannot draw the figures over the frame: %s", e.msg);
+            v->overlay_on = 0;
+        }
+    }
     if (v->screenshot_wanted) {
         v->screenshot_wanted = 0;
         char name[256];
@@ -736,6 +857,12 @@ static int draw(viewer *v, int last, asp_error *err)
     v->stats.height = h;
     asp_gl_context_swap_buffers(v->gl);
     update_title(v, now, v->frames == 1);
+    rec.frame_ms = 1000.0 * (asp_time_now() - v->frame_top);
+    v->frame_last_ms = rec.frame_ms;
+    rc = asp__viewer_frame_log_add(&v->flog, &v->ctx, &rec, err);
+    if (rc)
+        return rc;
+    budget_after_frame(v, rec.frame_ms, rec.count);
     return 0;
 }
 
@@ -748,12 +875,18 @@ static int loop(viewer *v, asp_error *err)
         int scripted = d->frames > 0;
         if (scripted && i >= d->frames)
             return 0;
+        v->frame_top = asp_time_now();
         if (scripted || v->dirty || v->queued || i < nkeys) {
             glfwPollEvents();
         } else {
             if (v->title_stale)
                 update_title(v, asp_time_now(), 1);
             glfwWaitEventsTimeout(0.5); // idle: sleep until input instead of redrawing
+            v->frame_top = asp_time_now(); // the frame begins when the input arrived, not while idle
+        }
+        if (scripted && d->fly) {
+            asp__viewer_fly(&v->fly_start, (double)i / (double)d->frames, &v->cam);
+            v->dirty = 1;
         }
         if (i < nkeys) {
             const asp__viewer_key *k = asp__viewer_key_find((unsigned char)keys[i]);
@@ -814,6 +947,8 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
     v.tolerance = desc->tolerance;
     v.depth_limit = desc->depth_limit;
     v.unlit = (desc->flags & ASP_VIEWER_UNLIT) != 0;
+    v.overlay_on = (desc->flags & ASP_VIEWER_OVERLAY) ||
+                   (desc->frame_ms > 0 && !(desc->flags & ASP_VIEWER_NO_OVERLAY));
     v.prim.method = (asp_prim_render_method)desc->prim_method;
     v.prim.alpha_ref = desc->prim_alpha_ref;
     if (ctx)
@@ -848,13 +983,24 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
         asp_gl_context_framebuffer_size(v.gl, &w, &h);
         v.cam.aspect = w && h ? (float)w / (float)h : 1.0f;
         reset_view(&v);
+        v.fly_start = v.cam;
         v.window_start = v.title_time = asp_time_now();
         rc = switch_renderer(&v, v.kind, err);
     }
+    if (!rc && desc->frame_ms > 0)
+        rc = budget_start(&v, err);
     if (!rc)
         rc = loop(&v, err);
     if (!rc && v.title_stale)
         update_title(&v, asp_time_now(), 1);
+    if (!rc) {
+        v.stats.budget_applied = v.budget_on && v.budget_ok;
+        snprintf(v.stats.renderer, sizeof v.stats.renderer, "%s", K(v.kind)->name);
+        v.stats.mean_frame_ms = v.frames ? v.total_ms / (double)v.frames : 0;
+        asp__viewer_frame_log_summary(&v.flog, &v.ctx, &v.stats);
+        if (desc->stats_json)
+            rc = asp__viewer_frame_log_save(&v.flog, &v.stats, desc, path, desc->stats_json, err);
+    }
     if (!rc && stats) {
         v.stats.frames = v.frames;
         v.stats.mean_frame_ms = v.frames ? v.total_ms / (double)v.frames : 0;
@@ -863,6 +1009,8 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
         snprintf(v.stats.renderer, sizeof v.stats.renderer, "%s", K(v.kind)->name);
         *stats = v.stats;
     }
+    asp_text_overlay_destroy(v.overlay);
+    asp__viewer_frame_log_release(&v.flog, &v.ctx);
     asp_renderer_destroy(v.r);
     asp_hier_destroy(v.hier);
     asp_gl_context_destroy(v.gl);
