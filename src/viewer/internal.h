@@ -38,7 +38,11 @@ enum asp__viewer_action {
     ASP__VIEWER_OUTLINE,
     ASP__VIEWER_CREASES,
     ASP__VIEWER_POINTS,
-    ASP__VIEWER_OVERLAY /* the figures over the frame (frame time, tau, depth limit, counts) */
+    ASP__VIEWER_OVERLAY, /* the figures over the frame (frame time, tau, depth limit, counts) */
+    /* thesis appendix C: the debug drawings and the Domain Set switch */
+    ASP__VIEWER_DEBUG_EIGENVECTORS,
+    ASP__VIEWER_DEBUG_TEXELS,
+    ASP__VIEWER_DOMAIN_SET
 };
 
 /* One printable key of the viewer; the table ends with key 0. */

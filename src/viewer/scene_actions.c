@@ -66,6 +66,11 @@ int asp__viewer_scene_load(asp_scene *s, const char *path, const asp_viewer_desc
     int rc = asp_scene_load(path, &d, ctx, &t, err);
     if (rc)
         return rc;
+    // the hybrid renderer draws the source points beside the primitives (docs/hybrid.md)
+    if (t.dps && desc->renderer && strcmp(desc->renderer, "hybrid") == 0 && (rc = asp_scene_load_source(&t, err))) {
+        asp_scene_release(&t);
+        return rc;
+    }
     if (t.amg && desc->amg_color == MODE_INPUT && !asp_amg_cloud(t.amg)->colors) {
         asp_scene_release(&t);
         return asp_error_set(err, ASP_EINVAL, "cannot view '%s' in input colours: its points have no colours", path);

@@ -513,6 +513,14 @@ static void prim_action(viewer *v, enum asp__viewer_action a)
         v->prim.crease_angle = v->prim.crease_angle < 0 ? 0.0f : -1.0f;
         vlog(v, "crease clipping %s", v->prim.crease_angle < 0 ? "off" : "on");
         break;
+    case ASP__VIEWER_DEBUG_EIGENVECTORS:
+    case ASP__VIEWER_DEBUG_TEXELS: {
+        unsigned flag = a == ASP__VIEWER_DEBUG_TEXELS ? ASP_PRIM_RENDER_DEBUG_TEXELS : ASP_PRIM_RENDER_DEBUG_EIGENVECTORS;
+        v->prim.flags ^= flag;
+        vlog(v, "%s %s", flag == ASP_PRIM_RENDER_DEBUG_TEXELS ? "texel midpoints" : "eigenvectors",
+             v->prim.flags & flag ? "on" : "off");
+        break;
+    }
     case ASP__VIEWER_COLOR_MODE:
         v->prim.flags ^= ASP_PRIM_RENDER_COLOR_BY_DOMAIN;
         vlog(v, "%s", v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? "a colour per domain" : "texture colours");
@@ -570,7 +578,8 @@ static void scene_action(viewer *v, enum asp__viewer_action a)
     }
     char note[160] = "";
     asp_error e = {0, ""};
-    int rc = asp__viewer_scene_action(&v->scene, a, note, sizeof note, &e);
+    int rc = a == ASP__VIEWER_DOMAIN_SET ? asp__viewer_scene_domain_set(&v->scene, note, sizeof note)
+                                         : asp__viewer_scene_action(&v->scene, a, note, sizeof note, &e);
     if (rc < 0) {
         vlog(v, "%s", e.msg);
         return;
@@ -613,12 +622,15 @@ static void apply(viewer *v, const action *a)
     case ASP__VIEWER_TAU_DOWN: change_tolerance(v, -1); break;
     case ASP__VIEWER_COLOR_MODE:
     case ASP__VIEWER_LEVEL_FINER:
-    case ASP__VIEWER_LEVEL_COARSER: scene_action(v, a->what); break;
+    case ASP__VIEWER_LEVEL_COARSER:
+    case ASP__VIEWER_DOMAIN_SET: scene_action(v, a->what); break;
     case ASP__VIEWER_NEXT_METHOD:
     case ASP__VIEWER_ALPHA_DOWN:
     case ASP__VIEWER_ALPHA_UP:
     case ASP__VIEWER_OUTLINE:
-    case ASP__VIEWER_CREASES: prim_action(v, a->what); break;
+    case ASP__VIEWER_CREASES:
+    case ASP__VIEWER_DEBUG_EIGENVECTORS:
+    case ASP__VIEWER_DEBUG_TEXELS: prim_action(v, a->what); break;
     case ASP__VIEWER_POINTS: toggle_points(v); break;
     case ASP__VIEWER_SCREENSHOT: v->screenshot_wanted = 1; break;
     case ASP__VIEWER_OVERLAY: v->overlay_on = !v->overlay_on; break;
