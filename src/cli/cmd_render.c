@@ -589,6 +589,8 @@ static int render_instance_scene(const char *path, struct render_opts *o, struct
         return cli_usage_error(env, "--budget is per model; a scene takes --tolerance (every instance's cut)");
     if (o->hybrid || o->hybrid_points)
         return cli_usage_error(env, "--hybrid draws one .dps with its points; a scene's sources are drawn one by one");
+    if (o->frame_ms > 0)
+        return cli_usage_error(env, "--frame-ms settles one model's cut; a scene takes --tolerance (every instance's cut)");
     const asp_renderer_kind *kind = NULL;
     asp_error err = {0, ""};
     if (o->renderer && asp_renderer_kind_find(o->renderer, ASP_RENDER_INPUT_POINTS, &kind, &err))
@@ -605,7 +607,7 @@ static int render_instance_scene(const char *path, struct render_opts *o, struct
     asp_image tiles[MAX_VIEWS];
     asp_image sheet = {0, 0, NULL};
     memset(tiles, 0, sizeof tiles);
-    struct view_stats vs = {SIZE_MAX, 0, 0, 0};
+    struct view_stats vs = {SIZE_MAX, 0, 0, 0, NULL, {0}};
     asp_renderer_options ropts;
     renderer_options(o, &ropts);
     asp_scene_desc d = {.level = o->level, .texture = o->texture};
