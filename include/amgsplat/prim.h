@@ -228,6 +228,8 @@ typedef struct asp_dps_cut_view {
     double eye[3];
     double pixels_per_unit;   /* pixels covered by one world unit at distance 1: height / (2 tan(fovy / 2)) */
     double tolerance;         /* pixels; <= 0 refines to the finest level everywhere */
+    double size_weight;       /* >= 0: the error measured is asp_prim.error + size_weight x the rectangle's half
+                                 diagonal, so large flat primitives refine too (0 = the geometric error alone) */
 } asp_dps_cut_view;
 
 /** Opaque cut state: child lists, target and drawn weights, the fade. */

@@ -136,7 +136,7 @@ static int refines(const asp_prim *p, float radius, const asp_dps_cut_view *v)
     /* inside the bounding sphere the projection is unbounded: refine (seed 001 section 5 does the same) */
     if (dist <= 1e-9)
         return 1;
-    return (double)p->error * v->pixels_per_unit / dist > v->tolerance;
+    return ((double)p->error + v->size_weight * radius) * v->pixels_per_unit / dist > v->tolerance;
 }
 
 size_t asp_dps_cut_target(const asp_dps_cut *cut, const asp_dps_cut_view *view, float *out)

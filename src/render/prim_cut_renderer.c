@@ -30,7 +30,7 @@ typedef struct cut_renderer {
     asp_renderer base;     /* first */
     const asp_dps *dps;
     asp_context actx;
-    float tolerance, alpha_ref, transparency;
+    float tolerance, alpha_ref, transparency, size_weight;
     double fade, origin[3];
     size_t nlevels;
     cut_level *levels;
@@ -281,7 +281,7 @@ int asp_cut_renderer_create(asp_gl_context *gl, const asp_dps *dps, const asp_cu
         return asp_error_set(err, ASP_EINVAL, "no links between the levels of this .dps (version 1 or 2, or a merged "
                              "level): rebuild it with 'amgsplat build --level L-6..L' for a cut across levels");
     if (isnan(desc->tolerance) || isnan(desc->alpha_ref) || desc->alpha_ref > 1 || isnan(desc->transparency) ||
-        desc->transparency > 1 || isnan(desc->fade_seconds))
+        desc->transparency > 1 || isnan(desc->fade_seconds) || isnan(desc->size_weight))
         return asp_error_set(err, ASP_EINVAL, "cut renderer options: tolerance %g, alpha reference %g, transparency "
                              "%g, fade %g s", (double)desc->tolerance, (double)desc->alpha_ref,
                              (double)desc->transparency, desc->fade_seconds);
@@ -305,6 +305,7 @@ int asp_cut_renderer_create(asp_gl_context *gl, const asp_dps *dps, const asp_cu
     r->tolerance = desc->tolerance > 0 ? desc->tolerance : desc->tolerance < 0 ? 0.0f : 1.0f;
     r->alpha_ref = desc->alpha_ref > 0 ? desc->alpha_ref : desc->alpha_ref < 0 ? 0.0f : 0.1f;
     r->transparency = desc->transparency > 0 ? desc->transparency : 1.0f;
+    r->size_weight = desc->size_weight > 0 ? desc->size_weight : desc->size_weight < 0 ? 0.0f : 0.2f;
     r->fade = desc->fade_seconds == 0 ? 0.25 : desc->fade_seconds < 0 ? 0 : desc->fade_seconds;
     r->time = r->last_time = NAN;
     memcpy(r->origin, desc->origin, sizeof r->origin);
@@ -390,7 +391,8 @@ static int build_items(cut_renderer *r, const asp__frame *f, asp_error *err)
 {
     double dt = isnan(r->time) || isnan(r->last_time) ? -1 : r->time - r->last_time;
     r->last_time = r->time;
-    asp_dps_cut_view view = {.pixels_per_unit = 0.5 * f->height * f->proj[5], .tolerance = r->tolerance};
+    asp_dps_cut_view view = {.pixels_per_unit = 0.5 * f->height * f->proj[5], .tolerance = r->tolerance,
+                             .size_weight = r->size_weight};
     size_t total = 0;
     for (size_t i = 0; i < r->instances; i++) {
         const float *m = r->models + 16 * i;
