@@ -14,6 +14,7 @@
 #include "amgsplat/mesh.h"
 #include "amgsplat/prim.h"
 #include "amgsplat/sample.h"
+#include "file_forge.h"
 #include "harness.h"
 
 static asp_amg *amg;
@@ -264,6 +265,29 @@ static void test_links_file(void)
         }
     }
     asp_dps_destroy(back);
+    /* damaged links are refused with the level, primitive and field: a weight above 1, a parent beyond the
+     * next level, a range that does not start at 0 (level 0's lists follow its header, primitives and
+     * neighbours) */
+    size_t size = 0;
+    unsigned char *bytes = forge_slurp(path, &size);
+    const asp_dps_level *l0 = &dps->levels[0];
+    const size_t first_at = 96 + 128 + 4 + strlen("bunny") + 112 + 124 * l0->prim_count + 4 * l0->neighbour_total,
+                 pair_at = first_at + 4 * (l0->prim_count + 1);
+    const struct { size_t at; uint32_t value; const char *field; } bad[] = {
+        {pair_at + 4, 0x40000000u /* 2.0f */, "weight 2"},
+        {pair_at, 1000000u, "names primitive 1000000"},
+        {first_at, 1u, "link range start 1"}};
+    for (size_t i = 0; bytes && i < sizeof bad / sizeof bad[0]; i++) {
+        unsigned char *b = malloc(size);
+        memcpy(b, bytes, size);
+        forge_put_le(b + bad[i].at, bad[i].value, 4);
+        forge_fix(b, size, 24);
+        asp_dps *x = NULL;
+        CHECK(asp_dps_load_memory(b, size, "forged.dps", NULL, &x, &err) == ASP_EFORMAT && !x);
+        CHECK_MSG(strstr(err.msg, bad[i].field) != NULL, "%s: %s", bad[i].field, err.msg);
+        free(b);
+    }
+    free(bytes);
     /* a cut needs links: a dps whose links were dropped is refused with a message */
     asp_dps_level *lv = &dps->levels[0];
     uint32_t *keep = lv->link_first;
