@@ -43,6 +43,7 @@ typedef struct cut_renderer {
     /* per frame */
     cut_item *items;
     size_t item_capacity, gpu_item_capacity, gpu_model_capacity, drawn;
+    double select_seconds;  /* CPU time of the last frame's cuts and item list */
     asp__gl_buffer item_buffer, model_buffer;
     asp__gl_vertex_array vao, empty_vao;
     asp__gl_program draw, resolve;
@@ -463,7 +464,9 @@ static void draw_levels(cut_renderer *r, int pass)
 static int cut_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
 {
     cut_renderer *r = (cut_renderer *)base;
+    double t0 = asp_time_now();
     int rc = build_items(r, f, err);
+    r->select_seconds = asp_time_now() - t0;
     if (!rc)
         rc = targets_ensure(r, f->width, f->height, err);
     if (rc)
@@ -537,6 +540,7 @@ static void cut_stats(const asp_renderer *base, asp_renderer_stats *out)
     const cut_renderer *r = (const cut_renderer *)base;
     out->count = r->drawn;
     out->tolerance = r->tolerance;
+    out->select_seconds = r->select_seconds;
     size_t prims = 0;
     for (size_t l = 0; l < r->nlevels; l++)
         prims += r->dps->levels[l].prim_count;
