@@ -858,7 +858,7 @@ typedef struct asp_renderer_kind {
 
 /**
  * Row i of the renderer table, in the order "disc", "splat", "square",
- * "prim", "mesh" (the viewer's 1..9 keys follow it), or NULL past the end.
+ * "prim", "mesh", "cut" (the viewer's 1..9 keys follow it), or NULL past the end.
  * Thread safe.
  */
 const asp_renderer_kind *asp_renderer_kind_at(size_t i);

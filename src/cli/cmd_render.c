@@ -505,6 +505,9 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--flat and --texture need a mesh input (OBJ, PLY with faces, OFF, STL, glTF, 3DS)");
     asp_error err = {0, ""};
     const asp_renderer_kind *kind = NULL;
+    if (o.dps_input && o.renderer && asp_renderer_kind_find(o.renderer, ASP_RENDER_INPUT_PRIMS, &kind, NULL))
+        return cli_usage_error(env, "--renderer is for point inputs; a .dps input is drawn with --method, or with "
+                                    "its levels mixed by view with --renderer cut");
     // a .hier is a hierarchy without its points: the splats draw it
     const char *dflt = type.kind == ASP_FILE_HIER ? "splat" : o.mesh_input ? "mesh" : "disc";
     unsigned inputs = o.dps_input    ? (unsigned)ASP_RENDER_INPUT_PRIMS

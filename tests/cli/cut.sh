@@ -53,7 +53,7 @@ check "$T/one.png" "px(32, 10)[:3] != (255, 255, 255)"
 grep -F '"renderer": "prim"' "$T/p.json" >/dev/null || fail "default renderer: $(cat "$T/p.json")"
 
 # refused: a point renderer for a .dps, the cut for points
-expect_fail 2 "unknown renderer 'disc'" "$AMGSPLAT" render "$T/t.dps" --renderer disc -o "$T/x.png"
+expect_fail 2 "--renderer cut" "$AMGSPLAT" render "$T/t.dps" --renderer disc -o "$T/x.png"
 expect_fail 2 "unknown renderer 'cut'" "$AMGSPLAT" render "$T/t.ply" --renderer cut -o "$T/x.png"
 [[ ! -e "$T/x.png" ]] || fail "a refused render wrote its output"
 echo ok
