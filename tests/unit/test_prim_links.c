@@ -288,6 +288,45 @@ static void test_links_file(void)
         free(b);
     }
     free(bytes);
+    /* a version-2 file of the two coarsest levels (no links, 96-byte level records) loads, and a cut of it is
+     * refused with the reason: forged from the version-3 bytes by cutting each level's 16 link bytes and lists */
+    asp_dps two = *dps;
+    two.levels = &dps->levels[dps->level_count - 2];
+    two.level_count = 2;
+    CHECK_OK(asp_dps_save(&two, path, &err), &err);
+    bytes = forge_slurp(path, &size);
+    unsigned char *v2 = bytes ? malloc(size) : NULL;
+    if (v2) {
+        size_t in = 96 + 128 + 4 + strlen("bunny"), out = in;
+        memcpy(v2, bytes, in);
+        for (size_t i = 0; i < 2; i++) {
+            const asp_dps_level *lv = &two.levels[i];
+            size_t atlas = 4 * (size_t)lv->atlas.width * lv->atlas.height * (lv->normal_atlas.width ? 2 : 1);
+            size_t body = 124 * lv->prim_count + 4 * lv->neighbour_total;
+            memcpy(v2 + out, bytes + in, 96);
+            memcpy(v2 + out + 96, bytes + in + 112, body);
+            size_t links = lv->link_first ? 4 * (lv->prim_count + 1) + 8 * lv->link_total : 0;
+            memcpy(v2 + out + 96 + body, bytes + in + 112 + body + links, atlas);
+            in += 112 + body + links + atlas;
+            out += 96 + body + atlas;
+        }
+        CHECK(in + 4 == size);
+        out += 4;
+        forge_put_le(v2 + 8, 2, 4);
+        forge_fix(v2, out, 24);
+        asp_dps *old = NULL;
+        CHECK_OK(asp_dps_load_memory(v2, out, "v2.dps", NULL, &old, &err), &err);
+        if (old) {
+            CHECK(old->level_count == 2 && !asp_dps_has_links(old));
+            CHECK(old->levels[0].prim_count == two.levels[0].prim_count && old->desc.brightness == 0);
+            asp_dps_cut *cut = NULL;
+            CHECK(asp_dps_cut_create(old, 0, NULL, &cut, &err) == ASP_EINVAL && !cut);
+            CHECK_MSG(strstr(err.msg, "rebuild") != NULL, "%s", err.msg);
+            asp_dps_destroy(old);
+        }
+    }
+    free(v2);
+    free(bytes);
     /* a cut needs links: a dps whose links were dropped is refused with a message */
     asp_dps_level *lv = &dps->levels[0];
     uint32_t *keep = lv->link_first;
