@@ -208,7 +208,8 @@ void asp_dps_destroy(asp_dps *dps);
  * levels and basis indices refer to amg): w(j -> k) = (P^{a+1} ... P^b)[basis_j][basis_k] between AMG
  * levels a < b (Psi^b = Psi^a P^{a+1} ... P^b, journal 2.3), entries below 1e-4 dropped. A merged
  * level (thesis 3.4: a primitive stands for several basis functions whose list is not kept) and the
- * level above it get no links (NEEDSWORK: weights from the point overlap of the merged domains).
+ * level above it get no links (NEEDSWORK: weights from the point overlap of the merged domains), nor
+ * do neighbours of different domain sets or not increasing in AMG level.
  * Replaces links already there. Returns 0, ASP_EINVAL (dps not from amg: a level or basis index out of
  * range), ASP_ENOMEM; on failure the levels keep no links. Thread-safe on a shared amg.
  */

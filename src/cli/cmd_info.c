@@ -212,7 +212,7 @@ static cJSON *dps_build_json(const asp_prim_desc *d)
     cJSON_AddBoolToObject(b, "normalise_color", d->normalise_color);
     cJSON_AddBoolToObject(b, "no_model_colors", d->no_model_colors);
     cJSON_AddItemToObject(b, "brightness", cli_json_number("%g", d->brightness));
-    cJSON_AddStringToObject(b, "domains", d->strict ? "strict" : "thresholded");
+    cJSON_AddStringToObject(b, "domains", d->strict == 2 ? "both" : d->strict ? "strict" : "thresholded");
     cJSON_AddItemToObject(b, "enlarge", cli_json_number("%g", d->enlarge));
     return b;
 }
@@ -275,7 +275,7 @@ static int info_dps(const char *path, struct cli_env *env)
                "neighbours %g%s%s%s%s%s%s, brightness %g, enlarge %g%%\n",
                d->tau, d->max_texture, asp_prim_method_name(d->method), asp_prim_shape_name(d->shape), d->width,
                asp_prim_normalise_name(d->normalise), d->normalise_color ? " (colour too)" : "",
-               d->strict ? "strict" : "thresholded", d->padding, d->neighbour_fraction,
+               d->strict == 2 ? "both" : d->strict ? "strict" : "thresholded", d->padding, d->neighbour_fraction,
                d->unweighted ? ", unweighted" : "", d->project_radii ? ", projected radii" : "",
                d->no_extend_color ? ", no colour extension" : "", d->normal_map ? ", normal maps" : "",
                d->merge ? ", merged" : "", d->no_model_colors ? ", grey points" : "", d->brightness, d->enlarge);

@@ -405,10 +405,12 @@ static int read_params(asp__byte_reader *r, asp_dps *dps, uint32_t version)
     if (version >= 3) {
         d->brightness = asp__get_f64(r), d->enlarge = asp__get_f64(r);
         uint32_t nc = asp__get_u32(r), nm = asp__get_u32(r), st = asp__get_u32(r);
+        /* strict is a domain set: 0 thresholded, 1 strict, 2 both (each level twice) */
         if (!(d->brightness >= -1 && d->brightness <= 1) || !(d->enlarge >= 0 && d->enlarge <= 1000) || nc > 1 ||
-            nm > 1 || st > 1) {
-            snprintf(msg, sizeof msg, "parameters: brightness %g, enlarge %g, flags %u %u %u, expected brightness "
-                     "in [-1, 1], enlarge in [0, 1000] and flags 0 or 1", d->brightness, d->enlarge, nc, nm, st);
+            nm > 1 || st > 2) {
+            snprintf(msg, sizeof msg, "parameters: brightness %g, enlarge %g, flags %u %u, domain set %u, expected "
+                     "brightness in [-1, 1], enlarge in [0, 1000], flags 0 or 1 and a domain set 0..2", d->brightness,
+                     d->enlarge, nc, nm, st);
             return asp__byte_bad(r, msg);
         }
         d->normalise_color = (int)nc, d->no_model_colors = (int)nm, d->strict = (int)st;

@@ -156,8 +156,7 @@ int asp_prim_links(const asp_amg *amg, asp_dps *dps, const asp_context *ctx, asp
     size_t nl = asp_amg_level_count(amg);
     for (size_t i = 0; i < dps->level_count; i++) {
         const asp_dps_level *lv = &dps->levels[i];
-        if (lv->level >= nl || lv->basis_count != asp_amg_level_size(amg, lv->level) ||
-            (i && lv->level <= dps->levels[i - 1].level))
+        if (lv->level >= nl || lv->basis_count != asp_amg_level_size(amg, lv->level))
             return asp_error_set(err, ASP_EINVAL, "level %zu (AMG level %u, %u basis functions) does not belong to "
                                  "the %zu-level decomposition", i, lv->level, lv->basis_count, nl);
         for (size_t k = 0; k < lv->prim_count; k++)
@@ -169,9 +168,13 @@ int asp_prim_links(const asp_amg *amg, asp_dps *dps, const asp_context *ctx, asp
         asp__level_links_release(ctx, &dps->levels[i]);
     for (size_t i = 0; i + 1 < dps->level_count; i++) {
         asp_dps_level *lv = &dps->levels[i];
-        if (lv->merges || dps->levels[i + 1].merges)
+        const asp_dps_level *up = &dps->levels[i + 1];
+        if (lv->merges || up->merges)
             continue; /* NEEDSWORK: a merged primitive's member basis functions are not kept */
-        int rc = link_pair_levels(amg, lv, &dps->levels[i + 1], ctx, err);
+        /* a file of both domain sets (each AMG level twice) has no single chain of coarser levels */
+        if (up->level <= lv->level || up->strict != lv->strict)
+            continue;
+        int rc = link_pair_levels(amg, lv, up, ctx, err);
         if (rc) {
             for (size_t q = 0; q < dps->level_count; q++)
                 asp__level_links_release(ctx, &dps->levels[q]);
