@@ -22,7 +22,8 @@ typedef struct cut_item {
 typedef struct cut_level {
     asp__gl_buffer prims;
     GLuint atlas;
-    float window;          /* depth window: half the level's mean primitive radius (as the prim renderer) */
+    float window;          /* depth window: half the level's mean primitive radius (as the prim renderer);
+                              NEEDSWORK: not scaled by an instance's model matrix (right for scale 1) */
     size_t first, count;   /* this frame's items */
 } cut_level;
 
