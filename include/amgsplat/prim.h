@@ -169,6 +169,16 @@ typedef struct asp_dps_level {
     uint32_t merges;          /* merge operations performed */
     uint32_t strict;          /* 1: built from strict domains (thesis eq. 2.5, desc.strict), drawn with the
                                  no-blend method; a .dps may hold thresholded and strict levels side by side */
+    /*
+     * Links to the next coarser stored level (issue 18; journal section 6, thesis 2.6.3): primitive k's
+     * share of coarse primitive link_parent[q] (an index into the next level's prims) is link_weight[q],
+     * q in link_first[k] .. link_first[k + 1] - 1, such that sum_k w(k -> c) Psi_k ~= Psi_c (docs/cut.md).
+     * link_first is NULL (link_total 0) on the coarsest level and when unknown (.dps versions 1, 2).
+     */
+    size_t link_total;
+    uint32_t *link_first;     /* prim_count + 1 entries */
+    uint32_t *link_parent;    /* link_total; increasing within a primitive's range */
+    float *link_weight;       /* link_total, in (0, 1] */
 } asp_dps_level;
 
 /** A set of levels; create with asp_prim_build or asp_dps_load, free with asp_dps_destroy. */
@@ -235,6 +245,82 @@ int asp_prim_level_for_budget(const asp_amg *amg, size_t max_prims, size_t *leve
 /** Frees a dps and everything it owns; NULL is accepted. */
 void asp_dps_destroy(asp_dps *dps);
 
+/* ---- links between levels and the view-dependent cut (issue 18, docs/cut.md) ---- */
+
+/**
+ * Fills the links of every stored level but the coarsest of dps (built from amg by asp_prim_build, so
+ * levels and basis indices refer to amg): w(j -> k) = (P^{a+1} ... P^b)[basis_j][basis_k] between AMG
+ * levels a < b (Psi^b = Psi^a P^{a+1} ... P^b, journal 2.3), entries below 1e-4 dropped. A merged
+ * level (thesis 3.4: a primitive stands for several basis functions whose list is not kept) and the
+ * level above it get no links (NEEDSWORK: weights from the point overlap of the merged domains), nor
+ * do neighbours of different domain sets or not increasing in AMG level.
+ * Replaces links already there. Returns 0, ASP_EINVAL (dps not from amg: a level or basis index out of
+ * range), ASP_ENOMEM; on failure the levels keep no links. Thread-safe on a shared amg.
+ */
+int asp_prim_links(const asp_amg *amg, asp_dps *dps, const asp_context *ctx, asp_error *err);
+
+/** 1 when every level but the coarsest has links (a cut across levels is possible), else 0. */
+int asp_dps_has_links(const asp_dps *dps);
+
+/** One primitive of a cut: level index into dps->levels, primitive index, weight d_f in (0, 1]. */
+typedef struct asp_dps_cut_item {
+    uint32_t level, prim;
+    float weight;
+} asp_dps_cut_item;
+
+/** The view a cut is taken for (coordinates of the dps's primitives). */
+typedef struct asp_dps_cut_view {
+    double eye[3];
+    double pixels_per_unit;   /* pixels covered by one world unit at distance 1: height / (2 tan(fovy / 2)) */
+    double tolerance;         /* pixels; <= 0 refines to the finest level everywhere */
+    double size_weight;       /* >= 0: the error measured is asp_prim.error + size_weight x the rectangle's half
+                                 diagonal, so large flat primitives refine too (0 = the geometric error alone) */
+} asp_dps_cut_view;
+
+/** Opaque cut state: child lists, target and drawn weights, the fade. */
+typedef struct asp_dps_cut asp_dps_cut;
+
+/**
+ * Prepares cuts of dps (borrowed: it must outlive the cut and keep its links). fade_seconds is how long
+ * a change of the cut takes to blend in (0 = 0.25, negative = no fade). Returns 0, ASP_EINVAL (a level
+ * without links: "no links between levels: rebuild with this version"), ASP_ENOMEM.
+ */
+int asp_dps_cut_create(const asp_dps *dps, double fade_seconds, const asp_context *ctx, asp_dps_cut **out,
+                       asp_error *err);
+void asp_dps_cut_destroy(asp_dps_cut *cut);
+
+/**
+ * Target cut for view (seed 001 section 5: per-node screen error): from the coarsest level down, a
+ * primitive with weight d > 0 is refined when its error (asp_prim.error, world units) projected at its
+ * nearest distance from the eye exceeds view->tolerance pixels: its weight passes to its children,
+ * d_j += d * w(j -> k); else it is drawn with weight d. The finest level draws what reaches it. So
+ * sum_f d_f Psi_f = sum of the coarsest Psi = 1 wherever the links are exact (docs/cut.md). Pure:
+ * writes target weights (asp_dps_cut_target_count entries, by level then primitive, 0 = not drawn) to
+ * out when not NULL and returns the number of drawn primitives.
+ */
+size_t asp_dps_cut_target(const asp_dps_cut *cut, const asp_dps_cut_view *view, float *out);
+
+/** Total primitives over all levels (the length of a weight array). */
+size_t asp_dps_cut_target_count(const asp_dps_cut *cut);
+
+/**
+ * Advances the drawn cut by dt seconds towards the target for view: when the target changes, the
+ * weights drawn now become the start of a fade and the drawn weights are (1 - s) start + s target,
+ * s rising linearly to 1 over the fade time, so the drawn weights keep the partition of unity during
+ * the fade (both are partitions of unity). The first update (or dt < 0) jumps to the target.
+ * Returns 0 or ASP_ENOMEM.
+ */
+int asp_dps_cut_update(asp_dps_cut *cut, const asp_dps_cut_view *view, double dt, asp_error *err);
+
+/**
+ * The drawn primitives after the last update, by level then primitive: *items stays valid until the
+ * next update or destroy. Returns their count.
+ */
+size_t asp_dps_cut_items(const asp_dps_cut *cut, const asp_dps_cut_item **items);
+
+/** 1 while a fade is in progress. */
+int asp_dps_cut_fading(const asp_dps_cut *cut);
+
 /* ---- kernels (usable and testable alone) ---- */
 
 /**
@@ -272,7 +358,8 @@ int asp_prim_neighbours(const asp_amg_csr *dom, double fraction, const asp_conte
 
 /**
  * Writes dps to path atomically in the versioned, little-endian .dps format
- * (docs/cli/build.md, version 2): the source frame (dps->frame), parameters,
+ * (docs/cli/build.md, version 3): the source frame (dps->frame), parameters (every
+ * field of asp_prim_desc), the levels' strict flags and links,
  * source name and per level the primitives,
  * neighbour lists and atlases, with a CRC-32 trailer. Returns 0, ASP_EIO,
  * ASP_ENOMEM.
@@ -282,7 +369,8 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err);
 /**
  * Reads a .dps file into a new asp_dps (*out): reads the whole file and parses
  * it with asp_dps_load_memory. A version-1 file (no recorded frame) loads
- * with frame.radius 0 ("not known"). Returns 0, ASP_EINVAL (path or out NULL),
+ * with frame.radius 0 ("not known"); versions 1 and 2 load without links
+ * (asp_dps_has_links 0) and with the build options they did not record at 0. Returns 0, ASP_EINVAL (path or out NULL),
  * ASP_EIO (cannot open/read), ASP_ENOMEM, or ASP_EFORMAT as
  * asp_dps_load_memory. On failure *out is unchanged. Thread-safe.
  */

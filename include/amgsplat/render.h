@@ -1045,6 +1045,53 @@ int asp_mesh_renderer_create(asp_gl_context *gl, const asp_render_mesh *mesh, co
 /* The renderer table (STYLE.md 9b: one table, owned by render)             */
 /* ------------------------------------------------------------------------ */
 
+/* ------------------------------------------------------------------------ */
+/* The cut across the levels of a .dps (issue 18, docs/cut.md)              */
+/* ------------------------------------------------------------------------ */
+
+/** Options of asp_cut_renderer_create; the zero value means defaults. */
+typedef struct asp_cut_renderer_desc {
+    float tolerance;      /* screen tolerance in pixels of asp_dps_cut_view (0 = 1; < 0 = 0: the finest level
+                             everywhere); asp_renderer_set_lod changes it later */
+    float alpha_ref;      /* alpha test of the front layer, as asp_prim_render_options (0 = 0.1) */
+    float transparency;   /* global opacity (0 = 1) */
+    double fade_seconds;  /* how long a change of the cut blends in (0 = 0.25; < 0 = no fade) */
+    float size_weight;    /* asp_dps_cut_view.size_weight: 0 = 0.2 (bench_field: at equal SSIM about 3x less
+                             frame time than the geometric error alone), < 0 = the geometric error alone */
+    double origin[3];     /* as asp_prim_renderer_desc.origin */
+} asp_cut_renderer_desc;
+
+/**
+ * Uploads every level of dps (which must have links, asp_dps_has_links, unless it has one level) once: one
+ * storage buffer of primitives and one sRGB atlas texture per level. Each frame it takes the cut of
+ * asp_dps_cut_update for the view (per instance, see asp_cut_renderer_set_instances) and draws it with the
+ * normalized method (asp_prim_render_method ASP_PRIM_RENDER_NORMALIZED: the front layer, the sum of
+ * colour x alpha x d_f and alpha x d_f within a depth window of it, then the division), so the levels
+ * blend as one surface. The depth window of each level is half its mean primitive radius (as the prim
+ * renderer's default). Normal maps, crease clipping and domain colours are not drawn. dps is borrowed and
+ * must outlive the renderer. asp_renderer_count is the number of primitives drawn in the last frame;
+ * asp_renderer_stats_get gives it with the tolerance. Errors: ASP_EINVAL (no links: "no links between
+ * levels ..."; bad option), ASP_EUNSUPPORTED (an atlas larger than GL allows), ASP_EGL, ASP_ENOMEM.
+ */
+int asp_cut_renderer_create(asp_gl_context *gl, const asp_dps *dps, const asp_cut_renderer_desc *desc,
+                            asp_renderer **out, asp_error *err);
+
+/**
+ * Draws count instances from now on (0 = back to one instance at the identity), instance i placed by the
+ * column-major matrix models[16 i .. 16 i + 15] (rotation, translation and a uniform scale; renderer
+ * frame to world); each instance gets its own cut for its own distance, and all share one normalized
+ * accumulation. Instances whose bounding sphere (the dps frame) lies outside the view are skipped. The
+ * matrices are copied. Returns 0, ASP_EINVAL (not a cut renderer), ASP_ENOMEM.
+ */
+int asp_cut_renderer_set_instances(asp_renderer *r, const float *models, size_t count, asp_error *err);
+
+/**
+ * The caller's clock in seconds for the next frame: the fade advances by the difference to the previous
+ * frame's time. Without it (or before the second timed frame) every frame shows its target cut at once.
+ * Returns 0 or ASP_EINVAL (not a cut renderer, or time not finite).
+ */
+int asp_cut_renderer_set_time(asp_renderer *r, double seconds, asp_error *err);
+
 /** What a renderer of the table can draw (asp_renderer_kind.inputs). */
 enum asp_render_input_bits {
     ASP_RENDER_INPUT_POINTS = 1 << 0, /* asp_render_source.cloud or .hier: points, splats */
@@ -1063,6 +1110,7 @@ typedef struct asp_render_source {
                                     square draw it instead of building one; NULL = built from cloud */
     const float *clip_planes;    /* 8 floats per point of cloud (asp_crease_clip_planes), NULL = none */
     const asp_dps_level *level;  /* domain primitives (the prim renderer) */
+    const asp_dps *dps;          /* every level of a .dps with its links (the cut renderer; issue 18) */
     const asp_render_mesh *mesh; /* a triangle mesh (the mesh renderer), drawn in the frame of origin */
     double origin[3];            /* the frame primitives and meshes are drawn in (asp_prim_renderer_desc.origin);
                                     for points it is cloud->origin (or asp_hier_origin), which the point
@@ -1077,6 +1125,7 @@ typedef struct asp_renderer_options {
     asp_prim_render_options prim;
     asp_mesh_renderer_desc mesh;     /* origin comes from the source */
     asp_hybrid_desc hybrid;          /* origin comes from the source; prim: these options' prim when zero */
+    asp_cut_renderer_desc cut;       /* origin comes from the source */
 } asp_renderer_options;
 
 /** One row of the renderer table. */
@@ -1098,7 +1147,7 @@ typedef struct asp_renderer_kind {
 
 /**
  * Row i of the renderer table, in the order "disc", "splat", "square",
- * "prim", "mesh", "hybrid" (the viewer's 1..9 keys follow it), or NULL past the end.
+ * "prim", "mesh", "hybrid", "cut" (the viewer's 1..9 keys follow it), or NULL past the end.
  * Thread safe.
  */
 const asp_renderer_kind *asp_renderer_kind_at(size_t i);

@@ -189,6 +189,34 @@ static void add_frame_json(cJSON *o, const asp_frame *f)
     }
 }
 
+/* Every build option a .dps records (version 3 stores them all; older files show 0 for the later ones). */
+static cJSON *dps_build_json(const asp_prim_desc *d)
+{
+    cJSON *b = cJSON_CreateObject();
+    cJSON_AddItemToObject(b, "tau", cli_json_number("%g", d->tau));
+    cJSON_AddItemToObject(b, "texel_size", cli_json_number("%g", d->texel_size));
+    cJSON_AddNumberToObject(b, "max_texture", d->max_texture);
+    cJSON_AddStringToObject(b, "method", asp_prim_method_name(d->method));
+    cJSON_AddStringToObject(b, "shape", asp_prim_shape_name(d->shape));
+    cJSON_AddItemToObject(b, "width", cli_json_number("%g", d->width));
+    cJSON_AddStringToObject(b, "normalise", asp_prim_normalise_name(d->normalise));
+    cJSON_AddBoolToObject(b, "unweighted", d->unweighted);
+    cJSON_AddBoolToObject(b, "project_radii", d->project_radii);
+    cJSON_AddBoolToObject(b, "no_extend_color", d->no_extend_color);
+    cJSON_AddBoolToObject(b, "normal_map", d->normal_map);
+    cJSON_AddItemToObject(b, "neighbour_fraction", cli_json_number("%g", d->neighbour_fraction));
+    cJSON_AddBoolToObject(b, "merge", d->merge);
+    cJSON_AddItemToObject(b, "merge_flatness", cli_json_number("%g", d->merge_flatness));
+    cJSON_AddItemToObject(b, "merge_angle", cli_json_number("%g", d->merge_angle));
+    cJSON_AddNumberToObject(b, "padding", d->padding);
+    cJSON_AddBoolToObject(b, "normalise_color", d->normalise_color);
+    cJSON_AddBoolToObject(b, "no_model_colors", d->no_model_colors);
+    cJSON_AddItemToObject(b, "brightness", cli_json_number("%g", d->brightness));
+    cJSON_AddStringToObject(b, "domains", d->strict == 2 ? "both" : d->strict ? "strict" : "thresholded");
+    cJSON_AddItemToObject(b, "enlarge", cli_json_number("%g", d->enlarge));
+    return b;
+}
+
 /* A .dps file (amgsplat build): the thesis Table 5.2 columns per stored level. */
 static int info_dps(const char *path, struct cli_env *env)
 {
@@ -210,6 +238,8 @@ static int info_dps(const char *path, struct cli_env *env)
         cJSON_AddStringToObject(o, "method", asp_prim_method_name(dps->desc.method));
         cJSON_AddItemToObject(o, "texel_size", cli_json_number("%g", dps->desc.texel_size));
         add_frame_json(o, &dps->frame);
+        cJSON_AddItemToObject(o, "build", dps_build_json(&dps->desc));
+        cJSON_AddBoolToObject(o, "links", asp_dps_has_links(dps)); // a cut across levels is possible (issue 18)
         for (size_t i = 0; i < nl; i++) {
             cJSON *l = cJSON_CreateObject();
             cJSON_AddNumberToObject(l, "level", rows[i].level);
@@ -229,6 +259,8 @@ static int info_dps(const char *path, struct cli_env *env)
                                                        2));
             cJSON_AddNumberToObject(l, "neighbour_pairs", (double)rows[i].neighbour_pairs);
             cJSON_AddBoolToObject(l, "normal_map", rows[i].normal_map);
+            cJSON_AddBoolToObject(l, "strict", dps->levels[i].strict != 0);
+            cJSON_AddNumberToObject(l, "links", (double)dps->levels[i].link_total);
             cJSON_AddItemToArray(levels, l);
         }
         cJSON_AddItemToObject(o, "levels", levels);
@@ -238,6 +270,17 @@ static int info_dps(const char *path, struct cli_env *env)
                (unsigned long long)dps->source_points, dps->mean_radius);
         printf("textures    %s, texel size %g\n", asp_prim_method_name(dps->desc.method), dps->desc.texel_size);
         print_frame_text(&dps->frame);
+        const asp_prim_desc *d = &dps->desc;
+        printf("build       tau %g, max texture %u, %s/%s width %g, normalise %s%s, %s domains, padding %u, "
+               "neighbours %g%s%s%s%s%s%s, brightness %g, enlarge %g%%\n",
+               d->tau, d->max_texture, asp_prim_method_name(d->method), asp_prim_shape_name(d->shape), d->width,
+               asp_prim_normalise_name(d->normalise), d->normalise_color ? " (colour too)" : "",
+               d->strict == 2 ? "both" : d->strict ? "strict" : "thresholded", d->padding, d->neighbour_fraction,
+               d->unweighted ? ", unweighted" : "", d->project_radii ? ", projected radii" : "",
+               d->no_extend_color ? ", no colour extension" : "", d->normal_map ? ", normal maps" : "",
+               d->merge ? ", merged" : "", d->no_model_colors ? ", grey points" : "", d->brightness, d->enlarge);
+        printf("links       %s\n", asp_dps_has_links(dps) ? "yes: levels can be mixed by view (render --renderer cut)"
+                                    : dps->level_count > 1 ? "none (rebuild for a cut across levels)" : "one level");
         printf("level  name   primitives    texels        error  normalised   cb (s)  dpc (s)  atlas\n");
         for (size_t i = 0; i < nl; i++)
             printf("%5u  %-5s %11zu %9llu  %11.6g  %10.3f  %7.3f  %7.3f  %ux%u\n", rows[i].level, rows[i].name,

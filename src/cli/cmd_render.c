@@ -156,6 +156,9 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
         r->splat.tolerance = r->square.tolerance = asp_render_tolerance_from_area(o->tolerance_area, o->width, o->height);
     r->prim = o->prim;
     r->hybrid = (asp_hybrid_desc){.prim = o->prim, .splat = r->splat};
+    // the cut across .dps levels (issue 18): the same tolerance in pixels; 0 = the finest level everywhere
+    r->cut = (asp_cut_renderer_desc){.tolerance = o->tolerance > 0 ? (float)o->tolerance : -1.0f,
+                                     .alpha_ref = o->prim.alpha_ref, .transparency = o->prim.transparency};
     r->mesh.flags = o->flat ? ASP_MESH_RENDER_FLAT : 0u;
 }
 
@@ -681,8 +684,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"size", 0, CLI_STRING, &o.size, "WxH", "image size of one view (default 512x512)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "camera azimuth, elevation (degrees), distance in radii (default 30,20)"},
         {"views", 0, CLI_SIZE, &o.views, "N", "N views around the object in a contact sheet (default 1)"},
-        {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "how points are drawn: disc (default), splat, square; meshes: mesh (default)"},
-        {"tolerance", 0, CLI_DOUBLE, &o.tolerance, "PX", "splat, square: screen tolerance tau in pixels (default 1; 0 = every point)"},
+        {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "how points are drawn: disc (default), splat, square; meshes: mesh (default); .dps: prim (default), cut (levels mixed by view)"},
+        {"tolerance", 0, CLI_DOUBLE, &o.tolerance, "PX", "splat, square, cut: screen tolerance tau in pixels (default 1; 0 = every point, finest level)"},
         {"budget", 0, CLI_SIZE, &o.budget, "N", "splat, square: cut the hierarchy to N splats per view instead of a tolerance"},
         {"kernel", 0, CLI_STRING, &o.kernel, "A,B,N", "splat: kernel exp(-A (r/B)^N) (default 6,1.5,3)"},
         {"epsilon", 0, CLI_DOUBLE, &o.epsilon, "X", "splat: depth offset in splat radii for blending (default 1; 0 = none)"},
@@ -758,19 +761,20 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         o.hybrid = 1;
     if (o.hybrid && !o.dps_input)
         return cli_usage_error(env, "--hybrid needs a .dps input (amgsplat build makes one)");
-    if (o.dps_input && o.renderer)
-        return cli_usage_error(env, "--renderer is for point inputs; a .dps input is drawn with --method");
     o.mesh_input = type.kind == ASP_FILE_MESH;
     if ((o.flat || o.texture) && !o.mesh_input)
         return cli_usage_error(env, "--flat and --texture need a mesh input (OBJ, PLY with faces, OFF, STL, glTF, 3DS)");
     asp_error err = {0, ""};
     const asp_renderer_kind *kind = NULL;
+    if (o.dps_input && o.renderer && asp_renderer_kind_find(o.renderer, ASP_RENDER_INPUT_PRIMS, &kind, NULL))
+        return cli_usage_error(env, "--renderer is for point inputs; a .dps input is drawn with --method, or with "
+                                    "its levels mixed by view with --renderer cut");
     // a .hier is a hierarchy without its points: the splats draw it
     const char *dflt = type.kind == ASP_FILE_HIER ? "splat" : o.mesh_input ? "mesh" : "disc";
     unsigned inputs = o.dps_input    ? (unsigned)ASP_RENDER_INPUT_PRIMS
                       : o.mesh_input ? (unsigned)(ASP_RENDER_INPUT_MESH | ASP_RENDER_INPUT_POINTS)
                                      : (unsigned)ASP_RENDER_INPUT_POINTS;
-    if (asp_renderer_kind_find(o.hybrid ? "hybrid" : o.dps_input ? "prim" : o.renderer ? o.renderer : dflt, inputs, &kind, &err))
+    if (asp_renderer_kind_find(o.hybrid ? "hybrid" : o.dps_input ? (o.renderer ? o.renderer : "prim") : o.renderer ? o.renderer : dflt, inputs, &kind, &err))
         return cli_usage_error(env, "%s", err.msg);
     // a PLY with faces holds its vertices as points; other meshes hold triangles only
     if (o.mesh_input && !(kind->inputs & ASP_RENDER_INPUT_MESH) && strcmp(type.format, "ply") != 0)

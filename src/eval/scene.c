@@ -358,6 +358,7 @@ void asp_scene_render_source(const asp_scene *s, asp_render_source *out)
     out->hier = s->hier;
     out->clip_planes = s->clip_planes;
     out->level = asp_scene_dps_level(s);
+    out->dps = s->dps;
     out->mesh = s->mesh ? &s->render_mesh : NULL;
     memcpy(out->origin, s->origin, sizeof out->origin);
 }

@@ -319,6 +319,7 @@ static void release_level(const asp_context *ctx, asp_dps_level *lv)
     asp_free(ctx, lv->neighbours);
     asp_image_release(&lv->atlas);
     asp_image_release(&lv->normal_atlas);
+    asp__level_links_release(ctx, lv);
     memset(lv, 0, sizeof *lv);
 }
 
@@ -667,6 +668,9 @@ int asp_prim_build(const asp_amg *amg, const asp_cloud *attrs, const size_t *lev
         rc = asp_error_set(err, ASP_EDEGENERATE, "no requested level has a domain with a point above tau = %g", d.tau);
         goto fail;
     }
+    /* links between the stored levels, for the cut across levels (issue 18, level_links.c) */
+    if ((rc = asp_prim_links(amg, dps, ctx, err)))
+        goto fail;
     asp_progress(ctx, "primitives", 1.0);
     dps->amg_levels = (uint32_t)nl;
     dps->source_points = n;

@@ -19,16 +19,22 @@
 /*
  * Version 2 appends the source point set's frame (asp_frame, 32 bytes) to the
  * header, so a .dps is framed exactly as its points (issue 12); version 1
- * files still load with radius 0 ("not known").
+ * files still load with radius 0 ("not known"). Version 3 (issue 18) stores
+ * the build options versions 1-2 did not (in the parameters' spare bytes), a
+ * level's strict flag (its spare u32) and appends to the level header the
+ * links to the next coarser level (16 bytes: count, flag), their lists after
+ * the neighbours; versions 1 and 2 load without links.
  */
-enum { DPS_VERSION = 2, DPS_HEADER = 96, DPS_HEADER_V1 = 64, DPS_PARAMS = 128, DPS_LEVEL = 96, DPS_PRIM = 124, DPS_SIDE = 16384 };
+enum { DPS_VERSION = 3, DPS_HEADER = 96, DPS_HEADER_V1 = 64, DPS_PARAMS = 128, DPS_LEVEL_V2 = 96, DPS_LEVEL = 112,
+       DPS_PRIM = 124, DPS_SIDE = 16384 };
 
 /* ---- writing: explicit little-endian bytes, so the format does not depend on the host ---- */
 
 static uint64_t level_bytes(const asp_dps_level *lv)
 {
     uint64_t atlas = 4 * (uint64_t)lv->atlas.width * lv->atlas.height;
-    return DPS_LEVEL + DPS_PRIM * (uint64_t)lv->prim_count + 4 * (uint64_t)lv->neighbour_total + atlas +
+    uint64_t links = lv->link_first ? 4 * ((uint64_t)lv->prim_count + 1) + 8 * (uint64_t)lv->link_total : 0;
+    return DPS_LEVEL + DPS_PRIM * (uint64_t)lv->prim_count + 4 * (uint64_t)lv->neighbour_total + links + atlas +
            (lv->normal_atlas.width ? atlas : 0);
 }
 
@@ -102,8 +108,13 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
                             (uint32_t)d->normal_map, (uint32_t)d->merge, d->padding};
     for (int k = 0; k < 10; k++)
         asp__put_u32(&w, u[k]);
-    for (int k = 0; k < (DPS_PARAMS - 48 - 40) / 8; k++)
-        asp__put_u64(&w, 0);
+    /* version 3: the options versions 1-2 left out (the 40 spare bytes), so info shows every build option */
+    asp__put_f64(&w, d->brightness);
+    asp__put_f64(&w, d->enlarge);
+    const uint32_t v3[4] = {(uint32_t)d->normalise_color, (uint32_t)d->no_model_colors, (uint32_t)d->strict, 0};
+    for (int k = 0; k < 4; k++)
+        asp__put_u32(&w, v3[k]);
+    asp__put_u64(&w, 0);
     asp__put_u32(&w, (uint32_t)slen);
     asp__crc_put(&w, dps->source, slen);
     for (size_t i = 0; i < dps->level_count; i++) {
@@ -119,16 +130,27 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
         asp__put_u32(&w, lv->degenerate);
         asp__put_u32(&w, lv->capped);
         asp__put_u32(&w, lv->merges);
-        asp__put_u32(&w, 0);
+        asp__put_u32(&w, lv->strict);
         asp__put_u64(&w, lv->texels);
         asp__put_f64(&w, lv->error);
         asp__put_f64(&w, lv->error_norm);
         asp__put_f64(&w, lv->t_basis);
         asp__put_f64(&w, lv->t_construct);
+        asp__put_u64(&w, lv->link_first ? lv->link_total : 0);
+        asp__put_u32(&w, lv->link_first ? 1u : 0u);
+        asp__put_u32(&w, 0);
         for (size_t k = 0; k < lv->prim_count; k++)
             put_prim(&w, &lv->prims[k]);
         for (size_t k = 0; k < lv->neighbour_total; k++)
             asp__put_u32(&w, lv->neighbours[k]);
+        if (lv->link_first) {
+            for (size_t k = 0; k <= lv->prim_count; k++)
+                asp__put_u32(&w, lv->link_first[k]);
+            for (size_t k = 0; k < lv->link_total; k++) {
+                asp__put_u32(&w, lv->link_parent[k]);
+                asp__put_f32(&w, lv->link_weight[k]);
+            }
+        }
         asp__crc_put(&w, lv->atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
         if (lv->normal_atlas.width)
             asp__crc_put(&w, lv->normal_atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
@@ -186,11 +208,46 @@ static int check_neighbours(asp__byte_reader *r, const asp_dps_level *lv, size_t
     return 0;
 }
 
-static int read_level(asp__byte_reader *r, const asp_dps *dps, size_t li, asp_dps_level *lv, const asp_context *ctx)
+/* Level li's links (version 3): ranges that tile 0..link_total, parents increasing, weights in (0, 1]. */
+static int read_links(asp__byte_reader *r, asp_dps_level *lv, size_t li, const asp_context *ctx)
 {
     char msg[200];
-    if (asp__byte_left(r) < DPS_LEVEL) {
-        snprintf(msg, sizeof msg, "level %zu: truncated level header (%d bytes needed, %zu left)", li, DPS_LEVEL,
+    size_t np = lv->prim_count, nl = lv->link_total;
+    lv->link_first = asp_alloc(ctx, (np + 1) * sizeof *lv->link_first);
+    lv->link_parent = asp_alloc(ctx, (nl ? nl : 1) * sizeof *lv->link_parent);
+    lv->link_weight = asp_alloc(ctx, (nl ? nl : 1) * sizeof *lv->link_weight);
+    if (!lv->link_first || !lv->link_parent || !lv->link_weight)
+        return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory for %zu links", r->path, nl);
+    for (size_t k = 0; k <= np; k++) {
+        lv->link_first[k] = asp__get_u32(r);
+        uint32_t lo = k ? lv->link_first[k - 1] : 0;
+        if ((k == 0 && lv->link_first[0] != 0) || lv->link_first[k] < lo || lv->link_first[k] > nl ||
+            (k == np && lv->link_first[k] != nl)) {
+            snprintf(msg, sizeof msg, "level %zu, primitive %zu: link range start %u, expected %u..%zu (%s)", li, k,
+                     lv->link_first[k], lo, nl, k == np ? "the last equals the link count" : "non-decreasing");
+            return asp__byte_bad(r, msg);
+        }
+    }
+    for (size_t q = 0; q < nl; q++)
+        lv->link_parent[q] = asp__get_u32(r), lv->link_weight[q] = asp__get_f32(r);
+    for (size_t k = 0; k < np; k++)
+        for (size_t q = lv->link_first[k]; q < lv->link_first[k + 1]; q++)
+            if (!(lv->link_weight[q] > 0 && lv->link_weight[q] <= 1) ||
+                (q > lv->link_first[k] && lv->link_parent[q] <= lv->link_parent[q - 1])) {
+                snprintf(msg, sizeof msg, "level %zu, primitive %zu: link to %u with weight %g, expected parents "
+                         "increasing and a weight in (0, 1]", li, k, lv->link_parent[q], lv->link_weight[q]);
+                return asp__byte_bad(r, msg);
+            }
+    return 0;
+}
+
+static int read_level(asp__byte_reader *r, const asp_dps *dps, uint32_t version, size_t li, asp_dps_level *lv,
+                      const asp_context *ctx)
+{
+    char msg[200];
+    const size_t hsize = version >= 3 ? DPS_LEVEL : DPS_LEVEL_V2;
+    if (asp__byte_left(r) < hsize) {
+        snprintf(msg, sizeof msg, "level %zu: truncated level header (%zu bytes needed, %zu left)", li, hsize,
                  asp__byte_left(r));
         return asp__byte_bad(r, msg);
     }
@@ -200,10 +257,24 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, size_t li, asp_dp
     uint32_t aw = asp__get_u32(r), ah = asp__get_u32(r), has_n = asp__get_u32(r);
     lv->skipped = asp__get_u32(r), lv->degenerate = asp__get_u32(r);
     lv->capped = asp__get_u32(r), lv->merges = asp__get_u32(r);
-    (void)asp__get_u32(r);
+    uint32_t strict = asp__get_u32(r); /* spare (0) before version 3 */
     lv->texels = asp__get_u64(r);
     lv->error = asp__get_f64(r), lv->error_norm = asp__get_f64(r);
     lv->t_basis = asp__get_f64(r), lv->t_construct = asp__get_f64(r);
+    uint64_t nlinks = 0;
+    uint32_t has_links = 0;
+    if (version >= 3) {
+        nlinks = asp__get_u64(r);
+        has_links = asp__get_u32(r);
+        (void)asp__get_u32(r);
+    }
+    if (strict > 1 || has_links > 1 || (!has_links && nlinks) || (has_links && li + 1 == dps->level_count)) {
+        snprintf(msg, sizeof msg, "level %zu: strict flag %u, link flag %u with %llu links, expected flags 0 or 1, "
+                 "no links when the flag is 0 and none on the coarsest level", li, strict, has_links,
+                 (unsigned long long)nlinks);
+        return asp__byte_bad(r, msg);
+    }
+    lv->strict = strict;
     /* levels are stored finest first without duplicates (asp_prim_build) */
     const uint32_t lo = li ? dps->levels[li - 1].level + 1 : 0;
     if (lv->level < lo || lv->level >= dps->amg_levels) {
@@ -229,7 +300,13 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, size_t li, asp_dp
                  li, aw, ah, has_n, DPS_SIDE);
         return asp__byte_bad(r, msg);
     }
-    const size_t after_nbrs = after_prims - (size_t)nn * 4, atlas = 4 * (size_t)aw * ah;
+    const size_t after_lists = after_prims - (size_t)nn * 4, atlas = 4 * (size_t)aw * ah;
+    if (has_links && (after_lists < 4 * ((size_t)np + 1) || nlinks > (after_lists - 4 * ((size_t)np + 1)) / 8)) {
+        snprintf(msg, sizeof msg, "level %zu: %llu links of %llu primitives, expected them to fit the %zu bytes left "
+                 "after the neighbours", li, (unsigned long long)nlinks, (unsigned long long)np, after_lists);
+        return asp__byte_bad(r, msg);
+    }
+    const size_t after_nbrs = after_lists - (has_links ? 4 * ((size_t)np + 1) + 8 * (size_t)nlinks : 0);
     if (atlas * (1 + has_n) > after_nbrs) {
         snprintf(msg, sizeof msg, "level %zu: truncated: %ux%u atlas%s of %zu bytes, expected at most the %zu "
                  "bytes left after the neighbours", li, aw, ah, has_n ? "es (colour and normal)" : "",
@@ -280,6 +357,9 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, size_t li, asp_dp
     int rc = check_neighbours(r, lv, li);
     if (rc)
         return rc;
+    lv->link_total = (size_t)nlinks;
+    if (has_links && (rc = read_links(r, lv, li, ctx)) != 0)
+        return rc;
     if (texels != lv->texels) {
         snprintf(msg, sizeof msg, "level %zu: %llu texels recorded, the rectangles hold %llu", li,
                  (unsigned long long)lv->texels, (unsigned long long)texels);
@@ -300,7 +380,7 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, size_t li, asp_dp
 }
 
 /* The build parameters (128 bytes) and the source name. */
-static int read_params(asp__byte_reader *r, asp_dps *dps)
+static int read_params(asp__byte_reader *r, asp_dps *dps, uint32_t version)
 {
     char msg[200];
     asp_prim_desc *d = &dps->desc;
@@ -322,7 +402,22 @@ static int read_params(asp__byte_reader *r, asp_dps *dps)
     d->normalise = (asp_prim_normalise)normalise;
     if (!isfinite(d->tau + d->texel_size + d->width + d->neighbour_fraction + d->merge_flatness + d->merge_angle))
         return asp__byte_bad(r, "parameters: a non-finite value, expected finite resolved options");
-    r->at += DPS_PARAMS - 88;
+    if (version >= 3) {
+        d->brightness = asp__get_f64(r), d->enlarge = asp__get_f64(r);
+        uint32_t nc = asp__get_u32(r), nm = asp__get_u32(r), st = asp__get_u32(r);
+        /* strict is a domain set: 0 thresholded, 1 strict, 2 both (each level twice) */
+        if (!(d->brightness >= -1 && d->brightness <= 1) || !(d->enlarge >= 0 && d->enlarge <= 1000) || nc > 1 ||
+            nm > 1 || st > 2) {
+            snprintf(msg, sizeof msg, "parameters: brightness %g, enlarge %g, flags %u %u, domain set %u, expected "
+                     "brightness in [-1, 1], enlarge in [0, 1000], flags 0 or 1 and a domain set 0..2", d->brightness,
+                     d->enlarge, nc, nm, st);
+            return asp__byte_bad(r, msg);
+        }
+        d->normalise_color = (int)nc, d->no_model_colors = (int)nm, d->strict = (int)st;
+        r->at += DPS_PARAMS - 88 - 28;
+    } else {
+        r->at += DPS_PARAMS - 88;
+    }
     uint32_t slen = asp__get_u32(r);
     if (slen >= sizeof dps->source || slen > asp__byte_left(r)) {
         snprintf(msg, sizeof msg, "source name of %u bytes, expected below %zu and within the %zu bytes left", slen,
@@ -349,8 +444,8 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_dps *dps)
     }
     r->at += 8;
     uint32_t version = asp__get_u32(r), hsize = asp__get_u32(r);
-    if (!(version == DPS_VERSION && hsize == DPS_HEADER) && !(version == 1 && hsize == DPS_HEADER_V1)) {
-        snprintf(msg, sizeof msg, "unsupported version %u (header %u bytes), expected version 1 (64 bytes) or %d "
+    if (!((version == 2 || version == DPS_VERSION) && hsize == DPS_HEADER) && !(version == 1 && hsize == DPS_HEADER_V1)) {
+        snprintf(msg, sizeof msg, "unsupported version %u (header %u bytes), expected version 1 (64 bytes), 2 or %d "
                  "(%d bytes)", version, hsize, DPS_VERSION, DPS_HEADER);
         return bad_file(r, msg);
     }
@@ -402,22 +497,32 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_dps *dps)
                  (unsigned long long)nl, dps->amg_levels, dps->mean_radius);
         return asp__byte_bad(r, msg);
     }
-    if (asp__byte_left(r) < DPS_PARAMS + 4 + (size_t)nl * DPS_LEVEL) {
+    const uint64_t lhead = version >= 3 ? DPS_LEVEL : DPS_LEVEL_V2;
+    if (asp__byte_left(r) < DPS_PARAMS + 4 + (size_t)nl * lhead) {
         snprintf(msg, sizeof msg, "truncated: %llu levels need at least %llu payload bytes, the file has %zu",
-                 (unsigned long long)nl, (unsigned long long)(DPS_PARAMS + 4 + nl * DPS_LEVEL), asp__byte_left(r));
+                 (unsigned long long)nl, (unsigned long long)(DPS_PARAMS + 4 + nl * lhead), asp__byte_left(r));
         return asp__byte_bad(r, msg);
     }
-    int rc = read_params(r, dps);
+    int rc = read_params(r, dps, version);
     if (rc)
         return rc;
     dps->levels = asp_calloc(ctx, (size_t)nl, sizeof *dps->levels);
     if (!dps->levels)
         return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory for %llu levels", r->path,
                              (unsigned long long)nl);
-    for (size_t i = 0; i < nl; i++) {
-        dps->level_count = i + 1;
-        if ((rc = read_level(r, dps, i, &dps->levels[i], ctx)) != 0)
+    dps->level_count = (size_t)nl; /* read_level checks the coarsest has no links */
+    for (size_t i = 0; i < nl; i++)
+        if ((rc = read_level(r, dps, version, i, &dps->levels[i], ctx)) != 0)
             return rc;
+    /* a link names a primitive of the next level, known only now */
+    for (size_t i = 0; i + 1 < nl; i++) {
+        const asp_dps_level *lv = &dps->levels[i];
+        for (size_t q = 0; q < lv->link_total; q++)
+            if (lv->link_parent[q] >= dps->levels[i + 1].prim_count) {
+                snprintf(msg, sizeof msg, "level %zu: link %zu names primitive %u of level %zu, expected below %zu",
+                         i, q, lv->link_parent[q], i + 1, dps->levels[i + 1].prim_count);
+                return asp__byte_bad(r, msg);
+            }
     }
     if (r->at != r->size) {
         snprintf(msg, sizeof msg, "%zu unexpected bytes after the last level", asp__byte_left(r));

@@ -105,4 +105,7 @@ int asp__prim_merge(const asp_amg_csr *dom, const float *pos, const float *norma
                     double angle_deg, const asp_context *ctx, asp_amg_csr **out, uint32_t **first, uint32_t **count,
                     uint32_t *merges, asp_error *err);
 
+/* Frees a level's links (level_links.c) and sets them absent. */
+void asp__level_links_release(const asp_context *ctx, asp_dps_level *lv);
+
 #endif

@@ -99,6 +99,17 @@ static int make_hybrid(asp_gl_context *gl, const asp_render_source *src, const a
     return asp_hybrid_renderer_create(gl, src->level, src->cloud, &d, ctx, out, err);
 }
 
+static int make_cut(asp_gl_context *gl, const asp_render_source *src, const asp_renderer_options *o,
+                    const asp_context *ctx, asp_renderer **out, asp_error *err)
+{
+    (void)ctx;
+    if (!src->dps)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "renderer 'cut' draws the levels of a .dps together (a .dps input)");
+    asp_cut_renderer_desc d = o ? o->cut : (asp_cut_renderer_desc){0};
+    memcpy(d.origin, src->origin, sizeof d.origin);
+    return asp_cut_renderer_create(gl, src->dps, &d, out, err);
+}
+
 static const asp_renderer_kind kinds[] = {
     {"disc", "points", ASP_RENDER_INPUT_POINTS, 0, make_disc},
     {"splat", "splats", ASP_RENDER_INPUT_POINTS, 1, make_splat},
@@ -106,6 +117,7 @@ static const asp_renderer_kind kinds[] = {
     {"prim", "primitives", ASP_RENDER_INPUT_PRIMS, 0, make_prim},
     {"mesh", "triangles", ASP_RENDER_INPUT_MESH, 0, make_mesh},
     {"hybrid", "primitives and splats", ASP_RENDER_INPUT_PRIMS, 0, make_hybrid},
+    {"cut", "primitives", ASP_RENDER_INPUT_PRIMS, 0, make_cut},
 };
 enum { N_KINDS = sizeof kinds / sizeof kinds[0] };
 

@@ -257,16 +257,21 @@ static void test_memory_cuts_and_forged_counts(void)
     forge_expect_refused(&dps_format, bytes, size, 88, minus_bits, 8, "byte 64: frame");
     forge_expect_refused(&dps_format, bytes, size, 64, inf_bits, 8, "byte 64: frame");
 
-    /* a version-1 file (64-byte header, no frame), forged by cutting the frame out, loads with radius 0 */
-    unsigned char *v1 = malloc(size - 32);
+    /*
+     * a version-1 file (64-byte header, no frame), forged by cutting the frame out and the 16 bytes of
+     * links (version 3) from the one level's header, loads with radius 0
+     */
+    const size_t v1_size = size - 32 - 16, links_at = level_at + 96;
+    unsigned char *v1 = malloc(v1_size);
     if (v1) {
         memcpy(v1, bytes, 64);
-        memcpy(v1 + 64, bytes + 96, size - 96);
+        memcpy(v1 + 64, bytes + 96, links_at - 96);
+        memcpy(v1 + 64 + links_at - 96, bytes + links_at + 16, size - links_at - 16);
         forge_put_le(v1 + 8, 1, 4);
         forge_put_le(v1 + 12, 64, 4);
-        forge_fix_header(v1, size - 32, 24, 64);
+        forge_fix_header(v1, v1_size, 24, 64);
         asp_dps *old = NULL;
-        CHECK_OK(asp_dps_load_memory(v1, size - 32, "v1.dps", NULL, &old, &err), &err);
+        CHECK_OK(asp_dps_load_memory(v1, v1_size, "v1.dps", NULL, &old, &err), &err);
         if (old) {
             const asp_frame zero = {{0, 0, 0}, 0};
             CHECK(memcmp(&old->frame, &zero, sizeof zero) == 0);
@@ -276,9 +281,9 @@ static void test_memory_cuts_and_forged_counts(void)
         }
         /* version 1 with the version-2 header size (and the reverse) is refused */
         forge_put_le(v1 + 12, 96, 4);
-        forge_fix_header(v1, size - 32, 24, 96);
+        forge_fix_header(v1, v1_size, 24, 96);
         old = NULL;
-        CHECK(asp_dps_load_memory(v1, size - 32, "v1.dps", NULL, &old, &err) == ASP_EFORMAT && !old);
+        CHECK(asp_dps_load_memory(v1, v1_size, "v1.dps", NULL, &old, &err) == ASP_EFORMAT && !old);
         CHECK_MSG(strstr(err.msg, "version 1 (header 96 bytes)") != NULL, "%s", err.msg);
         free(v1);
     }
