@@ -276,7 +276,8 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, uint32_t version,
     }
     lv->strict = strict;
     /* levels are stored finest first without duplicates (asp_prim_build) */
-    const uint32_t lo = li ? dps->levels[li - 1].level + 1 : 0;
+    /* thresholded then strict levels of one AMG level may sit side by side (build --domains both) */
+    const uint32_t lo = li ? dps->levels[li - 1].level + !(lv->strict && !dps->levels[li - 1].strict) : 0;
     if (lv->level < lo || lv->level >= dps->amg_levels) {
         snprintf(msg, sizeof msg, "level %zu: AMG level %u, expected %u..%u (increasing, below the level count)", li,
                  lv->level, lo, dps->amg_levels - 1);
