@@ -1,0 +1,459 @@
+/*
+ * The points of a distributed decomposition (issue 19): each rank reads its
+ * own range of a binary PLY's vertices, a sample sort along a Morton curve of
+ * quantised coordinates gives every rank a compact piece of the surface, and
+ * a halo brings copies of the other ranks' points within each owned point's
+ * neighbourhood radius (bounding boxes of the balls) so journal 2.1-2.2's
+ * neighbourhoods, classifier and fans of owned points see the whole surface.
+ */
+#ifdef ASP_HAVE_HYPRE
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amg/distributed.h"
+#include "util/regular_file.h"
+#include "util/banned.h"
+
+/* One point on its way between ranks: the Morton key, its input index (ties), and every attribute kept. */
+typedef struct rec {
+    uint64_t key, index;
+    float pos[3], nrm[3], radius;
+    uint32_t label;
+    uint8_t rgba[4];
+} rec;
+
+enum { P_X, P_Y, P_Z, P_NX, P_NY, P_NZ, P_R, P_G, P_B, P_A, P_RADIUS, P_LABEL, P_COUNT };
+static const char *const prop_names[P_COUNT] = {"x",   "y",     "z",    "nx",    "ny",     "nz",
+                                                "red", "green", "blue", "alpha", "radius", "label"};
+
+typedef struct layout {
+    size_t count, record, data_at;
+    int type[P_COUNT]; /* 0 = absent, else the byte size with sign/float flag below */
+    size_t at[P_COUNT];
+} layout;
+
+enum { T_FLOAT = 0x100, T_SIGNED = 0x200 };
+
+static int type_of(const char *name)
+{
+    static const struct {
+        const char *n;
+        int t;
+    } types[] = {{"char", 1 | T_SIGNED},  {"int8", 1 | T_SIGNED},   {"uchar", 1},          {"uint8", 1},
+                 {"short", 2 | T_SIGNED}, {"int16", 2 | T_SIGNED},  {"ushort", 2},         {"uint16", 2},
+                 {"int", 4 | T_SIGNED},   {"int32", 4 | T_SIGNED},  {"uint", 4},           {"uint32", 4},
+                 {"float", 4 | T_FLOAT},  {"float32", 4 | T_FLOAT}, {"double", 8 | T_FLOAT}, {"float64", 8 | T_FLOAT}};
+    for (size_t i = 0; i < sizeof types / sizeof types[0]; i++)
+        if (strcmp(types[i].n, name) == 0)
+            return types[i].t;
+    return 0;
+}
+
+static double load(const uint8_t *p, int t)
+{
+    switch (t) {
+    case 4 | T_FLOAT: { float f; memcpy(&f, p, 4); return f; }
+    case 8 | T_FLOAT: { double v; memcpy(&v, p, 8); return v; }
+    case 1: return p[0];
+    case 1 | T_SIGNED: return (int8_t)p[0];
+    case 2: { uint16_t v; memcpy(&v, p, 2); return v; }
+    case 2 | T_SIGNED: { int16_t v; memcpy(&v, p, 2); return v; }
+    case 4: { uint32_t v; memcpy(&v, p, 4); return v; }
+    default: { int32_t v; memcpy(&v, p, 4); return v; }
+    }
+}
+
+/* The vertex layout of a binary little-endian PLY whose first element is the vertices. */
+static int read_layout(FILE *fp, const char *path, layout *lay, asp_error *err)
+{
+    char line[512];
+    size_t lineno = 0;
+    int in_vertex = 0, seen_vertex = 0, fmt = 0;
+    memset(lay, 0, sizeof *lay);
+    while (fgets(line, sizeof line, fp)) {
+        lineno++;
+        char a[64] = "", b[64] = "", c[64] = "";
+        int n = sscanf(line, "%63s %63s %63s", a, b, c);
+        if (lineno == 1 && strcmp(a, "ply") != 0)
+            return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line 1: expected 'ply'", path);
+        if (strcmp(a, "format") == 0) {
+            if (strcmp(b, "binary_little_endian") != 0)
+                return asp_error_set(err, ASP_EFORMAT,
+                                     "cannot read '%s' on MPI ranks: line %zu: format %s, expected binary_little_endian "
+                                     "(convert it with 'amgsplat convert --encoding binary')", path, lineno, b);
+            fmt = 1;
+        } else if (strcmp(a, "element") == 0) {
+            if (seen_vertex && in_vertex)
+                in_vertex = 0;
+            if (!seen_vertex) {
+                if (strcmp(b, "vertex") != 0)
+                    return asp_error_set(err, ASP_EFORMAT,
+                                         "cannot read '%s' on MPI ranks: line %zu: element '%s' before 'vertex', "
+                                         "expected the vertices first", path, lineno, b);
+                char *end;
+                unsigned long long v = strtoull(c, &end, 10);
+                if (*end || n < 3)
+                    return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu: bad vertex count '%s'", path,
+                                         lineno, c);
+                lay->count = (size_t)v;
+                seen_vertex = in_vertex = 1;
+            }
+        } else if (strcmp(a, "property") == 0 && in_vertex) {
+            if (strcmp(b, "list") == 0)
+                return asp_error_set(err, ASP_EFORMAT,
+                                     "cannot read '%s' on MPI ranks: line %zu: a list property in the vertices, "
+                                     "expected fixed-size records", path, lineno);
+            int t = type_of(b);
+            if (!t || n < 3)
+                return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu: unknown property type '%s'", path,
+                                     lineno, b);
+            for (int p = 0; p < P_COUNT; p++)
+                if (strcmp(c, prop_names[p]) == 0 && !lay->type[p]) {
+                    lay->type[p] = t;
+                    lay->at[p] = lay->record;
+                }
+            lay->record += (size_t)(t & 0xff);
+        } else if (strcmp(a, "end_header") == 0) {
+            lay->data_at = (size_t)ftell(fp);
+            if (!fmt || !seen_vertex)
+                return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': no format or vertex element in the header",
+                                     path);
+            if (!lay->type[P_X] || !lay->type[P_Y] || !lay->type[P_Z])
+                return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': the vertices have no x, y, z", path);
+            for (int p = P_NX; p <= P_NZ; p++)
+                if (!(lay->type[P_NX] && lay->type[P_NY] && lay->type[P_NZ]))
+                    lay->type[p] = 0;
+            for (int p = P_R; p <= P_A; p++)
+                if (lay->type[p] != 1 || !(lay->type[P_R] == 1 && lay->type[P_G] == 1 && lay->type[P_B] == 1))
+                    lay->type[p] = p == P_A && lay->type[P_A] == 1 ? lay->type[P_A] : 0;
+            if (!lay->type[P_R])
+                lay->type[P_A] = 0;
+            return 0;
+        }
+    }
+    return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': no end_header", path);
+}
+
+/* 21 bits per axis, interleaved: Morton order keeps each rank's piece of the surface compact. */
+static uint64_t spread(uint64_t v)
+{
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+}
+
+static int cmp_rec(const void *a, const void *b)
+{
+    const rec *x = a, *y = b;
+    if (x->key != y->key)
+        return x->key < y->key ? -1 : 1;
+    return x->index < y->index ? -1 : x->index > y->index;
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* This rank's records [first, first+m) of the file, positions as offsets from origin. */
+static int read_range(FILE *fp, const char *path, const layout *lay, size_t first, size_t m, const double origin[3],
+                      rec *out, asp_error *err)
+{
+    enum { CHUNK = 1 << 16 };
+    uint8_t *buf = malloc(CHUNK * lay->record);
+    if (!buf)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", path);
+    for (size_t done = 0; done < m;) {
+        size_t take = m - done < CHUNK ? m - done : CHUNK;
+        if (fseeko(fp, (off_t)(lay->data_at + (first + done) * lay->record), SEEK_SET) != 0 ||
+            fread(buf, lay->record, take, fp) != take) {
+            free(buf);
+            return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': vertex %zu: the file ends before vertex %zu",
+                                 path, first + done, lay->count);
+        }
+        for (size_t i = 0; i < take; i++) {
+            const uint8_t *b = buf + i * lay->record;
+            rec *r = out + done + i;
+            memset(r, 0, sizeof *r);
+            r->index = first + done + i;
+            for (int k = 0; k < 3; k++) {
+                double v = load(b + lay->at[P_X + k], lay->type[P_X + k]);
+                if (!isfinite(v)) {
+                    free(buf);
+                    return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': vertex %zu: coordinate %c is not finite",
+                                         path, (size_t)r->index, "xyz"[k]);
+                }
+                r->pos[k] = (float)(v - origin[k]);
+                r->nrm[k] = lay->type[P_NX] ? (float)load(b + lay->at[P_NX + k], lay->type[P_NX + k]) : 0.0f;
+            }
+            for (int k = 0; k < 4; k++)
+                r->rgba[k] = lay->type[P_R + k] ? b[lay->at[P_R + k]] : 255;
+            r->radius = lay->type[P_RADIUS] ? (float)load(b + lay->at[P_RADIUS], lay->type[P_RADIUS]) : 0.0f;
+            r->label = lay->type[P_LABEL] ? (uint32_t)load(b + lay->at[P_LABEL], lay->type[P_LABEL]) : 0;
+        }
+        done += take;
+    }
+    free(buf);
+    return 0;
+}
+
+/* Reads this rank's share into *recs (count *m) with the file's layout and the origin of wide axes. */
+static int read_share(const asp__dist *d, const char *path, layout *lay, double origin[3], rec **recs, size_t *m,
+                      asp_error *err)
+{
+    FILE *fp = asp__regular_file_open(path, err);
+    int rc = fp ? 0 : err && err->code ? err->code : ASP_EIO;
+    if (!rc)
+        rc = read_layout(fp, path, lay, err);
+    if (!rc && lay->count < 3)
+        rc = asp_error_set(err, ASP_EDEGENERATE, "cannot decompose %zu points: need at least 3", lay->count);
+    if (!rc && lay->count > (size_t)INT32_MAX - 1)
+        rc = asp_error_set(err, ASP_EUNSUPPORTED, "cannot decompose %zu points: at most 2^31-2 are supported",
+                           lay->count);
+    size_t first = 0;
+    if (!rc) {
+        first = lay->count * (size_t)d->rank / (size_t)d->size;
+        *m = lay->count * (size_t)(d->rank + 1) / (size_t)d->size - first;
+        /* the serial reader's origin: wide (double) axes are offsets from the first point, rounded */
+        for (int k = 0; k < 3 && !rc; k++) {
+            uint8_t raw[8];
+            if (fseeko(fp, (off_t)(lay->data_at + lay->at[P_X + k]), SEEK_SET) || fread(raw, 1, 8, fp) < 4)
+                rc = asp_error_set(err, ASP_EFORMAT, "cannot read '%s': no vertex data", path);
+            double v = rc ? 0 : load(raw, lay->type[P_X + k]);
+            origin[k] = (lay->type[P_X + k] & 0xff) != 4 || !(lay->type[P_X + k] & T_FLOAT) ? floor(v + 0.5) : 0.0;
+        }
+    }
+    if (!rc) {
+        *recs = malloc((*m + 1) * sizeof **recs);
+        if (!*recs)
+            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu points of '%s'", *m, path);
+    }
+    if (!rc) {
+        rc = read_range(fp, path, lay, first, *m, origin, *recs, err);
+        if (rc) {
+            free(*recs);
+            *recs = NULL;
+        }
+    }
+    if (fp)
+        fclose(fp);
+    return rc;
+}
+
+/* Sample sort by key: splitters from regular samples of every rank, then one all-to-all of the records. */
+static int sample_sort(const asp__dist *d, rec **recs, size_t *m, asp_error *err)
+{
+    const int P = d->size;
+    rec *r = *recs;
+    qsort(r, *m, sizeof *r, cmp_rec);
+    if (P == 1)
+        return 0;
+    const int s = 32; /* samples per rank: enough for a few % of imbalance */
+    uint64_t mine[32], *all = malloc((size_t)P * s * sizeof *all), *split = malloc((size_t)P * sizeof *split);
+    int *cnt = calloc(4 * (size_t)P, sizeof *cnt);
+    if (!all || !split || !cnt) {
+        free(all);
+        free(split);
+        free(cnt);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for the sample sort");
+    }
+    for (int i = 0; i < s; i++)
+        mine[i] = *m ? r[(size_t)i * *m / (size_t)s].key : UINT64_MAX;
+    MPI_Allgather(mine, s, MPI_UINT64_T, all, s, MPI_UINT64_T, d->comm);
+    qsort(all, (size_t)P * s, sizeof *all, cmp_u64);
+    for (int q = 1; q < P; q++)
+        split[q] = all[(size_t)q * s];
+    int *dis = cnt + P, *rcnt = cnt + 2 * P, *rdis = cnt + 3 * P;
+    for (size_t i = 0, q = 0; i < *m; i++) {
+        while ((int)q + 1 < P && r[i].key >= split[q + 1])
+            q++;
+        cnt[q]++;
+    }
+    MPI_Alltoall(cnt, 1, MPI_INT, rcnt, 1, MPI_INT, d->comm);
+    size_t total = 0;
+    for (int q = 0; q < P; q++) {
+        dis[q] = q ? dis[q - 1] + cnt[q - 1] : 0;
+        rdis[q] = (int)total;
+        total += (size_t)rcnt[q];
+    }
+    rec *in = malloc((total + 1) * sizeof *in);
+    int ok = in != NULL, allok = 0;
+    MPI_Allreduce(&ok, &allok, 1, MPI_INT, MPI_MIN, d->comm);
+    if (allok) {
+        MPI_Datatype t;
+        MPI_Type_contiguous((int)sizeof(rec), MPI_BYTE, &t);
+        MPI_Type_commit(&t);
+        MPI_Alltoallv(r, cnt, dis, t, in, rcnt, rdis, t, d->comm);
+        MPI_Type_free(&t);
+        qsort(in, total, sizeof *in, cmp_rec);
+        free(r);
+        *recs = in;
+        *m = total;
+    } else {
+        free(in);
+    }
+    free(all);
+    free(split);
+    free(cnt);
+    return allok ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for %zu points from other ranks", total);
+}
+
+int asp__dist_read_sorted(const asp__dist *d, const char *path, asp__dist_points *pts, asp_error *err)
+{
+    layout lay;
+    rec *recs = NULL;
+    size_t m = 0;
+    memset(pts, 0, sizeof *pts);
+    int rc = read_share(d, path, &lay, pts->origin, &recs, &m, err);
+    if ((rc = asp__dist_agree(d, rc, err)) != 0) {
+        free(recs);
+        return rc;
+    }
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < m; i++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fminf(lo[k], recs[i].pos[k]);
+            hi[k] = fmaxf(hi[k], recs[i].pos[k]);
+        }
+    MPI_Allreduce(lo, pts->lo, 3, MPI_FLOAT, MPI_MIN, d->comm);
+    MPI_Allreduce(hi, pts->hi, 3, MPI_FLOAT, MPI_MAX, d->comm);
+    double ext = 0;
+    for (int k = 0; k < 3; k++)
+        ext = fmax(ext, (double)pts->hi[k] - pts->lo[k]);
+    const double scale = ext > 0 ? 2097151.0 / ext : 0;
+    for (size_t i = 0; i < m; i++) {
+        uint64_t q[3];
+        for (int k = 0; k < 3; k++)
+            q[k] = (uint64_t)(((double)recs[i].pos[k] - pts->lo[k]) * scale);
+        recs[i].key = spread(q[0]) | spread(q[1]) << 1 | spread(q[2]) << 2;
+    }
+    rc = sample_sort(d, &recs, &m, err);
+    if ((rc = asp__dist_agree(d, rc, err)) != 0) {
+        free(recs);
+        return rc;
+    }
+    const asp_context *ctx = &d->ctx;
+    pts->n_global = lay.count;
+    pts->n_own = m;
+    pts->starts = asp_alloc(ctx, ((size_t)d->size + 1) * sizeof *pts->starts);
+    pts->pos = asp_alloc(ctx, (3 * m + 3) * sizeof *pts->pos);
+    if (lay.type[P_NX])
+        pts->normals = asp_alloc(ctx, (3 * m + 3) * sizeof *pts->normals);
+    if (lay.type[P_R])
+        pts->colors = asp_alloc(ctx, 4 * m + 4);
+    if (lay.type[P_RADIUS])
+        pts->radii = asp_alloc(ctx, (m + 1) * sizeof *pts->radii);
+    if (lay.type[P_LABEL])
+        pts->labels = asp_alloc(ctx, (m + 1) * sizeof *pts->labels);
+    pts->has_alpha = lay.type[P_A] != 0;
+    rc = !pts->starts || !pts->pos || (lay.type[P_NX] && !pts->normals) || (lay.type[P_R] && !pts->colors) ||
+                 (lay.type[P_RADIUS] && !pts->radii) || (lay.type[P_LABEL] && !pts->labels)
+             ? asp_error_set(err, ASP_ENOMEM, "out of memory for %zu points", m)
+             : 0;
+    if (!rc && asp__dist_partition(d, m, pts->starts))
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the partition");
+    for (size_t i = 0; !rc && i < m; i++) {
+        memcpy(pts->pos + 3 * i, recs[i].pos, sizeof recs[i].pos);
+        if (pts->normals)
+            memcpy(pts->normals + 3 * i, recs[i].nrm, sizeof recs[i].nrm);
+        if (pts->colors)
+            memcpy(pts->colors + 4 * i, recs[i].rgba, 4);
+        if (pts->radii)
+            pts->radii[i] = recs[i].radius;
+        if (pts->labels)
+            pts->labels[i] = recs[i].label;
+    }
+    free(recs);
+    return asp__dist_agree(d, rc, err);
+}
+
+int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radius, asp_error *err)
+{
+    const int P = d->size;
+    const size_t n = pts->n_own;
+    /* the box of this rank's balls: a point of another rank outside it is nobody's neighbour here */
+    float box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            box[k] = fminf(box[k], pts->pos[3 * i + k] - radius[i]);
+            box[3 + k] = fmaxf(box[3 + k], pts->pos[3 * i + k] + radius[i]);
+        }
+    float *boxes = malloc(6 * (size_t)P * sizeof *boxes);
+    int *cnt = calloc(4 * (size_t)P, sizeof *cnt);
+    if (!boxes || !cnt) {
+        free(boxes);
+        free(cnt);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for the halo");
+    }
+    MPI_Allgather(box, 6, MPI_FLOAT, boxes, 6, MPI_FLOAT, d->comm);
+    int *dis = cnt + P, *rcnt = cnt + 2 * P, *rdis = cnt + 3 * P;
+#define INSIDE(q, i)                                                                                                 \
+    (pts->pos[3 * (i)] >= boxes[6 * (q)] && pts->pos[3 * (i) + 1] >= boxes[6 * (q) + 1] &&                           \
+     pts->pos[3 * (i) + 2] >= boxes[6 * (q) + 2] && pts->pos[3 * (i)] <= boxes[6 * (q) + 3] &&                       \
+     pts->pos[3 * (i) + 1] <= boxes[6 * (q) + 4] && pts->pos[3 * (i) + 2] <= boxes[6 * (q) + 5])
+    size_t total = 0;
+    for (int q = 0; q < P; q++) {
+        dis[q] = (int)total;
+        for (size_t i = 0; q != d->rank && i < n; i++)
+            cnt[q] += INSIDE(q, i);
+        total += (size_t)cnt[q];
+    }
+    float *spos = malloc((3 * total + 3) * sizeof *spos);
+    asp_index *sid = malloc((total + 1) * sizeof *sid);
+    if (spos && sid)
+        for (int q = 0, w = 0; q < P; q++)
+            for (size_t i = 0; q != d->rank && i < n; i++)
+                if (INSIDE(q, i)) {
+                    memcpy(spos + 3 * w, pts->pos + 3 * i, 3 * sizeof *spos);
+                    sid[w++] = (asp_index)(pts->starts[d->rank] + i);
+                }
+#undef INSIDE
+    MPI_Alltoall(cnt, 1, MPI_INT, rcnt, 1, MPI_INT, d->comm);
+    size_t got = 0;
+    for (int q = 0; q < P; q++) {
+        rdis[q] = (int)got;
+        got += (size_t)rcnt[q];
+    }
+    float *np = asp_realloc(&d->ctx, pts->pos, (3 * n + 3) * sizeof *np, (3 * (n + got) + 3) * sizeof *np);
+    if (np)
+        pts->pos = np;
+    pts->ghost_gid = asp_alloc(&d->ctx, (got + 1) * sizeof *pts->ghost_gid);
+    int ok = spos && sid && np && pts->ghost_gid, all = 0;
+    MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, d->comm);
+    if (all) {
+        MPI_Alltoallv(sid, cnt, dis, MPI_UINT32_T, pts->ghost_gid, rcnt, rdis, MPI_UINT32_T, d->comm);
+        MPI_Datatype t;
+        MPI_Type_contiguous(3, MPI_FLOAT, &t);
+        MPI_Type_commit(&t);
+        MPI_Alltoallv(spos, cnt, dis, t, pts->pos + 3 * n, rcnt, rdis, t, d->comm);
+        MPI_Type_free(&t);
+        pts->n_ghost = got;
+    }
+    free(spos);
+    free(sid);
+    free(boxes);
+    free(cnt);
+    return all ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for a halo of %zu points", got);
+}
+
+void asp__dist_points_release(const asp_context *ctx, asp__dist_points *pts)
+{
+    asp_free(ctx, pts->starts);
+    asp_free(ctx, pts->pos);
+    asp_free(ctx, pts->normals);
+    asp_free(ctx, pts->colors);
+    asp_free(ctx, pts->radii);
+    asp_free(ctx, pts->labels);
+    asp_free(ctx, pts->ghost_gid);
+    memset(pts, 0, sizeof *pts);
+}
+#else
+typedef int asp__dist_points_unused;
+#endif
