@@ -45,26 +45,36 @@ void asp_amg_distributed_shutdown(void) {}
 
 /* ---- neighbourhood radius and halo ---- */
 
-/*
- * Each owned point's k_max-th neighbour distance among this rank's points
- * bounds its true one from above, so the halo built from it holds every
- * neighbour; epsilon (journal 2.1) is the global median k_min-th distance,
- * found exactly by bisection on the float bits (the serial select_kth).
- */
-static int radii_and_epsilon(const asp__dist *d, const asp__dist_points *pts, asp_amg_desc *desc, float *radius,
-                             asp_error *err)
+/* The global order statistic: the smallest v with at least want values <= v among every rank's vals[i * stride]. */
+static float global_select(const asp__dist *d, const float *vals, size_t n, size_t stride, unsigned long long want)
 {
-    const size_t n = pts->n_own, k = desc->k_max;
+    uint32_t lo = 0, hi = 0x7f800000u; /* non-negative floats order as their bits */
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        unsigned long long c = 0, all = 0;
+        for (size_t i = 0; i < n; i++) {
+            uint32_t b;
+            memcpy(&b, &vals[i * stride], 4);
+            c += b <= mid;
+        }
+        MPI_Allreduce(&c, &all, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
+        if (all >= want)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    float v;
+    memcpy(&v, &lo, 4);
+    return v;
+}
+
+/* k nearest among the n points at pos (k < n): squared distances into a new array. */
+static int knn_dist2(const asp__dist *d, const float *pos, size_t n, size_t k, float **out, asp_error *err)
+{
     asp_kdtree *tree = NULL;
     asp_index *idx = NULL;
     float *d2 = NULL;
-    int rc = 0;
-    if (n <= k)
-        rc = asp_error_set(err, ASP_EINVAL,
-                           "rank %d holds %zu points, fewer than k_max + 1 = %zu: use fewer ranks for %zu points",
-                           d->rank, n, k + 1, pts->n_global);
-    if (!rc)
-        rc = asp_kdtree_create(pts->pos, n, 3 * sizeof(float), &d->ctx, &tree, err);
+    int rc = asp_kdtree_create(pos, n, 3 * sizeof(float), &d->ctx, &tree, err);
     if (!rc) {
         idx = asp_alloc(&d->ctx, n * k * sizeof *idx);
         d2 = asp_alloc(&d->ctx, n * k * sizeof *d2);
@@ -73,32 +83,41 @@ static int radii_and_epsilon(const asp__dist *d, const asp__dist_points *pts, as
     }
     asp_kdtree_destroy(tree);
     asp_free(&d->ctx, idx);
-    if ((rc = asp__dist_agree(d, rc, err)) != 0) {
+    if (rc)
         asp_free(&d->ctx, d2);
+    else
+        *out = d2;
+    return rc;
+}
+
+/*
+ * Each owned point's k_max-th neighbour distance among the rank's own points
+ * bounds its true one from above; epsilon (journal 2.1) is the global median
+ * k_min-th distance, found exactly by bisection on the float bits (the serial
+ * select_kth). The halo radius is capped at twice the median k_max-th
+ * distance: a few points of a rank's piece of the Morton curve lie apart from
+ * the rest, and their uncapped balls spanned much of the model (246k halo
+ * points for 1M on 2 ranks). halo_rounds checks the cap.
+ */
+static int radii_and_epsilon(const asp__dist *d, const asp__dist_points *pts, asp_amg_desc *desc, float *radius,
+                             asp_error *err)
+{
+    const size_t n = pts->n_own, k = desc->k_max;
+    float *d2 = NULL;
+    int rc = 0;
+    if (n <= k)
+        rc = asp_error_set(err, ASP_EINVAL,
+                           "rank %d holds %zu points, fewer than k_max + 1 = %zu: use fewer ranks for %zu points",
+                           d->rank, n, k + 1, pts->n_global);
+    if (!rc)
+        rc = knn_dist2(d, pts->pos, n, k, &d2, err);
+    if ((rc = asp__dist_agree(d, rc, err)) != 0)
         return rc;
-    }
+    const float cap = 2.0f * sqrtf(global_select(d, d2 + k - 1, n, k, pts->n_global / 2 + 1));
     for (size_t i = 0; i < n; i++)
-        radius[i] = sqrtf(d2[i * k + k - 1]) * (1.0f + 1e-5f) + 1e-30f;
+        radius[i] = fminf(sqrtf(d2[i * k + k - 1]), cap) * (1.0f + 1e-5f) + 1e-30f;
     if (desc->epsilon == 0) {
-        const unsigned long long want = pts->n_global / 2 + 1;
-        uint32_t lo = 0, hi = 0x7f800000u; /* non-negative floats order as their bits */
-        while (lo < hi) {
-            uint32_t mid = lo + (hi - lo) / 2;
-            unsigned long long c = 0, all = 0;
-            for (size_t i = 0; i < n; i++) {
-                uint32_t b;
-                memcpy(&b, &d2[i * k + desc->k_min - 1], 4);
-                c += b <= mid;
-            }
-            MPI_Allreduce(&c, &all, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
-            if (all >= want)
-                hi = mid;
-            else
-                lo = mid + 1;
-        }
-        float med;
-        memcpy(&med, &lo, 4);
-        desc->epsilon = sqrt((double)med);
+        desc->epsilon = sqrt((double)global_select(d, d2 + desc->k_min - 1, n, k, pts->n_global / 2 + 1));
         if (!(desc->epsilon > 0))
             rc = asp_error_set(err, ASP_EDEGENERATE,
                                "cannot decompose: most points coincide with %zu others (no neighbourhood radius)",
@@ -106,6 +125,39 @@ static int radii_and_epsilon(const asp__dist *d, const asp__dist_points *pts, as
     }
     asp_free(&d->ctx, d2);
     return rc;
+}
+
+/*
+ * The halo is complete for owned point i when its k_max-th neighbour among
+ * the rank's points and halo lies within radius[i]: everything closer was
+ * sent. Otherwise that distance (an upper bound of the true one) becomes
+ * radius[i] for another round, until no rank has such a point.
+ */
+static int halo_rounds(const asp__dist *d, asp__dist_points *pts, float *radius, size_t k, asp_error *err)
+{
+    for (int round = 0;; round++) {
+        int rc = asp__dist_halo(d, pts, radius, err);
+        float *d2 = NULL;
+        if (!rc)
+            rc = knn_dist2(d, pts->pos, pts->n_own + pts->n_ghost, k, &d2, err);
+        if ((rc = asp__dist_agree(d, rc, err)) != 0)
+            return rc;
+        unsigned long long short_ = 0;
+        for (size_t i = 0; i < pts->n_own; i++) {
+            float r = sqrtf(d2[i * k + k - 1]);
+            if (r > radius[i]) {
+                radius[i] = r * (1.0f + 1e-5f) + 1e-30f;
+                short_++;
+            }
+        }
+        asp_free(&d->ctx, d2);
+        unsigned long long all = 0;
+        MPI_Allreduce(&short_, &all, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
+        if (all == 0)
+            return 0;
+        if (round == 8)
+            return asp_error_set(err, ASP_ESOLVER, "the halo did not close after 8 rounds (%llu points short)", all);
+    }
 }
 
 static asp_index gid_of(const asp__dist *d, const asp__dist_points *pts, size_t local)
@@ -1069,9 +1121,9 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
     r.radius = asp_alloc(&d->ctx, (r.pts.n_own + 1) * sizeof *r.radius);
     rc = r.radius ? radii_and_epsilon(d, &r.pts, &r.desc, r.radius, err)
                   : asp_error_set(err, ASP_ENOMEM, "out of memory for %zu radii", r.pts.n_own);
-    if (!rc)
-        rc = asp__dist_halo(d, &r.pts, r.radius, err);
     if ((rc = asp__dist_agree(d, rc, err)) != 0)
+        goto done;
+    if ((rc = halo_rounds(d, &r.pts, r.radius, r.desc.k_max, err)) != 0)
         goto done;
     inf.halo_points = (size_t)sum_all(d, r.pts.n_ghost);
     inf.t_halo = asp_time_now() - t;

@@ -374,68 +374,141 @@ int asp__dist_read_sorted(const asp__dist *d, const char *path, asp__dist_points
     return asp__dist_agree(d, rc, err);
 }
 
-/* Boxes xyz-min, xyz-max: 1 when they overlap. */
-static int overlap(const float *a, const float *b)
-{
-    return a[0] <= b[3] && b[0] <= a[3] && a[1] <= b[4] && b[1] <= a[4] && a[2] <= b[5] && b[2] <= a[5];
-}
-
 static int inside(const float *p, const float *b)
 {
     return p[0] >= b[0] && p[1] >= b[1] && p[2] >= b[2] && p[0] <= b[3] && p[1] <= b[4] && p[2] <= b[5];
+}
+
+/* A uniform grid over the model's box listing, per cell, the boxes that reach into it (CSR). */
+typedef struct box_grid {
+    int g;
+    float lo[3], inv[3];
+    size_t *start; /* g^3 + 1 */
+    uint32_t *box;
+} box_grid;
+
+static int cell_of(const box_grid *gr, float v, int k)
+{
+    int c = (int)((v - gr->lo[k]) * gr->inv[k]);
+    return c < 0 ? 0 : c >= gr->g ? gr->g - 1 : c;
+}
+
+static int grid_build(box_grid *gr, const asp__dist_points *pts, const float *boxes, size_t nbox)
+{
+    int g = (int)(2 * cbrt((double)nbox)) + 1;
+    gr->g = g > 256 ? 256 : g;
+    for (int k = 0; k < 3; k++) {
+        gr->lo[k] = pts->lo[k];
+        float ext = pts->hi[k] - pts->lo[k];
+        gr->inv[k] = ext > 0 ? (float)gr->g / ext : 0;
+    }
+    const size_t cells = (size_t)gr->g * gr->g * gr->g;
+    gr->start = calloc(cells + 1, sizeof *gr->start);
+    gr->box = NULL;
+    if (!gr->start)
+        return ASP_ENOMEM;
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t b = 0; b < nbox; b++) {
+            const float *bb = boxes + 6 * b;
+            int c0[3], c1[3];
+            for (int k = 0; k < 3; k++) {
+                c0[k] = cell_of(gr, bb[k], k);
+                c1[k] = cell_of(gr, bb[3 + k], k);
+            }
+            for (int x = c0[0]; x <= c1[0]; x++)
+                for (int y = c0[1]; y <= c1[1]; y++)
+                    for (int z = c0[2]; z <= c1[2]; z++) {
+                        size_t c = ((size_t)x * gr->g + (size_t)y) * gr->g + (size_t)z;
+                        if (pass == 0)
+                            gr->start[c + 1]++;
+                        else
+                            gr->box[gr->start[c]++] = (uint32_t)b;
+                    }
+        }
+        if (pass == 0) {
+            for (size_t c = 0; c < cells; c++)
+                gr->start[c + 1] += gr->start[c];
+            gr->box = malloc((gr->start[cells] + 1) * sizeof *gr->box);
+            if (!gr->box)
+                return ASP_ENOMEM;
+        } else {
+            /* the fill advanced each start to the next cell's: shift back */
+            for (size_t c = cells; c > 0; c--)
+                gr->start[c] = gr->start[c - 1];
+            gr->start[0] = 0;
+        }
+    }
+    return 0;
 }
 
 /*
  * The halo by boxes of balls over runs of consecutive points: a piece of a
  * Morton curve is a staircase whose one bounding box can span the whole model
  * (measured: 526k halo points for 1M on 2 ranks with one box per rank), while
- * a run of a few hundred consecutive points is compact. Each rank publishes
- * the boxes of its runs' balls; a point goes to rank q when it lies in one of
- * q's boxes, tested only against the boxes that overlap its own run's box.
+ * a short run of consecutive points is compact. Each rank publishes the boxes of its runs' balls; a point goes
+ * to rank q when it lies in one of q's boxes, found through a grid of them.
  */
 int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radius, asp_error *err)
 {
     const int P = d->size;
-    const size_t n = pts->n_own, run = n / 2048 + 256, nrun = (n + run - 1) / run;
-    float *mine = malloc((12 * nrun + 1) * sizeof *mine); /* per run: the balls' box, then the points' box */
+    /* runs of at most max(32, N / 2^21) points: about 2^21 boxes in all, below 50 MB on every rank */
+    const size_t n = pts->n_own, run = pts->n_global >> 21 > 32 ? pts->n_global >> 21 : 32;
+    asp_free(&d->ctx, pts->ghost_gid); /* a new round replaces the last one's halo */
+    pts->ghost_gid = NULL;
+    pts->n_ghost = 0;
+    /*
+     * A run also ends where the curve jumps: its points' box may not grow past 8 mean radii (runs of 32
+     * points without this limit had boxes as wide as the model and a halo of 243k points for 1M on 2 ranks)
+     */
+    double mean_r = 0;
+    for (size_t i = 0; i < n; i++)
+        mean_r += radius[i];
+    const float limit = (float)(8 * mean_r / (double)(n ? n : 1));
+    float *mine = malloc((6 * n + 7) * sizeof *mine);
     int *cnt = calloc(6 * (size_t)P, sizeof *cnt);
     if (!mine || !cnt) {
         free(mine);
         free(cnt);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the halo");
     }
-    for (size_t c = 0; c < nrun; c++) {
-        float *bb = mine + 12 * c;
+    size_t nrun = 0;
+    for (size_t i = 0; i < n;) {
+        float *bb = mine + 6 * nrun++, pl[3], ph[3];
         for (int k = 0; k < 3; k++) {
-            bb[k] = bb[6 + k] = INFINITY;
-            bb[3 + k] = bb[9 + k] = -INFINITY;
+            bb[k] = pl[k] = INFINITY;
+            bb[3 + k] = ph[k] = -INFINITY;
         }
-        for (size_t i = c * run; i < n && i < (c + 1) * run; i++)
+        for (size_t first = i; i < n && i < first + run; i++) {
+            const float *p = pts->pos + 3 * i;
+            if (i > first && (fmaxf(ph[0], p[0]) - fminf(pl[0], p[0]) > limit ||
+                              fmaxf(ph[1], p[1]) - fminf(pl[1], p[1]) > limit ||
+                              fmaxf(ph[2], p[2]) - fminf(pl[2], p[2]) > limit))
+                break;
             for (int k = 0; k < 3; k++) {
-                bb[k] = fminf(bb[k], pts->pos[3 * i + k] - radius[i]);
-                bb[3 + k] = fmaxf(bb[3 + k], pts->pos[3 * i + k] + radius[i]);
-                bb[6 + k] = fminf(bb[6 + k], pts->pos[3 * i + k]);
-                bb[9 + k] = fmaxf(bb[9 + k], pts->pos[3 * i + k]);
+                pl[k] = fminf(pl[k], p[k]);
+                ph[k] = fmaxf(ph[k], p[k]);
+                bb[k] = fminf(bb[k], p[k] - radius[i]);
+                bb[3 + k] = fmaxf(bb[3 + k], p[k] + radius[i]);
             }
+        }
     }
-    int *bcnt = cnt + 4 * P, *bdis = cnt + 5 * P, nb = (int)nrun * 12, total_boxes = 0;
+    int *bcnt = cnt + 4 * P, *bdis = cnt + 5 * P, nb = (int)nrun * 6, total_boxes = 0;
     MPI_Allgather(&nb, 1, MPI_INT, bcnt, 1, MPI_INT, d->comm);
     for (int q = 0; q < P; q++) {
         bdis[q] = total_boxes;
         total_boxes += bcnt[q];
     }
     float *boxes = malloc(((size_t)total_boxes + 1) * sizeof *boxes);
-    size_t *list = malloc(((size_t)total_boxes / 12 + 1) * sizeof *list);
-    int ok = boxes && list, all = 0;
+    int ok = boxes != NULL, all = 0;
     MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, d->comm);
     if (!all) {
         free(mine);
         free(cnt);
         free(boxes);
-        free(list);
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for %d halo boxes", total_boxes / 12);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for %d halo boxes", total_boxes / 6);
     }
     MPI_Allgatherv(mine, nb, MPI_FLOAT, boxes, bcnt, bdis, MPI_FLOAT, d->comm);
+    free(mine);
     int *dis = cnt + P, *rcnt = cnt + 2 * P, *rdis = cnt + 3 * P;
     size_t cap = 1024, w = 0;
     asp_index *sid = malloc(cap * sizeof *sid);
@@ -444,36 +517,34 @@ int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radiu
         dis[q] = (int)w;
         if (q == d->rank)
             continue;
-        const size_t qruns = (size_t)bcnt[q] / 12;
         const float *qb = boxes + bdis[q];
-        for (size_t c = 0; c < nrun && !rc; c++) {
-            size_t m = 0;
-            for (size_t b = 0; b < qruns; b++)
-                if (overlap(mine + 12 * c + 6, qb + 12 * b))
-                    list[m++] = b;
-            for (size_t i = c * run; m && i < n && i < (c + 1) * run; i++) {
-                size_t b = 0;
-                while (b < m && !inside(pts->pos + 3 * i, qb + 12 * list[b]))
-                    b++;
-                if (b == m)
-                    continue;
-                if (w == cap) {
-                    asp_index *g = realloc(sid, 2 * cap * sizeof *sid);
-                    if (!g) {
-                        rc = ASP_ENOMEM;
-                        break;
-                    }
-                    sid = g;
-                    cap *= 2;
+        box_grid gr;
+        rc = grid_build(&gr, pts, qb, (size_t)bcnt[q] / 6);
+        for (size_t i = 0; !rc && i < n; i++) {
+            const float *p = pts->pos + 3 * i;
+            size_t c = ((size_t)cell_of(&gr, p[0], 0) * gr.g + (size_t)cell_of(&gr, p[1], 1)) * gr.g +
+                       (size_t)cell_of(&gr, p[2], 2);
+            size_t b = gr.start[c];
+            while (b < gr.start[c + 1] && !inside(p, qb + 6 * (size_t)gr.box[b]))
+                b++;
+            if (b == gr.start[c + 1])
+                continue;
+            if (w == cap) {
+                asp_index *g = realloc(sid, 2 * cap * sizeof *sid);
+                if (!g) {
+                    rc = ASP_ENOMEM;
+                    break;
                 }
-                sid[w++] = (asp_index)i; /* local for now */
+                sid = g;
+                cap *= 2;
             }
+            sid[w++] = (asp_index)i; /* local for now */
         }
+        free(gr.start);
+        free(gr.box);
         cnt[q] = (int)(w - (size_t)dis[q]);
     }
-    free(mine);
     free(boxes);
-    free(list);
     float *spos = rc ? NULL : malloc((3 * w + 3) * sizeof *spos);
     for (size_t k = 0; spos && k < w; k++) {
         memcpy(spos + 3 * k, pts->pos + 3 * (size_t)sid[k], 3 * sizeof *spos);
