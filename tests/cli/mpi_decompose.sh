@@ -14,9 +14,13 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_mpi_yield_when_idle=1
 MPI=(timeout 200 mpirun -np 2 --oversubscribe)
 "${MPI[@]}" true >"$T/probe" 2>&1 || { echo "SKIPPED: mpirun cannot start 2 ranks: $(head -3 "$T/probe")" >&2; exit 77; }
-# Open MPI keeps allocations past MPI_Finalize (tests/lsan.supp): the suppressions need full stacks
+# Open MPI keeps allocations past MPI_Finalize (tests/lsan.supp): the suppressions need full stacks.
+# On 2 ranks its progress thread also leaks 32 bytes from a component it has unloaded by then (no
+# symbol left to suppress): libevent, which runs that thread, is the one name in the stack.
+cp "${ASP_TEST_SRC:-$(dirname "$0")/..}/lsan.supp" "$T/lsan.supp"
+echo "leak:libevent_core" >>"$T/lsan.supp"
 export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}fast_unwind_on_malloc=0"
-export LSAN_OPTIONS="suppressions=${ASP_TEST_SRC:-$(dirname "$0")/..}/lsan.supp:print_suppressions=0"
+export LSAN_OPTIONS="suppressions=$T/lsan.supp:print_suppressions=0"
 
 "$A" synth cube -o "$T/cube.ply" -q
 "$A" decompose "$T/cube.ply" -o "$T/serial.amg" --stats --json -q >"$T/serial.json"
