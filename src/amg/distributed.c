@@ -97,7 +97,7 @@ static int knn_dist2(const asp__dist *d, const float *pos, size_t n, size_t k, f
  * select_kth). The halo radius is capped at twice the median k_max-th
  * distance: a few points of a rank's piece of the Morton curve lie apart from
  * the rest, and their uncapped balls spanned much of the model (246k halo
- * points for 1M on 2 ranks). halo_rounds checks the cap.
+ * points for 1M on 2 ranks). halo_and_neighbourhoods checks the cap.
  */
 static int radii_and_epsilon(const asp__dist *d, const asp__dist_points *pts, asp_amg_desc *desc, float *radius,
                              asp_error *err)
@@ -125,39 +125,6 @@ static int radii_and_epsilon(const asp__dist *d, const asp__dist_points *pts, as
     }
     asp_free(&d->ctx, d2);
     return rc;
-}
-
-/*
- * The halo is complete for owned point i when its k_max-th neighbour among
- * the rank's points and halo lies within radius[i]: everything closer was
- * sent. Otherwise that distance (an upper bound of the true one) becomes
- * radius[i] for another round, until no rank has such a point.
- */
-static int halo_rounds(const asp__dist *d, asp__dist_points *pts, float *radius, size_t k, asp_error *err)
-{
-    for (int round = 0;; round++) {
-        int rc = asp__dist_halo(d, pts, radius, err);
-        float *d2 = NULL;
-        if (!rc)
-            rc = knn_dist2(d, pts->pos, pts->n_own + pts->n_ghost, k, &d2, err);
-        if ((rc = asp__dist_agree(d, rc, err)) != 0)
-            return rc;
-        unsigned long long short_ = 0;
-        for (size_t i = 0; i < pts->n_own; i++) {
-            float r = sqrtf(d2[i * k + k - 1]);
-            if (r > radius[i]) {
-                radius[i] = r * (1.0f + 1e-5f) + 1e-30f;
-                short_++;
-            }
-        }
-        asp_free(&d->ctx, d2);
-        unsigned long long all = 0;
-        MPI_Allreduce(&short_, &all, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
-        if (all == 0)
-            return 0;
-        if (round == 8)
-            return asp_error_set(err, ASP_ESOLVER, "the halo did not close after 8 rounds (%llu points short)", all);
-    }
 }
 
 static asp_index gid_of(const asp__dist *d, const asp__dist_points *pts, size_t local)
@@ -831,36 +798,63 @@ static int cmp_index(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* Psi^l = Psi^(l-1) P^l (journal 2.3) with the rows of P^l that this rank's columns need fetched from their owners. */
+/*
+ * Psi^l = Psi^(l-1) P^l (journal 2.3). The rows of P^l for this rank's own
+ * columns are at hand (Morton order keeps most columns local); the others
+ * are fetched from their owners, sorted and deduplicated first.
+ */
 static int next_basis(const asp__dist *d, const asp_amg_csr *psi, const asp_amg_csr *p, const size_t *pst,
                       double drop, asp_amg_csr **out, asp_error *err)
 {
-    const size_t nnz = psi->row_ptr[psi->rows];
+    const size_t nnz = psi->row_ptr[psi->rows], lo = pst[d->rank], nloc = pst[d->rank + 1] - lo;
     asp_index *cols = asp_alloc(&d->ctx, (nnz + 1) * sizeof *cols);
-    asp_amg_csr *b = NULL, *a = NULL;
+    asp_amg_csr *fetched = NULL, *b = NULL, *a = NULL;
     size_t m = 0;
     int rc = cols ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for the basis");
+    for (size_t k = 0; cols && k < nnz; k++)
+        if (psi->col[k] < lo || psi->col[k] >= lo + nloc)
+            cols[m++] = psi->col[k];
     if (cols) {
-        memcpy(cols, psi->col, nnz * sizeof *cols);
-        qsort(cols, nnz, sizeof *cols, cmp_index);
-        for (size_t k = 0; k < nnz; k++)
-            if (m == 0 || cols[k] != cols[m - 1])
-                cols[m++] = cols[k];
+        qsort(cols, m, sizeof *cols, cmp_index);
+        size_t u = 0;
+        for (size_t k = 0; k < m; k++)
+            if (u == 0 || cols[k] != cols[u - 1])
+                cols[u++] = cols[k];
+        m = u;
     }
-    if ((rc = asp__dist_agree(d, rc, err)) != 0)
+    if ((rc = asp__dist_agree(d, rc, err)) != 0) {
+        asp_free(&d->ctx, cols);
         return rc;
-    rc = asp__dist_fetch_rows(d, pst, p, cols, m, &b, err);
+    }
+    rc = asp__dist_fetch_rows(d, pst, p, cols, m, &fetched, err);
+    /* b: the local rows of P^l, then the fetched ones */
     if (!rc)
-        rc = asp_amg_csr_create(psi->rows, m, nnz, &d->ctx, &a, err);
+        rc = asp_amg_csr_create(nloc + m, p->cols, p->row_ptr[nloc] + fetched->row_ptr[m], &d->ctx, &b, err);
+    if (!rc) {
+        const size_t pn = p->row_ptr[nloc];
+        memcpy(b->row_ptr, p->row_ptr, (nloc + 1) * sizeof *b->row_ptr);
+        memcpy(b->col, p->col, pn * sizeof *b->col);
+        memcpy(b->val, p->val, pn * sizeof *b->val);
+        for (size_t r = 0; r < m; r++)
+            b->row_ptr[nloc + r + 1] = pn + fetched->row_ptr[r + 1];
+        memcpy(b->col + pn, fetched->col, fetched->row_ptr[m] * sizeof *b->col);
+        memcpy(b->val + pn, fetched->val, fetched->row_ptr[m] * sizeof *b->val);
+        rc = asp_amg_csr_create(psi->rows, nloc + m, nnz, &d->ctx, &a, err);
+    }
     if (!rc) {
         memcpy(a->row_ptr, psi->row_ptr, (psi->rows + 1) * sizeof *a->row_ptr);
         memcpy(a->val, psi->val, nnz * sizeof *a->val);
-        for (size_t k = 0; k < nnz; k++)
-            a->col[k] = (asp_index)((asp_index *)bsearch(&psi->col[k], cols, m, sizeof *cols, cmp_index) - cols);
+        for (size_t k = 0; k < nnz; k++) {
+            asp_index c = psi->col[k];
+            a->col[k] = c >= lo && c < lo + nloc
+                            ? (asp_index)(c - lo)
+                            : (asp_index)(nloc + (size_t)((asp_index *)bsearch(&c, cols, m, sizeof *cols, cmp_index) - cols));
+        }
         rc = asp__amg_spgemm_pou(a, b, drop, &d->ctx, out, err);
     }
     asp_amg_csr_destroy(a);
     asp_amg_csr_destroy(b);
+    asp_amg_csr_destroy(fetched);
     asp_free(&d->ctx, cols);
     return asp__dist_agree(d, rc, err);
 }
@@ -990,6 +984,7 @@ static void frame_of(const asp__dist *d, const asp__dist_points *pts, double cen
 typedef struct run {
     asp__dist d;
     asp_amg_desc desc;
+    int auto_epsilon; /* desc.epsilon was not given: the median k_min-th distance */
     asp__dist_points pts;
     float *radius, *cls, *tangent;
     asp__amg_nbhd nb;
@@ -1015,21 +1010,98 @@ static void run_release(run *r)
 }
 
 /* Neighbourhoods, classifier, fans and stiffness rows of the owned points (journal 2.1-2.2). */
+static float dist2(const float *x, const float *y)
+{
+    return (x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2]);
+}
+
+/*
+ * Epsilon of one process (the median k_min-th neighbour distance, journal
+ * 2.1): the estimate from each rank's own points is a little high at rank
+ * borders (0.6% on a 20k bunny on 2 ranks); with the halo the owned points'
+ * k_min-th neighbours are exact, so the median is taken again and the
+ * neighbourhood sizes follow it.
+ */
+static int exact_epsilon(run *r, asp_error *err)
+{
+    const asp__dist_points *pts = &r->pts;
+    const size_t n = pts->n_own, kmin = r->desc.k_min, kmax = r->desc.k_max;
+    float *kth = asp_alloc(&r->d.ctx, (n + 1) * sizeof *kth);
+    int rc = asp__dist_agree(&r->d, kth ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for %zu distances", n), err);
+    if (rc)
+        return rc;
+    for (size_t i = 0; i < n; i++)
+        kth[i] = dist2(pts->pos + 3 * i, pts->pos + 3 * (size_t)r->nb.nbr[i * kmax + kmin - 1]);
+    r->desc.epsilon = sqrt((double)global_select(&r->d, kth, n, 1, pts->n_global / 2 + 1));
+    asp_free(&r->d.ctx, kth);
+    const float eps2 = (float)(r->desc.epsilon * r->desc.epsilon);
+    for (size_t i = 0; i < n; i++) {
+        size_t m = kmin;
+        while (m < kmax && dist2(pts->pos + 3 * i, pts->pos + 3 * (size_t)r->nb.nbr[i * kmax + m]) <= eps2)
+            m++;
+        r->nb.nn[i] = (uint16_t)m;
+    }
+    return 0;
+}
+
+/*
+ * The halo, then the neighbourhoods N(x) of journal 2.1 on the rank's points
+ * and halo. N(x_i) is the one of a single process when everything within its
+ * farthest member, and within epsilon when it stopped short of k_max, lay
+ * within radius[i] (all of that was sent). Otherwise that distance becomes
+ * radius[i] and the halo is made again (none was needed on the bunny).
+ */
+static int halo_and_neighbourhoods(run *r, asp_amg_dist_info *info, asp_error *err)
+{
+    asp__dist *d = &r->d;
+    asp__dist_points *pts = &r->pts;
+    const size_t kmax = r->desc.k_max;
+    for (int round = 0;; round++) {
+        double t = asp_time_now(), mean = 0;
+        int rc = d->size > 1 ? asp__dist_halo(d, pts, r->radius, err) : 0;
+        info->t_halo += asp_time_now() - t;
+        t = asp_time_now();
+        if (!rc)
+            rc = asp__amg_neighbourhoods(pts->pos, pts->n_own + pts->n_ghost, &r->desc, &d->ctx, &r->nb, &mean, err);
+        info->amg.t_neighbours += asp_time_now() - t;
+        if ((rc = asp__dist_agree(d, rc, err)) != 0)
+            return rc;
+        if (r->auto_epsilon && d->size > 1 && (rc = exact_epsilon(r, err)) != 0)
+            return rc;
+        unsigned long long short_ = 0, all = 0;
+        for (size_t i = 0; d->size > 1 && i < pts->n_own; i++) {
+            const size_t m = r->nb.nn[i];
+            const float *x = pts->pos + 3 * i, *y = pts->pos + 3 * (size_t)r->nb.nbr[i * kmax + m - 1];
+            float far = sqrtf((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) +
+                              (x[2] - y[2]) * (x[2] - y[2]));
+            if (m < kmax)
+                far = fmaxf(far, (float)r->desc.epsilon);
+            if (far > r->radius[i]) {
+                r->radius[i] = far * (1.0f + 1e-5f) + 1e-30f;
+                short_++;
+            }
+        }
+        MPI_Allreduce(&short_, &all, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
+        if (all == 0)
+            return 0;
+        asp__amg_nbhd_release(&d->ctx, &r->nb);
+        if (round == 8)
+            return asp_error_set(err, ASP_ESOLVER, "the halo did not close after 8 rounds (%llu points short)", all);
+    }
+}
+
+/* Classifier, fans and stiffness rows of the owned points (journal 2.1-2.2). */
 static int local_stages(run *r, asp_amg_dist_info *info, asp_error *err)
 {
     asp__dist *d = &r->d;
     asp__dist_points *pts = &r->pts;
     const size_t n = pts->n_own, nl = pts->n_own + pts->n_ghost;
-    double t = asp_time_now(), mean = 0;
-    int rc = asp__amg_neighbourhoods(pts->pos, nl, &r->desc, &d->ctx, &r->nb, &mean, err);
-    if ((rc = asp__dist_agree(d, rc, err)) != 0)
-        return rc;
+    int rc = 0;
     unsigned long long nn = 0;
     for (size_t i = 0; i < n; i++)
         nn += r->nb.nn[i];
     info->amg.mean_neighbourhood = (double)sum_all(d, nn) / (double)pts->n_global;
-    info->amg.t_neighbours = asp_time_now() - t;
-    t = asp_time_now();
+    double t = asp_time_now();
     r->cls = asp_alloc(&d->ctx, (nl + 1) * sizeof *r->cls);
     r->tangent = asp_alloc(&d->ctx, (3 * nl + 3) * sizeof *r->tangent);
     rc = r->cls && r->tangent ? asp__amg_classify(pts->pos, &r->nb, &r->desc, &d->ctx, r->cls, r->tangent, err)
@@ -1109,6 +1181,7 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
         rc = asp__dist_agree(d, asp__amg_resolve_desc(desc, r.pts.n_global, &r.desc, err), err);
     if (rc)
         goto done;
+    r.auto_epsilon = r.desc.epsilon == 0;
     inf.points = r.pts.n_global;
     inf.own_points_min = SIZE_MAX;
     for (int q = 0; q < d->size; q++) {
@@ -1119,14 +1192,16 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
     inf.t_read = asp_time_now() - t0;
     double t = asp_time_now();
     r.radius = asp_alloc(&d->ctx, (r.pts.n_own + 1) * sizeof *r.radius);
-    rc = r.radius ? radii_and_epsilon(d, &r.pts, &r.desc, r.radius, err)
-                  : asp_error_set(err, ASP_ENOMEM, "out of memory for %zu radii", r.pts.n_own);
+    /* on one rank there is no halo: the neighbourhoods find epsilon themselves, as in one process */
+    rc = !r.radius ? asp_error_set(err, ASP_ENOMEM, "out of memory for %zu radii", r.pts.n_own)
+         : d->size > 1 ? radii_and_epsilon(d, &r.pts, &r.desc, r.radius, err)
+                       : 0;
     if ((rc = asp__dist_agree(d, rc, err)) != 0)
         goto done;
-    if ((rc = halo_rounds(d, &r.pts, r.radius, r.desc.k_max, err)) != 0)
+    inf.t_halo = asp_time_now() - t; /* the radii; the exchange is added to it */
+    if ((rc = halo_and_neighbourhoods(&r, &inf, err)) != 0)
         goto done;
     inf.halo_points = (size_t)sum_all(d, r.pts.n_ghost);
-    inf.t_halo = asp_time_now() - t;
     if ((rc = local_stages(&r, &inf, err)) != 0)
         goto done;
     t = asp_time_now();
