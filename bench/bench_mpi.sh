@@ -9,7 +9,8 @@
 # usage: bench/bench_mpi.sh [AMGSPLAT] [MESH]
 #   AMGSPLAT defaults to build/amgsplat, MESH to ../shared/data/stanford-bunny.obj.
 # Environment: SIZES (default "1000000 4000000"), RANKS ("1 2 4"), THREADS (serial threads, 2),
-#   REPS (1), WORK (a directory for the samples and outputs; default a temporary one).
+#   REPS (1), WORK (a directory for the samples and outputs; default a temporary one), REUSE (set:
+#   keep the serial results already in WORK).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 A=${1:-$here/build/amgsplat}
@@ -20,7 +21,9 @@ THREADS=${THREADS:-2}
 REPS=${REPS:-1}
 command -v mpirun >/dev/null || { echo "bench_mpi: no mpirun" >&2; exit 77; }
 [[ -r $M ]] || { echo "bench_mpi: no mesh '$M'" >&2; exit 77; }
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+# only for mpirun: with any OMPI_* variable in its environment the serial command runs each hypre
+# level in a forked child that starts MPI again (hypre_bridge.c, issue 13), 0.5 s per level
+MPIRUN=(env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun)
 if [[ -z ${WORK:-} ]]; then
     WORK=$(mktemp -d)
     trap 'rm -rf "$WORK"' EXIT
@@ -50,11 +53,14 @@ echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for N in $SIZES; do
     ply="$WORK/bunny_$N.ply"
     [[ -s $ply ]] || "$A" sample "$M" -n "$N" -o "$ply" -q
-    run "serial_$N" /usr/bin/env "$A" decompose "$ply" -o "$WORK/serial_$N.amg" --stats --json -q --threads "$THREADS"
-    # the serial command reports no RSS: measure it around the process
-    /usr/bin/time -f %M -o "$WORK/serial_$N.rss" "$A" decompose "$ply" --json -q --threads "$THREADS" >/dev/null
+    if [[ -z ${REUSE:-} || ! -s $WORK/serial_$N.rss ]]; then
+        run "serial_$N" /usr/bin/env "$A" decompose "$ply" -o "$WORK/serial_$N.amg" --stats --json -q --threads "$THREADS"
+        # the serial command reports no RSS: measure it around the process (decomposition and write)
+        /usr/bin/time -f %M -o "$WORK/serial_$N.rss" "$A" decompose "$ply" -o "$WORK/serial_rss_$N.amg" -q \
+            --threads "$THREADS"
+    fi
     for P in $RANKS; do
-        run "mpi_${N}_$P" mpirun -np "$P" --oversubscribe "$A" decompose "$ply" -o "$WORK/mpi_${N}_$P.amg" \
+        run "mpi_${N}_$P" "${MPIRUN[@]}" -np "$P" --oversubscribe "$A" decompose "$ply" -o "$WORK/mpi_${N}_$P.amg" \
             --distributed --stats --json -q --threads 1
         # the file loads in one process with the level sizes the ranks reported
         "$A" decompose "$WORK/mpi_${N}_$P.amg" --stats --json -q --threads "$THREADS" >"$WORK/reload_${N}_$P.json"
@@ -66,7 +72,7 @@ def load(name): return json.load(open(f"{work}/{name}.json"))
 def wall(name): return float(open(f"{work}/{name}.wall").read())
 s = load(f"serial_{n}")
 sd = [l["domains"] for l in s["level_stats"]]
-rss = float(open(f"{work}/serial_{n}.rss").read()) / 1024
+rss = float(open(f"{work}/serial_{n}.rss").read().split()[-1]) / 1024
 print(f"| {int(n):,} | serial | {wall(f'serial_{n}'):.1f} | {s['seconds']['amg']:.1f} | "
       f"{sum(l['seconds'] for l in s['level_stats']):.1f} | {rss:.0f} | 0 | {s['levels']} | - | "
       f"{max(l['max_pou_error'] for l in s['level_stats']):.1e} | - |")

@@ -3,7 +3,9 @@
  * layout): rank 0 writes the header and streams every rank's part of each
  * array in rank order, in chunks of at most 4 MB, through the CRC writer
  * and the atomic temporary file. No rank holds more than its own part and
- * one chunk; the points are in the Morton order of the ranks.
+ * one chunk; the points are in the Morton order of the ranks. NEEDSWORK: at
+ * 10^9 points this one writer is the longest step (BENCHMARKS.md); each rank
+ * could write its part at computed offsets (MPI-IO) with CRCs combined.
  */
 #ifdef ASP_HAVE_HYPRE
 #include <stdint.h>
