@@ -46,14 +46,14 @@ int asp__dist_owner(const size_t *starts, int size, size_t g)
 
 int asp__dist_partition(const asp__dist *d, size_t local, size_t *starts)
 {
-    unsigned long long mine = local, *all = malloc((size_t)d->size * sizeof *all);
+    unsigned long long mine = local, *all = asp_alloc(&d->ctx, (size_t)d->size * sizeof *all);
     if (!all)
         return ASP_ENOMEM;
     MPI_Allgather(&mine, 1, MPI_UNSIGNED_LONG_LONG, all, 1, MPI_UNSIGNED_LONG_LONG, d->comm);
     starts[0] = 0;
     for (int q = 0; q < d->size; q++)
         starts[q + 1] = starts[q] + (size_t)all[q];
-    free(all);
+    asp_free(&d->ctx, all);
     return 0;
 }
 
@@ -65,23 +65,23 @@ typedef struct requests {
     size_t *slot;           /* slot[i]: where request i sits in send */
 } requests;
 
-static void requests_free(requests *r)
+static void requests_free(const asp__dist *d, requests *r)
 {
-    free(r->scnt);
-    free(r->send);
-    free(r->recv);
-    free(r->slot);
+    asp_free(&d->ctx, r->scnt);
+    asp_free(&d->ctx, r->send);
+    asp_free(&d->ctx, r->recv);
+    asp_free(&d->ctx, r->slot);
 }
 
 static int requests_make(const asp__dist *d, const size_t *starts, const asp_index *gids, size_t m, requests *r)
 {
     const int P = d->size;
     memset(r, 0, sizeof *r);
-    r->scnt = calloc(4 * (size_t)P, sizeof *r->scnt);
-    r->send = malloc((m + 1) * sizeof *r->send);
-    r->slot = malloc((m + 1) * sizeof *r->slot);
+    r->scnt = asp_calloc(&d->ctx, 4 * (size_t)P, sizeof *r->scnt);
+    r->send = asp_alloc(&d->ctx, (m + 1) * sizeof *r->send);
+    r->slot = asp_alloc(&d->ctx, (m + 1) * sizeof *r->slot);
     if (!r->scnt || !r->send || !r->slot) {
-        requests_free(r);
+        requests_free(d, r);
         return ASP_ENOMEM;
     }
     r->sdis = r->scnt + P;
@@ -91,9 +91,9 @@ static int requests_make(const asp__dist *d, const size_t *starts, const asp_ind
         r->scnt[asp__dist_owner(starts, P, gids[i])]++;
     for (int q = 1; q < P; q++)
         r->sdis[q] = r->sdis[q - 1] + r->scnt[q - 1];
-    int *fill = calloc((size_t)P, sizeof *fill);
+    int *fill = asp_calloc(&d->ctx, (size_t)P, sizeof *fill);
     if (!fill) {
-        requests_free(r);
+        requests_free(d, r);
         return ASP_ENOMEM;
     }
     for (size_t i = 0; i < m; i++) {
@@ -102,7 +102,7 @@ static int requests_make(const asp__dist *d, const size_t *starts, const asp_ind
         r->send[s] = gids[i];
         r->slot[i] = s;
     }
-    free(fill);
+    asp_free(&d->ctx, fill);
     r->sent = m;
     MPI_Alltoall(r->scnt, 1, MPI_INT, r->rcnt, 1, MPI_INT, d->comm);
     for (int q = 0; q < P; q++) {
@@ -110,11 +110,11 @@ static int requests_make(const asp__dist *d, const size_t *starts, const asp_ind
             r->rdis[q] = r->rdis[q - 1] + r->rcnt[q - 1];
         r->received += (size_t)r->rcnt[q];
     }
-    r->recv = malloc((r->received + 1) * sizeof *r->recv);
+    r->recv = asp_alloc(&d->ctx, (r->received + 1) * sizeof *r->recv);
     int ok = r->recv != NULL, all = 0;
     MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, d->comm);
     if (!all) {
-        requests_free(r);
+        requests_free(d, r);
         return ASP_ENOMEM;
     }
     MPI_Alltoallv(r->send, r->scnt, r->sdis, MPI_UINT32_T, r->recv, r->rcnt, r->rdis, MPI_UINT32_T, d->comm);
@@ -128,13 +128,13 @@ int asp__dist_fetch(const asp__dist *d, const size_t *starts, const void *local,
     if (requests_make(d, starts, gids, m, &r))
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu requests to other ranks", m);
     const size_t mine = starts[d->rank];
-    char *answer = malloc(r.received * elem + 1), *back = malloc(m * elem + 1);
+    char *answer = asp_alloc(&d->ctx, r.received * elem + 1), *back = asp_alloc(&d->ctx, m * elem + 1);
     int ok = answer && back, all = 0;
     MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, d->comm);
     if (!all) {
-        free(answer);
-        free(back);
-        requests_free(&r);
+        asp_free(&d->ctx, answer);
+        asp_free(&d->ctx, back);
+        requests_free(d, &r);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu answers to other ranks", r.received);
     }
     for (size_t i = 0; i < r.received; i++)
@@ -146,9 +146,9 @@ int asp__dist_fetch(const asp__dist *d, const size_t *starts, const void *local,
     MPI_Type_free(&item);
     for (size_t i = 0; i < m; i++)
         memcpy((char *)out + i * elem, back + r.slot[i] * elem, elem);
-    free(answer);
-    free(back);
-    requests_free(&r);
+    asp_free(&d->ctx, answer);
+    asp_free(&d->ctx, back);
+    requests_free(d, &r);
     return 0;
 }
 
@@ -158,13 +158,13 @@ int asp__dist_scatter_add(const asp__dist *d, const size_t *starts, const asp_in
     requests r;
     if (requests_make(d, starts, gids, m, &r))
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu sums on other ranks", m);
-    double *sv = malloc((m + 1) * sizeof *sv), *rv = malloc((r.received + 1) * sizeof *rv);
+    double *sv = asp_alloc(&d->ctx, (m + 1) * sizeof *sv), *rv = asp_alloc(&d->ctx, (r.received + 1) * sizeof *rv);
     int ok = sv && rv, all = 0;
     MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, d->comm);
     if (!all) {
-        free(sv);
-        free(rv);
-        requests_free(&r);
+        asp_free(&d->ctx, sv);
+        asp_free(&d->ctx, rv);
+        requests_free(d, &r);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu sums on other ranks", m);
     }
     for (size_t i = 0; i < m; i++)
@@ -174,9 +174,9 @@ int asp__dist_scatter_add(const asp__dist *d, const size_t *starts, const asp_in
     const size_t mine = starts[d->rank];
     for (size_t i = 0; i < r.received; i++)
         local[r.recv[i] - mine] += rv[i];
-    free(sv);
-    free(rv);
-    requests_free(&r);
+    asp_free(&d->ctx, sv);
+    asp_free(&d->ctx, rv);
+    requests_free(d, &r);
     return 0;
 }
 
@@ -188,16 +188,16 @@ int asp__dist_fetch_rows(const asp__dist *d, const size_t *starts, const asp_amg
     if (requests_make(d, starts, gids, m, &r))
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu row requests", m);
     const size_t mine = starts[d->rank];
-    uint64_t *len = malloc((r.received + 1) * sizeof *len), *back = malloc((m + 1) * sizeof *back);
-    int *ecnt = calloc(4 * (size_t)P, sizeof *ecnt);
+    uint64_t *len = asp_alloc(&d->ctx, (r.received + 1) * sizeof *len), *back = asp_alloc(&d->ctx, (m + 1) * sizeof *back);
+    int *ecnt = asp_calloc(&d->ctx, 4 * (size_t)P, sizeof *ecnt);
     size_t etotal = 0;
     for (size_t i = 0; len && i < r.received; i++) {
         size_t row = r.recv[i] - mine;
         len[i] = rows->row_ptr[row + 1] - rows->row_ptr[row];
         etotal += len[i];
     }
-    asp_index *ecol = malloc((etotal + 1) * sizeof *ecol);
-    double *evel = malloc((etotal + 1) * sizeof *evel);
+    asp_index *ecol = asp_alloc(&d->ctx, (etotal + 1) * sizeof *ecol);
+    double *evel = asp_alloc(&d->ctx, (etotal + 1) * sizeof *evel);
     int ok = len && back && ecnt && ecol && evel, all = 0;
     MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, d->comm);
     asp_amg_csr *res = NULL;
@@ -229,9 +229,9 @@ int asp__dist_fetch_rows(const asp__dist *d, const size_t *starts, const asp_amg
         rdv[q] = (int)rtotal;
         rtotal += (size_t)rcv[q];
     }
-    rcol = malloc((rtotal + 1) * sizeof *rcol);
-    rval = malloc((rtotal + 1) * sizeof *rval);
-    size_t *at = malloc((m + 1) * sizeof *at); // start of each answer (in send order) in rcol
+    rcol = asp_alloc(&d->ctx, (rtotal + 1) * sizeof *rcol);
+    rval = asp_alloc(&d->ctx, (rtotal + 1) * sizeof *rval);
+    size_t *at = asp_alloc(&d->ctx, (m + 1) * sizeof *at); // start of each answer (in send order) in rcol
     size_t nnz = 0;
     for (size_t i = 0; i < m; i++)
         nnz += back[i];
@@ -240,7 +240,7 @@ int asp__dist_fetch_rows(const asp__dist *d, const size_t *starts, const asp_amg
         ok = asp_amg_csr_create(m, rows->cols, nnz, &d->ctx, &res, err) == 0;
     MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, d->comm);
     if (!all) {
-        free(at);
+        asp_free(&d->ctx, at);
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu fetched rows", m);
         goto done;
     }
@@ -257,19 +257,19 @@ int asp__dist_fetch_rows(const asp__dist *d, const size_t *starts, const asp_amg
         memcpy(res->col + res->row_ptr[i], rcol + k0, cnt * sizeof *rcol);
         memcpy(res->val + res->row_ptr[i], rval + k0, cnt * sizeof *rval);
     }
-    free(at);
+    asp_free(&d->ctx, at);
     *out = res;
     res = NULL;
 done:
     asp_amg_csr_destroy(res);
-    free(len);
-    free(back);
-    free(ecnt);
-    free(ecol);
-    free(evel);
-    free(rcol);
-    free(rval);
-    requests_free(&r);
+    asp_free(&d->ctx, len);
+    asp_free(&d->ctx, back);
+    asp_free(&d->ctx, ecnt);
+    asp_free(&d->ctx, ecol);
+    asp_free(&d->ctx, evel);
+    asp_free(&d->ctx, rcol);
+    asp_free(&d->ctx, rval);
+    requests_free(d, &r);
     return rc;
 }
 #endif

@@ -80,12 +80,12 @@ static int to_ij(const asp__dist *d, const asp_amg_csr *m, const size_t *starts,
                  HYPRE_IJMatrix *out, asp_error *err)
 {
     const size_t rows = m->rows, nnz = m->row_ptr[rows];
-    HYPRE_Int *ncols = malloc((rows + 1) * sizeof *ncols);
-    HYPRE_BigInt *rowid = malloc((rows + 1) * sizeof *rowid), *cols = malloc((nnz + 1) * sizeof *cols);
+    HYPRE_Int *ncols = asp_alloc(&d->ctx, (rows + 1) * sizeof *ncols);
+    HYPRE_BigInt *rowid = asp_alloc(&d->ctx, (rows + 1) * sizeof *rowid), *cols = asp_alloc(&d->ctx, (nnz + 1) * sizeof *cols);
     if (!ncols || !rowid || !cols) {
-        free(ncols);
-        free(rowid);
-        free(cols);
+        asp_free(&d->ctx, ncols);
+        asp_free(&d->ctx, rowid);
+        asp_free(&d->ctx, cols);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for a hypre matrix of %zu rows", rows);
     }
     for (size_t r = 0; r < rows; r++) {
@@ -103,9 +103,9 @@ static int to_ij(const asp__dist *d, const asp_amg_csr *m, const size_t *starts,
     if (rows)
         HYPRE_IJMatrixSetValues(ij, (HYPRE_Int)rows, ncols, rowid, cols, m->val);
     HYPRE_IJMatrixAssemble(ij);
-    free(ncols);
-    free(rowid);
-    free(cols);
+    asp_free(&d->ctx, ncols);
+    asp_free(&d->ctx, rowid);
+    asp_free(&d->ctx, cols);
     *out = ij;
     return 0;
 }
@@ -141,9 +141,9 @@ static int from_parcsr(const asp__dist *d, hypre_ParCSRMatrix *p, size_t cols, a
     for (HYPRE_Int r = 0; r < rows; r++) {
         size_t len = (size_t)(di[r + 1] - di[r]) + (has_offd ? (size_t)(oi[r + 1] - oi[r]) : 0);
         if (len > cap) {
-            free(row);
+            asp_free(&d->ctx, row);
             cap = 2 * len;
-            row = malloc(cap * sizeof *row);
+            row = asp_alloc(&d->ctx, cap * sizeof *row);
             if (!row) {
                 asp_amg_csr_destroy(m);
                 return asp_error_set(err, ASP_ENOMEM, "out of memory for a hypre row");
@@ -165,7 +165,7 @@ static int from_parcsr(const asp__dist *d, hypre_ParCSRMatrix *p, size_t cols, a
         }
         m->row_ptr[r + 1] = w;
     }
-    free(row);
+    asp_free(&d->ctx, row);
     *out = m;
     return 0;
 }

@@ -163,18 +163,18 @@ static int cmp_u64(const void *a, const void *b)
 }
 
 /* This rank's records [first, first+m) of the file, positions as offsets from origin. */
-static int read_range(FILE *fp, const char *path, const layout *lay, size_t first, size_t m, const double origin[3],
-                      rec *out, asp_error *err)
+static int read_range(const asp_context *ctx, FILE *fp, const char *path, const layout *lay, size_t first, size_t m,
+                      const double origin[3], rec *out, asp_error *err)
 {
     enum { CHUNK = 1 << 16 };
-    uint8_t *buf = malloc(CHUNK * lay->record);
+    uint8_t *buf = asp_alloc(ctx, CHUNK * lay->record);
     if (!buf)
         return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", path);
     for (size_t done = 0; done < m;) {
         size_t take = m - done < CHUNK ? m - done : CHUNK;
         if (fseeko(fp, (off_t)(lay->data_at + (first + done) * lay->record), SEEK_SET) != 0 ||
             fread(buf, lay->record, take, fp) != take) {
-            free(buf);
+            asp_free(ctx, buf);
             return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': vertex %zu: the file ends before vertex %zu",
                                  path, first + done, lay->count);
         }
@@ -186,7 +186,7 @@ static int read_range(FILE *fp, const char *path, const layout *lay, size_t firs
             for (int k = 0; k < 3; k++) {
                 double v = load(b + lay->at[P_X + k], lay->type[P_X + k]);
                 if (!isfinite(v)) {
-                    free(buf);
+                    asp_free(ctx, buf);
                     return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': vertex %zu: coordinate %c is not finite",
                                          path, (size_t)r->index, "xyz"[k]);
                 }
@@ -200,7 +200,7 @@ static int read_range(FILE *fp, const char *path, const layout *lay, size_t firs
         }
         done += take;
     }
-    free(buf);
+    asp_free(ctx, buf);
     return 0;
 }
 
@@ -231,14 +231,14 @@ static int read_share(const asp__dist *d, const char *path, layout *lay, double 
         }
     }
     if (!rc) {
-        *recs = malloc((*m + 1) * sizeof **recs);
+        *recs = asp_alloc(&d->ctx, (*m + 1) * sizeof **recs);
         if (!*recs)
             rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu points of '%s'", *m, path);
     }
     if (!rc) {
-        rc = read_range(fp, path, lay, first, *m, origin, *recs, err);
+        rc = read_range(&d->ctx, fp, path, lay, first, *m, origin, *recs, err);
         if (rc) {
-            free(*recs);
+            asp_free(&d->ctx, *recs);
             *recs = NULL;
         }
     }
@@ -256,12 +256,12 @@ static int sample_sort(const asp__dist *d, rec **recs, size_t *m, asp_error *err
     if (P == 1)
         return 0;
     const int s = 32; /* samples per rank: enough for a few % of imbalance */
-    uint64_t mine[32], *all = malloc((size_t)P * s * sizeof *all), *split = malloc((size_t)P * sizeof *split);
-    int *cnt = calloc(4 * (size_t)P, sizeof *cnt);
+    uint64_t mine[32], *all = asp_alloc(&d->ctx, (size_t)P * s * sizeof *all), *split = asp_alloc(&d->ctx, (size_t)P * sizeof *split);
+    int *cnt = asp_calloc(&d->ctx, 4 * (size_t)P, sizeof *cnt);
     if (!all || !split || !cnt) {
-        free(all);
-        free(split);
-        free(cnt);
+        asp_free(&d->ctx, all);
+        asp_free(&d->ctx, split);
+        asp_free(&d->ctx, cnt);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the sample sort");
     }
     for (int i = 0; i < s; i++)
@@ -283,7 +283,7 @@ static int sample_sort(const asp__dist *d, rec **recs, size_t *m, asp_error *err
         rdis[q] = (int)total;
         total += (size_t)rcnt[q];
     }
-    rec *in = malloc((total + 1) * sizeof *in);
+    rec *in = asp_alloc(&d->ctx, (total + 1) * sizeof *in);
     int ok = in != NULL, allok = 0;
     MPI_Allreduce(&ok, &allok, 1, MPI_INT, MPI_MIN, d->comm);
     if (allok) {
@@ -293,15 +293,15 @@ static int sample_sort(const asp__dist *d, rec **recs, size_t *m, asp_error *err
         MPI_Alltoallv(r, cnt, dis, t, in, rcnt, rdis, t, d->comm);
         MPI_Type_free(&t);
         qsort(in, total, sizeof *in, cmp_rec);
-        free(r);
+        asp_free(&d->ctx, r);
         *recs = in;
         *m = total;
     } else {
-        free(in);
+        asp_free(&d->ctx, in);
     }
-    free(all);
-    free(split);
-    free(cnt);
+    asp_free(&d->ctx, all);
+    asp_free(&d->ctx, split);
+    asp_free(&d->ctx, cnt);
     return allok ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for %zu points from other ranks", total);
 }
 
@@ -313,7 +313,7 @@ int asp__dist_read_sorted(const asp__dist *d, const char *path, asp__dist_points
     memset(pts, 0, sizeof *pts);
     int rc = read_share(d, path, &lay, pts->origin, &recs, &m, err);
     if ((rc = asp__dist_agree(d, rc, err)) != 0) {
-        free(recs);
+        asp_free(&d->ctx, recs);
         return rc;
     }
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -336,7 +336,7 @@ int asp__dist_read_sorted(const asp__dist *d, const char *path, asp__dist_points
     }
     rc = sample_sort(d, &recs, &m, err);
     if ((rc = asp__dist_agree(d, rc, err)) != 0) {
-        free(recs);
+        asp_free(&d->ctx, recs);
         return rc;
     }
     const asp_context *ctx = &d->ctx;
@@ -370,7 +370,7 @@ int asp__dist_read_sorted(const asp__dist *d, const char *path, asp__dist_points
         if (pts->labels)
             pts->labels[i] = recs[i].label;
     }
-    free(recs);
+    asp_free(&d->ctx, recs);
     return asp__dist_agree(d, rc, err);
 }
 
@@ -393,7 +393,7 @@ static int cell_of(const box_grid *gr, float v, int k)
     return c < 0 ? 0 : c >= gr->g ? gr->g - 1 : c;
 }
 
-static int grid_build(box_grid *gr, const asp__dist_points *pts, const float *boxes, size_t nbox)
+static int grid_build(const asp_context *ctx, box_grid *gr, const asp__dist_points *pts, const float *boxes, size_t nbox)
 {
     int g = (int)(2 * cbrt((double)nbox)) + 1;
     gr->g = g > 256 ? 256 : g;
@@ -403,7 +403,7 @@ static int grid_build(box_grid *gr, const asp__dist_points *pts, const float *bo
         gr->inv[k] = ext > 0 ? (float)gr->g / ext : 0;
     }
     const size_t cells = (size_t)gr->g * gr->g * gr->g;
-    gr->start = calloc(cells + 1, sizeof *gr->start);
+    gr->start = asp_calloc(ctx, cells + 1, sizeof *gr->start);
     gr->box = NULL;
     if (!gr->start)
         return ASP_ENOMEM;
@@ -428,7 +428,7 @@ static int grid_build(box_grid *gr, const asp__dist_points *pts, const float *bo
         if (pass == 0) {
             for (size_t c = 0; c < cells; c++)
                 gr->start[c + 1] += gr->start[c];
-            gr->box = malloc((gr->start[cells] + 1) * sizeof *gr->box);
+            gr->box = asp_alloc(ctx, (gr->start[cells] + 1) * sizeof *gr->box);
             if (!gr->box)
                 return ASP_ENOMEM;
         } else {
@@ -464,11 +464,11 @@ int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radiu
     for (size_t i = 0; i < n; i++)
         mean_r += radius[i];
     const float limit = (float)(8 * mean_r / (double)(n ? n : 1));
-    float *mine = malloc((6 * n + 7) * sizeof *mine);
-    int *cnt = calloc(6 * (size_t)P, sizeof *cnt);
+    float *mine = asp_alloc(&d->ctx, (6 * n + 7) * sizeof *mine);
+    int *cnt = asp_calloc(&d->ctx, 6 * (size_t)P, sizeof *cnt);
     if (!mine || !cnt) {
-        free(mine);
-        free(cnt);
+        asp_free(&d->ctx, mine);
+        asp_free(&d->ctx, cnt);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the halo");
     }
     size_t nrun = 0;
@@ -498,20 +498,20 @@ int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radiu
         bdis[q] = total_boxes;
         total_boxes += bcnt[q];
     }
-    float *boxes = malloc(((size_t)total_boxes + 1) * sizeof *boxes);
+    float *boxes = asp_alloc(&d->ctx, ((size_t)total_boxes + 1) * sizeof *boxes);
     int ok = boxes != NULL, all = 0;
     MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, d->comm);
     if (!all) {
-        free(mine);
-        free(cnt);
-        free(boxes);
+        asp_free(&d->ctx, mine);
+        asp_free(&d->ctx, cnt);
+        asp_free(&d->ctx, boxes);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %d halo boxes", total_boxes / 6);
     }
     MPI_Allgatherv(mine, nb, MPI_FLOAT, boxes, bcnt, bdis, MPI_FLOAT, d->comm);
-    free(mine);
+    asp_free(&d->ctx, mine);
     int *dis = cnt + P, *rcnt = cnt + 2 * P, *rdis = cnt + 3 * P;
     size_t cap = 1024, w = 0;
-    asp_index *sid = malloc(cap * sizeof *sid);
+    asp_index *sid = asp_alloc(&d->ctx, cap * sizeof *sid);
     int rc = sid ? 0 : ASP_ENOMEM;
     for (int q = 0; q < P && !rc; q++) {
         dis[q] = (int)w;
@@ -519,7 +519,7 @@ int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radiu
             continue;
         const float *qb = boxes + bdis[q];
         box_grid gr;
-        rc = grid_build(&gr, pts, qb, (size_t)bcnt[q] / 6);
+        rc = grid_build(&d->ctx, &gr, pts, qb, (size_t)bcnt[q] / 6);
         for (size_t i = 0; !rc && i < n; i++) {
             const float *p = pts->pos + 3 * i;
             size_t c = ((size_t)cell_of(&gr, p[0], 0) * gr.g + (size_t)cell_of(&gr, p[1], 1)) * gr.g +
@@ -530,7 +530,7 @@ int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radiu
             if (b == gr.start[c + 1])
                 continue;
             if (w == cap) {
-                asp_index *g = realloc(sid, 2 * cap * sizeof *sid);
+                asp_index *g = asp_realloc(&d->ctx, sid, cap * sizeof *sid, 2 * cap * sizeof *sid);
                 if (!g) {
                     rc = ASP_ENOMEM;
                     break;
@@ -540,12 +540,12 @@ int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radiu
             }
             sid[w++] = (asp_index)i; /* local for now */
         }
-        free(gr.start);
-        free(gr.box);
+        asp_free(&d->ctx, gr.start);
+        asp_free(&d->ctx, gr.box);
         cnt[q] = (int)(w - (size_t)dis[q]);
     }
-    free(boxes);
-    float *spos = rc ? NULL : malloc((3 * w + 3) * sizeof *spos);
+    asp_free(&d->ctx, boxes);
+    float *spos = rc ? NULL : asp_alloc(&d->ctx, (3 * w + 3) * sizeof *spos);
     for (size_t k = 0; spos && k < w; k++) {
         memcpy(spos + 3 * k, pts->pos + 3 * (size_t)sid[k], 3 * sizeof *spos);
         sid[k] = (asp_index)(pts->starts[d->rank] + sid[k]);
@@ -571,9 +571,9 @@ int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radiu
         MPI_Type_free(&t);
         pts->n_ghost = got;
     }
-    free(spos);
-    free(sid);
-    free(cnt);
+    asp_free(&d->ctx, spos);
+    asp_free(&d->ctx, sid);
+    asp_free(&d->ctx, cnt);
     return all ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for a halo of %zu points", got);
 }
 
