@@ -16,6 +16,7 @@
 #include "eval.h"
 #include "hier.h"
 #include "amg.h"
+#include "amg_distributed.h"
 #include "prim.h"
 #include "export.h"
 #include "render.h"

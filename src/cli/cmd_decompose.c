@@ -18,10 +18,11 @@ static const char usage[] =
     "                          [--coarsen rs|falgout|cljp|pmis|hmis] [--interp classical|direct|standard|ext+i]\n"
     "                          [--strong X] [--trunc X] [--max-levels N] [--max-coarse N] [--crease-cut X]\n"
     "                          [--weak-cut X]\n"
-    "                          [--drop X] [--stats] [--tau X] [--critical-k] [--json]\n"
+    "                          [--drop X] [--stats] [--tau X] [--critical-k] [--json] [--distributed]\n"
     "                          [--mesh-stiffness (MESH input)]\n"
     "                          [--export-colors classifier|domains|strict --level L-3 --colors-out X.ply]\n"
     "       amgsplat decompose IN.amg --stats | --export-colors ...\n"
+    "       mpirun -np P amgsplat decompose IN.ply -o OUT.amg [options] (docs/mpi.md)\n"
     "\n"
     "Classifies every point's neighbourhood (surface variation or the journal's moment\n"
     "classifier), builds a stiffness matrix on local Delaunay fans and coarsens it with\n"
@@ -242,6 +243,95 @@ static int check_output_name(const struct cli_env *env, const char *input, const
     return 0;
 }
 
+/* The level figures of a distributed run as decompose --stats --json writes them, plus the agreement checks. */
+static void add_distributed_json(cJSON *o, const asp_amg_dist_info *in, double tau)
+{
+    cJSON *sizes = cJSON_CreateArray(), *sec = cJSON_CreateObject(), *levels = cJSON_CreateArray();
+    cJSON_AddNumberToObject(o, "ranks", in->ranks);
+    cJSON_AddNumberToObject(o, "points", (double)in->points);
+    cJSON_AddNumberToObject(o, "levels", (double)in->nlevels);
+    for (size_t l = 0; l < in->nlevels; l++)
+        cJSON_AddItemToArray(sizes, cJSON_CreateNumber((double)in->level[l].unknowns));
+    cJSON_AddItemToObject(o, "level_sizes", sizes);
+    cJSON_AddItemToObject(o, "epsilon", cli_json_number("%.9g", in->amg.epsilon));
+    cJSON_AddNumberToObject(o, "k_min", (double)in->amg.k_min);
+    cJSON_AddNumberToObject(o, "k_max", (double)in->amg.k_max);
+    cJSON_AddNumberToObject(o, "fan_k", (double)in->amg.fan_k);
+    cJSON_AddItemToObject(o, "mean_neighbourhood", cli_json_number("%.4g", in->amg.mean_neighbourhood));
+    cJSON_AddItemToObject(o, "mean_fan", cli_json_number("%.4g", in->amg.mean_fan));
+    cJSON_AddNumberToObject(o, "matrix_nnz", (double)in->amg.matrix_nnz);
+    cJSON_AddNumberToObject(o, "positive_offdiag_clamped", (double)in->amg.positive_offdiag);
+    cJSON_AddNumberToObject(o, "isolated_points", (double)in->amg.isolated_points);
+    cJSON_AddNumberToObject(o, "repaired_rows", (double)in->amg.repaired_rows);
+    cJSON_AddNumberToObject(o, "own_points_min", (double)in->own_points_min);
+    cJSON_AddNumberToObject(o, "own_points_max", (double)in->own_points_max);
+    cJSON_AddNumberToObject(o, "halo_points", (double)in->halo_points);
+    cJSON_AddItemToObject(o, "peak_rss_mb_max_rank", cli_json_number("%.1f", in->peak_rss_max_mb));
+    cJSON_AddItemToObject(o, "peak_rss_mb_mean_rank", cli_json_number("%.1f", in->peak_rss_mean_mb));
+    cJSON_AddItemToObject(sec, "read", cli_json_number("%.4f", in->t_read));
+    cJSON_AddItemToObject(sec, "halo", cli_json_number("%.4f", in->t_halo));
+    cJSON_AddItemToObject(sec, "neighbours", cli_json_number("%.4f", in->amg.t_neighbours));
+    cJSON_AddItemToObject(sec, "classifier", cli_json_number("%.4f", in->amg.t_classifier));
+    cJSON_AddItemToObject(sec, "fans", cli_json_number("%.4f", in->amg.t_fans));
+    cJSON_AddItemToObject(sec, "assembly", cli_json_number("%.4f", in->amg.t_assembly));
+    cJSON_AddItemToObject(sec, "amg", cli_json_number("%.4f", in->amg.t_amg));
+    cJSON_AddItemToObject(sec, "basis_stats", cli_json_number("%.4f", in->t_stats));
+    cJSON_AddItemToObject(sec, "write", cli_json_number("%.4f", in->t_write));
+    cJSON_AddItemToObject(o, "seconds", sec);
+    cJSON_AddItemToObject(o, "tau", cli_json_number("%g", tau));
+    for (size_t l = 0; l < in->nlevels; l++) {
+        const asp_amg_dist_level *lv = &in->level[l];
+        cJSON *j = cJSON_CreateObject();
+        cJSON_AddNumberToObject(j, "level", (double)l);
+        cJSON_AddNumberToObject(j, "unknowns", (double)lv->unknowns);
+        cJSON_AddNumberToObject(j, "domains", (double)lv->domains);
+        cJSON_AddNumberToObject(j, "strict_domains", (double)lv->strict_domains);
+        cJSON_AddNumberToObject(j, "points_outside", (double)lv->points_outside);
+        cJSON_AddItemToObject(j, "mean_domains_per_point", cli_json_number("%.6g", lv->mean_domains_per_point));
+        cJSON_AddItemToObject(j, "max_pou_error", cli_json_number("%.3g", lv->max_pou_error));
+        cJSON_AddItemToArray(levels, j);
+    }
+    cJSON_AddItemToObject(o, "level_stats", levels);
+}
+
+/* mpirun -np P decompose (or --distributed): every rank runs this; rank 0 reports (docs/mpi.md). */
+static int decompose_distributed(struct cli_env *env, const char *input, const char *output,
+                                 const asp_amg_desc *desc, double tau, int stats)
+{
+    asp_error err = {0};
+    asp_amg_dist_info info;
+    int rc = asp_amg_decompose_distributed(input, output, desc, tau, &env->ctx, &info, &err);
+    cli_progress_end(env);
+    int status = 0;
+    if (rc)
+        status = info.rank == 0 ? cli_fail(env, &err) : 1; // one report, from rank 0
+    else if (info.rank == 0 && env->json) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "input", input);
+        if (output)
+            cJSON_AddStringToObject(o, "output", output);
+        else
+            cJSON_AddNullToObject(o, "output");
+        add_distributed_json(o, &info, tau);
+        cJSON_AddItemToObject(o, "total_seconds", cli_json_number("%.4f", info.t_total));
+        status = cli_json_print(env, o);
+    } else if (info.rank == 0 && !env->quiet) {
+        printf("%s: %zu points on %d ranks, %zu levels (L = %zu, coarsest %zu unknowns), epsilon %.4g, %.2f s, "
+               "peak RSS %.0f MB per rank (max)\n", output ? output : input, info.points, info.ranks, info.nlevels,
+               info.nlevels - 1, info.level[info.nlevels - 1].unknowns, info.amg.epsilon, info.t_total,
+               info.peak_rss_max_mb);
+        if (stats) {
+            printf("level   unknowns   domains    strict  outside  domains/pt  max |sum Psi - 1|\n");
+            for (size_t l = 0; l < info.nlevels; l++)
+                printf("%5zu  %9zu %9zu %9zu %8zu  %10.2f  %.3g\n", l, info.level[l].unknowns, info.level[l].domains,
+                       info.level[l].strict_domains, info.level[l].points_outside,
+                       info.level[l].mean_domains_per_point, info.level[l].max_pou_error);
+        }
+    }
+    asp_amg_distributed_shutdown();
+    return status;
+}
+
 int cmd_decompose(int argc, char **argv, struct cli_env *env)
 {
     const char *output = NULL, *classifier = "variation", *coarsen = "rs", *interp = "classical";
@@ -250,7 +340,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     /* UNSET, not 0: 0 means "default" to the library, so a given 0 would pass silently */
     size_t k = UNSET, k_max = UNSET, fan_k = UNSET, max_levels = UNSET, max_coarse = UNSET;
     double epsilon = 0, alpha = 0, beta = 0, strong = 0, trunc = 0, weak = 0, drop = 0, tau = 0.05, crease = 0;
-    int stats = 0, critical = 0, mesh_stiffness = 0;
+    int stats = 0, critical = 0, mesh_stiffness = 0, distributed = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output decomposition (.amg)"},
         {"preset", 0, CLI_STRING, &preset, "SEED", "the seed's options: thesis, journal (docs/seeds.md)"},
@@ -280,6 +370,8 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         {"export-colors", 0, CLI_STRING, &export_mode, "M", "write a coloured point file: classifier, domains, strict"},
         {"level", 'l', CLI_STRING, &level_name, "L", "level for --export-colors domains|strict (default L-3)"},
         {"colors-out", 0, CLI_STRING, &colors_out, "FILE", "point file for --export-colors (.ply)"},
+        {"distributed", 0, CLI_FLAG, &distributed, NULL,
+         "the MPI path even on one rank (automatic under mpirun -np P > 1; docs/mpi.md)"},
         {0},
     };
     int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -329,6 +421,13 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "missing -o OUT.amg (or --stats / --export-colors)");
     if (from_amg && output)
         return cli_usage_error(env, "'%s' is already a decomposition; -o applies to point input", input);
+
+    if (distributed || asp_amg_mpi_ranks() > 1) {
+        if (from_amg || export_mode || critical || mesh_stiffness)
+            return cli_usage_error(env, "on MPI ranks decompose takes a binary PLY point file and -o or --stats only "
+                                        "(no .amg input, --export-colors, --critical-k, --mesh-stiffness)");
+        return decompose_distributed(env, input, output, &desc, tau, stats);
+    }
 
     asp_error err = {0};
     asp_amg *amg = NULL;
