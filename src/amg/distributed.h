@@ -64,7 +64,7 @@ int asp__dist_read_sorted(const asp__dist *d, const char *path, asp__dist_points
 int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radius, asp_error *err);
 void asp__dist_points_release(const asp_context *ctx, asp__dist_points *pts);
 
-/* ---- distributed_hypre.c (hypre and MPI start-up) ---- */
+/* ---- hypre_distributed.c (hypre and MPI start-up) ---- */
 
 int asp__dist_start(asp__dist *d, asp_error *err);
 /*
