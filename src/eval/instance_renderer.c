@@ -60,7 +60,9 @@ static int pick_kind(const asp_scene *sc, const char *point_renderer, const asp_
     unsigned inputs = asp_scene_inputs(sc);
     // a .hier holds splats without their points: discs cannot draw it, the splats do
     int splats_only = sc->hier && !sc->cloud;
-    const char *name = sc->dps    ? "prim"
+    // a .dps with linked levels is drawn as its view-dependent cut, so far instances take coarse levels
+    // (issue 18; docs/cut.md); a single level as it is
+    const char *name = sc->dps    ? (sc->dps->level_count > 1 && asp_dps_has_links(sc->dps) ? "cut" : "prim")
                        : sc->mesh ? "mesh"
                        : point_renderer && !(splats_only && strcmp(point_renderer, "disc") == 0) ? point_renderer
                        : splats_only ? "splat"
