@@ -192,8 +192,8 @@ static int decompose(const asp_cloud *cloud, const uint32_t *triangles, size_t n
 #else
     const size_t n = cloud->count;
     asp_amg *a = NULL;
-    asp__amg_nbhd nb = {0, 0, NULL, NULL};
-    asp__amg_fans fans = {0, 0, NULL, NULL};
+    asp__amg_nbhd nb = {0};
+    asp__amg_fans fans = {0};
     asp_amg_csr **p = NULL, *flat = NULL;
     size_t nlevels = 0;
     if ((rc = asp__amg_alloc(ctx, &a, err)) != 0)

@@ -22,19 +22,39 @@ struct asp_amg {
     asp_frame frame;       /* the source points' frame (asp_cloud_frame) */
 };
 
-/* Neighbourhoods N(x) of journal 2.1: row i of nbr (stride kmax) holds nn[i] indices, nearest first. */
+/*
+ * Neighbourhoods N(x) of journal 2.1: row i (asp__amg_nbhd_row) holds nn[i]
+ * indices, nearest first, and at least the fan_k nearest. Rows start at
+ * first[i] (compact, issue 19), or at i * kmax when first is NULL.
+ */
 typedef struct asp__amg_nbhd {
     size_t n, kmax;
-    asp_index *nbr; /* n * kmax */
+    asp_index *nbr; /* first[n] (or n * kmax) */
     uint16_t *nn;   /* n */
+    size_t *first;  /* n + 1, or NULL */
 } asp__amg_nbhd;
 
-/* Local triangle fans (journal 2.2): point i's triangles are (i, tri[2(i*stride+t)], tri[2(i*stride+t)+1]), t < ntri[i]. */
+static inline const asp_index *asp__amg_nbhd_row(const asp__amg_nbhd *nb, size_t i)
+{
+    return nb->nbr + (nb->first ? nb->first[i] : i * nb->kmax);
+}
+
+/*
+ * Local triangle fans (journal 2.2): point i's triangles are (i, r[2t],
+ * r[2t+1]), t < ntri[i], r = asp__amg_fan_row. Rows start at pair first[i]
+ * (compact, issue 19), or at pair i * stride when first is NULL.
+ */
 typedef struct asp__amg_fans {
     size_t n, stride;
-    asp_index *tri;  /* 2 * n * stride */
+    asp_index *tri;  /* 2 * first[n] (or 2 * n * stride) */
     uint16_t *ntri;  /* n */
+    size_t *first;   /* n + 1, or NULL */
 } asp__amg_fans;
+
+static inline const asp_index *asp__amg_fan_row(const asp__amg_fans *f, size_t i)
+{
+    return f->tri + 2 * (f->first ? f->first[i] : i * f->stride);
+}
 
 int asp__amg_resolve_desc(const asp_amg_desc *in, size_t count, asp_amg_desc *out, asp_error *err);
 
@@ -48,6 +68,8 @@ int asp__amg_classify(const float *pos, const asp__amg_nbhd *nb, const asp_amg_d
 int asp__amg_build_fans(const float *pos, const float *normals, const asp__amg_nbhd *nb, size_t fan_k,
                         const asp_context *ctx, asp__amg_fans *out, asp_error *err);
 void asp__amg_fans_release(const asp_context *ctx, asp__amg_fans *f);
+/* Moves stride-layout rows together (first[] offsets) and shrinks tri; left as is when out of memory. */
+void asp__amg_fans_compact(const asp_context *ctx, asp__amg_fans *f);
 /* Fans of the mesh triangles incident to each of n vertices (mesh_fans.c, journal eq. 4). */
 int asp__amg_mesh_fans(size_t n, const uint32_t *triangles, size_t ntris, const asp_context *ctx,
                        asp__amg_fans *out, asp_error *err);
