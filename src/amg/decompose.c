@@ -237,6 +237,7 @@ static int decompose(const asp_cloud *cloud, const uint32_t *triangles, size_t n
     if (rc)
         goto fail;
     asp__amg_nbhd_release(ctx, &nb);
+    asp__amg_fans_compact(ctx, &fans); /* after the neighbourhoods are gone: not both at once */
     size_t tri_total = 0;
     for (size_t i = 0; i < n; i++)
         tri_total += fans.ntri[i];
@@ -265,10 +266,18 @@ static int decompose(const asp_cloud *cloud, const uint32_t *triangles, size_t n
     t = t1;
     if ((rc = stage(ctx, "amg", 0, err)) != 0)
         goto fail;
-    rc = asp__amg_build_hierarchy(a->matrix, flat, a->classifier, &d, ctx, &nlevels, &p, &a->level_size,
-                                  &a->info.repaired_rows, err);
-    asp_amg_csr_destroy(flat);
-    flat = NULL;
+    if (d.keep_matrix) {
+        rc = asp__amg_build_hierarchy(a->matrix, flat, a->classifier, &d, ctx, &nlevels, &p, &a->level_size,
+                                      &a->info.repaired_rows, err);
+        asp_amg_csr_destroy(flat);
+        flat = NULL;
+    } else {
+        /* A^0 and F^0 go as soon as the hierarchy is done with them: the peak of the AMG stage (issue 19) */
+        asp_amg_csr *a0 = a->matrix;
+        a->matrix = NULL;
+        rc = asp__amg_build_hierarchy_take(&a0, &flat, a->classifier, &d, ctx, &nlevels, &p, &a->level_size,
+                                           &a->info.repaired_rows, err);
+    }
     if (rc)
         goto fail;
     a->prolong = p;

@@ -190,7 +190,6 @@ int asp__amg_build_fans(const float *pos, const float *normals, const asp__amg_n
         f.ntri[i] = (uint16_t)nt;
     }
     asp_free(ctx, scratch);
-    asp__amg_fans_compact(ctx, &f);
     *out = f;
     (void)err;
     return 0;

@@ -82,6 +82,9 @@ int asp__amg_assemble(const float *pos, const float *classifier, const asp__amg_
 /* One BoomerAMG setup level on a: copies P (a->rows x nc) and A^1 = P^T a P; *p = NULL when hypre did not coarsen. */
 int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
                            asp_amg_csr **p, asp_amg_csr **ac, asp_error *err);
+/* The same, taking *a: it is destroyed (*a = NULL) as soon as hypre holds its own copy, before the setup. */
+int asp__amg_hypre_coarsen_take(asp_amg_csr **a, const asp_amg_desc *desc, const asp_context *ctx,
+                                asp_amg_csr **p, asp_amg_csr **ac, asp_error *err);
 
 /* The hierarchy level by level (hierarchy.c): p[1..nlevels-1], sizes[0..nlevels-1]; arrays sized max_levels. */
 /*
@@ -91,6 +94,14 @@ int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const
 int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const float *cls,
                              const asp_amg_desc *desc, const asp_context *ctx, size_t *nlevels, asp_amg_csr ***p,
                              size_t **sizes, size_t *repaired, asp_error *err);
+/*
+ * The same, taking *a0 and *f0 (either may point to NULL): each is destroyed
+ * and set to NULL once the hierarchy no longer needs it (A^0 inside the first
+ * hypre call, F^0 after the first Galerkin product), on failure too (issue 19).
+ */
+int asp__amg_build_hierarchy_take(asp_amg_csr **a0, asp_amg_csr **f0, const float *cls, const asp_amg_desc *desc,
+                                  const asp_context *ctx, size_t *nlevels, asp_amg_csr ***p, size_t **sizes,
+                                  size_t *repaired, asp_error *err);
 
 /* Galerkin product P^T F P (p: n x nc, f: n x n); columns within a row are not sorted. */
 int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_context *ctx, asp_amg_csr **out,
