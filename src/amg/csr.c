@@ -167,6 +167,29 @@ static size_t rap_row(const asp_amg_csr *pt, const asp_amg_csr *f, const asp_amg
     return cnt;
 }
 
+/* Length of row I of P^T F P: the columns rap_row would write, counted without the products. */
+static size_t rap_count(const asp_amg_csr *pt, const asp_amg_csr *f, const asp_amg_csr *p, size_t row, uint8_t *mark,
+                        asp_index *list)
+{
+    size_t cnt = 0;
+    for (size_t a = pt->row_ptr[row]; a < pt->row_ptr[row + 1]; a++) {
+        const size_t i = pt->col[a];
+        for (size_t b = f->row_ptr[i]; b < f->row_ptr[i + 1]; b++) {
+            const size_t k = f->col[b];
+            for (size_t c = p->row_ptr[k]; c < p->row_ptr[k + 1]; c++) {
+                asp_index j = p->col[c];
+                if (!mark[j]) {
+                    mark[j] = 1;
+                    list[cnt++] = j;
+                }
+            }
+        }
+    }
+    for (size_t q = 0; q < cnt; q++)
+        mark[list[q]] = 0;
+    return cnt;
+}
+
 int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_context *ctx, asp_amg_csr **out,
                       asp_error *err)
 {
@@ -195,8 +218,7 @@ int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_cont
 #ifdef _OPENMP
         t = omp_get_thread_num();
 #endif
-        cnt[rr] = rap_row(pt, f, p, (size_t)rr, acc + (size_t)t * nc, mark + (size_t)t * nc, list + (size_t)t * nc,
-                          nc, NULL, NULL);
+        cnt[rr] = rap_count(pt, f, p, (size_t)rr, mark + (size_t)t * nc, list + (size_t)t * nc);
     }
     size_t total = 0;
     for (size_t r = 0; r < nc; r++)

@@ -199,20 +199,26 @@ void asp__amg_fans_compact(const asp_context *ctx, asp__amg_fans *f)
 {
     if (f->first)
         return;
+    const int threads = asp_context_threads(ctx);
     size_t *first = asp_alloc(ctx, (f->n + 1) * sizeof *first);
-    if (!first)
-        return; /* the stride layout stays valid */
-    first[0] = 0;
-    for (size_t i = 0; i < f->n; i++) {
-        /* rows move down in order: a row never overlaps a later one's source */
-        if (first[i] != i * f->stride)
-            memmove(f->tri + 2 * first[i], f->tri + 2 * i * f->stride, 2 * (size_t)f->ntri[i] * sizeof *f->tri);
-        first[i + 1] = first[i] + f->ntri[i];
+    asp_index *tri = NULL;
+    if (first) {
+        first[0] = 0;
+        for (size_t i = 0; i < f->n; i++)
+            first[i + 1] = first[i] + f->ntri[i];
+        tri = asp_alloc(ctx, (2 * first[f->n] + 1) * sizeof *tri);
     }
-    asp_index *shrunk = asp_realloc(ctx, f->tri, 2 * f->n * f->stride * sizeof *f->tri,
-                                    (2 * first[f->n] + 1) * sizeof *f->tri);
-    if (shrunk)
-        f->tri = shrunk;
+    if (!tri) {
+        asp_free(ctx, first); /* the stride layout stays valid */
+        return;
+    }
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long ii = 0; ii < (long long)f->n; ii++) {
+        size_t i = (size_t)ii;
+        memcpy(tri + 2 * first[i], f->tri + 2 * i * f->stride, 2 * (size_t)f->ntri[i] * sizeof *tri);
+    }
+    asp_free(ctx, f->tri);
+    f->tri = tri;
     f->first = first;
 }
 

@@ -506,7 +506,7 @@ static int coarsen_isolated(const asp_amg_csr *a, asp_amg_csr **take, const asp_
             _exit(3);
         asp_amg_csr *p = NULL, *ac = NULL;
         if (!rc)
-            rc = coarsen_here(a, NULL, desc, ctx, &p, &ac, &cerr);
+            rc = coarsen_here(a, take, desc, ctx, &p, &ac, &cerr); // frees the child's view of *take too
         int32_t has = p != NULL;
         if (rc) {
             uint32_t len = (uint32_t)strlen(cerr.msg);

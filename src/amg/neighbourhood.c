@@ -191,20 +191,29 @@ int asp__amg_neighbourhoods(const float *pos, size_t n, asp_amg_desc *desc, cons
     }
     /*
      * Rows shrink to what the classifier and the fans read (about k_min of
-     * k_max on a scan): compacted in place, in order, then the block shrinks.
+     * k_max on a scan): copied in parallel into a block of that size.
      */
     double total = 0;
     nb.first[0] = 0;
     for (size_t i = 0; i < n; i++) {
-        size_t m = nb.nn[i] > keep_min ? nb.nn[i] : keep_min;
         total += (double)nb.nn[i];
-        if (nb.first[i] != i * kmax)
-            memmove(nb.nbr + nb.first[i], nb.nbr + i * kmax, m * sizeof *nb.nbr);
-        nb.first[i + 1] = nb.first[i] + m;
+        nb.first[i + 1] = nb.first[i] + (nb.nn[i] > keep_min ? nb.nn[i] : keep_min);
     }
-    asp_index *shrunk = asp_realloc(ctx, nb.nbr, n * kmax * sizeof *nb.nbr, nb.first[n] * sizeof *nb.nbr);
-    if (shrunk)
-        nb.nbr = shrunk; /* else keep the larger block: same contents */
+    asp_free(ctx, kth);
+    kth = NULL;
+    asp_index *compact = asp_alloc(ctx, (nb.first[n] + 1) * sizeof *compact);
+    if (compact) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (long long ii = 0; ii < (long long)n; ii++) {
+            size_t i = (size_t)ii;
+            memcpy(compact + nb.first[i], nb.nbr + i * kmax, (nb.first[i + 1] - nb.first[i]) * sizeof *compact);
+        }
+        asp_free(ctx, nb.nbr);
+        nb.nbr = compact;
+    } else {
+        asp_free(ctx, nb.first); /* out of memory: the stride layout serves as well */
+        nb.first = NULL;
+    }
     *mean_size = total / (double)n;
     *out = nb;
     nb.nbr = NULL;
