@@ -90,19 +90,6 @@ static void mem_mark(mem_track *t, const char *name)
         s->live_peak = atomic_load(&t->peak);
         s->hwm_kb = hwm;
     }
-    if (getenv("BENCH_MAPS")) {
-        char l[512];
-        FILE *m = fopen("/proc/self/smaps", "r");
-        char cur[512] = "";
-        while (m && fgets(l, sizeof l, m)) {
-            if (strchr(l, '-') && l[0] != ' ' && strncmp(l, "Rss", 3) && strchr(l, ':') == NULL + 0) {}
-            if ((l[0] >= '0' && l[0] <= '9') || (l[0] >= 'a' && l[0] <= 'f'))
-                snprintf(cur, sizeof cur, "%s", l);
-            else if (strncmp(l, "Rss:", 4) == 0 && atol(l + 4) > 10000)
-                printf("MAP %s %s", name ? name : "end", cur), printf("    %s", l);
-        }
-        if (m) fclose(m);
-    }
     if (!name || t->nst == MAX_STAGES)
         return;
     /* "5" resets the peak RSS to the current RSS (Linux 4.0, proc(5)) */
@@ -245,8 +232,11 @@ int main(int argc, char **argv)
     for (int s = 0; s < STAGES; s++)
         printf("  %-11s %8.3f s (median)%s\n", names[s], bench_median_upper(t[s], runs),
                s == 5 && save ? " (includes writing the .amg)" : "");
-    printf("  peak memory %.0f MB (max RSS, includes %s)\n", (double)ru.ru_maxrss / 1024.0,
-           in ? "the input" : "sampling");
+    /* --mem resets the peak at each stage (clear_refs), so getrusage's maximum is the last stage's */
+    double peak_kb = (double)ru.ru_maxrss;
+    for (int i = 0; mem && i < track.nst; i++)
+        peak_kb = i == 0 || (double)track.st[i].hwm_kb > peak_kb ? (double)track.st[i].hwm_kb : peak_kb;
+    printf("  peak memory %.0f MB (max RSS, includes %s)\n", peak_kb / 1024.0, in ? "the input" : "sampling");
     if (mem)
         mem_print(&track, cloud->count);
     asp_cloud_destroy(cloud);
