@@ -1,0 +1,122 @@
+/*
+ * The decomposition's memory (issue 19): freed arrays go back to the system
+ * although libsuperlu_dist (linked through hypre) turns glibc's mmap and trim
+ * off at load time, and the library's own allocations stay within the
+ * per-point budget at every stage (a counting allocator in the context, as
+ * bench_decompose --mem measures them).
+ */
+#include <stdatomic.h>
+
+#include "amgsplat/amg.h"
+#include "amgsplat/mesh.h"
+#include "amgsplat/sample.h"
+#include "harness.h"
+
+/* VmRSS of this process in KiB, or -1 where /proc is not there. */
+static long rss_kb(void)
+{
+    char line[256];
+    long kb = -1;
+    FILE *fp = fopen("/proc/self/status", "r");
+    if (!fp)
+        return -1;
+    while (fgets(line, sizeof line, fp))
+        if (strncmp(line, "VmRSS:", 6) == 0)
+            kb = atol(line + 6);
+    fclose(fp);
+    return kb;
+}
+
+/* A freed 256 MiB array leaves the resident set (before the fix it stayed: mmap off, trim off). */
+static void test_free_returns(void)
+{
+#if defined(__SANITIZE_ADDRESS__)
+    fprintf(stderr, "AddressSanitizer's allocator keeps freed blocks in quarantine: nothing to check\n");
+#elif defined(__linux__) && defined(__GLIBC__)
+    const size_t size = (size_t)256 << 20;
+    long before = rss_kb();
+    char *p = malloc(size);
+    CHECK(p != NULL);
+    if (!p || before < 0)
+        return;
+    for (size_t i = 0; i < size; i += 4096)
+        ((volatile char *)p)[i] = 1; // every page, through volatile so the stores stay
+    long held = rss_kb();
+    free(p);
+    long after = rss_kb();
+    fprintf(stderr, "RSS: %ld KiB before, %ld with 256 MiB, %ld after free\n", before, held, after);
+    CHECK(held - before > 200 * 1024);
+    CHECK_MSG(after - before < 32 * 1024, "%ld KiB still resident after free", after - before);
+#else
+    fprintf(stderr, "not glibc on Linux: nothing to check\n");
+#endif
+}
+
+typedef struct counter {
+    atomic_size_t live, peak;
+} counter;
+
+enum { HDR = 64 };
+
+static void *count_alloc(void *user, size_t size, size_t alignment)
+{
+    counter *c = user;
+    (void)alignment;
+    char *b = aligned_alloc(HDR, (size + 2 * HDR - 1) / HDR * HDR);
+    if (!b)
+        return NULL;
+    memcpy(b, &size, sizeof size);
+    size_t now = atomic_fetch_add(&c->live, size) + size, old = atomic_load(&c->peak);
+    while (now > old && !atomic_compare_exchange_weak(&c->peak, &old, now))
+        ;
+    return b + HDR;
+}
+
+static void count_free(void *user, void *ptr)
+{
+    counter *c = user;
+    char *b = (char *)ptr - HDR;
+    size_t size;
+    memcpy(&size, b, sizeof size);
+    atomic_fetch_sub(&c->live, size);
+    free(b);
+}
+
+/*
+ * 200,000 bunny points: the library's peak, the input cloud included, stays
+ * under 400 bytes per point (measured 372 at 1M, in the neighbour search; it
+ * was 778 in the assembly before issue 19) and nothing is left after destroy.
+ */
+static void test_budget(void)
+{
+    static counter c;
+    asp_context ctx = {.allocator = {count_alloc, count_free, &c}};
+    asp_error errbuf, *err = &errbuf;
+    asp_mesh *mesh = NULL;
+    asp_cloud *cloud = NULL;
+    if (asp_mesh_load(ASP_TEST_DATA "/stanford-bunny.obj", NULL, NULL, &mesh, err) != 0) {
+        fprintf(stderr, "SKIP: %s\n", err->msg);
+        asp_test_skips++;
+        return;
+    }
+    const size_t n = 200000;
+    CHECK_OK(asp_sample_mesh(mesh, &(asp_sample_desc){.method = ASP_SAMPLE_AREA, .points = n}, &ctx, &cloud, NULL, err),
+             err);
+    asp_mesh_destroy(mesh);
+    if (!cloud)
+        return;
+    atomic_store(&c.peak, atomic_load(&c.live));
+    asp_amg *amg = NULL;
+    CHECK_OK(asp_amg_decompose(cloud, NULL, &ctx, &amg, err), err);
+    double peak = (double)atomic_load(&c.peak) / (double)n;
+    fprintf(stderr, "library peak %.1f bytes/point over %zu points\n", peak, n);
+    CHECK_MSG(peak < 400, "library peak %.1f bytes/point", peak);
+    CHECK(amg && asp_amg_matrix(amg) == NULL); /* A^0 is not kept unless asked (keep_matrix) */
+    asp_amg_destroy(amg);
+    asp_cloud_destroy(cloud);
+    CHECK_MSG(atomic_load(&c.live) == 0, "%zu bytes still allocated", (size_t)atomic_load(&c.live));
+}
+
+static void shutdown(void) { asp_amg_shutdown(); }
+
+TEST_MAIN(TEST_CASE(test_free_returns), TEST_CASE(test_budget), TEST_CASE(shutdown))
