@@ -200,6 +200,7 @@ void asp__amg_fans_compact(const asp_context *ctx, asp__amg_fans *f)
     if (f->first)
         return;
     const int threads = asp_context_threads(ctx);
+    (void)threads; /* read by the OpenMP pragma only */
     size_t *first = asp_alloc(ctx, (f->n + 1) * sizeof *first);
     asp_index *tri = NULL;
     if (first) {

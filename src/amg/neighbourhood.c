@@ -142,6 +142,7 @@ int asp__amg_neighbourhoods(const float *pos, size_t n, asp_amg_desc *desc, cons
     /* rows keep at least fan_k entries: the fans (fan.c) project the fan_k nearest whatever N(x) holds */
     const size_t keep_min = desc->fan_k > kmin ? (desc->fan_k < kmax ? desc->fan_k : kmax) : kmin;
     const int threads = asp_context_threads(ctx);
+    (void)threads; /* read by the OpenMP pragmas only */
     asp_kdtree *tree = NULL;
     float *kth = NULL;
     asp__amg_nbhd nb = {n, kmax, NULL, NULL, NULL};
