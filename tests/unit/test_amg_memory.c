@@ -3,7 +3,7 @@
  * although libsuperlu_dist (linked through hypre) turns glibc's mmap and trim
  * off at load time, and the library's own allocations stay within the
  * per-point budget at every stage (a counting allocator in the context, as
- * bench_decompose --mem measures them).
+ * bench_decompose --mem measures them), less when the cloud is handed over.
  */
 #include <stdatomic.h>
 
@@ -117,18 +117,53 @@ static void test_budget(void)
     asp_mesh_destroy(mesh);
     if (!cloud)
         return;
+    asp_cloud *given = NULL;
+    CHECK_OK(asp_cloud_clone(cloud, &given, err), err);
     atomic_store(&c.peak, atomic_load(&c.live));
     asp_amg *amg = NULL;
     CHECK_OK(asp_amg_decompose(cloud, NULL, &ctx, &amg, err), err);
-    double peak = (double)atomic_load(&c.peak) / (double)n;
+    double peak = (double)(atomic_load(&c.peak) - (given ? 28 * n : 0)) / (double)n; /* less the clone */
     fprintf(stderr, "library peak %.1f bytes/point over %zu points\n", peak, n);
     CHECK_MSG(peak < 400, "library peak %.1f bytes/point", peak);
     CHECK(amg && asp_amg_matrix(amg) == NULL); /* A^0 is not kept unless asked (keep_matrix) */
-    asp_amg_destroy(amg);
     asp_cloud_destroy(cloud);
+    /* handing the cloud over: no copy of the points, the same hierarchy to the bit */
+    if (given) {
+        asp_amg *took = NULL;
+        atomic_store(&c.peak, atomic_load(&c.live));
+        size_t base = atomic_load(&c.live) - 28 * n; /* the result above is live; the given cloud counts */
+        CHECK_OK(asp_amg_decompose_take(&given, NULL, &ctx, &took, err), err);
+        CHECK(given == NULL);
+        double peak_take = (double)(atomic_load(&c.peak) - base) / (double)n;
+        fprintf(stderr, "library peak with the cloud handed over %.1f bytes/point\n", peak_take);
+        CHECK_MSG(peak_take < peak - 20, "%.1f bytes/point handed over, %.1f copied", peak_take, peak);
+        if (amg && took) {
+            CHECK(asp_amg_level_count(amg) == asp_amg_level_count(took));
+            CHECK(memcmp(asp_amg_classifier(amg), asp_amg_classifier(took), n * sizeof(float)) == 0);
+            for (size_t l = 1; l < asp_amg_level_count(amg) && l < asp_amg_level_count(took); l++) {
+                const asp_amg_csr *p1 = asp_amg_prolongation(amg, l), *p2 = asp_amg_prolongation(took, l);
+                CHECK(p1->row_ptr[p1->rows] == p2->row_ptr[p2->rows]);
+                if (p1->row_ptr[p1->rows] == p2->row_ptr[p2->rows])
+                    CHECK(memcmp(p1->val, p2->val, p1->row_ptr[p1->rows] * sizeof *p1->val) == 0);
+            }
+        }
+        asp_amg_destroy(took);
+    }
+    asp_amg_destroy(amg);
     CHECK_MSG(atomic_load(&c.live) == 0, "%zu bytes still allocated", (size_t)atomic_load(&c.live));
+}
+
+/* A refused cloud is destroyed, and the pointer cleared, as documented. */
+static void test_take_refused(void)
+{
+    asp_cloud *two = NULL;
+    asp_error err;
+    CHECK_OK(asp_cloud_create(2, 0, NULL, &two, &err), &err);
+    asp_amg *amg = NULL;
+    CHECK(asp_amg_decompose_take(&two, NULL, NULL, &amg, &err) == ASP_EDEGENERATE);
+    CHECK(two == NULL && amg == NULL);
 }
 
 static void shutdown(void) { asp_amg_shutdown(); }
 
-TEST_MAIN(TEST_CASE(test_free_returns), TEST_CASE(test_budget), TEST_CASE(shutdown))
+TEST_MAIN(TEST_CASE(test_free_returns), TEST_CASE(test_budget), TEST_CASE(test_take_refused), TEST_CASE(shutdown))
