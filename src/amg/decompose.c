@@ -228,6 +228,7 @@ static int decompose(const asp_cloud *cloud, asp_cloud **take, const uint32_t *t
     rc = asp__amg_neighbourhoods(pos, n, &d, ctx, &nb, &a->info.mean_neighbourhood, err);
     if (rc)
         goto fail;
+    asp__amg_nbhd_compact(ctx, &nb, triangles ? 0 : d.fan_k);
     t1 = asp_time_now();
     a->info.t_neighbours = t1 - t;
     t = t1;

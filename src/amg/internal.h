@@ -61,6 +61,13 @@ int asp__amg_resolve_desc(const asp_amg_desc *in, size_t count, asp_amg_desc *ou
 int asp__amg_neighbourhoods(const float *pos, size_t n, asp_amg_desc *desc, const asp_context *ctx,
                             asp__amg_nbhd *out, double *mean_size, asp_error *err);
 void asp__amg_nbhd_release(const asp_context *ctx, asp__amg_nbhd *nb);
+/*
+ * Moves the stride-layout rows (what asp__amg_neighbourhoods gives) into a
+ * block of their lengths, max(nn[i], fan_k) (first[] offsets): about half the
+ * bytes on a scan (issue 19). Left as is when out of memory. After it nn[i]
+ * may not grow (the distributed run re-derives nn on the stride layout).
+ */
+void asp__amg_nbhd_compact(const asp_context *ctx, asp__amg_nbhd *nb, size_t fan_k);
 
 int asp__amg_classify(const float *pos, const asp__amg_nbhd *nb, const asp_amg_desc *desc, const asp_context *ctx,
                       float *classifier, float *normals, asp_error *err);

@@ -139,8 +139,6 @@ int asp__amg_neighbourhoods(const float *pos, size_t n, asp_amg_desc *desc, cons
                             asp__amg_nbhd *out, double *mean_size, asp_error *err)
 {
     const size_t kmax = desc->k_max, kmin = desc->k_min;
-    /* rows keep at least fan_k entries: the fans (fan.c) project the fan_k nearest whatever N(x) holds */
-    const size_t keep_min = desc->fan_k > kmin ? (desc->fan_k < kmax ? desc->fan_k : kmax) : kmin;
     const int threads = asp_context_threads(ctx);
     (void)threads; /* read by the OpenMP pragmas only */
     asp_kdtree *tree = NULL;
@@ -151,9 +149,8 @@ int asp__amg_neighbourhoods(const float *pos, size_t n, asp_amg_desc *desc, cons
         return rc;
     nb.nbr = asp_alloc(ctx, n * kmax * sizeof *nb.nbr);
     nb.nn = asp_alloc(ctx, n * sizeof *nb.nn);
-    nb.first = asp_alloc(ctx, (n + 1) * sizeof *nb.first);
     kth = asp_alloc(ctx, n * sizeof *kth);
-    if (!nb.nbr || !nb.nn || !nb.first || !kth) {
+    if (!nb.nbr || !nb.nn || !kth) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu neighbourhoods of %zu points", n, kmax);
         goto done;
     }
@@ -190,31 +187,9 @@ int asp__amg_neighbourhoods(const float *pos, size_t n, asp_amg_desc *desc, cons
             m++;
         nb.nn[i] = (uint16_t)m;
     }
-    /*
-     * Rows shrink to what the classifier and the fans read (about k_min of
-     * k_max on a scan): copied in parallel into a block of that size.
-     */
     double total = 0;
-    nb.first[0] = 0;
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n; i++)
         total += (double)nb.nn[i];
-        nb.first[i + 1] = nb.first[i] + (nb.nn[i] > keep_min ? nb.nn[i] : keep_min);
-    }
-    asp_free(ctx, kth);
-    kth = NULL;
-    asp_index *compact = asp_alloc(ctx, (nb.first[n] + 1) * sizeof *compact);
-    if (compact) {
-#pragma omp parallel for schedule(static) num_threads(threads)
-        for (long long ii = 0; ii < (long long)n; ii++) {
-            size_t i = (size_t)ii;
-            memcpy(compact + nb.first[i], nb.nbr + i * kmax, (nb.first[i + 1] - nb.first[i]) * sizeof *compact);
-        }
-        asp_free(ctx, nb.nbr);
-        nb.nbr = compact;
-    } else {
-        asp_free(ctx, nb.first); /* out of memory: the stride layout serves as well */
-        nb.first = NULL;
-    }
     *mean_size = total / (double)n;
     *out = nb;
     nb.nbr = NULL;
@@ -225,6 +200,37 @@ done:
     asp_free(ctx, kth);
     asp_kdtree_destroy(tree);
     return rc;
+}
+
+void asp__amg_nbhd_compact(const asp_context *ctx, asp__amg_nbhd *nb, size_t fan_k)
+{
+    if (nb->first || !nb->nbr)
+        return;
+    const size_t n = nb->n, kmax = nb->kmax;
+    const int threads = asp_context_threads(ctx);
+    (void)threads; /* read by the OpenMP pragma only */
+    /* rows keep at least fan_k entries: the fans (fan.c) project the fan_k nearest whatever N(x) holds */
+    const size_t keep_min = fan_k < kmax ? fan_k : kmax;
+    size_t *first = asp_alloc(ctx, (n + 1) * sizeof *first);
+    asp_index *compact = NULL;
+    if (first) {
+        first[0] = 0;
+        for (size_t i = 0; i < n; i++)
+            first[i + 1] = first[i] + (nb->nn[i] > keep_min ? nb->nn[i] : keep_min);
+        compact = asp_alloc(ctx, (first[n] + 1) * sizeof *compact);
+    }
+    if (!compact) {
+        asp_free(ctx, first); /* out of memory: the stride layout serves as well */
+        return;
+    }
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long ii = 0; ii < (long long)n; ii++) {
+        size_t i = (size_t)ii;
+        memcpy(compact + first[i], nb->nbr + i * kmax, (first[i + 1] - first[i]) * sizeof *compact);
+    }
+    asp_free(ctx, nb->nbr);
+    nb->nbr = compact;
+    nb->first = first;
 }
 
 void asp__amg_nbhd_release(const asp_context *ctx, asp__amg_nbhd *nb)
