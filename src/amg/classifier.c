@@ -67,8 +67,9 @@ int asp__amg_classify(const float *pos, const asp__amg_nbhd *nb, const asp_amg_d
         /* x itself belongs to its ball B_eps(x) */
         p[0] = p[1] = p[2] = 0;
         size_t m = nb->nn[i];
+        const asp_index *row = asp__amg_nbhd_row(nb, i);
         for (size_t j = 0; j < m; j++) {
-            const float *q = pos + 3 * (size_t)nb->nbr[i * kmax + j];
+            const float *q = pos + 3 * (size_t)row[j];
             for (int a = 0; a < 3; a++)
                 p[3 * (j + 1) + a] = (double)q[a] - (double)x[a];
         }

@@ -167,62 +167,58 @@ static size_t rap_row(const asp_amg_csr *pt, const asp_amg_csr *f, const asp_amg
     return cnt;
 }
 
+/* Length of row I of P^T F P: the columns rap_row would write, counted without the products. */
+static size_t rap_count(const asp_amg_csr *pt, const asp_amg_csr *f, const asp_amg_csr *p, size_t row, uint8_t *mark,
+                        asp_index *list)
+{
+    size_t cnt = 0;
+    for (size_t a = pt->row_ptr[row]; a < pt->row_ptr[row + 1]; a++) {
+        const size_t i = pt->col[a];
+        for (size_t b = f->row_ptr[i]; b < f->row_ptr[i + 1]; b++) {
+            const size_t k = f->col[b];
+            for (size_t c = p->row_ptr[k]; c < p->row_ptr[k + 1]; c++) {
+                asp_index j = p->col[c];
+                if (!mark[j]) {
+                    mark[j] = 1;
+                    list[cnt++] = j;
+                }
+            }
+        }
+    }
+    for (size_t q = 0; q < cnt; q++)
+        mark[list[q]] = 0;
+    return cnt;
+}
+
 int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_context *ctx, asp_amg_csr **out,
                       asp_error *err)
 {
     const int threads = asp_context_threads(ctx);
-    const size_t n = p->rows, nc = p->cols;
+    const size_t nc = p->cols;
     asp_amg_csr *pt = NULL, *c = NULL;
-    double *acc = asp_calloc(ctx, (size_t)threads * nc, sizeof *acc), *sval = NULL;
+    double *acc = asp_calloc(ctx, (size_t)threads * nc, sizeof *acc);
     uint8_t *mark = asp_calloc(ctx, (size_t)threads * nc, 1);
-    asp_index *list = asp_alloc(ctx, (size_t)threads * nc * sizeof *list), *scol = NULL;
+    asp_index *list = asp_alloc(ctx, (size_t)threads * nc * sizeof *list);
     size_t *cnt = asp_calloc(ctx, nc + 1, sizeof *cnt);
-    size_t *ub = asp_calloc(ctx, (n > nc ? n : nc) + 1, sizeof *ub);
     int rc = 0;
-    if (!acc || !mark || !list || !cnt || !ub) {
+    if (!acc || !mark || !list || !cnt) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for a coarse matrix of %zu rows", nc);
         goto done;
     }
     if ((rc = transpose(p, ctx, &pt, err)) != 0)
         goto done;
     /*
-     * One pass into slots of a per-row upper bound (the number of products the
-     * row sums), then a copy: half the work of a count pass plus a fill pass.
-     * ub first holds, per fine row i, the products one P^T entry of it brings.
+     * A counting pass, then the filling pass straight into the result: twice
+     * the products, but no slots of a per-row upper bound, which at the first
+     * level held several times the result (issue 19: the AMG stage's peak).
      */
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (long long ii = 0; ii < (long long)n; ii++) {
-        size_t i = (size_t)ii, w = 0;
-        for (size_t b = f->row_ptr[i]; b < f->row_ptr[i + 1]; b++)
-            w += p->row_ptr[f->col[b] + 1] - p->row_ptr[f->col[b]];
-        ub[i] = w;
-    }
-#pragma omp parallel for schedule(static) num_threads(threads)
     for (long long rr = 0; rr < (long long)nc; rr++) {
-        size_t r = (size_t)rr, w = 0;
-        for (size_t a = pt->row_ptr[r]; a < pt->row_ptr[r + 1]; a++)
-            w += ub[pt->col[a]];
-        cnt[r] = w < nc ? w : nc;
-    }
-    ub[0] = 0;
-    for (size_t r = 0; r < nc; r++)
-        ub[r + 1] = ub[r] + cnt[r];
-    scol = asp_alloc(ctx, (ub[nc] + 1) * sizeof *scol);
-    sval = asp_alloc(ctx, (ub[nc] + 1) * sizeof *sval);
-    if (!scol || !sval) {
-        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for a coarse matrix of %zu rows", nc);
-        goto done;
-    }
-    /* each row is summed in the same fixed order, so any thread count gives the same bits */
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (long long rr = 0; rr < (long long)nc; rr++) {
-        size_t r = (size_t)rr;
         int t = 0;
 #ifdef _OPENMP
         t = omp_get_thread_num();
 #endif
-        cnt[r] = rap_row(pt, f, p, r, acc + (size_t)t * nc, mark + (size_t)t * nc, list + (size_t)t * nc, nc,
-                         scol + ub[r], sval + ub[r]);
+        cnt[rr] = rap_count(pt, f, p, (size_t)rr, mark + (size_t)t * nc, list + (size_t)t * nc);
     }
     size_t total = 0;
     for (size_t r = 0; r < nc; r++)
@@ -231,11 +227,16 @@ int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_cont
         goto done;
     for (size_t r = 0; r < nc; r++)
         c->row_ptr[r + 1] = c->row_ptr[r] + cnt[r];
+    /* each row is summed in the same fixed order, so any thread count gives the same bits */
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (long long rr = 0; rr < (long long)nc; rr++) {
         size_t r = (size_t)rr;
-        memcpy(c->col + c->row_ptr[r], scol + ub[r], cnt[r] * sizeof *scol);
-        memcpy(c->val + c->row_ptr[r], sval + ub[r], cnt[r] * sizeof *sval);
+        int t = 0;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+#endif
+        rap_row(pt, f, p, r, acc + (size_t)t * nc, mark + (size_t)t * nc, list + (size_t)t * nc, nc,
+                c->col + c->row_ptr[r], c->val + c->row_ptr[r]);
     }
     *out = c;
     c = NULL;
@@ -246,8 +247,5 @@ done:
     asp_free(ctx, mark);
     asp_free(ctx, list);
     asp_free(ctx, cnt);
-    asp_free(ctx, ub);
-    asp_free(ctx, scol);
-    asp_free(ctx, sval);
     return rc;
 }

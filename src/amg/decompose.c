@@ -172,9 +172,12 @@ static int stage(const asp_context *ctx, const char *name, double f, asp_error *
 }
 #endif
 
-/* The pipeline; with triangles, the fans are the mesh's own (journal eq. 4) instead of journal 2.2's. */
-static int decompose(const asp_cloud *cloud, const uint32_t *triangles, size_t ntris, const asp_amg_desc *desc,
-                     const asp_context *ctx, asp_amg **out, asp_error *err)
+/*
+ * The pipeline; with triangles, the fans are the mesh's own (journal eq. 4) instead of journal 2.2's.
+ * take (may be NULL) owns cloud: the result keeps it instead of a copy, and it is destroyed on failure.
+ */
+static int decompose(const asp_cloud *cloud, asp_cloud **take, const uint32_t *triangles, size_t ntris,
+                     const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out, asp_error *err)
 {
     int rc = check_cloud(cloud, err);
     if (rc)
@@ -188,21 +191,29 @@ static int decompose(const asp_cloud *cloud, const uint32_t *triangles, size_t n
     (void)out;
     (void)triangles;
     (void)ntris;
+    (void)take;
     return asp_error_set(err, ASP_EUNSUPPORTED, "cannot decompose: this build has no hypre (ASP_WITH_HYPRE=OFF)");
 #else
     const size_t n = cloud->count;
     asp_amg *a = NULL;
-    asp__amg_nbhd nb = {0, 0, NULL, NULL};
-    asp__amg_fans fans = {0, 0, NULL, NULL};
+    asp__amg_nbhd nb = {0};
+    asp__amg_fans fans = {0};
     asp_amg_csr **p = NULL, *flat = NULL;
     size_t nlevels = 0;
     if ((rc = asp__amg_alloc(ctx, &a, err)) != 0)
         return rc;
-    if ((rc = copy_points(cloud, ctx, &a->cloud, err)) != 0)
-        goto fail;
     if (asp_cloud_frame(cloud, &a->frame, NULL) != 0)
         memset(&a->frame, 0, sizeof a->frame); // nothing to frame: radius 0 ("not known")
     a->input_normals = cloud->normals != NULL;
+    if (take) {
+        /* the caller's cloud itself: no second copy of the points (issue 19, 28 bytes a point on a scan) */
+        a->cloud = *take;
+        *take = NULL;
+        if (!a->input_normals && (rc = asp_cloud_add_attrs(a->cloud, ASP_ATTR_NORMALS, err)) != 0)
+            goto fail;
+    } else if ((rc = copy_points(cloud, ctx, &a->cloud, err)) != 0) {
+        goto fail;
+    }
     a->classifier = asp_alloc(ctx, n * sizeof *a->classifier);
     a->tangent = asp_alloc(ctx, 3 * n * sizeof *a->tangent);
     if (!a->classifier || !a->tangent) {
@@ -217,6 +228,7 @@ static int decompose(const asp_cloud *cloud, const uint32_t *triangles, size_t n
     rc = asp__amg_neighbourhoods(pos, n, &d, ctx, &nb, &a->info.mean_neighbourhood, err);
     if (rc)
         goto fail;
+    asp__amg_nbhd_compact(ctx, &nb, triangles ? 0 : d.fan_k);
     t1 = asp_time_now();
     a->info.t_neighbours = t1 - t;
     t = t1;
@@ -237,6 +249,7 @@ static int decompose(const asp_cloud *cloud, const uint32_t *triangles, size_t n
     if (rc)
         goto fail;
     asp__amg_nbhd_release(ctx, &nb);
+    asp__amg_fans_compact(ctx, &fans); /* after the neighbourhoods are gone: not both at once */
     size_t tri_total = 0;
     for (size_t i = 0; i < n; i++)
         tri_total += fans.ntri[i];
@@ -265,10 +278,18 @@ static int decompose(const asp_cloud *cloud, const uint32_t *triangles, size_t n
     t = t1;
     if ((rc = stage(ctx, "amg", 0, err)) != 0)
         goto fail;
-    rc = asp__amg_build_hierarchy(a->matrix, flat, a->classifier, &d, ctx, &nlevels, &p, &a->level_size,
-                                  &a->info.repaired_rows, err);
-    asp_amg_csr_destroy(flat);
-    flat = NULL;
+    if (d.keep_matrix) {
+        rc = asp__amg_build_hierarchy(a->matrix, flat, a->classifier, &d, ctx, &nlevels, &p, &a->level_size,
+                                      &a->info.repaired_rows, err);
+        asp_amg_csr_destroy(flat);
+        flat = NULL;
+    } else {
+        /* A^0 and F^0 go as soon as the hierarchy is done with them: the peak of the AMG stage (issue 19) */
+        asp_amg_csr *a0 = a->matrix;
+        a->matrix = NULL;
+        rc = asp__amg_build_hierarchy_take(&a0, &flat, a->classifier, &d, ctx, &nlevels, &p, &a->level_size,
+                                           &a->info.repaired_rows, err);
+    }
     if (rc)
         goto fail;
     a->prolong = p;
@@ -293,7 +314,19 @@ fail:
 int asp_amg_decompose(const asp_cloud *cloud, const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out,
                       asp_error *err)
 {
-    return decompose(cloud, NULL, 0, desc, ctx, out, err);
+    return decompose(cloud, NULL, NULL, 0, desc, ctx, out, err);
+}
+
+int asp_amg_decompose_take(asp_cloud **cloud, const asp_amg_desc *desc, const asp_context *ctx, asp_amg **out,
+                           asp_error *err)
+{
+    ASP_ASSERT(cloud && *cloud);
+    int rc = decompose(*cloud, cloud, NULL, 0, desc, ctx, out, err);
+    if (rc) {
+        asp_cloud_destroy(*cloud); // still here when the checks refused it before the pipeline took it
+        *cloud = NULL;
+    }
+    return rc;
 }
 
 int asp_amg_decompose_mesh(const asp_cloud *vertices, const uint32_t *triangles, size_t triangle_count,
@@ -301,5 +334,5 @@ int asp_amg_decompose_mesh(const asp_cloud *vertices, const uint32_t *triangles,
 {
     if (!triangles || triangle_count == 0)
         return asp_error_set(err, ASP_EINVAL, "cannot decompose a mesh without triangles");
-    return decompose(vertices, triangles, triangle_count, desc, ctx, out, err);
+    return decompose(vertices, NULL, triangles, triangle_count, desc, ctx, out, err);
 }

@@ -151,10 +151,10 @@ static void tangent_basis(const float *nrm, double e0[3], double e1[3])
 int asp__amg_build_fans(const float *pos, const float *normals, const asp__amg_nbhd *nb, size_t fan_k,
                         const asp_context *ctx, asp__amg_fans *out, asp_error *err)
 {
-    const size_t n = nb->n, kmax = nb->kmax;
+    const size_t n = nb->n;
     const int threads = asp_context_threads(ctx);
     const size_t scratch_size = asp_amg_fan_scratch_size(fan_k) + 2 * fan_k * sizeof(double);
-    asp__amg_fans f = {n, fan_k, NULL, NULL};
+    asp__amg_fans f = {n, fan_k, NULL, NULL, NULL};
     f.tri = asp_alloc(ctx, 2 * n * fan_k * sizeof *f.tri);
     f.ntri = asp_alloc(ctx, n * sizeof *f.ntri);
     char *scratch = asp_alloc(ctx, (size_t)threads * scratch_size);
@@ -176,14 +176,14 @@ int asp__amg_build_fans(const float *pos, const float *normals, const asp__amg_n
         double e0[3], e1[3];
         tangent_basis(normals + 3 * i, e0, e1);
         const float *x = pos + 3 * i;
-        const asp_index *row = nb->nbr + i * kmax;
+        const asp_index *row = asp__amg_nbhd_row(nb, i);
         for (size_t j = 0; j < fan_k; j++) {
             const float *q = pos + 3 * (size_t)row[j];
             double d[3] = {(double)q[0] - x[0], (double)q[1] - x[1], (double)q[2] - x[2]};
             xy[2 * j] = d[0] * e0[0] + d[1] * e0[1] + d[2] * e0[2];
             xy[2 * j + 1] = d[0] * e1[0] + d[1] * e1[1] + d[2] * e1[2];
         }
-        asp_index *tri = f.tri + 2 * i * fan_k;
+        asp_index *tri = f.tri + 2 * i * fan_k; /* the stride layout until asp__amg_fans_compact */
         size_t nt = asp_amg_fan(xy, fan_k, tri, fan_scratch);
         for (size_t c = 0; c < 2 * nt; c++)
             tri[c] = row[tri[c]];
@@ -195,10 +195,40 @@ int asp__amg_build_fans(const float *pos, const float *normals, const asp__amg_n
     return 0;
 }
 
+void asp__amg_fans_compact(const asp_context *ctx, asp__amg_fans *f)
+{
+    if (f->first)
+        return;
+    const int threads = asp_context_threads(ctx);
+    (void)threads; /* read by the OpenMP pragma only */
+    size_t *first = asp_alloc(ctx, (f->n + 1) * sizeof *first);
+    asp_index *tri = NULL;
+    if (first) {
+        first[0] = 0;
+        for (size_t i = 0; i < f->n; i++)
+            first[i + 1] = first[i] + f->ntri[i];
+        tri = asp_alloc(ctx, (2 * first[f->n] + 1) * sizeof *tri);
+    }
+    if (!tri) {
+        asp_free(ctx, first); /* the stride layout stays valid */
+        return;
+    }
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long ii = 0; ii < (long long)f->n; ii++) {
+        size_t i = (size_t)ii;
+        memcpy(tri + 2 * first[i], f->tri + 2 * i * f->stride, 2 * (size_t)f->ntri[i] * sizeof *tri);
+    }
+    asp_free(ctx, f->tri);
+    f->tri = tri;
+    f->first = first;
+}
+
 void asp__amg_fans_release(const asp_context *ctx, asp__amg_fans *f)
 {
     asp_free(ctx, f->tri);
     asp_free(ctx, f->ntri);
+    asp_free(ctx, f->first);
     f->tri = NULL;
     f->ntri = NULL;
+    f->first = NULL;
 }

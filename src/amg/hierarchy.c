@@ -230,9 +230,10 @@ static void carry(const asp_amg_csr *p, const double *src, double *dst)
             dst[p->col[k]] += p->val[k] * src[r];
 }
 
-int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const float *cls,
-                             const asp_amg_desc *desc, const asp_context *ctx, size_t *nlevels, asp_amg_csr ***p_out,
-                             size_t **sizes_out, size_t *repaired, asp_error *err)
+/* own_a0, own_f0: NULL, or a0's and f0's owners (asp__amg_build_hierarchy_take) */
+static int build(const asp_amg_csr *a0, asp_amg_csr **own_a0, const asp_amg_csr *f0, asp_amg_csr **own_f0,
+                 const float *cls, const asp_amg_desc *desc, const asp_context *ctx, size_t *nlevels,
+                 asp_amg_csr ***p_out, size_t **sizes_out, size_t *repaired, asp_error *err)
 {
     const size_t maxl = desc->max_levels, n = a0->rows;
     const int crease = desc->crease_cut > 0 && f0 && cls;
@@ -263,10 +264,16 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
         cm[i] = cls ? cls[i] : 1.0;
     }
     const double cut = desc->weak_coupling > 0 ? desc->weak_coupling * median_coupling(a0, ctx) : 0;
-    while (levels < maxl && cur->rows > desc->max_coarse) {
+    size_t cur_rows = n;
+    while (levels < maxl && cur_rows > desc->max_coarse) {
         asp_amg_csr *praw = NULL, *araw = NULL, *next = NULL, *fnext = NULL;
         size_t fresh = 0, offdiag = 0, ncut = 0;
-        rc = asp__amg_hypre_coarsen(cur, desc, ctx, &praw, &araw, err);
+        if (own_a0 && *own_a0 && cur == *own_a0) {
+            cur = NULL; /* freed inside, once hypre has its copy */
+            rc = asp__amg_hypre_coarsen_take(own_a0, desc, ctx, &praw, &araw, err);
+        } else {
+            rc = asp__amg_hypre_coarsen(cur, desc, ctx, &praw, &araw, err);
+        }
         if (rc)
             goto done;
         if (!praw) {
@@ -282,6 +289,11 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
         }
         if (!rc && crease) {
             rc = asp__amg_galerkin(praw, fcur, ctx, &fnext, err);
+            if (!rc && own_f0 && *own_f0 == fcur) {
+                asp_amg_csr_destroy(*own_f0); /* only the first Galerkin product reads F^0 */
+                *own_f0 = NULL;
+                fcur = NULL;
+            }
             asp_free(ctx, cutflag);
             cutflag = rc ? NULL : asp_alloc(ctx, (araw->row_ptr[araw->rows] + 1) * sizeof *cutflag);
             if (!rc && !cutflag)
@@ -302,7 +314,7 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
             asp_amg_csr_destroy(fnext);
             goto done;
         }
-        if (praw->cols >= cur->rows) {
+        if (praw->cols >= cur_rows) {
             /* nothing left to merge: every unknown is its own part of the surface */
             asp_amg_csr_destroy(praw);
             asp_amg_csr_destroy(next);
@@ -315,6 +327,7 @@ int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const
         asp_amg_csr_destroy(owned);
         owned = next;
         cur = next;
+        cur_rows = next->rows;
         if (fnext) {
             asp_amg_csr_destroy(fowned);
             fowned = fnext;
@@ -348,4 +361,23 @@ done:
     *p_out = p;
     *sizes_out = sizes;
     return 0;
+}
+
+int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const float *cls,
+                             const asp_amg_desc *desc, const asp_context *ctx, size_t *nlevels, asp_amg_csr ***p_out,
+                             size_t **sizes_out, size_t *repaired, asp_error *err)
+{
+    return build(a0, NULL, f0, NULL, cls, desc, ctx, nlevels, p_out, sizes_out, repaired, err);
+}
+
+int asp__amg_build_hierarchy_take(asp_amg_csr **a0, asp_amg_csr **f0, const float *cls, const asp_amg_desc *desc,
+                                  const asp_context *ctx, size_t *nlevels, asp_amg_csr ***p_out, size_t **sizes_out,
+                                  size_t *repaired, asp_error *err)
+{
+    int rc = build(*a0, a0, *f0, f0, cls, desc, ctx, nlevels, p_out, sizes_out, repaired, err);
+    asp_amg_csr_destroy(*a0);
+    asp_amg_csr_destroy(*f0);
+    *a0 = NULL;
+    *f0 = NULL;
+    return rc;
 }

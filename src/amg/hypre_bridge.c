@@ -6,6 +6,9 @@
 #include <errno.h>
 #include <stdint.h>
 #include <limits.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,6 +39,26 @@ int ffs(int i);
 
 #include "amg/internal.h"
 #include "util/banned.h"
+
+/*
+ * libsuperlu_dist, which comes with hypre, calls mallopt(M_MMAP_MAX, 0) and
+ * mallopt(M_TRIM_THRESHOLD, -1) in its load-time constructor: glibc then
+ * never maps a large block of its own and never gives freed memory back, so
+ * every array a stage frees stays resident and the peak RSS is the heap's
+ * high-water mark, fragmentation included (issue 19: 1M points, 764 MB RSS
+ * where the library never held more than 778 B/point in one stage and under
+ * 260 B/point between stages). This runs after the shared libraries'
+ * constructors and puts glibc's defaults back before main (the dynamic mmap
+ * threshold stays off: superlu's M_TRIM_THRESHOLD call disabled it, so blocks
+ * from 128 KiB up are mapped and unmapped on free). Nothing here uses SuperLU.
+ */
+#ifdef __GLIBC__
+__attribute__((constructor)) static void restore_malloc_defaults(void)
+{
+    mallopt(M_MMAP_MAX, 65536);
+    mallopt(M_TRIM_THRESHOLD, 128 * 1024);
+}
+#endif
 
 /*
  * MPI is process-wide state that we cannot keep in asp_context: initialise it
@@ -230,43 +253,73 @@ static int copy_parcsr(hypre_ParCSRMatrix *p, const asp_context *ctx, asp_amg_cs
     return 0;
 }
 
-static int coarsen_here(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
+/*
+ * a as a one-process hypre ParCSR matrix, written straight into hypre's
+ * arrays (issue 19): the IJ interface kept its own row buffers beside the
+ * result and cost about 240 B/point at the peak for 88 in the matrix. The
+ * layout is the one IJ assembly produced: each row's diagonal first (hypre's
+ * rule for the diag block), then the other columns in a's increasing order,
+ * so BoomerAMG sees the same matrix and gives the same bits.
+ */
+static int build_parcsr(const asp_amg_csr *a, hypre_ParCSRMatrix **out, asp_error *err)
+{
+    const size_t n = a->rows, nnz = a->row_ptr[n];
+    HYPRE_BigInt starts[2] = {0, (HYPRE_BigInt)n};
+    hypre_ParCSRMatrix *m = hypre_ParCSRMatrixCreate(MPI_COMM_SELF, (HYPRE_BigInt)n, (HYPRE_BigInt)n, starts, starts, 0,
+                                                     (HYPRE_Int)nnz, 0);
+    if (!m || hypre_ParCSRMatrixInitialize(m) != 0 || !hypre_CSRMatrixI(hypre_ParCSRMatrixDiag(m)) ||
+        (nnz && (!hypre_CSRMatrixJ(hypre_ParCSRMatrixDiag(m)) || !hypre_CSRMatrixData(hypre_ParCSRMatrixDiag(m))))) {
+        if (m)
+            hypre_ParCSRMatrixDestroy(m);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for the hypre copy of the %zu x %zu matrix", n, n);
+    }
+    hypre_CSRMatrix *d = hypre_ParCSRMatrixDiag(m);
+    HYPRE_Int *ia = hypre_CSRMatrixI(d), *ja = hypre_CSRMatrixJ(d);
+    HYPRE_Complex *va = hypre_CSRMatrixData(d);
+    ia[0] = 0;
+    for (size_t r = 0; r < n; r++) {
+        size_t b = a->row_ptr[r], e = a->row_ptr[r + 1], w = b;
+        for (size_t k = b; k < e; k++)
+            if (a->col[k] == r) {
+                ja[w] = (HYPRE_Int)r;
+                va[w++] = a->val[k];
+            }
+        for (size_t k = b; k < e; k++)
+            if (a->col[k] != r) {
+                ja[w] = (HYPRE_Int)a->col[k];
+                va[w++] = a->val[k];
+            }
+        ia[r + 1] = (HYPRE_Int)e;
+    }
+    hypre_ParCSRMatrixSetNumNonzeros(m);
+    hypre_ParCSRMatrixSetDNumNonzeros(m);
+    *out = m;
+    return 0;
+}
+
+/* take (may be NULL) is a's owner: a is destroyed once hypre has its copy */
+static int coarsen_here(const asp_amg_csr *a, asp_amg_csr **take, const asp_amg_desc *desc, const asp_context *ctx,
                         asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
 {
     int rc = ensure_mpi(err);
     if (rc)
         return rc;
     HYPRE_Int n = (HYPRE_Int)a->rows;
-    HYPRE_IJMatrix ij = NULL;
+    const size_t rows = a->rows;
     HYPRE_IJVector bij = NULL, xij = NULL;
     HYPRE_Solver amg = NULL;
-    HYPRE_Int *ncols = NULL, *rowsv = NULL, *colsv = NULL;
+    hypre_ParCSRMatrix *pa = NULL;
     asp_amg_csr *p = NULL, *ac = NULL;
 
-    ncols = asp_alloc(ctx, (size_t)n * sizeof *ncols);
-    rowsv = asp_alloc(ctx, (size_t)n * sizeof *rowsv);
-    colsv = asp_alloc(ctx, (a->row_ptr[a->rows] + 1) * sizeof *colsv);
-    if (!ncols || !rowsv || !colsv) {
-        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the hypre matrix");
-        goto done;
-    }
-    for (HYPRE_Int r = 0; r < n; r++) {
-        ncols[r] = (HYPRE_Int)(a->row_ptr[r + 1] - a->row_ptr[r]);
-        rowsv[r] = r;
-    }
-    for (size_t k = 0; k < a->row_ptr[a->rows]; k++)
-        colsv[k] = (HYPRE_Int)a->col[k];
-
     HYPRE_ClearAllErrors();
-    HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, n - 1, 0, n - 1, &ij);
-    HYPRE_IJMatrixSetObjectType(ij, HYPRE_PARCSR);
-    HYPRE_IJMatrixSetRowSizes(ij, ncols);
-    HYPRE_IJMatrixInitialize(ij);
-    HYPRE_IJMatrixSetValues(ij, n, ncols, rowsv, colsv, a->val);
-    HYPRE_IJMatrixAssemble(ij);
-    HYPRE_ParCSRMatrix pa;
-    HYPRE_IJMatrixGetObject(ij, (void **)&pa);
-
+    rc = build_parcsr(a, &pa, err);
+    if (rc)
+        goto done;
+    if (take) {
+        asp_amg_csr_destroy(*take);
+        *take = NULL;
+        a = NULL;
+    }
     HYPRE_IJVectorCreate(MPI_COMM_SELF, 0, n - 1, &bij);
     HYPRE_IJVectorSetObjectType(bij, HYPRE_PARCSR);
     HYPRE_IJVectorInitialize(bij);
@@ -297,31 +350,32 @@ static int coarsen_here(const asp_amg_csr *a, const asp_amg_desc *desc, const as
     /* our matrix is singular (zero row sums): keep Gaussian elimination off the coarsest level */
     HYPRE_BoomerAMGSetCycleRelaxType(amg, 3, 3);
     HYPRE_BoomerAMGSetMaxIter(amg, 1);
-    HYPRE_BoomerAMGSetup(amg, pa, pb, px);
+    HYPRE_BoomerAMGSetup(amg, (HYPRE_ParCSRMatrix)pa, pb, px);
     /* hypre flags harmless conditions (a zero diagonal on a disconnected coarse point) as errors */
     HYPRE_ClearAllErrors();
+    /* the fine matrix is ours, not the solver's (A_array[0] is only borrowed): free it before copying P and A^1 out */
+    hypre_ParCSRMatrixDestroy(pa);
+    pa = NULL;
+    hypre_ParAMGDataAArray((hypre_ParAMGData *)amg)[0] = NULL;
 
     hypre_ParAMGData *data = (hypre_ParAMGData *)amg;
     if (hypre_ParAMGDataNumLevels(data) >= 2) {
         rc = copy_parcsr(hypre_ParAMGDataPArray(data)[0], ctx, &p, err);
         if (!rc)
             rc = copy_parcsr(hypre_ParAMGDataAArray(data)[1], ctx, &ac, err);
-        if (!rc && (p->rows != a->rows || ac->rows != p->cols || ac->cols != p->cols))
+        if (!rc && (p->rows != rows || ac->rows != p->cols || ac->cols != p->cols))
             rc = asp_error_set(err, ASP_ESOLVER, "hypre returned inconsistent coarse sizes");
     }
 
 done:
     if (amg)
         HYPRE_BoomerAMGDestroy(amg);
-    if (ij)
-        HYPRE_IJMatrixDestroy(ij);
+    if (pa)
+        hypre_ParCSRMatrixDestroy(pa);
     if (bij)
         HYPRE_IJVectorDestroy(bij);
     if (xij)
         HYPRE_IJVectorDestroy(xij);
-    asp_free(ctx, ncols);
-    asp_free(ctx, rowsv);
-    asp_free(ctx, colsv);
     if (rc) {
         asp_amg_csr_destroy(p);
         asp_amg_csr_destroy(ac);
@@ -409,9 +463,10 @@ static int read_csr(int fd, const asp_context *ctx, asp_amg_csr **out, asp_error
  * line. Cost: MPI's start-up (0.4-0.5 s) per level, only in such runs; the
  * child runs hypre on one thread (libgomp's pool is not safe across fork).
  */
-static int coarsen_isolated(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
-                            asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
+static int coarsen_isolated(const asp_amg_csr *a, asp_amg_csr **take, const asp_amg_desc *desc,
+                            const asp_context *ctx, asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
 {
+    const size_t rows = a->rows;
     const char *dir = getenv("TMPDIR");
     snprintf(mpi_log, sizeof mpi_log, "%s/amgsplat-mpi-XXXXXX", dir && *dir ? dir : "/tmp");
     int logfd = mkstemp(mpi_log);
@@ -451,7 +506,7 @@ static int coarsen_isolated(const asp_amg_csr *a, const asp_amg_desc *desc, cons
             _exit(3);
         asp_amg_csr *p = NULL, *ac = NULL;
         if (!rc)
-            rc = coarsen_here(a, desc, ctx, &p, &ac, &cerr);
+            rc = coarsen_here(a, take, desc, ctx, &p, &ac, &cerr); // frees the child's view of *take too
         int32_t has = p != NULL;
         if (rc) {
             uint32_t len = (uint32_t)strlen(cerr.msg);
@@ -466,6 +521,11 @@ static int coarsen_isolated(const asp_amg_csr *a, const asp_amg_desc *desc, cons
     }
     close(logfd);
     close(fds[1]);
+    if (take) { // the child has its own copy of the pages now
+        asp_amg_csr_destroy(*take);
+        *take = NULL;
+        a = NULL;
+    }
     char started = 0;
     int32_t crc = 0, has = 0;
     asp_amg_csr *p = NULL, *ac = NULL;
@@ -529,17 +589,29 @@ static int coarsen_isolated(const asp_amg_csr *a, const asp_amg_desc *desc, cons
     return asp_error_set(err, ASP_ESOLVER,
                          "the AMG solver (hypre on Open MPI) failed in its process on a %zu x %zu matrix: %s; "
                          "Open MPI's report is in '%s'",
-                         a->rows, a->rows, reason, mpi_log);
+                         rows, rows, reason, mpi_log);
 }
 
-int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
-                           asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
+static int coarsen(const asp_amg_csr *a, asp_amg_csr **take, const asp_amg_desc *desc, const asp_context *ctx,
+                   asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
 {
     if (a->rows > (size_t)INT_MAX - 1 || a->row_ptr[a->rows] > (size_t)INT_MAX)
         return asp_error_set(err, ASP_EUNSUPPORTED, "matrix of %zu rows is too large for this hypre build", a->rows);
     int started = 0;
     MPI_Initialized(&started);
     if (!started && mpi_start_at_risk())
-        return coarsen_isolated(a, desc, ctx, p_out, ac_out, err);
-    return coarsen_here(a, desc, ctx, p_out, ac_out, err);
+        return coarsen_isolated(a, take, desc, ctx, p_out, ac_out, err);
+    return coarsen_here(a, take, desc, ctx, p_out, ac_out, err);
+}
+
+int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
+                           asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
+{
+    return coarsen(a, NULL, desc, ctx, p_out, ac_out, err);
+}
+
+int asp__amg_hypre_coarsen_take(asp_amg_csr **a, const asp_amg_desc *desc, const asp_context *ctx,
+                                asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
+{
+    return coarsen(*a, a, desc, ctx, p_out, ac_out, err);
 }

@@ -22,25 +22,52 @@ struct asp_amg {
     asp_frame frame;       /* the source points' frame (asp_cloud_frame) */
 };
 
-/* Neighbourhoods N(x) of journal 2.1: row i of nbr (stride kmax) holds nn[i] indices, nearest first. */
+/*
+ * Neighbourhoods N(x) of journal 2.1: row i (asp__amg_nbhd_row) holds nn[i]
+ * indices, nearest first, and at least the fan_k nearest. Rows start at
+ * first[i] (compact, issue 19), or at i * kmax when first is NULL.
+ */
 typedef struct asp__amg_nbhd {
     size_t n, kmax;
-    asp_index *nbr; /* n * kmax */
+    asp_index *nbr; /* first[n] (or n * kmax) */
     uint16_t *nn;   /* n */
+    size_t *first;  /* n + 1, or NULL */
 } asp__amg_nbhd;
 
-/* Local triangle fans (journal 2.2): point i's triangles are (i, tri[2(i*stride+t)], tri[2(i*stride+t)+1]), t < ntri[i]. */
+static inline const asp_index *asp__amg_nbhd_row(const asp__amg_nbhd *nb, size_t i)
+{
+    return nb->nbr + (nb->first ? nb->first[i] : i * nb->kmax);
+}
+
+/*
+ * Local triangle fans (journal 2.2): point i's triangles are (i, r[2t],
+ * r[2t+1]), t < ntri[i], r = asp__amg_fan_row. Rows start at pair first[i]
+ * (compact, issue 19), or at pair i * stride when first is NULL.
+ */
 typedef struct asp__amg_fans {
     size_t n, stride;
-    asp_index *tri;  /* 2 * n * stride */
+    asp_index *tri;  /* 2 * first[n] (or 2 * n * stride) */
     uint16_t *ntri;  /* n */
+    size_t *first;   /* n + 1, or NULL */
 } asp__amg_fans;
+
+static inline const asp_index *asp__amg_fan_row(const asp__amg_fans *f, size_t i)
+{
+    return f->tri + 2 * (f->first ? f->first[i] : i * f->stride);
+}
 
 int asp__amg_resolve_desc(const asp_amg_desc *in, size_t count, asp_amg_desc *out, asp_error *err);
 
 int asp__amg_neighbourhoods(const float *pos, size_t n, asp_amg_desc *desc, const asp_context *ctx,
                             asp__amg_nbhd *out, double *mean_size, asp_error *err);
 void asp__amg_nbhd_release(const asp_context *ctx, asp__amg_nbhd *nb);
+/*
+ * Moves the stride-layout rows (what asp__amg_neighbourhoods gives) into a
+ * block of their lengths, max(nn[i], fan_k) (first[] offsets): about half the
+ * bytes on a scan (issue 19). Left as is when out of memory. After it nn[i]
+ * may not grow (the distributed run re-derives nn on the stride layout).
+ */
+void asp__amg_nbhd_compact(const asp_context *ctx, asp__amg_nbhd *nb, size_t fan_k);
 
 int asp__amg_classify(const float *pos, const asp__amg_nbhd *nb, const asp_amg_desc *desc, const asp_context *ctx,
                       float *classifier, float *normals, asp_error *err);
@@ -48,6 +75,8 @@ int asp__amg_classify(const float *pos, const asp__amg_nbhd *nb, const asp_amg_d
 int asp__amg_build_fans(const float *pos, const float *normals, const asp__amg_nbhd *nb, size_t fan_k,
                         const asp_context *ctx, asp__amg_fans *out, asp_error *err);
 void asp__amg_fans_release(const asp_context *ctx, asp__amg_fans *f);
+/* Moves stride-layout rows together (first[] offsets) and shrinks tri; left as is when out of memory. */
+void asp__amg_fans_compact(const asp_context *ctx, asp__amg_fans *f);
 /* Fans of the mesh triangles incident to each of n vertices (mesh_fans.c, journal eq. 4). */
 int asp__amg_mesh_fans(size_t n, const uint32_t *triangles, size_t ntris, const asp_context *ctx,
                        asp__amg_fans *out, asp_error *err);
@@ -60,6 +89,9 @@ int asp__amg_assemble(const float *pos, const float *classifier, const asp__amg_
 /* One BoomerAMG setup level on a: copies P (a->rows x nc) and A^1 = P^T a P; *p = NULL when hypre did not coarsen. */
 int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
                            asp_amg_csr **p, asp_amg_csr **ac, asp_error *err);
+/* The same, taking *a: it is destroyed (*a = NULL) as soon as hypre holds its own copy, before the setup. */
+int asp__amg_hypre_coarsen_take(asp_amg_csr **a, const asp_amg_desc *desc, const asp_context *ctx,
+                                asp_amg_csr **p, asp_amg_csr **ac, asp_error *err);
 
 /* The hierarchy level by level (hierarchy.c): p[1..nlevels-1], sizes[0..nlevels-1]; arrays sized max_levels. */
 /*
@@ -69,6 +101,14 @@ int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const
 int asp__amg_build_hierarchy(const asp_amg_csr *a0, const asp_amg_csr *f0, const float *cls,
                              const asp_amg_desc *desc, const asp_context *ctx, size_t *nlevels, asp_amg_csr ***p,
                              size_t **sizes, size_t *repaired, asp_error *err);
+/*
+ * The same, taking *a0 and *f0 (either may point to NULL): each is destroyed
+ * and set to NULL once the hierarchy no longer needs it (A^0 inside the first
+ * hypre call, F^0 after the first Galerkin product), on failure too (issue 19).
+ */
+int asp__amg_build_hierarchy_take(asp_amg_csr **a0, asp_amg_csr **f0, const float *cls, const asp_amg_desc *desc,
+                                  const asp_context *ctx, size_t *nlevels, asp_amg_csr ***p, size_t **sizes,
+                                  size_t *repaired, asp_error *err);
 
 /* Galerkin product P^T F P (p: n x nc, f: n x n); columns within a row are not sorted. */
 int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_context *ctx, asp_amg_csr **out,

@@ -32,7 +32,7 @@ int asp__amg_mesh_fans(size_t n, const uint32_t *triangles, size_t ntris, const 
         return asp_error_set(err, ASP_EUNSUPPORTED, "a vertex has %zu triangles: at most %u are supported", stride,
                              (unsigned)UINT16_MAX);
     }
-    asp__amg_fans f = {n, stride, NULL, NULL};
+    asp__amg_fans f = {n, stride, NULL, NULL, NULL};
     f.tri = asp_alloc(ctx, 2 * n * stride * sizeof *f.tri);
     f.ntri = asp_calloc(ctx, n ? n : 1, sizeof *f.ntri);
     asp_free(ctx, deg);
@@ -52,6 +52,7 @@ int asp__amg_mesh_fans(size_t n, const uint32_t *triangles, size_t ntris, const 
             f.ntri[p]++;
         }
     }
+    asp__amg_fans_compact(ctx, &f);
     *out = f;
     return 0;
 }

@@ -124,29 +124,51 @@ static float select_kth(float *v, size_t n, size_t k)
     return v[k];
 }
 
+/*
+ * Squared distance as the kd-tree computes it (kdtree.c dist2_3: float, same
+ * expression and order; (p - q)^2 equals (q - p)^2 exactly), so a recomputed
+ * distance is bit-identical to the one the search ranked by.
+ */
+static inline float dist2(const float *p, const float *q)
+{
+    float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+    return dx * dx + dy * dy + dz * dz;
+}
+
 int asp__amg_neighbourhoods(const float *pos, size_t n, asp_amg_desc *desc, const asp_context *ctx,
                             asp__amg_nbhd *out, double *mean_size, asp_error *err)
 {
     const size_t kmax = desc->k_max, kmin = desc->k_min;
+    const int threads = asp_context_threads(ctx);
+    (void)threads; /* read by the OpenMP pragmas only */
     asp_kdtree *tree = NULL;
-    float *d2 = NULL, *kth = NULL;
-    asp__amg_nbhd nb = {n, kmax, NULL, NULL};
+    float *kth = NULL;
+    asp__amg_nbhd nb = {n, kmax, NULL, NULL, NULL};
     int rc = asp_kdtree_create(pos, n, 3 * sizeof(float), ctx, &tree, err);
     if (rc)
         return rc;
     nb.nbr = asp_alloc(ctx, n * kmax * sizeof *nb.nbr);
     nb.nn = asp_alloc(ctx, n * sizeof *nb.nn);
-    d2 = asp_alloc(ctx, n * kmax * sizeof *d2);
     kth = asp_alloc(ctx, n * sizeof *kth);
-    if (!nb.nbr || !nb.nn || !d2 || !kth) {
+    if (!nb.nbr || !nb.nn || !kth) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %zu neighbourhoods of %zu points", n, kmax);
         goto done;
     }
-    rc = asp_knn_all(tree, kmax, nb.nbr, d2, ctx, err);
+    /*
+     * No distance array (issue 19: n k_max floats, as large as the indices):
+     * the two distances per point that are needed, the k_min-th for epsilon
+     * and the ball test, are recomputed exactly from the positions.
+     */
+    rc = asp_knn_all(tree, kmax, nb.nbr, NULL, ctx, err);
+    asp_kdtree_destroy(tree);
+    tree = NULL;
     if (rc)
         goto done;
-    for (size_t i = 0; i < n; i++)
-        kth[i] = d2[i * kmax + kmin - 1];
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long ii = 0; ii < (long long)n; ii++) {
+        size_t i = (size_t)ii;
+        kth[i] = dist2(pos + 3 * (size_t)nb.nbr[i * kmax + kmin - 1], pos + 3 * i);
+    }
     if (desc->epsilon == 0) {
         /* journal 2.1 leaves epsilon to the user: the median k_min-th neighbour distance is the typical scale */
         desc->epsilon = sqrt((double)select_kth(kth, n, n / 2));
@@ -157,30 +179,66 @@ int asp__amg_neighbourhoods(const float *pos, size_t n, asp_amg_desc *desc, cons
         }
     }
     const float eps2 = (float)(desc->epsilon * desc->epsilon);
-    double total = 0;
-    for (size_t i = 0; i < n; i++) {
-        size_t m = kmin;
-        while (m < kmax && d2[i * kmax + m] <= eps2)
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long ii = 0; ii < (long long)n; ii++) {
+        size_t i = (size_t)ii, m = kmin;
+        const asp_index *row = nb.nbr + i * kmax;
+        while (m < kmax && dist2(pos + 3 * (size_t)row[m], pos + 3 * i) <= eps2)
             m++;
         nb.nn[i] = (uint16_t)m;
-        total += (double)m;
     }
+    double total = 0;
+    for (size_t i = 0; i < n; i++)
+        total += (double)nb.nn[i];
     *mean_size = total / (double)n;
     *out = nb;
     nb.nbr = NULL;
     nb.nn = NULL;
+    nb.first = NULL;
 done:
     asp__amg_nbhd_release(ctx, &nb);
-    asp_free(ctx, d2);
     asp_free(ctx, kth);
     asp_kdtree_destroy(tree);
     return rc;
+}
+
+void asp__amg_nbhd_compact(const asp_context *ctx, asp__amg_nbhd *nb, size_t fan_k)
+{
+    if (nb->first || !nb->nbr)
+        return;
+    const size_t n = nb->n, kmax = nb->kmax;
+    const int threads = asp_context_threads(ctx);
+    (void)threads; /* read by the OpenMP pragma only */
+    /* rows keep at least fan_k entries: the fans (fan.c) project the fan_k nearest whatever N(x) holds */
+    const size_t keep_min = fan_k < kmax ? fan_k : kmax;
+    size_t *first = asp_alloc(ctx, (n + 1) * sizeof *first);
+    asp_index *compact = NULL;
+    if (first) {
+        first[0] = 0;
+        for (size_t i = 0; i < n; i++)
+            first[i + 1] = first[i] + (nb->nn[i] > keep_min ? nb->nn[i] : keep_min);
+        compact = asp_alloc(ctx, (first[n] + 1) * sizeof *compact);
+    }
+    if (!compact) {
+        asp_free(ctx, first); /* out of memory: the stride layout serves as well */
+        return;
+    }
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long ii = 0; ii < (long long)n; ii++) {
+        size_t i = (size_t)ii;
+        memcpy(compact + first[i], nb->nbr + i * kmax, (first[i + 1] - first[i]) * sizeof *compact);
+    }
+    asp_free(ctx, nb->nbr);
+    nb->nbr = compact;
+    nb->first = first;
 }
 
 void asp__amg_nbhd_release(const asp_context *ctx, asp__amg_nbhd *nb)
 {
     asp_free(ctx, nb->nbr);
     asp_free(ctx, nb->nn);
+    asp_free(ctx, nb->first);
     nb->nbr = NULL;
     nb->nn = NULL;
+    nb->first = NULL;
 }

@@ -113,7 +113,7 @@ static void run_model(const char *name, asp_cloud *cloud)
         return;
     asp_error errbuf, *err = &errbuf;
     asp_amg *amg = NULL;
-    CHECK_OK(asp_amg_decompose(cloud, NULL, NULL, &amg, err), err);
+    CHECK_OK(asp_amg_decompose(cloud, &(asp_amg_desc){.keep_matrix = 1}, NULL, &amg, err), err);
     if (amg) {
         const asp_amg_info *in = asp_amg_get_info(amg);
         fprintf(stderr, "%s: epsilon %g, |N| %.1f, fan %.2f, %zu positive off-diagonals clamped, %zu isolated\n", name,
@@ -153,7 +153,7 @@ static void test_disconnected(void)
             two->positions[3 * (a->count + i) + k] = a->positions[3 * i + k] + (k == 0 ? 10.0f : 0.0f);
         }
     asp_amg *amg = NULL;
-    CHECK_OK(asp_amg_decompose(two, NULL, NULL, &amg, err), err);
+    CHECK_OK(asp_amg_decompose(two, &(asp_amg_desc){.keep_matrix = 1}, NULL, &amg, err), err);
     if (amg) {
         check_matrix("two octahedra", amg);
         const asp_amg_csr *m = asp_amg_matrix(amg);
@@ -190,8 +190,8 @@ static void test_threads(void)
     if (!c)
         return;
     asp_amg *one = NULL, *two = NULL;
-    CHECK_OK(asp_amg_decompose(c, NULL, &(asp_context){.threads = 1}, &one, err), err);
-    CHECK_OK(asp_amg_decompose(c, NULL, &(asp_context){.threads = 2}, &two, err), err);
+    CHECK_OK(asp_amg_decompose(c, &(asp_amg_desc){.keep_matrix = 1}, &(asp_context){.threads = 1}, &one, err), err);
+    CHECK_OK(asp_amg_decompose(c, &(asp_amg_desc){.keep_matrix = 1}, &(asp_context){.threads = 2}, &two, err), err);
     if (one && two) {
         const asp_amg_csr *a1 = asp_amg_matrix(one), *a2 = asp_amg_matrix(two);
         CHECK(a1->row_ptr[a1->rows] == a2->row_ptr[a2->rows]);
@@ -208,6 +208,23 @@ static void test_threads(void)
                 CHECK(memcmp(p1->val, p2->val, p1->row_ptr[p1->rows] * sizeof *p1->val) == 0);
         }
     }
+    /* the default frees A^0 and F^0 inside the hierarchy (issue 19): the same hierarchy, no matrix kept */
+    asp_amg *lean = NULL;
+    CHECK_OK(asp_amg_decompose(c, NULL, &(asp_context){.threads = 2}, &lean, err), err);
+    if (one && lean) {
+        CHECK(asp_amg_matrix(lean) == NULL);
+        CHECK(asp_amg_get_info(lean)->matrix_nnz == asp_amg_matrix(one)->row_ptr[c->count]);
+        CHECK(asp_amg_level_count(one) == asp_amg_level_count(lean));
+        for (size_t l = 1; l < asp_amg_level_count(one) && l < asp_amg_level_count(lean); l++) {
+            const asp_amg_csr *p1 = asp_amg_prolongation(one, l), *p2 = asp_amg_prolongation(lean, l);
+            CHECK(p1->cols == p2->cols && p1->row_ptr[p1->rows] == p2->row_ptr[p2->rows]);
+            if (p1->row_ptr[p1->rows] == p2->row_ptr[p2->rows]) {
+                CHECK(memcmp(p1->col, p2->col, p1->row_ptr[p1->rows] * sizeof *p1->col) == 0);
+                CHECK(memcmp(p1->val, p2->val, p1->row_ptr[p1->rows] * sizeof *p1->val) == 0);
+            }
+        }
+    }
+    asp_amg_destroy(lean);
     asp_amg_destroy(one);
     asp_amg_destroy(two);
     asp_cloud_destroy(c);

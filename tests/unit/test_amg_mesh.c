@@ -72,7 +72,7 @@ static void test_fold(void)
     asp_error err;
     asp_amg *amg = NULL;
     if (c && tris)
-        CHECK_OK(asp_amg_decompose_mesh(c, tris, ntris, NULL, NULL, &amg, &err), &err);
+        CHECK_OK(asp_amg_decompose_mesh(c, tris, ntris, &(asp_amg_desc){.keep_matrix = 1}, NULL, &amg, &err), &err);
     if (amg) {
         const asp_amg_csr *a = asp_amg_matrix(amg);
         asp_amg_matrix_check mc;

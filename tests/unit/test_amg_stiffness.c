@@ -26,7 +26,7 @@ static void test_forms(void)
         return;
     asp_amg *amg[2] = {NULL, NULL};
     for (int f = 0; f < 2; f++)
-        CHECK_OK(asp_amg_decompose(cloud, &(asp_amg_desc){.stiffness = (asp_amg_stiffness)f}, NULL, &amg[f], err), err);
+        CHECK_OK(asp_amg_decompose(cloud, &(asp_amg_desc){.stiffness = (asp_amg_stiffness)f, .keep_matrix = 1}, NULL, &amg[f], err), err);
     if (amg[0] && amg[1]) {
         const asp_amg_csr *c = asp_amg_matrix(amg[0]), *u = asp_amg_matrix(amg[1]);
         asp_amg_matrix_check mc, mu;
