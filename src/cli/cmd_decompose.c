@@ -452,7 +452,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
             return 0;
         }
         rc = mesh ? asp_amg_decompose_mesh(cloud, mesh->triangles, mesh->triangle_count, &desc, &env->ctx, &amg, &err)
-                  : asp_amg_decompose(cloud, &desc, &env->ctx, &amg, &err);
+                  : asp_amg_decompose_take(&cloud, &desc, &env->ctx, &amg, &err); // no copy of the points (issue 19)
         asp_cloud_destroy(cloud);
         asp_mesh_destroy(mesh);
         if (rc) {
