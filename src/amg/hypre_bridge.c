@@ -159,7 +159,8 @@ static int mpi_start_at_risk(void)
            (getrlimit(RLIMIT_DATA, &data) == 0 && data.rlim_cur != RLIM_INFINITY);
 }
 
-static int ensure_mpi(asp_error *err)
+/* The one start of MPI and hypre in the process, for the serial and the distributed path (hypre_distributed.c). */
+int asp__amg_hypre_start(asp_error *err)
 {
     int flag = 0, done = 0;
     MPI_Finalized(&done);
@@ -196,7 +197,7 @@ void asp_amg_shutdown(void)
     }
 }
 
-static HYPRE_Int coarsen_code(asp_amg_coarsen c)
+int asp__amg_hypre_coarsen_code(asp_amg_coarsen c)
 {
     switch (c) {
     case ASP_AMG_COARSEN_FALGOUT: return 6;
@@ -207,7 +208,7 @@ static HYPRE_Int coarsen_code(asp_amg_coarsen c)
     }
 }
 
-static HYPRE_Int interp_code(asp_amg_interp i)
+int asp__amg_hypre_interp_code(asp_amg_interp i)
 {
     switch (i) {
     case ASP_AMG_INTERP_DIRECT: return 3;
@@ -301,7 +302,7 @@ static int build_parcsr(const asp_amg_csr *a, hypre_ParCSRMatrix **out, asp_erro
 static int coarsen_here(const asp_amg_csr *a, asp_amg_csr **take, const asp_amg_desc *desc, const asp_context *ctx,
                         asp_amg_csr **p_out, asp_amg_csr **ac_out, asp_error *err)
 {
-    int rc = ensure_mpi(err);
+    int rc = asp__amg_hypre_start(err);
     if (rc)
         return rc;
     HYPRE_Int n = (HYPRE_Int)a->rows;
@@ -338,8 +339,8 @@ static int coarsen_here(const asp_amg_csr *a, asp_amg_csr **take, const asp_amg_
 
     HYPRE_BoomerAMGCreate(&amg);
     HYPRE_BoomerAMGSetPrintLevel(amg, 0);
-    HYPRE_BoomerAMGSetCoarsenType(amg, coarsen_code(desc->coarsen));
-    HYPRE_BoomerAMGSetInterpType(amg, interp_code(desc->interp));
+    HYPRE_BoomerAMGSetCoarsenType(amg, asp__amg_hypre_coarsen_code(desc->coarsen));
+    HYPRE_BoomerAMGSetInterpType(amg, asp__amg_hypre_interp_code(desc->interp));
     HYPRE_BoomerAMGSetStrongThreshold(amg, desc->strong_threshold);
     HYPRE_BoomerAMGSetTruncFactor(amg, desc->trunc_factor);
     /* one level at a time: the caller filters each coarse matrix before coarsening it again */
@@ -500,7 +501,7 @@ static int coarsen_isolated(const asp_amg_csr *a, asp_amg_csr **take, const asp_
         omp_set_num_threads(1);
 #endif
         asp_error cerr = {0, ""};
-        int32_t rc = ensure_mpi(&cerr);
+        int32_t rc = asp__amg_hypre_start(&cerr);
         char started = 'M'; // MPI is up: a failure from here on is the solver's, not start-up's
         if (!rc && write_all(fds[1], &started, 1))
             _exit(3);

@@ -24,23 +24,11 @@ int ffs(int i); /* hypre's internal header calls it without declaring it under s
 #include "amg/distributed.h"
 #include "util/banned.h"
 
-/* MPI and hypre are process-wide: remember what this file started so the shutdown ends only that */
-static int mpi_started_here, hypre_started_here;
-
 int asp__dist_start(asp__dist *d, asp_error *err)
 {
-    int started = 0;
-    MPI_Initialized(&started);
-    if (!started) {
-        int provided;
-        if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
-            return asp_error_set(err, ASP_ESOLVER, "cannot start MPI: MPI_Init_thread failed");
-        mpi_started_here = 1;
-    }
-    if (!hypre_started_here) {
-        HYPRE_Init();
-        hypre_started_here = 1;
-    }
+    int rc = asp__amg_hypre_start(err); /* hypre_bridge.c: the one start of MPI and hypre */
+    if (rc)
+        return rc;
     d->comm = MPI_COMM_WORLD;
     MPI_Comm_rank(d->comm, &d->rank);
     MPI_Comm_size(d->comm, &d->size);
@@ -49,30 +37,7 @@ int asp__dist_start(asp__dist *d, asp_error *err)
 
 void asp_amg_distributed_shutdown(void)
 {
-    int done = 0;
-    MPI_Finalized(&done);
-    if (done)
-        return;
-    if (hypre_started_here) {
-        HYPRE_Finalize();
-        hypre_started_here = 0;
-    }
-    if (mpi_started_here) {
-        MPI_Finalize();
-        mpi_started_here = 0;
-    }
-}
-
-/* The serial path's codes (hypre_bridge.c). */
-static HYPRE_Int coarsen_code(asp_amg_coarsen c)
-{
-    return c == ASP_AMG_COARSEN_FALGOUT ? 6 : c == ASP_AMG_COARSEN_CLJP ? 0 : c == ASP_AMG_COARSEN_PMIS ? 8
-                                                                       : c == ASP_AMG_COARSEN_HMIS ? 10 : 3;
-}
-
-static HYPRE_Int interp_code(asp_amg_interp i)
-{
-    return i == ASP_AMG_INTERP_DIRECT ? 3 : i == ASP_AMG_INTERP_STANDARD ? 8 : i == ASP_AMG_INTERP_EXTENDED_I ? 6 : 0;
+    asp_amg_shutdown(); /* one shutdown: MPI and hypre are process-wide */
 }
 
 /* An IJ matrix of the local rows m (global columns) with rows starts[rank].. and columns cstarts[rank]... */
@@ -201,8 +166,8 @@ int asp__dist_coarsen(const asp__dist *d, const asp_amg_csr *a, const size_t *st
     /* the serial path's options (hypre_bridge.c): one level per call, the caller filters between levels */
     HYPRE_BoomerAMGCreate(&amg);
     HYPRE_BoomerAMGSetPrintLevel(amg, 0);
-    HYPRE_BoomerAMGSetCoarsenType(amg, coarsen_code(desc->coarsen));
-    HYPRE_BoomerAMGSetInterpType(amg, interp_code(desc->interp));
+    HYPRE_BoomerAMGSetCoarsenType(amg, asp__amg_hypre_coarsen_code(desc->coarsen));
+    HYPRE_BoomerAMGSetInterpType(amg, asp__amg_hypre_interp_code(desc->interp));
     HYPRE_BoomerAMGSetStrongThreshold(amg, desc->strong_threshold);
     HYPRE_BoomerAMGSetTruncFactor(amg, desc->trunc_factor);
     HYPRE_BoomerAMGSetMaxLevels(amg, 2);
