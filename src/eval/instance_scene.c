@@ -375,35 +375,9 @@ int asp_instance_scene_parse(const char *text, size_t len, const char *path, asp
 
 int asp_instance_scene_read(const char *path, asp_instance_scene *out, asp_error *err)
 {
-    FILE *fp = asp__regular_file_open(path, err);
-    if (!fp)
-        return err ? err->code : ASP_EIO;
     char *text = NULL;
-    size_t len = 0, cap = 0;
-    int rc = 0;
-    for (;;) {
-        if (len + 4096 > cap) {
-            cap = cap ? 2 * cap : 8192;
-            if (cap > MAX_FILE) {
-                rc = asp_error_set(err, ASP_EFORMAT, "'%s': a scene file over 64 MiB", path);
-                break;
-            }
-            char *t = realloc(text, cap);
-            if (!t) {
-                rc = asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", path);
-                break;
-            }
-            text = t;
-        }
-        size_t n = fread(text + len, 1, 4096, fp);
-        len += n;
-        if (n < 4096) {
-            if (ferror(fp))
-                rc = asp_error_set(err, ASP_EIO, "cannot read '%s'", path);
-            break;
-        }
-    }
-    fclose(fp);
+    size_t len = 0;
+    int rc = asp__text_file_read(path, MAX_FILE, "a scene file", &text, &len, err);
     if (!rc)
         rc = asp_instance_scene_parse(text, len, path, out, err);
     free(text);

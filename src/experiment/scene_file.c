@@ -170,40 +170,11 @@ static int parse_root(const cJSON *root, const char *path, asp_experiment_scenes
 
 int asp_experiment_scenes_load(const char *path, asp_experiment_scenes *out, asp_error *err)
 {
-    FILE *fp = asp__regular_file_open(path, err);
-    if (!fp)
-        return err ? err->code : ASP_EIO;
     char *text = NULL;
-    size_t len = 0, cap = 0;
-    int rc = 0;
-    for (;;) {
-        if (len + 4096 + 1 > cap) {
-            cap = cap ? 2 * cap : 8192;
-            if (cap > (64u << 20)) {
-                rc = asp_error_set(err, ASP_EFORMAT, "'%s': a scene file over 64 MiB", path);
-                break;
-            }
-            char *t = realloc(text, cap);
-            if (!t) {
-                rc = asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", path);
-                break;
-            }
-            text = t;
-        }
-        size_t n = fread(text + len, 1, 4096, fp);
-        len += n;
-        if (n < 4096) {
-            if (ferror(fp))
-                rc = asp_error_set(err, ASP_EIO, "cannot read '%s'", path);
-            break;
-        }
-    }
-    fclose(fp);
-    if (rc) {
-        free(text);
+    size_t len = 0;
+    int rc = asp__text_file_read(path, 64u << 20, "a scene file", &text, &len, err);
+    if (rc)
         return rc;
-    }
-    text[len] = 0;
     cJSON *root = cJSON_ParseWithLength(text, len);
     if (!root) {
         const char *at = cJSON_GetErrorPtr();

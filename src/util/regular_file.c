@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -63,4 +64,47 @@ FILE *asp__regular_file_open(const char *path, asp_error *err)
         close(fd);
     }
     return fp;
+}
+
+int asp__text_file_read(const char *path, size_t max, const char *what, char **text, size_t *len, asp_error *err)
+{
+    *text = NULL;
+    *len = 0;
+    FILE *fp = asp__regular_file_open(path, err);
+    if (!fp)
+        return err ? err->code : ASP_EIO;
+    char *buf = NULL;
+    size_t n = 0, cap = 0;
+    int rc = 0;
+    for (;;) {
+        if (n > max)
+            break; /* reported below */
+        if (n + 4096 + 1 > cap) {
+            cap = cap ? 2 * cap : 8192;
+            char *t = realloc(buf, cap);
+            if (!t) {
+                rc = asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", path);
+                break;
+            }
+            buf = t;
+        }
+        size_t got = fread(buf + n, 1, 4096, fp);
+        n += got;
+        if (got < 4096) {
+            if (ferror(fp))
+                rc = asp_error_set(err, ASP_EIO, "cannot read '%s'", path);
+            break;
+        }
+    }
+    fclose(fp);
+    if (!rc && n > max)
+        rc = asp_error_set(err, ASP_EFORMAT, "'%s': %s over %zu MiB", path, what, max >> 20);
+    if (rc) {
+        free(buf);
+        return rc;
+    }
+    buf[n] = 0;
+    *text = buf;
+    *len = n;
+    return 0;
 }

@@ -27,4 +27,13 @@ int asp__regular_file_check(const char *path, asp_error *err);
  */
 FILE *asp__regular_file_open(const char *path, asp_error *err);
 
+/*
+ * The whole of a small text file (scene lists, JSON): asp__regular_file_open,
+ * then read into a new NUL-terminated buffer (*text, free() it; *len bytes
+ * without the NUL). Fails with ASP_EFORMAT "'<path>': <what> over <max> MiB"
+ * when the file is larger than max bytes, ASP_EIO, ASP_ENOMEM; *text is NULL
+ * on failure.
+ */
+int asp__text_file_read(const char *path, size_t max, const char *what, char **text, size_t *len, asp_error *err);
+
 #endif
