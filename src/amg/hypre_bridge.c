@@ -38,6 +38,7 @@ int ffs(int i);
 #pragma GCC diagnostic pop
 
 #include "amg/internal.h"
+#include "amg/hypre_internal.h"
 #include "util/banned.h"
 
 /*
@@ -197,7 +198,7 @@ void asp_amg_shutdown(void)
     }
 }
 
-int asp__amg_hypre_coarsen_code(asp_amg_coarsen c)
+static HYPRE_Int coarsen_code(asp_amg_coarsen c)
 {
     switch (c) {
     case ASP_AMG_COARSEN_FALGOUT: return 6;
@@ -208,7 +209,7 @@ int asp__amg_hypre_coarsen_code(asp_amg_coarsen c)
     }
 }
 
-int asp__amg_hypre_interp_code(asp_amg_interp i)
+static HYPRE_Int interp_code(asp_amg_interp i)
 {
     switch (i) {
     case ASP_AMG_INTERP_DIRECT: return 3;
@@ -216,6 +217,26 @@ int asp__amg_hypre_interp_code(asp_amg_interp i)
     case ASP_AMG_INTERP_EXTENDED_I: return 6;
     default: return 0; /* modified classical */
     }
+}
+
+HYPRE_Solver asp__amg_hypre_create_level_solver(const asp_amg_desc *desc)
+{
+    HYPRE_Solver amg;
+    HYPRE_BoomerAMGCreate(&amg);
+    HYPRE_BoomerAMGSetPrintLevel(amg, 0);
+    HYPRE_BoomerAMGSetCoarsenType(amg, coarsen_code(desc->coarsen));
+    HYPRE_BoomerAMGSetInterpType(amg, interp_code(desc->interp));
+    HYPRE_BoomerAMGSetStrongThreshold(amg, desc->strong_threshold);
+    HYPRE_BoomerAMGSetTruncFactor(amg, desc->trunc_factor);
+    /* one level at a time: the caller filters each coarse matrix before coarsening it again */
+    HYPRE_BoomerAMGSetMaxLevels(amg, 2);
+    HYPRE_BoomerAMGSetMaxCoarseSize(amg, 1);
+    HYPRE_BoomerAMGSetMinCoarseSize(amg, 1);
+    HYPRE_BoomerAMGSetAggNumLevels(amg, 0);
+    /* our matrix is singular (zero row sums): keep Gaussian elimination off the coarsest level */
+    HYPRE_BoomerAMGSetCycleRelaxType(amg, 3, 3);
+    HYPRE_BoomerAMGSetMaxIter(amg, 1);
+    return amg;
 }
 
 /* Copies a hypre ParCSR matrix (single process: everything lives in the diag block) with rows sorted by column. */
@@ -337,20 +358,7 @@ static int coarsen_here(const asp_amg_csr *a, asp_amg_csr **take, const asp_amg_
         goto done;
     }
 
-    HYPRE_BoomerAMGCreate(&amg);
-    HYPRE_BoomerAMGSetPrintLevel(amg, 0);
-    HYPRE_BoomerAMGSetCoarsenType(amg, asp__amg_hypre_coarsen_code(desc->coarsen));
-    HYPRE_BoomerAMGSetInterpType(amg, asp__amg_hypre_interp_code(desc->interp));
-    HYPRE_BoomerAMGSetStrongThreshold(amg, desc->strong_threshold);
-    HYPRE_BoomerAMGSetTruncFactor(amg, desc->trunc_factor);
-    /* one level at a time: the caller filters each coarse matrix before coarsening it again */
-    HYPRE_BoomerAMGSetMaxLevels(amg, 2);
-    HYPRE_BoomerAMGSetMaxCoarseSize(amg, 1);
-    HYPRE_BoomerAMGSetMinCoarseSize(amg, 1);
-    HYPRE_BoomerAMGSetAggNumLevels(amg, 0);
-    /* our matrix is singular (zero row sums): keep Gaussian elimination off the coarsest level */
-    HYPRE_BoomerAMGSetCycleRelaxType(amg, 3, 3);
-    HYPRE_BoomerAMGSetMaxIter(amg, 1);
+    amg = asp__amg_hypre_create_level_solver(desc);
     HYPRE_BoomerAMGSetup(amg, (HYPRE_ParCSRMatrix)pa, pb, px);
     /* hypre flags harmless conditions (a zero diagonal on a disconnected coarse point) as errors */
     HYPRE_ClearAllErrors();

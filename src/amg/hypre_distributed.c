@@ -22,6 +22,7 @@ int ffs(int i); /* hypre's internal header calls it without declaring it under s
 #pragma GCC diagnostic pop
 
 #include "amg/distributed.h"
+#include "amg/hypre_internal.h"
 #include "util/banned.h"
 
 int asp__dist_start(asp__dist *d, asp_error *err)
@@ -164,18 +165,7 @@ int asp__dist_coarsen(const asp__dist *d, const asp_amg_csr *a, const size_t *st
     HYPRE_IJVectorGetObject(xij, (void **)&px);
 
     /* the serial path's options (hypre_bridge.c): one level per call, the caller filters between levels */
-    HYPRE_BoomerAMGCreate(&amg);
-    HYPRE_BoomerAMGSetPrintLevel(amg, 0);
-    HYPRE_BoomerAMGSetCoarsenType(amg, asp__amg_hypre_coarsen_code(desc->coarsen));
-    HYPRE_BoomerAMGSetInterpType(amg, asp__amg_hypre_interp_code(desc->interp));
-    HYPRE_BoomerAMGSetStrongThreshold(amg, desc->strong_threshold);
-    HYPRE_BoomerAMGSetTruncFactor(amg, desc->trunc_factor);
-    HYPRE_BoomerAMGSetMaxLevels(amg, 2);
-    HYPRE_BoomerAMGSetMaxCoarseSize(amg, 1);
-    HYPRE_BoomerAMGSetMinCoarseSize(amg, 1);
-    HYPRE_BoomerAMGSetAggNumLevels(amg, 0);
-    HYPRE_BoomerAMGSetCycleRelaxType(amg, 3, 3);
-    HYPRE_BoomerAMGSetMaxIter(amg, 1);
+    amg = asp__amg_hypre_create_level_solver(desc);
     HYPRE_BoomerAMGSetup(amg, pa, pb, px);
     HYPRE_ClearAllErrors();
 

@@ -88,9 +88,6 @@ int asp__amg_assemble(const float *pos, const float *classifier, const asp__amg_
 
 /* Starts MPI (a singleton when no launcher did) and hypre once per process; asp_amg_shutdown ends what it started. */
 int asp__amg_hypre_start(asp_error *err);
-/* hypre's codes for the coarsening and interpolation options (serial and distributed setups alike). */
-int asp__amg_hypre_coarsen_code(asp_amg_coarsen c);
-int asp__amg_hypre_interp_code(asp_amg_interp i);
 /* One BoomerAMG setup level on a: copies P (a->rows x nc) and A^1 = P^T a P; *p = NULL when hypre did not coarsen. */
 int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
                            asp_amg_csr **p, asp_amg_csr **ac, asp_error *err);
