@@ -398,7 +398,7 @@ static int build_items(cut_renderer *r, const asp__frame *f, asp_error *err)
     size_t total = 0;
     for (size_t i = 0; i < r->instances; i++) {
         const float *m = r->models + 16 * i;
-        double local[3];
+        double local[3] = {0, 0, 0}; // gcc -O3 cannot see that affine_inverse_point fills it when it returns 1
         r->visible[i] = sphere_visible(r, m, f) && affine_inverse_point(m, f->eye, local);
         if (!r->visible[i])
             continue;
