@@ -788,11 +788,13 @@ static void update_title(viewer *v, double now, int force)
     if (v->budget_on && v->budget_ok && v->depth_limit)
         snprintf(budget + strlen(budget), sizeof budget - strlen(budget), " %u", v->depth_limit);
     char *title = v->stats.title;
-    snprintf(title, sizeof v->stats.title, "amgsplat view: %s | %s | %zu %s | %.1f ms (%.0f fps)%s%s | %s%s%s", base,
+    // a long path or status shortens the title; the test on the result tells gcc that is meant
+    if (snprintf(title, sizeof v->stats.title, "amgsplat view: %s | %s | %zu %s | %.1f ms (%.0f fps)%s%s | %s%s%s", base,
              K(v->kind)->name, v->r ? asp_renderer_count(v->r) : 0,
              K(v->kind)->noun, v->last_ms,
              v->last_ms > 0 ? 1000.0 / v->last_ms : 0.0, tau, budget, v->unlit ? "unlit" : "lit",
-             v->status[0] ? " | " : "", v->status);
+             v->status[0] ? " | " : "", v->status) >= (int)sizeof v->stats.title)
+        title[sizeof v->stats.title - 1] = 0;
     glfwSetWindowTitle(v->window, title);
 }
 
