@@ -34,6 +34,7 @@ const asp__viewer_key asp__viewer_keys[] = {
     {'p', ASP__VIEWER_POINTS, 0, ".dps: toggle the source points (disc renderer) and the primitives; mesh: its points and the mesh"},
     {'e', ASP__VIEWER_DEBUG_EIGENVECTORS, 0, ".dps: toggle the primitives' PCA axes (thesis appendix C)"},
     {'t', ASP__VIEWER_DEBUG_TEXELS, 0, ".dps: toggle the texel midpoints (thesis appendix C)"},
+    {'g', ASP__VIEWER_PICK_DOMAIN, 0, ".dps: draw the next domain alone, then every domain again (thesis appendix C)"},
     {'D', ASP__VIEWER_DOMAIN_SET, 0, ".dps built with --domains both: thresholded / strict domains (thesis appendix C)"},
     {'s', ASP__VIEWER_SCREENSHOT, 0, "screenshot to <input>-NNN.png in the current directory"},
     {'v', ASP__VIEWER_PRINT_VIEW, 0, "print the view as --view AZ,EL,DIST"},

@@ -42,7 +42,8 @@ enum asp__viewer_action {
     /* thesis appendix C: the debug drawings and the Domain Set switch */
     ASP__VIEWER_DEBUG_EIGENVECTORS,
     ASP__VIEWER_DEBUG_TEXELS,
-    ASP__VIEWER_DOMAIN_SET
+    ASP__VIEWER_DOMAIN_SET,
+    ASP__VIEWER_PICK_DOMAIN /* thesis appendix C: one picked domain only */
 };
 
 /* One printable key of the viewer; the table ends with key 0. */

@@ -122,6 +122,7 @@ struct viewer {
     uint32_t depth_limit;  /* desc->depth_limit, kept across tau changes */
     int unlit;
     asp_prim_render_options prim; /* .dps: options of the prim renderer, kept while the points are shown */
+    size_t picked;                /* .dps: the one primitive drawn (thesis appendix C), SIZE_MAX = every one */
     asp_camera cam;
     int quit;
     int dirty;             /* something changed: draw a frame */
@@ -327,12 +328,23 @@ static int make_renderer(viewer *v, size_t k, asp_renderer **out, asp_error *err
     o.square.tolerance = v->tolerance;
     o.splat.flags = o.square.flags = v->desc->lod_flags;
     o.prim = v->prim;
+    // thesis appendix C "one picked domain only": a copy of the level holding that primitive alone
+    asp_dps_level one;
+    memset(&one, 0, sizeof one);
+    if (src.level && v->picked != SIZE_MAX) {
+        int rc = asp_dps_level_pick(src.level, v->picked, &v->ctx, &one, err);
+        if (rc)
+            return rc;
+        src.level = &one;
+    }
     int rc = v->is_scene ? asp__viewer_instances_renderer(v->gl, &v->instances, K(k)->name, &o, &v->ctx, out, err)
                          : K(k)->create(v->gl, &src, &o, &v->ctx, out, err);
     if (!rc && v->depth_limit && K(k)->has_lod && (rc = asp_renderer_set_lod(*out, v->tolerance, v->depth_limit, err))) {
         asp_renderer_destroy(*out);
         *out = NULL;
     }
+    if (one.prim_count)
+        asp_dps_level_release(&one, &v->ctx);
     return rc;
 }
 
@@ -521,6 +533,23 @@ static void prim_action(viewer *v, enum asp__viewer_action a)
              v->prim.flags & flag ? "on" : "off");
         break;
     }
+    case ASP__VIEWER_PICK_DOMAIN: {
+        // the next primitive alone, then every one again (thesis appendix C)
+        const asp_dps_level *lv = asp_scene_dps_level(&v->scene);
+        size_t n = lv ? lv->prim_count : 0, was = v->picked;
+        v->picked = v->picked == SIZE_MAX ? 0 : v->picked + 1 < n ? v->picked + 1 : SIZE_MAX;
+        asp_error e = {0, ""};
+        if (v->kind == v->kind_prim && switch_renderer(v, v->kind, &e)) {
+            vlog(v, "cannot draw one domain: %s", e.msg);
+            v->picked = was;
+            return;
+        }
+        if (v->picked == SIZE_MAX)
+            vlog(v, "every domain");
+        else
+            vlog(v, "domain %zu of %zu only", v->picked, n);
+        return;
+    }
     case ASP__VIEWER_COLOR_MODE:
         v->prim.flags ^= ASP_PRIM_RENDER_COLOR_BY_DOMAIN;
         vlog(v, "%s", v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? "a colour per domain" : "texture colours");
@@ -630,7 +659,8 @@ static void apply(viewer *v, const action *a)
     case ASP__VIEWER_OUTLINE:
     case ASP__VIEWER_CREASES:
     case ASP__VIEWER_DEBUG_EIGENVECTORS:
-    case ASP__VIEWER_DEBUG_TEXELS: prim_action(v, a->what); break;
+    case ASP__VIEWER_DEBUG_TEXELS:
+    case ASP__VIEWER_PICK_DOMAIN: prim_action(v, a->what); break;
     case ASP__VIEWER_POINTS: toggle_points(v); break;
     case ASP__VIEWER_SCREENSHOT: v->screenshot_wanted = 1; break;
     case ASP__VIEWER_OVERLAY: v->overlay_on = !v->overlay_on; break;
@@ -959,6 +989,7 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
     v.desc = desc;
     v.path = path;
     v.tolerance = desc->tolerance;
+    v.picked = SIZE_MAX; // every domain
     v.depth_limit = desc->depth_limit;
     v.unlit = (desc->flags & ASP_VIEWER_UNLIT) != 0;
     v.overlay_on = (desc->flags & ASP_VIEWER_OVERLAY) ||

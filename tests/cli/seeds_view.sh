@@ -25,4 +25,16 @@ n = [json.load(open("%s/%s.json" % (sys.argv[1], x)))["count"] for x in "abc"]
 assert n[0] == 6000 and n[1] < 0.7 * n[0] and n[2] <= 8 ** 3, n
 PY
 expect_fail 2 "--depth-limit expects 0..64" "$A" view "$T/s.ply" --depth-limit 65
+
+# thesis appendix C "one picked domain only": g draws the first primitive alone, a second g the next
+"$A" decompose "$T/s.ply" -o "$T/s.amg" -q
+"$A" build "$T/s.amg" --primitives 30 -o "$T/s.dps" -q >/dev/null
+W=(--size 96x96 --view 30,20 -q)
+"$A" view "$T/s.dps" --frames 1 --screenshot "$T/all.png" "${W[@]}"
+"$A" view "$T/s.dps" --frames 2 --keys g --screenshot "$T/one.png" "${W[@]}"
+"$A" view "$T/s.dps" --frames 3 --keys gg --screenshot "$T/two.png" "${W[@]}"
+px() { "$A" imgdiff "$1" "$2" --background 255,255,255 | awk '/^silhouette B/ { print $(NF-1) }'; }
+all=$(px "$T/all.png" "$T/all.png") one=$(px "$T/all.png" "$T/one.png") two=$(px "$T/all.png" "$T/two.png")
+(( one > 0 && one * 2 < all && two > 0 && two * 2 < all )) || fail "picked domain: $one and $two of $all pixels"
+cmp -s "$T/one.png" "$T/two.png" && fail "g twice drew the same domain"
 exit 0
