@@ -31,7 +31,13 @@ step "build: one textured polygon per domain, level nearest 400 primitives (jour
 $bin build out/bunny.amg --primitives 400 -o out/bunny.dps --atlas out/bunny-atlas.png
 $bin render out/bunny.dps --method prefix --views 8 --size 256x256 -o out/bunny-primitives.png
 
+step "hybrid and scenes: points where primitives fail; 200 bunnies mixing AMG levels by view (issue 18)"
+$bin render out/bunny.dps --hybrid --views 8 --size 256x256 -o out/bunny-hybrid.png
+$bin build out/bunny.amg --level L-7..L -o out/bunny-levels.dps
+$bin scene field out/bunny-levels.dps --instances 200 -o out/field.json
+$bin render out/field.json --tolerance 2 --size 512x512 -o out/field.png
+
 step "eval: primitives against the point set, every level up to 500 primitives"
 $bin eval out/bunny.ply -o out/eval-bunny --views 8 --sizes 128 --max-primitives 500
 echo
-echo "demo: pictures and tables in out/ (bunny-points.png, bunny-primitives.png, eval-bunny/ssim-128.png, eval-bunny/eval.csv)"
+echo "demo: pictures and tables in out/ (bunny-points.png, bunny-primitives.png, bunny-hybrid.png, field.png, eval-bunny/ssim-128.png, eval-bunny/eval.csv)"
