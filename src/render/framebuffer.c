@@ -68,3 +68,17 @@ int asp__gl_target_ensure(asp_gl_context *gl, uint32_t width, uint32_t height, u
     t->samples = samples;
     return 0;
 }
+
+void asp__gl_restore_state(GLuint fbo)
+{
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
+    glDisable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glBindVertexArray(0);
+    glUseProgram(0);
+}

@@ -95,19 +95,6 @@ static void hybrid_destroy(asp_renderer *base)
     asp_free(&actx, h);
 }
 
-static void restore_state(GLuint fbo)
-{
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
-    glDisable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glDisable(GL_CULL_FACE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glBindVertexArray(0);
-    glUseProgram(0);
-}
 
 static void draw_parts(hybrid_renderer *h, const asp__frame *f, int depth_only)
 {
@@ -168,7 +155,7 @@ static int hybrid_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     glBindVertexArray(h->vao.id);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindTextureUnit(0, 0);
-    restore_state((GLuint)caller);
+    asp__gl_restore_state((GLuint)caller);
     base->count = h->counts.prims_kept + (h->splats ? asp_renderer_count(h->splats) : 0);
     return asp__gl_check(base->gl, "draw the hybrid of primitives and points", err);
 }

@@ -78,6 +78,10 @@ int asp__gl_program_create(asp_gl_context *gl, const char *name, const char *vs,
                            asp__gl_program *out, asp_error *err);
 void asp__gl_program_destroy(asp__gl_program *p);
 
+/* After a multi-pass draw: the caller's draw framebuffer back and GL's default state (no blending, add
+ * equation, no culling, depth test LESS with writes, all colour channels, no vertex array or program). */
+void asp__gl_restore_state(GLuint fbo);
+
 /* Makes sure gl->target is width x height with samples (reallocating if needed). */
 int asp__gl_target_ensure(asp_gl_context *gl, uint32_t width, uint32_t height, uint32_t samples,
                           asp_error *err);

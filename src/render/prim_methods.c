@@ -483,19 +483,6 @@ static void outlines(asp__prim_renderer *r)
     glProgramUniform1i(mp, r->uniforms[ASP__PROG_MAIN][PU_CORNERS], 0);
 }
 
-static void restore_state(GLuint fbo)
-{
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
-    glDisable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glDisable(GL_CULL_FACE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glBindVertexArray(0);
-    glUseProgram(0);
-}
 
 int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err)
 {
@@ -521,7 +508,7 @@ int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err)
         outlines(r);
     glBindTextureUnit(ASP__PRIM_UNIT_ATLAS, 0);
     glBindTextureUnit(ASP__PRIM_UNIT_NORMALS, 0);
-    restore_state((GLuint)caller);
+    asp__gl_restore_state((GLuint)caller);
     return asp__gl_check(gl, "draw domain primitives", err);
 }
 
@@ -622,7 +609,7 @@ int asp__prim_draw_instances(asp__prim_renderer *r, const asp__frame *f, const f
             resolve(r, (GLuint)caller, 1);
             glBindTextureUnit(ASP__PRIM_UNIT_ATLAS, 0);
             glBindTextureUnit(ASP__PRIM_UNIT_NORMALS, 0);
-            restore_state((GLuint)caller);
+            asp__gl_restore_state((GLuint)caller);
             rc = asp__gl_check(gl, "draw domain primitive instances", err);
         }
         r->base.count = count * r->count;

@@ -382,17 +382,6 @@ static uint32_t target_samples(const asp_gl_context *gl)
     return 1;
 }
 
-static void restore_state(GLint fbo)
-{
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)fbo);
-    glDisable(GL_BLEND);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glBindVertexArray(0);
-    glUseProgram(0);
-}
 
 /*
  * One pass of the splats: the last cut with frame f, or with batch (n > 0) each instance's cut with
@@ -495,7 +484,7 @@ static int splat_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     } else {
         rc = draw_blended(s, f, caller_fbo, NULL, 0, err);
     }
-    restore_state(caller_fbo);
+    asp__gl_restore_state((GLuint)caller_fbo);
     if (rc)
         return rc;
     return asp__gl_check(base->gl, "draw splats", err);
@@ -599,7 +588,7 @@ static int splat_draw_instances(asp_renderer *base, const asp__frame *f, const f
         return 0; // everything culled: the background stays
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ASP__LOD_BIND_CLIPS, s->clips.id);
     rc = draw_blended(s, f, caller_fbo, s->insts, count, err);
-    restore_state(caller_fbo);
+    asp__gl_restore_state((GLuint)caller_fbo);
     if (rc)
         return rc;
     return asp__gl_check(base->gl, "draw splat instances", err);
