@@ -81,7 +81,7 @@ build_d() {
   configure build-nogl -DCMAKE_BUILD_TYPE=RelWithDebInfo -DASP_WITH_GL=OFF -DASP_BUILD_BENCH=OFF
   cmake --build build-nogl -j "$jobs"
   # the modules this build leaves out whole (GL): their headers declare what it lacks
-  scripts/check_declared.py build-nogl/libamgsplat.a render.h viewer.h experiment.h
+  scripts/check_declared.py build-nogl/libamgsplat.a render.h viewer.h experiment.h scene_renderer.h
   run_ctest build-nogl
   configure build-nohypre -DCMAKE_BUILD_TYPE=RelWithDebInfo -DASP_WITH_HYPRE=OFF -DASP_BUILD_BENCH=OFF
   cmake --build build-nohypre -j "$jobs"

@@ -6,6 +6,7 @@
 #define ASP_VIEWER_INTERNAL_H
 
 #include "amgsplat/instances.h"
+#include "amgsplat/scene_renderer.h"
 #include "amgsplat/scene.h"
 #include "amgsplat/viewer.h"
 

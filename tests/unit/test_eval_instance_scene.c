@@ -12,6 +12,9 @@
 
 #include "amgsplat/instances.h"
 #include "amgsplat/sample.h"
+#ifdef ASP_HAVE_GL
+#include "amgsplat/scene_renderer.h" /* the scene camera is render's */
+#endif
 #include "harness.h"
 
 static asp_error *ep(asp_error *e)
