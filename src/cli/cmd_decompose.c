@@ -62,15 +62,9 @@ static int lookup(const struct name_code *t, const char *name, int *out)
     return -1;
 }
 
-static void add_info_json(cJSON *o, const asp_amg *amg)
+/* The figures of asp_amg_info, as the serial and the distributed run report them alike. */
+static void add_amg_info(cJSON *o, const asp_amg_info *in)
 {
-    const asp_amg_info *in = asp_amg_get_info(amg);
-    cJSON *sizes = cJSON_CreateArray(), *sec = cJSON_CreateObject();
-    cJSON_AddNumberToObject(o, "points", (double)asp_amg_cloud(amg)->count);
-    cJSON_AddNumberToObject(o, "levels", (double)asp_amg_level_count(amg));
-    for (size_t l = 0; l < asp_amg_level_count(amg); l++)
-        cJSON_AddItemToArray(sizes, cJSON_CreateNumber((double)asp_amg_level_size(amg, l)));
-    cJSON_AddItemToObject(o, "level_sizes", sizes);
     cJSON_AddItemToObject(o, "epsilon", cli_json_number("%.9g", in->epsilon));
     cJSON_AddNumberToObject(o, "k_min", (double)in->k_min);
     cJSON_AddNumberToObject(o, "k_max", (double)in->k_max);
@@ -81,11 +75,29 @@ static void add_info_json(cJSON *o, const asp_amg *amg)
     cJSON_AddNumberToObject(o, "positive_offdiag_clamped", (double)in->positive_offdiag);
     cJSON_AddNumberToObject(o, "isolated_points", (double)in->isolated_points);
     cJSON_AddNumberToObject(o, "repaired_rows", (double)in->repaired_rows);
+}
+
+/* The stage times of asp_amg_info into decompose --json's "seconds". */
+static void add_stage_seconds(cJSON *sec, const asp_amg_info *in)
+{
     cJSON_AddItemToObject(sec, "neighbours", cli_json_number("%.4f", in->t_neighbours));
     cJSON_AddItemToObject(sec, "classifier", cli_json_number("%.4f", in->t_classifier));
     cJSON_AddItemToObject(sec, "fans", cli_json_number("%.4f", in->t_fans));
     cJSON_AddItemToObject(sec, "assembly", cli_json_number("%.4f", in->t_assembly));
     cJSON_AddItemToObject(sec, "amg", cli_json_number("%.4f", in->t_amg));
+}
+
+static void add_info_json(cJSON *o, const asp_amg *amg)
+{
+    const asp_amg_info *in = asp_amg_get_info(amg);
+    cJSON *sizes = cJSON_CreateArray(), *sec = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "points", (double)asp_amg_cloud(amg)->count);
+    cJSON_AddNumberToObject(o, "levels", (double)asp_amg_level_count(amg));
+    for (size_t l = 0; l < asp_amg_level_count(amg); l++)
+        cJSON_AddItemToArray(sizes, cJSON_CreateNumber((double)asp_amg_level_size(amg, l)));
+    cJSON_AddItemToObject(o, "level_sizes", sizes);
+    add_amg_info(o, in);
+    add_stage_seconds(sec, in);
     cJSON_AddItemToObject(o, "seconds", sec);
 }
 
@@ -253,16 +265,7 @@ static void add_distributed_json(cJSON *o, const asp_amg_dist_info *in, double t
     for (size_t l = 0; l < in->nlevels; l++)
         cJSON_AddItemToArray(sizes, cJSON_CreateNumber((double)in->level[l].unknowns));
     cJSON_AddItemToObject(o, "level_sizes", sizes);
-    cJSON_AddItemToObject(o, "epsilon", cli_json_number("%.9g", in->amg.epsilon));
-    cJSON_AddNumberToObject(o, "k_min", (double)in->amg.k_min);
-    cJSON_AddNumberToObject(o, "k_max", (double)in->amg.k_max);
-    cJSON_AddNumberToObject(o, "fan_k", (double)in->amg.fan_k);
-    cJSON_AddItemToObject(o, "mean_neighbourhood", cli_json_number("%.4g", in->amg.mean_neighbourhood));
-    cJSON_AddItemToObject(o, "mean_fan", cli_json_number("%.4g", in->amg.mean_fan));
-    cJSON_AddNumberToObject(o, "matrix_nnz", (double)in->amg.matrix_nnz);
-    cJSON_AddNumberToObject(o, "positive_offdiag_clamped", (double)in->amg.positive_offdiag);
-    cJSON_AddNumberToObject(o, "isolated_points", (double)in->amg.isolated_points);
-    cJSON_AddNumberToObject(o, "repaired_rows", (double)in->amg.repaired_rows);
+    add_amg_info(o, &in->amg);
     cJSON_AddNumberToObject(o, "own_points_min", (double)in->own_points_min);
     cJSON_AddNumberToObject(o, "own_points_max", (double)in->own_points_max);
     cJSON_AddNumberToObject(o, "halo_points", (double)in->halo_points);
@@ -270,11 +273,7 @@ static void add_distributed_json(cJSON *o, const asp_amg_dist_info *in, double t
     cJSON_AddItemToObject(o, "peak_rss_mb_mean_rank", cli_json_number("%.1f", in->peak_rss_mean_mb));
     cJSON_AddItemToObject(sec, "read", cli_json_number("%.4f", in->t_read));
     cJSON_AddItemToObject(sec, "halo", cli_json_number("%.4f", in->t_halo));
-    cJSON_AddItemToObject(sec, "neighbours", cli_json_number("%.4f", in->amg.t_neighbours));
-    cJSON_AddItemToObject(sec, "classifier", cli_json_number("%.4f", in->amg.t_classifier));
-    cJSON_AddItemToObject(sec, "fans", cli_json_number("%.4f", in->amg.t_fans));
-    cJSON_AddItemToObject(sec, "assembly", cli_json_number("%.4f", in->amg.t_assembly));
-    cJSON_AddItemToObject(sec, "amg", cli_json_number("%.4f", in->amg.t_amg));
+    add_stage_seconds(sec, &in->amg);
     cJSON_AddItemToObject(sec, "basis_stats", cli_json_number("%.4f", in->t_stats));
     cJSON_AddItemToObject(sec, "write", cli_json_number("%.4f", in->t_write));
     cJSON_AddItemToObject(o, "seconds", sec);
