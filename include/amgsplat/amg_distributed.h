@@ -16,6 +16,9 @@ extern "C" {
 
 enum { ASP_AMG_DIST_MAX_LEVELS = 100 };
 
+/** tau for asp_amg_decompose_distributed when no level figures are wanted (only the level sizes). */
+#define ASP_AMG_DIST_NO_FIGURES (-1.0)
+
 /** Agreement figures of one level (journal eq. 8, thesis eq. 2.5), over every rank's points. */
 typedef struct asp_amg_dist_level {
     size_t unknowns;
@@ -54,7 +57,9 @@ int asp_amg_mpi_ranks(void);
  * nobody did (asp_amg_distributed_shutdown ends them). With out_path the
  * result is written as a version-3 .amg file that asp_amg_load reads as a
  * serial one, with the points in Morton order (not the input order). tau is
- * the domain threshold of the level figures in info (0.05 in the journal).
+ * the domain threshold of the level figures in info (0.05 in the journal);
+ * ASP_AMG_DIST_NO_FIGURES skips them (the basis of every level, about a sixth
+ * of the time at 1M points), and info->level then holds only the unknowns.
  * Returns the same code on every rank: 0, ASP_EIO, ASP_EFORMAT (not a binary
  * little-endian PLY with x y z), ASP_EINVAL, ASP_EDEGENERATE, ASP_ENOMEM,
  * ASP_ESOLVER, ASP_EUNSUPPORTED (built without hypre); err holds the first

@@ -194,12 +194,15 @@ static int decompose(const asp_cloud *cloud, asp_cloud **take, const uint32_t *t
     (void)take;
     return asp_error_set(err, ASP_EUNSUPPORTED, "cannot decompose: this build has no hypre (ASP_WITH_HYPRE=OFF)");
 #else
+    asp__amg_hypre_prestart(); /* MPI's start (a singleton's orted) overlaps the neighbour search */
     const size_t n = cloud->count;
     asp_amg *a = NULL;
     asp__amg_nbhd nb = {0};
     asp__amg_fans fans = {0};
     asp_amg_csr **p = NULL, *flat = NULL;
     size_t nlevels = 0;
+    asp_index *order = NULL; /* Morton numbering (morton.c); NULL: the input's (a mesh's triangles index it) */
+    float *mpos = NULL;      /* the positions in that order, until the matrix is assembled */
     if ((rc = asp__amg_alloc(ctx, &a, err)) != 0)
         return rc;
     if (asp_cloud_frame(cloud, &a->frame, NULL) != 0)
@@ -225,6 +228,18 @@ static int decompose(const asp_cloud *cloud, asp_cloud **take, const uint32_t *t
     double t = asp_time_now(), t1;
     if ((rc = stage(ctx, "neighbours", 0, err)) != 0)
         goto fail;
+    if (!triangles) {
+        /* the distributed decomposition's numbering, so one rank gives this hierarchy (morton.c) */
+        if ((rc = asp__amg_morton_order(pos, n, ctx, &order, err)) != 0)
+            goto fail;
+        if (!(mpos = asp_alloc(ctx, 3 * n * sizeof *mpos))) {
+            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the ordered positions of %zu points", n);
+            goto fail;
+        }
+        for (size_t m = 0; m < n; m++)
+            memcpy(mpos + 3 * m, pos + 3 * (size_t)order[m], 3 * sizeof *mpos);
+        pos = mpos;
+    }
     rc = asp__amg_neighbourhoods(pos, n, &d, ctx, &nb, &a->info.mean_neighbourhood, err);
     if (rc)
         goto fail;
@@ -237,8 +252,6 @@ static int decompose(const asp_cloud *cloud, asp_cloud **take, const uint32_t *t
     rc = asp__amg_classify(pos, &nb, &d, ctx, a->classifier, a->tangent, err);
     if (rc)
         goto fail;
-    if (!a->input_normals)
-        memcpy(a->cloud->normals, a->tangent, 3 * n * sizeof *a->tangent);
     t1 = asp_time_now();
     a->info.t_classifier = t1 - t;
     t = t1;
@@ -265,6 +278,13 @@ static int decompose(const asp_cloud *cloud, asp_cloud **take, const uint32_t *t
     if (rc)
         goto fail;
     asp__amg_fans_release(ctx, &fans);
+    asp_free(ctx, mpos);
+    mpos = NULL;
+    /* the tangent normals go back to the input order now; the classifier is the hierarchy's, in its order */
+    if (order && (rc = asp__amg_unpermute(a->tangent, n, 3 * sizeof *a->tangent, order, ctx, err)) != 0)
+        goto fail;
+    if (!a->input_normals)
+        memcpy(a->cloud->normals, a->tangent, 3 * n * sizeof *a->tangent);
     a->info.matrix_nnz = a->matrix->row_ptr[n];
     for (size_t i = 0; i < n; i++)
         a->info.isolated_points += a->matrix->row_ptr[i + 1] - a->matrix->row_ptr[i] == 1;
@@ -294,6 +314,15 @@ static int decompose(const asp_cloud *cloud, asp_cloud **take, const uint32_t *t
         goto fail;
     a->prolong = p;
     a->nlevels = nlevels;
+    if (order) {
+        /* the result in the input order: per-point arrays and the point rows of P^1 (and A^0's rows and columns) */
+        if ((rc = asp__amg_unpermute(a->classifier, n, sizeof *a->classifier, order, ctx, err)) != 0 ||
+            (nlevels >= 2 && (rc = asp__amg_csr_unpermute(&a->prolong[1], order, 0, ctx, err)) != 0) ||
+            (a->matrix && (rc = asp__amg_csr_unpermute(&a->matrix, order, 1, ctx, err)) != 0))
+            goto fail;
+        asp_free(ctx, order);
+        order = NULL;
+    }
     a->info.t_amg = asp_time_now() - t;
     a->info.epsilon = d.epsilon;
     a->info.k_min = d.k_min;
@@ -303,6 +332,8 @@ static int decompose(const asp_cloud *cloud, asp_cloud **take, const uint32_t *t
     *out = a;
     return 0;
 fail:
+    asp_free(ctx, order);
+    asp_free(ctx, mpos);
     asp_amg_csr_destroy(flat);
     asp__amg_nbhd_release(ctx, &nb);
     asp__amg_fans_release(ctx, &fans);

@@ -621,16 +621,26 @@ done:
 }
 
 /*
- * Below this many unknowns a level moves to rank 0 and is coarsened there as
- * in one process (hypre's own answer is BoomerAMGSetSeqThreshold): measured on
- * a 20k bunny, parallel RS coarsening of a level with a few hundred unknowns
- * per rank keeps nearly every unknown at a rank border, so the coarse levels
- * stopped shrinking (58 unknowns at L on 2 ranks, 5 serially); above about
- * 1000 unknowns per rank the level sizes stayed within 2% of the serial
- * ones. So a level below 2048 unknowns per rank is gathered. The global ids
- * stay; only the partition changes, to [0, N, N, ...].
+ * A level moves to rank 0 and is coarsened there as in one process (hypre's
+ * own answer is BoomerAMGSetSeqThreshold) below 2048 unknowns per rank, and on
+ * a few ranks below 65,536 unknowns in all. Measured on a 20k bunny, parallel
+ * RS coarsening of a level with a few hundred unknowns per rank keeps nearly
+ * every unknown at a rank border, so the coarse levels stopped shrinking (58
+ * unknowns at L on 2 ranks, 5 serially). Above that, each border still adds
+ * its own C points, and the coarse levels amplify any difference (RS is
+ * greedy): on a 4M-point bunny with the per-rank rule alone, 4 ranks ended
+ * with 58 unknowns on level 14 against 50 in one process; gathering below
+ * 65,536 (level 6 on) gave 53, and 49 on 2 ranks. A level of 65,536 unknowns
+ * costs rank 0 a few megabytes and well under a second. The global ids stay;
+ * only the partition changes, to [0, N, N, ...].
  */
-enum { GATHER_BELOW_PER_RANK = 2048 };
+enum { GATHER_BELOW_PER_RANK = 2048, GATHER_BELOW = 65536 };
+
+static size_t gather_below(int P)
+{
+    const size_t g = GATHER_BELOW_PER_RANK * (size_t)P;
+    return g > GATHER_BELOW ? g : GATHER_BELOW;
+}
 
 static int gather_level(const asp__dist *d, size_t *starts, asp_amg_csr **a, asp_amg_csr **f, double **mass,
                         double **cm, asp_error *err)
@@ -697,7 +707,7 @@ static int build_hierarchy(const asp__dist *d, const asp__dist_points *pts, cons
     while (h->nlevels < maxl && h->sizes[h->nlevels - 1] > desc->max_coarse) {
         const size_t l = h->nlevels;
         size_t *st = h->starts[l - 1];
-        if (P > 1 && l >= 2 && h->sizes[l - 1] < GATHER_BELOW_PER_RANK * (size_t)P && st[1] < st[P]) {
+        if (P > 1 && l >= 2 && h->sizes[l - 1] < gather_below(P) && st[1] < st[P]) {
             asp_amg_csr *ga = (asp_amg_csr *)cur, *gf = (asp_amg_csr *)fcur;
             if ((rc = gather_level(d, st, &ga, &gf, &mass, &cm, err)) != 0)
                 break;
@@ -1174,7 +1184,8 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
     const double t0 = asp_time_now();
     inf.rank = d->rank;
     inf.ranks = d->size;
-    if (!(tau >= 0 && tau < 1))
+    const int figures = tau != ASP_AMG_DIST_NO_FIGURES;
+    if (figures && !(tau >= 0 && tau < 1))
         return asp_error_set(err, ASP_EINVAL, "invalid domain threshold %g: expected a value in [0, 1)", tau);
     rc = asp__dist_read_sorted(d, in_path, &r.pts, err);
     if (!rc)
@@ -1218,8 +1229,10 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
     inf.amg.fan_k = r.desc.fan_k;
     inf.nlevels = r.h.nlevels;
     t = asp_time_now();
-    if ((rc = basis_figures(d, &r.pts, &r.h, &r.desc, tau, &inf, err)) != 0)
+    if (figures && (rc = basis_figures(d, &r.pts, &r.h, &r.desc, tau, &inf, err)) != 0)
         goto done;
+    for (size_t l = 0; !figures && l < r.h.nlevels; l++)
+        inf.level[l].unknowns = r.h.sizes[l];
     inf.t_stats = asp_time_now() - t;
     t = asp_time_now();
     if (out_path) {

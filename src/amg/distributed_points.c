@@ -136,18 +136,6 @@ static int read_layout(FILE *fp, const char *path, layout *lay, asp_error *err)
     return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': no end_header", path);
 }
 
-/* 21 bits per axis, interleaved: Morton order keeps each rank's piece of the surface compact. */
-static uint64_t spread(uint64_t v)
-{
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffULL;
-    v = (v | v << 16) & 0x1f0000ff0000ffULL;
-    v = (v | v << 8) & 0x100f00f00f00f00fULL;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-    v = (v | v << 2) & 0x1249249249249249ULL;
-    return v;
-}
-
 static int cmp_rec(const void *a, const void *b)
 {
     const rec *x = a, *y = b;
@@ -324,16 +312,10 @@ int asp__dist_read_sorted(const asp__dist *d, const char *path, asp__dist_points
         }
     MPI_Allreduce(lo, pts->lo, 3, MPI_FLOAT, MPI_MIN, d->comm);
     MPI_Allreduce(hi, pts->hi, 3, MPI_FLOAT, MPI_MAX, d->comm);
-    double ext = 0;
-    for (int k = 0; k < 3; k++)
-        ext = fmax(ext, (double)pts->hi[k] - pts->lo[k]);
-    const double scale = ext > 0 ? 2097151.0 / ext : 0;
-    for (size_t i = 0; i < m; i++) {
-        uint64_t q[3];
-        for (int k = 0; k < 3; k++)
-            q[k] = (uint64_t)(((double)recs[i].pos[k] - pts->lo[k]) * scale);
-        recs[i].key = spread(q[0]) | spread(q[1]) << 1 | spread(q[2]) << 2;
-    }
+    /* the serial decomposition's numbering (morton.c): one rank gives exactly its hierarchy */
+    const double scale = asp__amg_morton_scale(pts->lo, pts->hi);
+    for (size_t i = 0; i < m; i++)
+        recs[i].key = asp__amg_morton_key(recs[i].pos, pts->lo, scale);
     rc = sample_sort(d, &recs, &m, err);
     if ((rc = asp__dist_agree(d, rc, err)) != 0) {
         asp_free(&d->ctx, recs);

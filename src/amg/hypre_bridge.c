@@ -10,6 +10,7 @@
 #include <malloc.h>
 #endif
 #include <mpi.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -160,10 +161,72 @@ static int mpi_start_at_risk(void)
            (getrlimit(RLIMIT_DATA, &data) == 0 && data.rlim_cur != RLIM_INFINITY);
 }
 
+/*
+ * MPI started early on a thread of its own (issue 19). A singleton
+ * MPI_Init_thread forks Open MPI's orted helper and waits for it: 0.35-0.45 s
+ * here, a tenth of a 1M-point decomposition, spent waiting. Started when the
+ * decomposition begins, it overlaps the neighbour search. MPI's rules: the
+ * thread that initialises MPI is its main thread and must also finalise it,
+ * so this thread stays until asp_amg_shutdown; with MPI_THREAD_SERIALIZED the
+ * caller's thread makes every other MPI call, never two at once. Nothing calls
+ * MPI before the thread has finished starting (mpi_thread_wait).
+ */
+enum { MPI_THREAD_NONE, MPI_THREAD_STARTING, MPI_THREAD_UP, MPI_THREAD_FAILED };
+static pthread_mutex_t mpi_thread_mutex = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t mpi_thread_cond = PTHREAD_COND_INITIALIZER;
+static pthread_t mpi_thread;
+static int mpi_thread_state, mpi_thread_stop;
+
+static void *mpi_thread_main(void *arg)
+{
+    (void)arg;
+    int provided = 0;
+    int ok = MPI_Init_thread(NULL, NULL, MPI_THREAD_SERIALIZED, &provided) == MPI_SUCCESS;
+    pthread_mutex_lock(&mpi_thread_mutex);
+    mpi_thread_state = ok ? MPI_THREAD_UP : MPI_THREAD_FAILED;
+    pthread_cond_broadcast(&mpi_thread_cond);
+    while (ok && !mpi_thread_stop)
+        pthread_cond_wait(&mpi_thread_cond, &mpi_thread_mutex);
+    pthread_mutex_unlock(&mpi_thread_mutex);
+    if (ok)
+        MPI_Finalize();
+    return NULL;
+}
+
+void asp__amg_hypre_prestart(void)
+{
+    int flag = 0;
+    pthread_mutex_lock(&mpi_thread_mutex);
+    int idle = mpi_thread_state == MPI_THREAD_NONE;
+    pthread_mutex_unlock(&mpi_thread_mutex);
+    if (!idle)
+        return;
+    MPI_Initialized(&flag); /* callable before MPI_Init; a launcher's or a caller's MPI needs no start */
+    if (flag || mpi_start_at_risk())
+        return; /* at risk: each level runs in a child process instead (coarsen_isolated) */
+    pthread_mutex_lock(&mpi_thread_mutex);
+    if (mpi_thread_state == MPI_THREAD_NONE && pthread_create(&mpi_thread, NULL, mpi_thread_main, NULL) == 0)
+        mpi_thread_state = MPI_THREAD_STARTING;
+    pthread_mutex_unlock(&mpi_thread_mutex);
+}
+
+/* Waits for an early start to finish; the thread's state (MPI_THREAD_NONE when there was none). */
+static int mpi_thread_wait(void)
+{
+    pthread_mutex_lock(&mpi_thread_mutex);
+    while (mpi_thread_state == MPI_THREAD_STARTING)
+        pthread_cond_wait(&mpi_thread_cond, &mpi_thread_mutex);
+    int state = mpi_thread_state;
+    pthread_mutex_unlock(&mpi_thread_mutex);
+    return state;
+}
+
 /* The one start of MPI and hypre in the process, for the serial and the distributed path (hypre_distributed.c). */
 int asp__amg_hypre_start(asp_error *err)
 {
     int flag = 0, done = 0;
+    if (mpi_thread_wait() == MPI_THREAD_FAILED)
+        return asp_error_set(err, ASP_ESOLVER, "cannot start MPI for the AMG solver: MPI_Init_thread failed");
     MPI_Finalized(&done);
     if (done)
         return asp_error_set(err, ASP_ESOLVER, "cannot start hypre: MPI was already finalised");
@@ -184,13 +247,27 @@ int asp__amg_hypre_start(asp_error *err)
 
 void asp_amg_shutdown(void)
 {
-    int done = 0;
-    MPI_Finalized(&done);
-    if (done)
-        return;
+    int done = 0, state = mpi_thread_wait();
+    if (state != MPI_THREAD_UP) {
+        MPI_Finalized(&done);
+        if (done)
+            return;
+    }
     if (hypre_started) {
         HYPRE_Finalize();
         hypre_started = 0;
+    }
+    if (state == MPI_THREAD_UP || state == MPI_THREAD_FAILED) {
+        /* MPI's main thread finalises it */
+        pthread_mutex_lock(&mpi_thread_mutex);
+        mpi_thread_stop = 1;
+        pthread_cond_broadcast(&mpi_thread_cond);
+        pthread_mutex_unlock(&mpi_thread_mutex);
+        pthread_join(mpi_thread, NULL);
+        pthread_mutex_lock(&mpi_thread_mutex);
+        mpi_thread_state = MPI_THREAD_NONE;
+        mpi_thread_stop = 0;
+        pthread_mutex_unlock(&mpi_thread_mutex);
     }
     if (mpi_started_here) {
         MPI_Finalize();
@@ -607,6 +684,7 @@ static int coarsen(const asp_amg_csr *a, asp_amg_csr **take, const asp_amg_desc 
     if (a->rows > (size_t)INT_MAX - 1 || a->row_ptr[a->rows] > (size_t)INT_MAX)
         return asp_error_set(err, ASP_EUNSUPPORTED, "matrix of %zu rows is too large for this hypre build", a->rows);
     int started = 0;
+    mpi_thread_wait();
     MPI_Initialized(&started);
     if (!started && mpi_start_at_risk())
         return coarsen_isolated(a, take, desc, ctx, p_out, ac_out, err);

@@ -88,6 +88,11 @@ int asp__amg_assemble(const float *pos, const float *classifier, const asp__amg_
 
 /* Starts MPI (a singleton when no launcher did) and hypre once per process; asp_amg_shutdown ends what it started. */
 int asp__amg_hypre_start(asp_error *err);
+/*
+ * Starts MPI on a thread of its own when this process will need it and nobody started it, so the
+ * start overlaps the stages before the AMG (hypre_bridge.c); asp__amg_hypre_start waits for it.
+ */
+void asp__amg_hypre_prestart(void);
 /* One BoomerAMG setup level on a: copies P (a->rows x nc) and A^1 = P^T a P; *p = NULL when hypre did not coarsen. */
 int asp__amg_hypre_coarsen(const asp_amg_csr *a, const asp_amg_desc *desc, const asp_context *ctx,
                            asp_amg_csr **p, asp_amg_csr **ac, asp_error *err);
@@ -119,6 +124,22 @@ int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_cont
 /* Sparse product c = a * b with entries < drop dropped and rows renormalised to sum 1. */
 int asp__amg_spgemm_pou(const asp_amg_csr *a, const asp_amg_csr *b, double drop, const asp_context *ctx,
                         asp_amg_csr **out, asp_error *err);
+
+/*
+ * The decomposition's numbering of points (morton.c): *order (n entries) lists the input indices
+ * along the Morton curve of the positions quantised over their bounding box, ties in input order.
+ * The key alone, for the distributed reader: scale from the global box (asp__amg_morton_scale).
+ */
+int asp__amg_morton_order(const float *pos, size_t n, const asp_context *ctx, asp_index **order, asp_error *err);
+double asp__amg_morton_scale(const float lo[3], const float hi[3]);
+uint64_t asp__amg_morton_key(const float p[3], const float lo[3], double scale);
+
+/* Back to the input order: element m of data (n elements of elem bytes) moves to order[m]. */
+int asp__amg_unpermute(void *data, size_t n, size_t elem, const asp_index *order, const asp_context *ctx,
+                       asp_error *err);
+/* The same for the rows of *m (and its columns, with columns_too: a square point-by-point matrix). */
+int asp__amg_csr_unpermute(asp_amg_csr **m, const asp_index *order, int columns_too, const asp_context *ctx,
+                           asp_error *err);
 
 /* Allocates an empty asp_amg owning nothing yet. */
 int asp__amg_alloc(const asp_context *ctx, asp_amg **out, asp_error *err);

@@ -118,4 +118,11 @@ cJSON *cli_json_number(const char *fmt, double v);
 /* A JSON array of n doubles, each to 17 significant digits (round trip exact). */
 cJSON *cli_json_doubles(const double *v, int n);
 
+/*
+ * For the commands that allocate most (decompose, build): starts the process again with glibc's
+ * transparent-huge-page tunable where the kernel's THP mode is "madvise" (huge_pages.c). Returns
+ * when nothing was done or the start failed.
+ */
+void cli_huge_pages_restart(char **argv);
+
 #endif

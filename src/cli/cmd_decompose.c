@@ -256,7 +256,7 @@ static int check_output_name(const struct cli_env *env, const char *input, const
 }
 
 /* The level figures of a distributed run as decompose --stats --json writes them, plus the agreement checks. */
-static void add_distributed_json(cJSON *o, const asp_amg_dist_info *in, double tau)
+static void add_distributed_json(cJSON *o, const asp_amg_dist_info *in, double tau, int stats)
 {
     cJSON *sizes = cJSON_CreateArray(), *sec = cJSON_CreateObject(), *levels = cJSON_CreateArray();
     cJSON_AddNumberToObject(o, "ranks", in->ranks);
@@ -277,6 +277,8 @@ static void add_distributed_json(cJSON *o, const asp_amg_dist_info *in, double t
     cJSON_AddItemToObject(sec, "basis_stats", cli_json_number("%.4f", in->t_stats));
     cJSON_AddItemToObject(sec, "write", cli_json_number("%.4f", in->t_write));
     cJSON_AddItemToObject(o, "seconds", sec);
+    if (!stats)
+        return; /* the figures were not computed (ASP_AMG_DIST_NO_FIGURES), as the serial JSON has none */
     cJSON_AddItemToObject(o, "tau", cli_json_number("%g", tau));
     for (size_t l = 0; l < in->nlevels; l++) {
         const asp_amg_dist_level *lv = &in->level[l];
@@ -299,7 +301,9 @@ static int decompose_distributed(struct cli_env *env, const char *input, const c
 {
     asp_error err = {0};
     asp_amg_dist_info info;
-    int rc = asp_amg_decompose_distributed(input, output, desc, tau, &env->ctx, &info, &err);
+    /* the basis of every level only where --stats reports its figures */
+    int rc = asp_amg_decompose_distributed(input, output, desc, stats ? tau : ASP_AMG_DIST_NO_FIGURES, &env->ctx,
+                                           &info, &err);
     cli_progress_end(env);
     int status = 0;
     if (rc)
@@ -311,7 +315,7 @@ static int decompose_distributed(struct cli_env *env, const char *input, const c
             cJSON_AddStringToObject(o, "output", output);
         else
             cJSON_AddNullToObject(o, "output");
-        add_distributed_json(o, &info, tau);
+        add_distributed_json(o, &info, tau, stats);
         cJSON_AddItemToObject(o, "total_seconds", cli_json_number("%.4f", info.t_total));
         status = cli_json_print(env, o);
     } else if (info.rank == 0 && !env->quiet) {

@@ -94,6 +94,8 @@ int main(int argc, char **argv)
         return run(c, 2, help_argv);
     }
     const struct cli_command *c = find_command(name);
+    if (c && (strcmp(name, "decompose") == 0 || strcmp(name, "build") == 0))
+        cli_huge_pages_restart(argv);
     if (!c) {
         fprintf(stderr, "amgsplat: '%s' is not a command; see 'amgsplat help'\n", name);
         return 2;
