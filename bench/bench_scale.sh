@@ -62,10 +62,14 @@ for n in $sizes; do
         fi
         for r in $(seq "$repeat"); do
             echo "== N $count, P $p, run $r ($(uptime | sed 's/.*load/load/'))" >&2
-            run=()
-            [ "$p" -gt 1 ] && run=(mpirun -np "$p" --oversubscribe)
+            run=() opts=("${threads[@]}")
+            # one thread per rank (ranks and threads together must not exceed the cores, docs/mpi.md);
+            # as root Open MPI wants the two variables, given to mpirun only (hypre_bridge.c, issue 13)
+            [ "$p" -gt 1 ] && run=(env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+                mpirun -np "$p" --oversubscribe) opts=(--threads 1)
+            # GNU time's maximum resident set size of mpirun is that of its largest child: one rank's peak
             /usr/bin/time -v -o "$work/time.txt" "${run[@]}" "$A" decompose "$ply" -o "$work/out.amg" --json \
-                "${threads[@]}" >"$work/out.json"
+                "${opts[@]}" >"$work/out.json"
             load=$(cut -d' ' -f1 /proc/loadavg)
             python3 - "$work/out.json" "$work/time.txt" "$count" "$p" "$load" >>"$results" <<'PY'
 import json, re, sys
@@ -91,11 +95,12 @@ for r in rows:
     cells.setdefault((int(r[0]), int(r[1])), []).append([float(x) for x in r[2:]])
 def med(v, k):
     return statistics.median(x[k] for x in v)
-print("| N | P | wall (s) | peak RSS | bytes/point | neighbours | classifier | fans | assembly | AMG | levels | load |")
+# P > 1: the peak RSS is the largest rank's, and bytes/point are per point that rank owns (N / P)
+print("| N | P | wall (s) | peak RSS (per process) | bytes/point (per process) | neighbours | classifier | fans | assembly | AMG | levels | load |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|")
 for (n, p), v in sorted(cells.items()):
     wall, rss = med(v, 0), med(v, 1) * 1024
-    print(f"| {n / 1e6:g}M | {p} | {wall:.2f} | {rss / 2**20:.0f} MB | {rss / n:.0f} | "
+    print(f"| {n / 1e6:g}M | {p} | {wall:.2f} | {rss / 2**20:.0f} MB | {rss * p / n:.0f} | "
           + " | ".join(f"{med(v, k):.2f}" for k in range(2, 7)) + f" | {med(v, 7):.0f} | {med(v, 8):.1f} |")
 for p in sorted({p for _, p in cells}):
     pts = sorted((n, med(v, 0), med(v, 1) * 1024) for (n, q), v in cells.items() if q == p)
@@ -112,7 +117,7 @@ for p in sorted({p for _, p in cells}):
           f"({len(pts)} sizes, {pts[0][0] / 1e6:g}M..{n / 1e6:g}M).")
     # Paper estimate for 10^9 points: each rank holds N/P points at the measured bytes per point and runs at the
     # measured rate; the distributed run adds halo exchange and hypre's communication, not modelled here.
-    bpp = m / n
+    bpp = m * p / n  # per point a process owns
     t1e9 = t * (1e9 / n) ** at
     for ranks, gb in ((64, 16), (256, 4)):
         per_rank = 1e9 / ranks
