@@ -258,7 +258,7 @@ static int check_output_name(const struct cli_env *env, const char *input, const
 /* The level figures of a distributed run as decompose --stats --json writes them, plus the agreement checks. */
 static void add_distributed_json(cJSON *o, const asp_amg_dist_info *in, double tau, int stats)
 {
-    cJSON *sizes = cJSON_CreateArray(), *sec = cJSON_CreateObject(), *levels = cJSON_CreateArray();
+    cJSON *sizes = cJSON_CreateArray(), *sec = cJSON_CreateObject();
     cJSON_AddNumberToObject(o, "ranks", in->ranks);
     cJSON_AddNumberToObject(o, "points", (double)in->points);
     cJSON_AddNumberToObject(o, "levels", (double)in->nlevels);
@@ -280,6 +280,7 @@ static void add_distributed_json(cJSON *o, const asp_amg_dist_info *in, double t
     if (!stats)
         return; /* the figures were not computed (ASP_AMG_DIST_NO_FIGURES), as the serial JSON has none */
     cJSON_AddItemToObject(o, "tau", cli_json_number("%g", tau));
+    cJSON *levels = cJSON_CreateArray();
     for (size_t l = 0; l < in->nlevels; l++) {
         const asp_amg_dist_level *lv = &in->level[l];
         cJSON *j = cJSON_CreateObject();

@@ -29,6 +29,13 @@ assert st[-1]["name"] == "L-0"
 assert set(d["seconds"]) == {"neighbours", "classifier", "fans", "assembly", "amg"}
 PY
 
+# the start with glibc's huge-page tunable (src/cli/huge_pages.c, where THP is in madvise mode) keeps
+# the arguments and the result: the same file, byte for byte, as with it turned off
+"$A" decompose "$T/oct.ply" -o "$T/oct_nohp.amg" -q
+ASP_HUGE_PAGES=0 "$A" decompose "$T/oct.ply" -o "$T/oct_hp0.amg" -q
+cmp -s "$T/oct_nohp.amg" "$T/oct_hp0.amg" || fail "decompose with and without the huge-page start differ"
+cmp -s "$T/oct.amg" "$T/oct_hp0.amg" || fail "decompose with --stats and without differ"
+
 # info on the .amg: the same level sizes as decompose reported, the points and attributes it keeps
 "$A" info "$T/oct.amg" --json > "$T/info.json"
 "$A" info "$T/oct.amg" > "$T/info.txt"
