@@ -88,6 +88,15 @@ for p in ranks:
           f"{m['halo_points']:,} | {m['levels']} | {100 * rel:.1f}% (>= 30), {small} (< 30) | "
           f"{max(l['max_pou_error'] for l in m['level_stats']):.1e} | "
           f"{sum(l['points_outside'] for l in m['level_stats'])} |")
+    # the agreement checks (point 2), one verdict line each on stderr (the table stays clean)
+    worst = max(((abs(a - b) / b, l, a, b) for l, (a, b) in enumerate(zip(md, sd)) if b >= 30), default=None)
+    ok_levels = abs(m["levels"] - s["levels"]) <= 1
+    ok_domains = worst is None or worst[0] <= 0.10
+    ok_inv = all(l["max_pou_error"] < 1e-6 and l["points_outside"] == 0 for l in m["level_stats"])
+    print(f"agreement N {int(n):,} np {p}: levels within one {'yes' if ok_levels else 'NO'}; domains within 10% "
+          f"on every level with >= 30: {'yes' if ok_domains else 'NO'}"
+          + (f" (largest {100 * worst[0]:.1f}% at level {worst[1]}: {worst[2]} against {worst[3]})" if worst else "")
+          + f"; partition of unity and every point in a domain {'yes' if ok_inv else 'NO'}", file=sys.stderr)
 PY
 done
 echo "load after: $(uptime)" >&2
