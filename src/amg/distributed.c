@@ -1212,6 +1212,8 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
     inf.t_halo = asp_time_now() - t; /* the radii; the exchange is added to it */
     if ((rc = halo_and_neighbourhoods(&r, &inf, err)) != 0)
         goto done;
+    asp_free(&d->ctx, r.radius); /* the halo is closed */
+    r.radius = NULL;
     inf.halo_points = (size_t)sum_all(d, r.pts.n_ghost);
     if ((rc = local_stages(&r, &inf, err)) != 0)
         goto done;

@@ -75,10 +75,11 @@ static int to_ij(const asp__dist *d, const asp_amg_csr *m, const size_t *starts,
     HYPRE_IJMatrixInitialize(ij);
     if (rows)
         HYPRE_IJMatrixSetValues(ij, (HYPRE_Int)rows, ncols, rowid, cols, m->val);
-    HYPRE_IJMatrixAssemble(ij);
+    /* hypre has copied the values: our index arrays go before the assembly, its peak (issue 19) */
     asp_free(&d->ctx, ncols);
     asp_free(&d->ctx, rowid);
     asp_free(&d->ctx, cols);
+    HYPRE_IJMatrixAssemble(ij);
     *out = ij;
     return 0;
 }
