@@ -154,11 +154,12 @@ static int cmp_triple(const void *a, const void *b)
  * owner has in row j, column i: each rank sends those to the owners. Then
  * stiffness.c's clamping and zero row sums (eq. 7) on the completed rows.
  */
-static int global_rows(const asp__dist *d, const asp__dist_points *pts, const asp_amg_csr *a, const asp_amg_csr *f,
+static int global_rows(const asp__dist *d, const asp__dist_points *pts, asp_amg_csr **take_a, asp_amg_csr **take_f,
                        asp_amg_stiffness form, asp_amg_csr **ga, asp_amg_csr **gf, size_t *positive,
                        asp_error *err)
 {
-    const int P = d->size;
+    const asp_amg_csr *a = *take_a, *f = *take_f;
+    const int P = d->size, want_f = f != NULL;
     const size_t n = pts->n_own, start = pts->starts[d->rank];
     int *cnt = asp_calloc(&d->ctx, 4 * (size_t)P, sizeof *cnt);
     if (!cnt)
@@ -211,11 +212,16 @@ static int global_rows(const asp__dist *d, const asp__dist_points *pts, const as
         for (size_t k = a->row_ptr[i]; k < a->row_ptr[i + 1]; k++)
             if (a->col[k] != i)
                 all[w++] = (triple){(asp_index)(start + i), gid_of(d, pts, a->col[k]), a->val[k], f ? f->val[k] : 0};
+    /* every entry is in the triples now: the local matrices go before the global ones are made (issue 19) */
+    asp_amg_csr_destroy(*take_a);
+    asp_amg_csr_destroy(*take_f);
+    *take_a = *take_f = NULL;
+    a = f = NULL;
     qsort(all, own_n + got, sizeof *all, cmp_triple);
     const size_t total = own_n + got;
     asp_amg_csr *A = NULL, *F = NULL;
     rc = asp_amg_csr_create(n, pts->n_global, total + n, &d->ctx, &A, err);
-    if (!rc && f)
+    if (!rc && want_f)
         rc = asp_amg_csr_create(n, pts->n_global, total + n, &d->ctx, &F, err);
     const int clamp = form != ASP_AMG_STIFFNESS_UNCLAMPED;
     size_t pos_count = 0, k = 0;
@@ -679,13 +685,14 @@ static int gather_level(const asp__dist *d, size_t *starts, asp_amg_csr **a, asp
     return 0;
 }
 
-static int build_hierarchy(const asp__dist *d, const asp__dist_points *pts, const asp_amg_csr *a0,
+/* Takes *a0: destroyed (*a0 = NULL) once hypre holds its copy of the first level (the AMG stage's peak). */
+static int build_hierarchy(const asp__dist *d, const asp__dist_points *pts, asp_amg_csr **a0,
                            const asp_amg_csr *f0, const float *cls, const asp_amg_desc *desc, hier *h, asp_error *err)
 {
     const int P = d->size;
     const size_t maxl = desc->max_levels < ASP_AMG_DIST_MAX_LEVELS ? desc->max_levels : ASP_AMG_DIST_MAX_LEVELS;
     const int crease = desc->crease_cut > 0 && f0;
-    const asp_amg_csr *cur = a0, *fcur = f0;
+    const asp_amg_csr *cur = *a0, *fcur = f0;
     asp_amg_csr *owned = NULL, *fowned = NULL;
     size_t n = pts->n_own, *cst = asp_alloc(&d->ctx, ((size_t)P + 1) * sizeof *cst);
     double *mass = asp_alloc(&d->ctx, (n + 1) * sizeof *mass), *cm = asp_alloc(&d->ctx, (n + 1) * sizeof *cm);
@@ -703,7 +710,7 @@ static int build_hierarchy(const asp__dist *d, const asp__dist_points *pts, cons
         mass[i] = 1.0;
         cm[i] = cls[i];
     }
-    const double cut = desc->weak_coupling > 0 ? desc->weak_coupling * median_coupling(d, a0, pts->starts[d->rank]) : 0;
+    const double cut = desc->weak_coupling > 0 ? desc->weak_coupling * median_coupling(d, *a0, pts->starts[d->rank]) : 0;
     while (h->nlevels < maxl && h->sizes[h->nlevels - 1] > desc->max_coarse) {
         const size_t l = h->nlevels;
         size_t *st = h->starts[l - 1];
@@ -720,8 +727,15 @@ static int build_hierarchy(const asp__dist *d, const asp__dist_points *pts, cons
         }
         asp_amg_csr *p = NULL, *ac = NULL, *next = NULL, *fnext = NULL;
         size_t *nst = asp_alloc(&d->ctx, ((size_t)P + 1) * sizeof *nst), offdiag = 0;
-        rc = asp__dist_coarsen(d, cur, st, desc, &p, &ac, cst, err);
+        /* the first level: A^0 goes as soon as hypre has it; the rows P leaves empty come back for the fill */
+        asp_amg_csr *a_rows = NULL;
+        const int first = *a0 && cur == *a0;
+        rc = first ? asp__dist_coarsen_take(d, a0, st, desc, &p, &ac, cst, &a_rows, err)
+                   : asp__dist_coarsen(d, cur, st, desc, &p, &ac, cst, err);
+        if (first && !*a0)
+            cur = NULL; /* taken */
         if (rc || !p) {
+            asp_amg_csr_destroy(a_rows);
             asp_free(&d->ctx, nst);
             break;
         }
@@ -729,7 +743,10 @@ static int build_hierarchy(const asp__dist *d, const asp__dist_points *pts, cons
             rc = ASP_ENOMEM;
         if ((rc = asp__dist_agree(d, rc ? asp_error_set(err, rc, "out of memory for the AMG hierarchy") : 0, err)))
             goto level_fail;
-        if ((rc = fill_empty_rows(d, &p, cur, st, err)) != 0)
+        rc = fill_empty_rows(d, &p, a_rows ? a_rows : cur, st, err);
+        asp_amg_csr_destroy(a_rows);
+        a_rows = NULL;
+        if (rc)
             goto level_fail;
         if ((rc = asp__dist_agree(d, repair(d, &p, cst, nst, &h->repaired, err), err)) != 0)
             goto level_fail;
@@ -783,6 +800,7 @@ static int build_hierarchy(const asp__dist *d, const asp__dist_points *pts, cons
             break;
         continue;
     level_fail:
+        asp_amg_csr_destroy(a_rows);
         asp_amg_csr_destroy(p);
         asp_amg_csr_destroy(ac);
         asp_amg_csr_destroy(next);
@@ -1147,7 +1165,7 @@ static int local_stages(run *r, asp_amg_dist_info *info, asp_error *err)
     if ((rc = asp__dist_agree(d, rc, err)) != 0)
         return rc;
     asp__amg_fans_release(&d->ctx, &r->fans);
-    rc = global_rows(d, pts, r->la, r->lf, r->desc.stiffness, &r->a, &r->f, &info->amg.positive_offdiag, err);
+    rc = global_rows(d, pts, &r->la, &r->lf, r->desc.stiffness, &r->a, &r->f, &info->amg.positive_offdiag, err);
     if ((rc = asp__dist_agree(d, rc, err)) != 0)
         return rc;
     asp_amg_csr_destroy(r->la);
@@ -1218,7 +1236,7 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
     if ((rc = local_stages(&r, &inf, err)) != 0)
         goto done;
     t = asp_time_now();
-    rc = build_hierarchy(d, &r.pts, r.a, r.f, r.cls, &r.desc, &r.h, err);
+    rc = build_hierarchy(d, &r.pts, &r.a, r.f, r.cls, &r.desc, &r.h, err);
     if ((rc = asp__dist_agree(d, rc, err)) != 0)
         goto done;
     asp_amg_csr_destroy(r.f);

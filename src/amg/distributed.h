@@ -74,6 +74,13 @@ int asp__dist_start(asp__dist *d, asp_error *err);
  */
 int asp__dist_coarsen(const asp__dist *d, const asp_amg_csr *a, const size_t *starts, const asp_amg_desc *desc,
                       asp_amg_csr **p, asp_amg_csr **ac, size_t *cstarts, asp_error *err);
+/*
+ * The same, taking *a: it is destroyed (*a = NULL) once hypre holds its copy, before the setup
+ * (issue 19: A^0 is the largest array of the AMG stage's peak). *a_rows gets the rows of a that
+ * P left empty (the others empty), read back from hypre's copy, for the rows filled at borders.
+ */
+int asp__dist_coarsen_take(const asp__dist *d, asp_amg_csr **a, const size_t *starts, const asp_amg_desc *desc,
+                           asp_amg_csr **p, asp_amg_csr **ac, size_t *cstarts, asp_amg_csr **a_rows, asp_error *err);
 /* Galerkin product P^T F P of row-distributed P (rows starts, columns cstarts) and F: local rows of cstarts. */
 int asp__dist_galerkin(const asp__dist *d, const asp_amg_csr *p, const size_t *starts, const size_t *cstarts,
                        const asp_amg_csr *f, asp_amg_csr **out, asp_error *err);

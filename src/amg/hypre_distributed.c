@@ -90,8 +90,12 @@ static int cmp_entry(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* Local rows of a ParCSR matrix as asp_amg_csr with global, increasing columns (cols: the global column count). */
-static int from_parcsr(const asp__dist *d, hypre_ParCSRMatrix *p, size_t cols, asp_amg_csr **out, asp_error *err)
+/*
+ * Local rows of a ParCSR matrix as asp_amg_csr with global, increasing columns (cols: the global column
+ * count); with keep, only the rows r with keep[r] (the others empty).
+ */
+static int from_parcsr_rows(const asp__dist *d, hypre_ParCSRMatrix *p, size_t cols, const uint8_t *keep,
+                            asp_amg_csr **out, asp_error *err)
 {
     hypre_CSRMatrix *dg = hypre_ParCSRMatrixDiag(p), *od = hypre_ParCSRMatrixOffd(p);
     const HYPRE_Int rows = hypre_CSRMatrixNumRows(dg);
@@ -101,7 +105,10 @@ static int from_parcsr(const asp__dist *d, hypre_ParCSRMatrix *p, size_t cols, a
     const HYPRE_Complex *dv = hypre_CSRMatrixData(dg), *ov = hypre_CSRMatrixData(od);
     const HYPRE_BigInt *cmap = hypre_ParCSRMatrixColMapOffd(p);
     const int has_offd = oi && hypre_CSRMatrixNumCols(od) > 0;
-    size_t nnz = rows ? (size_t)di[rows] + (has_offd ? (size_t)oi[rows] : 0) : 0;
+    size_t nnz = 0;
+    for (HYPRE_Int r = 0; r < rows; r++)
+        if (!keep || keep[r])
+            nnz += (size_t)(di[r + 1] - di[r]) + (has_offd ? (size_t)(oi[r + 1] - oi[r]) : 0);
     (void)first_row;
     asp_amg_csr *m;
     int rc = asp_amg_csr_create((size_t)rows, cols, nnz, &d->ctx, &m, err);
@@ -113,6 +120,10 @@ static int from_parcsr(const asp__dist *d, hypre_ParCSRMatrix *p, size_t cols, a
     } *row = NULL;
     size_t cap = 0, w = 0;
     for (HYPRE_Int r = 0; r < rows; r++) {
+        if (keep && !keep[r]) {
+            m->row_ptr[r + 1] = w;
+            continue;
+        }
         size_t len = (size_t)(di[r + 1] - di[r]) + (has_offd ? (size_t)(oi[r + 1] - oi[r]) : 0);
         if (len > cap) {
             asp_free(&d->ctx, row);
@@ -144,8 +155,15 @@ static int from_parcsr(const asp__dist *d, hypre_ParCSRMatrix *p, size_t cols, a
     return 0;
 }
 
-int asp__dist_coarsen(const asp__dist *d, const asp_amg_csr *a, const size_t *starts, const asp_amg_desc *desc,
-                      asp_amg_csr **p_out, asp_amg_csr **ac_out, size_t *cstarts, asp_error *err)
+static int from_parcsr(const asp__dist *d, hypre_ParCSRMatrix *p, size_t cols, asp_amg_csr **out, asp_error *err)
+{
+    return from_parcsr_rows(d, p, cols, NULL, out, err);
+}
+
+/* take (may be NULL) owns a: destroyed once hypre has its copy; a_rows (with take) as asp__dist_coarsen_take */
+static int coarsen(const asp__dist *d, const asp_amg_csr *a, asp_amg_csr **take, const size_t *starts,
+                   const asp_amg_desc *desc, asp_amg_csr **p_out, asp_amg_csr **ac_out, size_t *cstarts,
+                   asp_amg_csr **a_rows, asp_error *err)
 {
     if (starts[d->size] > (size_t)INT_MAX - 1)
         return asp_error_set(err, ASP_EUNSUPPORTED, "matrix of %zu rows is too large for this hypre build",
@@ -159,6 +177,12 @@ int asp__dist_coarsen(const asp__dist *d, const asp_amg_csr *a, const size_t *st
         return rc;
     HYPRE_ParCSRMatrix pa;
     HYPRE_IJMatrixGetObject(ij, (void **)&pa);
+    const size_t nrows = a->rows;
+    if (take) {
+        asp_amg_csr_destroy(*take);
+        *take = NULL;
+        a = NULL;
+    }
     const HYPRE_BigInt lo = (HYPRE_BigInt)starts[d->rank], hi = (HYPRE_BigInt)starts[d->rank + 1] - 1;
     HYPRE_IJVectorCreate(d->comm, lo, hi, &bij);
     HYPRE_IJVectorSetObjectType(bij, HYPRE_PARCSR);
@@ -188,9 +212,20 @@ int asp__dist_coarsen(const asp__dist *d, const asp_amg_csr *a, const size_t *st
             rc = from_parcsr(d, hp, cstarts[d->size], &p, err);
         if (!rc)
             rc = from_parcsr(d, hac, cstarts[d->size], &ac, err);
-        if (!rc && (p->rows != a->rows || ac->rows != nc_local ||
+        if (!rc && (p->rows != nrows || ac->rows != nc_local ||
                     (size_t)hypre_ParCSRMatrixFirstColDiag(hp) != cstarts[d->rank]))
             rc = asp_error_set(err, ASP_ESOLVER, "hypre returned inconsistent coarse sizes on rank %d", d->rank);
+        if (!rc && a_rows) {
+            /* the rows of A where P is empty, from hypre's copy of A (ours is gone) */
+            uint8_t *keep = asp_alloc(&d->ctx, nrows + 1);
+            if (!keep)
+                rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
+            for (size_t r = 0; keep && r < nrows; r++)
+                keep[r] = p->row_ptr[r + 1] == p->row_ptr[r];
+            if (!rc)
+                rc = from_parcsr_rows(d, (hypre_ParCSRMatrix *)pa, starts[d->size], keep, a_rows, err);
+            asp_free(&d->ctx, keep);
+        }
     }
     HYPRE_BoomerAMGDestroy(amg);
     HYPRE_IJMatrixDestroy(ij);
@@ -199,11 +234,29 @@ int asp__dist_coarsen(const asp__dist *d, const asp_amg_csr *a, const size_t *st
     if ((rc = asp__dist_agree(d, rc, err)) != 0) {
         asp_amg_csr_destroy(p);
         asp_amg_csr_destroy(ac);
+        if (a_rows) {
+            asp_amg_csr_destroy(*a_rows);
+            *a_rows = NULL;
+        }
         return rc;
     }
     *p_out = p;
     *ac_out = ac;
     return 0;
+}
+
+int asp__dist_coarsen(const asp__dist *d, const asp_amg_csr *a, const size_t *starts, const asp_amg_desc *desc,
+                      asp_amg_csr **p_out, asp_amg_csr **ac_out, size_t *cstarts, asp_error *err)
+{
+    return coarsen(d, a, NULL, starts, desc, p_out, ac_out, cstarts, NULL, err);
+}
+
+int asp__dist_coarsen_take(const asp__dist *d, asp_amg_csr **a, const size_t *starts, const asp_amg_desc *desc,
+                           asp_amg_csr **p_out, asp_amg_csr **ac_out, size_t *cstarts, asp_amg_csr **a_rows,
+                           asp_error *err)
+{
+    *a_rows = NULL;
+    return coarsen(d, *a, a, starts, desc, p_out, ac_out, cstarts, a_rows, err);
 }
 
 int asp__dist_galerkin(const asp__dist *d, const asp_amg_csr *p, const size_t *starts, const size_t *cstarts,
