@@ -375,10 +375,11 @@ static int cell_of(const box_grid *gr, float v, int k)
     return c < 0 ? 0 : c >= gr->g ? gr->g - 1 : c;
 }
 
+/* At most 128^3 cells: 17 MB of cell starts on every rank when the boxes of all ranks share one grid. */
 static int grid_build(const asp_context *ctx, box_grid *gr, const asp__dist_points *pts, const float *boxes, size_t nbox)
 {
     int g = (int)(2 * cbrt((double)nbox)) + 1;
-    gr->g = g > 256 ? 256 : g;
+    gr->g = g > 128 ? 128 : g;
     for (int k = 0; k < 3; k++) {
         gr->lo[k] = pts->lo[k];
         float ext = pts->hi[k] - pts->lo[k];
@@ -492,41 +493,76 @@ int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radiu
     MPI_Allgatherv(mine, nb, MPI_FLOAT, boxes, bcnt, bdis, MPI_FLOAT, d->comm);
     asp_free(&d->ctx, mine);
     int *dis = cnt + P, *rcnt = cnt + 2 * P, *rdis = cnt + 3 * P;
+    /*
+     * One grid over the boxes of every other rank, each box knowing its rank: every owned point is
+     * looked up once, whatever P (a grid per rank looked every point up P - 1 times). A point goes to
+     * each rank once; the lists come out per rank in increasing point order, as before.
+     */
+    const size_t nother = (size_t)total_boxes / 6 - (size_t)bcnt[d->rank] / 6;
+    float *oth = asp_alloc(&d->ctx, (6 * nother + 6) * sizeof *oth);
+    int *oth_rank = asp_alloc(&d->ctx, (nother + 1) * sizeof *oth_rank);
+    size_t *seen = asp_calloc(&d->ctx, (size_t)P, sizeof *seen);
     size_t cap = 1024, w = 0;
-    asp_index *sid = asp_alloc(&d->ctx, cap * sizeof *sid);
-    int rc = sid ? 0 : ASP_ENOMEM;
-    for (int q = 0; q < P && !rc; q++) {
-        dis[q] = (int)w;
-        if (q == d->rank)
-            continue;
-        const float *qb = boxes + bdis[q];
-        box_grid gr;
-        rc = grid_build(&d->ctx, &gr, pts, qb, (size_t)bcnt[q] / 6);
-        for (size_t i = 0; !rc && i < n; i++) {
-            const float *p = pts->pos + 3 * i;
-            size_t c = ((size_t)cell_of(&gr, p[0], 0) * gr.g + (size_t)cell_of(&gr, p[1], 1)) * gr.g +
-                       (size_t)cell_of(&gr, p[2], 2);
-            size_t b = gr.start[c];
-            while (b < gr.start[c + 1] && !inside(p, qb + 6 * (size_t)gr.box[b]))
-                b++;
-            if (b == gr.start[c + 1])
+    struct pair {
+        int q;
+        asp_index i;
+    } *pairs = asp_alloc(&d->ctx, cap * sizeof *pairs);
+    int rc = oth && oth_rank && seen && pairs ? 0 : ASP_ENOMEM;
+    box_grid gr = {0};
+    if (!rc) {
+        size_t o = 0;
+        for (int q = 0; q < P; q++)
+            for (size_t b = (size_t)bdis[q] / 6; q != d->rank && b < (size_t)(bdis[q] + bcnt[q]) / 6; b++, o++) {
+                memcpy(oth + 6 * o, boxes + 6 * b, 6 * sizeof *oth);
+                oth_rank[o] = q;
+            }
+        rc = grid_build(&d->ctx, &gr, pts, oth, nother);
+    }
+    for (size_t i = 0; !rc && i < n; i++) {
+        const float *p = pts->pos + 3 * i;
+        size_t c = ((size_t)cell_of(&gr, p[0], 0) * gr.g + (size_t)cell_of(&gr, p[1], 1)) * gr.g +
+                   (size_t)cell_of(&gr, p[2], 2);
+        for (size_t b = gr.start[c]; b < gr.start[c + 1]; b++) {
+            const int q = oth_rank[gr.box[b]];
+            if (seen[q] == i + 1 || !inside(p, oth + 6 * (size_t)gr.box[b]))
                 continue;
+            seen[q] = i + 1;
             if (w == cap) {
-                asp_index *g = asp_realloc(&d->ctx, sid, cap * sizeof *sid, 2 * cap * sizeof *sid);
+                struct pair *g = asp_realloc(&d->ctx, pairs, cap * sizeof *pairs, 2 * cap * sizeof *pairs);
                 if (!g) {
                     rc = ASP_ENOMEM;
                     break;
                 }
-                sid = g;
+                pairs = g;
                 cap *= 2;
             }
-            sid[w++] = (asp_index)i; /* local for now */
+            pairs[w++] = (struct pair){q, (asp_index)i};
+            cnt[q]++;
         }
-        asp_free(&d->ctx, gr.start);
-        asp_free(&d->ctx, gr.box);
-        cnt[q] = (int)(w - (size_t)dis[q]);
     }
+    asp_free(&d->ctx, gr.start);
+    asp_free(&d->ctx, gr.box);
+    asp_free(&d->ctx, oth);
+    asp_free(&d->ctx, oth_rank);
+    asp_free(&d->ctx, seen);
     asp_free(&d->ctx, boxes);
+    /* by rank, each rank's points in increasing order (the pairs are in increasing point order) */
+    asp_index *sid = rc ? NULL : asp_alloc(&d->ctx, (w + 1) * sizeof *sid);
+    if (!rc && !sid)
+        rc = ASP_ENOMEM;
+    if (!rc) {
+        size_t at = 0;
+        for (int q = 0; q < P; q++) {
+            dis[q] = (int)at;
+            at += (size_t)cnt[q];
+        }
+        int *next = rcnt; /* scratch until the all-to-all below fills it */
+        for (int q = 0; q < P; q++)
+            next[q] = dis[q];
+        for (size_t k = 0; k < w; k++)
+            sid[next[pairs[k].q]++] = pairs[k].i; /* local for now */
+    }
+    asp_free(&d->ctx, pairs);
     float *spos = rc ? NULL : asp_alloc(&d->ctx, (3 * w + 3) * sizeof *spos);
     for (size_t k = 0; spos && k < w; k++) {
         memcpy(spos + 3 * k, pts->pos + 3 * (size_t)sid[k], 3 * sizeof *spos);
