@@ -423,24 +423,30 @@ static int fill_empty_rows(const asp__dist *d, asp_amg_csr **pp, const asp_amg_c
     return 0;
 }
 
+/* A coarse column in the repaired numbering: shifted by the orphans of the ranks before its owner. */
+typedef struct {
+    const size_t *cst, *ost;
+    int P;
+} orphan_shift;
+
+static asp_index shift_column(asp_index c, const void *arg)
+{
+    const orphan_shift *s = arg;
+    return (asp_index)(c + s->ost[asp__dist_owner(s->cst, s->P, c)]);
+}
+
 /*
- * hierarchy.c's repair_level on distributed rows: empty rows become orphans,
- * each a new coarse unknown numbered after its rank's hypre unknowns, so the
- * coarse partition becomes nst; columns are renumbered into it (monotone, so
- * rows stay sorted) and other rows renormalised.
+ * hierarchy.c's repair on distributed rows (asp__amg_pou_rows): empty rows
+ * become orphans, each a new coarse unknown numbered after its rank's hypre
+ * unknowns, so the coarse partition becomes nst; columns are renumbered into
+ * it (monotone, so rows stay sorted) and other rows renormalised.
  */
 static int repair(const asp__dist *d, asp_amg_csr **pp, const size_t *cst, size_t *nst, size_t *repaired,
                   asp_error *err)
 {
     const asp_amg_csr *p = *pp;
     const int P = d->size;
-    size_t orphans = 0;
-    for (size_t r = 0; r < p->rows; r++) {
-        double s = 0;
-        for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++)
-            s += p->val[k] > 0 ? p->val[k] : 0;
-        orphans += !(s > 1e-12);
-    }
+    const size_t orphans = asp__amg_empty_rows(p);
     size_t *ost = asp_alloc(&d->ctx, ((size_t)P + 1) * sizeof *ost);
     if (!ost || asp__dist_partition(d, orphans, ost)) {
         asp_free(&d->ctx, ost);
@@ -454,33 +460,15 @@ static int repair(const asp__dist *d, asp_amg_csr **pp, const size_t *cst, size_
         asp_free(&d->ctx, ost);
         return rc;
     }
-    size_t w = 0, next = nst[d->rank] + (cst[d->rank + 1] - cst[d->rank]);
-    for (size_t r = 0; r < p->rows; r++) {
-        double s = 0;
-        for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++)
-            s += p->val[k] > 0 ? p->val[k] : 0;
-        if (!(s > 1e-12)) {
-            qm->col[w] = (asp_index)next++;
-            qm->val[w++] = 1.0;
-            (*repaired)++;
-        } else {
-            if (fabs(s - 1.0) > 1e-9)
-                (*repaired)++;
-            for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++)
-                if (p->val[k] > 0) {
-                    qm->col[w] = (asp_index)(p->col[k] + ost[asp__dist_owner(cst, P, p->col[k])]);
-                    qm->val[w++] = p->val[k] / s;
-                }
-        }
-        qm->row_ptr[r + 1] = w;
-    }
+    const orphan_shift shift = {cst, ost, P};
+    asp__amg_pou_rows(p, qm, (asp_index)(nst[d->rank] + (cst[d->rank + 1] - cst[d->rank])), shift_column, &shift,
+                      repaired);
     asp_free(&d->ctx, ost);
     asp_amg_csr_destroy(*pp);
     *pp = qm;
     return 0;
 }
 
-/* The coarse matrix in the repaired numbering, with an empty row per orphan. */
 static int renumber_coarse(const asp__dist *d, asp_amg_csr **pac, const size_t *cst, const size_t *nst,
                            asp_error *err)
 {

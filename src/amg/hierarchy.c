@@ -12,33 +12,32 @@
 #include "amg/internal.h"
 #include "util/banned.h"
 
-/* Rebuilds p (hypre rows x hypre cols) with carried orphans (carried) and new ones; returns the new count. */
-static int repair_level(asp_amg_csr **pp, size_t carried, const asp_context *ctx, size_t *new_orphans,
-                        size_t *repaired, asp_error *err)
+static double positive_sum(const asp_amg_csr *p, size_t r)
 {
-    const asp_amg_csr *p = *pp;
-    size_t rows = p->rows + carried, orphans = 0;
+    double s = 0;
+    for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++)
+        if (p->val[k] > 0)
+            s += p->val[k];
+    return s;
+}
+
+size_t asp__amg_empty_rows(const asp_amg_csr *p)
+{
+    size_t n = 0;
+    for (size_t r = 0; r < p->rows; r++)
+        n += !(positive_sum(p, r) > 1e-12);
+    return n;
+}
+
+size_t asp__amg_pou_rows(const asp_amg_csr *p, asp_amg_csr *q, asp_index first_orphan,
+                         asp_index (*map)(asp_index c, const void *arg), const void *arg, size_t *repaired)
+{
+    size_t w = 0;
+    asp_index next_orphan = first_orphan;
     for (size_t r = 0; r < p->rows; r++) {
-        double s = 0;
-        for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++)
-            if (p->val[k] > 0)
-                s += p->val[k];
-        if (!(s > 1e-12))
-            orphans++;
-    }
-    size_t cols = p->cols + carried + orphans;
-    asp_amg_csr *q;
-    int rc = asp_amg_csr_create(rows, cols, p->row_ptr[p->rows] + carried + orphans, ctx, &q, err);
-    if (rc)
-        return rc;
-    size_t w = 0, next_orphan = p->cols + carried;
-    for (size_t r = 0; r < p->rows; r++) {
-        double s = 0;
-        for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++)
-            if (p->val[k] > 0)
-                s += p->val[k];
+        const double s = positive_sum(p, r);
         if (!(s > 1e-12)) {
-            q->col[w] = (asp_index)next_orphan++;
+            q->col[w] = next_orphan++;
             q->val[w++] = 1.0;
             (*repaired)++;
         } else {
@@ -51,12 +50,29 @@ static int repair_level(asp_amg_csr **pp, size_t carried, const asp_context *ctx
                 (*repaired)++;
             for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++)
                 if (p->val[k] > 0) {
-                    q->col[w] = p->col[k];
+                    q->col[w] = map ? map(p->col[k], arg) : p->col[k];
                     q->val[w++] = p->val[k] / s;
                 }
         }
         q->row_ptr[r + 1] = w;
     }
+    return next_orphan - first_orphan;
+}
+
+/* Rebuilds p (hypre rows x hypre cols) with carried orphans (carried) and new ones; returns the new count. */
+static int repair_level(asp_amg_csr **pp, size_t carried, const asp_context *ctx, size_t *new_orphans,
+                        size_t *repaired, asp_error *err)
+{
+    const asp_amg_csr *p = *pp;
+    const size_t rows = p->rows + carried, orphans = asp__amg_empty_rows(p);
+    asp_amg_csr *q;
+    int rc = asp_amg_csr_create(rows, p->cols + carried + orphans, p->row_ptr[p->rows] + carried + orphans, ctx,
+                                &q, err);
+    if (rc)
+        return rc;
+    /* the new orphans are numbered after hypre's unknowns and the carried ones */
+    asp__amg_pou_rows(p, q, (asp_index)(p->cols + carried), NULL, NULL, repaired);
+    size_t w = q->row_ptr[p->rows];
     for (size_t o = 0; o < carried; o++) {
         q->col[w] = (asp_index)(p->cols + o);
         q->val[w++] = 1.0;

@@ -117,6 +117,19 @@ int asp__amg_build_hierarchy_take(asp_amg_csr **a0, asp_amg_csr **f0, const floa
                                   const asp_context *ctx, size_t *nlevels, asp_amg_csr ***p, size_t **sizes,
                                   size_t *repaired, asp_error *err);
 
+/*
+ * P^l's rows as a partition of unity (journal 2.3, hierarchy.c): each row of p keeps its positive
+ * weights over their sum; a row without any (sum <= 1e-12: a point hypre left without interpolation)
+ * gets weight 1 on a new orphan unknown, numbered from first_orphan in row order. Columns go through
+ * map (NULL: unchanged; it must be increasing, so rows stay sorted). q has p->rows rows or more and
+ * room for p's entries plus one per orphan; rows from p->rows on are the caller's. Counts the rows it
+ * changed into *repaired; returns the orphans.
+ */
+size_t asp__amg_pou_rows(const asp_amg_csr *p, asp_amg_csr *q, asp_index first_orphan,
+                         asp_index (*map)(asp_index c, const void *arg), const void *arg, size_t *repaired);
+/* The rows of p that asp__amg_pou_rows turns into orphans. */
+size_t asp__amg_empty_rows(const asp_amg_csr *p);
+
 /* Galerkin product P^T F P (p: n x nc, f: n x n); columns within a row are not sorted. */
 int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_context *ctx, asp_amg_csr **out,
                       asp_error *err);
