@@ -144,8 +144,8 @@ fuzz_smoke() {
     # leaks are checked: the readers start no MPI. -max_len keeps mutations near the seeds' sizes.
     local log=build-fuzz/$name.log st=0
     local asan="detect_leaks=1:strict_string_checks=1" lsan=""
-    if [[ $name == fuzz_mesh ]]; then # assimp's own leaks on damaged files: tools/fuzz_mesh.supp says why
-      asan+=":fast_unwind_on_malloc=0"
+    if [[ $name == fuzz_mesh ]]; then # assimp's own leaks and strtol calls: the two .supp files say why
+      asan+=":fast_unwind_on_malloc=0:suppressions=$PWD/tools/fuzz_mesh_asan.supp"
       lsan="suppressions=$PWD/tools/fuzz_mesh.supp:print_suppressions=0"
     fi
     ASAN_OPTIONS="$asan" LSAN_OPTIONS="$lsan" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
