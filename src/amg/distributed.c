@@ -469,6 +469,7 @@ static int repair(const asp__dist *d, asp_amg_csr **pp, const size_t *cst, size_
     return 0;
 }
 
+/* The coarse matrix in the repaired numbering, with an empty row per orphan. */
 static int renumber_coarse(const asp__dist *d, asp_amg_csr **pac, const size_t *cst, const size_t *nst,
                            asp_error *err)
 {
