@@ -15,8 +15,8 @@
 # usage: bench/bench_mpi.sh [AMGSPLAT] [MESH]
 #   AMGSPLAT defaults to build/amgsplat, MESH to ../shared/data/stanford-bunny.obj.
 # Environment: SIZES (default "1000000 4000000"), RANKS ("1 2 4"), THREADS (serial threads, 2),
-#   REPS (1), NOISE (5; 0: no spread runs), WORK (a directory for the samples and outputs; default a temporary one), REUSE (set:
-#   keep the serial results already in WORK).
+#   REPS (1), NOISE (5; 0: no runs on copies), WORK (a directory for the samples and outputs; default
+#   a temporary one), REUSE (set: keep the serial results already in WORK).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 A=${1:-$here/build/amgsplat}
@@ -134,7 +134,6 @@ for p in ranks:
     ok_levels = abs(m["levels"] - s["levels"]) <= 1
     ok_domains = worst is None or worst[0] <= 0.10
     # the mean count per level over the sample and its copies, on levels with a serial mean >= 30
-    mworst = None
     if noise:
         mmean = means([md] + [domains(f"noise_mpi_{n}_{p}_{k}") for k in range(1, noise + 1)])
         mworst = max(((abs(a - b) / b, l, a, b) for l, (a, b) in enumerate(zip(mmean, smean)) if b >= 30),
