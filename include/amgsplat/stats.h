@@ -80,6 +80,28 @@ int asp_stats_ttest(const asp_stats_summary *a, const asp_stats_summary *b, cons
 int asp_stats_ttest_one(const asp_stats_summary *a, double mu, const asp_ttest_desc *desc, asp_ttest_result *out,
                         asp_error *err);
 
+/** What asp_stats_ttest_json writes beside the result; the zero value means a two-sample test alone. */
+typedef struct asp_ttest_json_desc {
+    const char *test;                 /* the "test" name; NULL = "welch" or "pooled" from the result */
+    int one_sample;                   /* the result is asp_stats_ttest_one's: "mu" is written */
+    double mu;                        /* one sample: the mean it was tested against */
+    const asp_stats_summary *samples; /* NULL, or the 1 (one sample) or 2 samples tested: n, mean, sd, mean_ci */
+} asp_ttest_json_desc;
+
+struct cJSON;
+
+/**
+ * The one JSON object of a t test, written by `experiment ttest --json` and in
+ * every test of `experiment analyze`'s report.json (docs/experiment-analysis.md
+ * lists the keys): "test", "mu" (one sample), "samples" (when given), "diff",
+ * "se", "t", "df", "p_one", "p_greater", "p_less", "p_two", "level",
+ * "diff_ci"; a NaN figure (a test that could not be made) is null. Returns 0
+ * and *out, a new cJSON object the caller owns (cJSON_Delete), or ASP_ENOMEM
+ * with *out unchanged. Thread safe.
+ */
+int asp_stats_ttest_json(const asp_ttest_result *r, const asp_ttest_json_desc *desc, struct cJSON **out,
+                         asp_error *err);
+
 /**
  * The level interval of a mean from its summary: mean +- t_{(1+level)/2, n-1}
  * sd / sqrt(n); *lo = *hi = NaN when n < 2 or level is outside (0, 1). Pure.

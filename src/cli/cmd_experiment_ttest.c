@@ -39,36 +39,16 @@ static int parse_sample(struct cli_env *env, const char *s, int which, asp_stats
     return 0;
 }
 
+/* the one t-test object of src/stats (asp_stats_ttest_json), as the analysis report writes it */
 static int print_json(const struct cli_env *env, const asp_stats_summary s[2], int nsamples, double mu,
                       const asp_ttest_result *r)
 {
-    cJSON *o = cJSON_CreateObject();
-    cJSON_AddStringToObject(o, "test", nsamples == 1 ? "one-sample" : r->welch ? "welch" : "pooled");
-    if (nsamples == 1)
-        cJSON_AddNumberToObject(o, "mu", mu);
-    cJSON *samples = cJSON_AddArrayToObject(o, "samples");
-    for (int k = 0; k < nsamples; k++) {
-        cJSON *x = cJSON_CreateObject();
-        cJSON_AddNumberToObject(x, "n", (double)s[k].n);
-        cJSON_AddNumberToObject(x, "mean", s[k].mean);
-        cJSON_AddNumberToObject(x, "sd", s[k].sd);
-        cJSON *ci = cJSON_AddArrayToObject(x, "mean_ci");
-        cJSON_AddItemToArray(ci, cJSON_CreateNumber(r->mean_lo[k]));
-        cJSON_AddItemToArray(ci, cJSON_CreateNumber(r->mean_hi[k]));
-        cJSON_AddItemToArray(samples, x);
-    }
-    cJSON_AddNumberToObject(o, "diff", r->diff);
-    cJSON_AddNumberToObject(o, "se", r->se);
-    cJSON_AddNumberToObject(o, "t", r->t);
-    cJSON_AddNumberToObject(o, "df", r->df);
-    cJSON_AddNumberToObject(o, "p_one", r->p_one);
-    cJSON_AddNumberToObject(o, "p_greater", r->p_greater);
-    cJSON_AddNumberToObject(o, "p_less", r->p_less);
-    cJSON_AddNumberToObject(o, "p_two", r->p_two);
-    cJSON_AddNumberToObject(o, "level", r->level);
-    cJSON *ci = cJSON_AddArrayToObject(o, "diff_ci");
-    cJSON_AddItemToArray(ci, cJSON_CreateNumber(r->diff_lo));
-    cJSON_AddItemToArray(ci, cJSON_CreateNumber(r->diff_hi));
+    const asp_ttest_json_desc d = {.test = nsamples == 1 ? "one-sample" : NULL, .one_sample = nsamples == 1,
+                                   .mu = mu, .samples = s};
+    cJSON *o = NULL;
+    asp_error err = {0};
+    if (asp_stats_ttest_json(r, &d, &o, &err))
+        return cli_fail(env, &err);
     return cli_json_print(env, o);
 }
 

@@ -66,19 +66,8 @@ cJSON *asp__report_json_summary(const asp_stats_summary *s, double scale)
 
 cJSON *asp__report_json_ttest(const asp_ttest_result *r)
 {
-    cJSON *o = cJSON_CreateObject();
-    cJSON_AddStringToObject(o, "test", r->welch ? "welch" : "pooled");
-    cJSON_AddNumberToObject(o, "diff", r->diff);
-    cJSON_AddNumberToObject(o, "se", r->se);
-    cJSON_AddNumberToObject(o, "t", r->t);
-    cJSON_AddNumberToObject(o, "df", r->df);
-    cJSON_AddNumberToObject(o, "p_greater", r->p_greater);
-    cJSON_AddNumberToObject(o, "p_less", r->p_less);
-    cJSON_AddNumberToObject(o, "p_two", r->p_two);
-    cJSON_AddNumberToObject(o, "level", r->level);
-    cJSON *ci = cJSON_AddArrayToObject(o, "diff_ci");
-    cJSON_AddItemToArray(ci, cJSON_CreateNumber(r->diff_lo));
-    cJSON_AddItemToArray(ci, cJSON_CreateNumber(r->diff_hi));
+    cJSON *o = NULL;
+    asp_stats_ttest_json(r, NULL, &o, NULL); // out of memory: NULL, which cJSON's adders refuse
     return o;
 }
 
@@ -88,7 +77,7 @@ void asp__report_both_tests(const asp_stats_summary *a, const asp_stats_summary 
 {
     for (int w = 0; w < 2; w++) {
         memset(&out[w], 0, sizeof out[w]);
-        out[w].t = out[w].df = out[w].p_greater = out[w].p_less = out[w].p_two = NAN;
+        out[w].t = out[w].df = out[w].p_greater = out[w].p_less = out[w].p_one = out[w].p_two = NAN;
         out[w].diff_lo = out[w].diff_hi = out[w].diff = out[w].se = NAN;
         out[w].welch = w;
         out[w].level = level;

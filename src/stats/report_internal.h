@@ -41,6 +41,7 @@ const char *asp__report_cell(char *buf, size_t cap, double v, int prec);
 /* A p-value cell: 4 decimals, scientific below 1e-4. Returns buf. */
 const char *asp__report_p_cell(char *buf, size_t cap, double p);
 cJSON *asp__report_json_summary(const asp_stats_summary *s, double scale);
+/* asp_stats_ttest_json of a two-sample test; NULL when out of memory */
 cJSON *asp__report_json_ttest(const asp_ttest_result *r);
 /* The pooled ([0]) and Welch ([1]) tests of a against b; a test that cannot be made has NaN fields. */
 void asp__report_both_tests(const asp_stats_summary *a, const asp_stats_summary *b, double level,

@@ -175,8 +175,8 @@ static void paired_tests(struct report *r, const struct nav_group *g, size_t ng,
                 asp__report_cell(b[0], 32, pr.diff, 1), asp__report_cell(b[1], 32, pr.t, 3),
                 asp__report_cell(b[2], 32, pr.df, 0), asp__report_p_cell(b[3], 32, pr.p_one),
                 asp__report_cell(b[4], 32, pr.diff_lo, 1), asp__report_cell(b[5], 32, pr.diff_hi, 1));
-        cJSON *o = asp__report_json_ttest(&pr);
-        cJSON_ReplaceItemInObject(o, "test", cJSON_CreateString("paired"));
+        cJSON *o = NULL;
+        asp_stats_ttest_json(&pr, &(asp_ttest_json_desc){.test = "paired", .one_sample = 1, .mu = 0}, &o, NULL);
         cJSON_AddStringToObject(o, "group", g[k].name);
         cJSON_AddItemToArray(paired, o);
     }
