@@ -663,7 +663,11 @@ typedef struct asp_text_overlay_desc {
     float scale;          /* pixels per font unit (stb_easy_font's glyphs are ~7 units tall); 0 = 2 */
     uint8_t color[4];     /* sRGB text colour; all 0 = white */
     uint8_t box[4];       /* sRGB colour of the box behind the text, alpha blended; all 0 = black, alpha 160 */
+    uint8_t fill[4];      /* sRGB colour the whole target is covered with first (a text screen); alpha 0 = none */
 } asp_text_overlay_desc;
+
+/** Width and height in pixels of the box asp_text_overlay_draw draws for text at scale (0 = 2). Pure. */
+void asp_text_overlay_measure(const char *text, float scale, float *width, float *height);
 
 /** Creates the overlay's GL program and buffers. Returns 0, ASP_EGL or ASP_ENOMEM; *out unchanged on failure. */
 int asp_text_overlay_create(asp_gl_context *gl, asp_text_overlay **out, asp_error *err);

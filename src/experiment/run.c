@@ -1,10 +1,9 @@
 /*
  * The experiment program of seed 004 2.3: for each subject the four tests in
  * a random order, each run twice (A polygons; B polygons or the variable
- * condition), every frame logged (docs/experiment-log.md). The machine
- * observer sees only the frame read back from the framebuffer; the simulation
- * advances by a fixed time step so one seed gives one set of logs (only
- * frame_ms and the start timestamps differ between runs).
+ * condition), every frame logged (docs/experiment-log.md). The runs' input
+ * comes from one source, a person at the window (window.c) or the machine
+ * observer (observer_source.c); the trial loops (trial.c) are the same for both.
  */
 #include <errno.h>
 #include <math.h>
@@ -19,10 +18,6 @@
 #include "util/atomic_file.h"
 #include "util/json_file.h"
 #include "util/banned.h"
-
-
-const uint8_t asp__exp_sky[4] = {150, 190, 230, 255};      /* navigation background: bluish, never sandy */
-const uint8_t asp__exp_backdrop[4] = {40, 40, 48, 255};    /* recognition background */
 
 static void say(const exp_study *st, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -72,377 +67,8 @@ static int exists(const char *path)
     return stat(path, &sb) == 0;
 }
 
-static double gauss(uint64_t *s)
-{
-    /* Box-Muller from two uniforms; deterministic for a stream */
-    double u = asp__exp_uniform(s), v = asp__exp_uniform(s);
-    return sqrt(-2.0 * log(u > 1e-300 ? u : 1e-300)) * cos(6.283185307179586 * v);
-}
-
-static cJSON *vec3(const float v[3])
-{
-    double d[3] = {v[0], v[1], v[2]};
-    return cJSON_CreateDoubleArray(d, 3);
-}
-
-/* ---------------------------------------------------------------- drawing */
-
-/* the first-person camera: eye at eye (world), heading yaw (0 = +z), pitch (negative looks down) */
-void asp__exp_first_person(asp_camera *cam, const double origin[3], const float eye[3], float yaw, float pitch,
-                         float aspect, float far_plane)
-{
-    asp_camera_init(cam);
-    float f[3] = {cosf(pitch) * sinf(yaw), sinf(pitch), cosf(pitch) * cosf(yaw)};
-    for (int k = 0; k < 3; k++)
-        cam->target[k] = (float)(eye[k] - origin[k]) + f[k];
-    cam->distance = 1.0f;
-    cam->azimuth = yaw / DEG + 180.0f;  // the eye sits at target - f
-    cam->elevation = -pitch / DEG;
-    cam->fov_y = 50.0f;
-    cam->aspect = aspect;
-    cam->z_near = 0.05f;
-    cam->z_far = far_plane;
-}
-
-void asp__exp_object_camera(asp_camera *cam, const exp_prepared *p, const double origin[3], float yaw, float pitch,
-                          float distance_radii, float aspect)
-{
-    asp_camera_init(cam);
-    cam->azimuth = yaw;
-    cam->elevation = pitch;
-    cam->fov_y = 40.0f;
-    asp_camera_frame(cam, &p->frame, origin, aspect, distance_radii);
-}
-
-/* draws one frame of condition c and reads it back (the observer's only input); blank = background only */
-int asp__exp_draw(exp_study *st, exp_prepared *p, asp_experiment_condition c, const asp_camera *cam,
-                const uint8_t bg[4], asp_image *img, double *ms, size_t *drawn, asp_error *err)
-{
-    asp_image_release(img);
-    double t0 = asp_time_now();
-    int rc = 0;
-    if (c == ASP_EXPERIMENT_BLANK) {
-        rc = asp_image_init(img, st->width, st->height, err);
-        if (!rc)
-            asp_image_fill(img, bg);
-        *drawn = 0;
-    } else {
-        if (c == ASP_EXPERIMENT_POINTS && p->adapting) {
-            rc = asp_renderer_set_lod(p->renderer[c], p->tau, p->adapt.depth, err);
-            if (rc)
-                return rc;
-        }
-        asp_render_desc rd = {.width = st->width, .height = st->height, .light_elevation = 45.0f};
-        memcpy(rd.background, bg, 4);
-        rc = asp_render_to_image(st->gl, p->renderer[c], cam, &rd, img, err);
-        *drawn = rc ? 0 : asp_renderer_count(p->renderer[c]);
-    }
-    *ms = 1000.0 * (asp_time_now() - t0);
-    if (!rc && c == ASP_EXPERIMENT_POINTS && p->adapting)
-        asp_hier_adapt_update(&p->adapt, *ms / 1000.0, 1); // every frame of a run moves the view: an event
-    return rc;
-}
-
-/* ---------------------------------------------------------------- logging */
-
-static void iso_now(char *buf, size_t cap)
-{
-    time_t now = time(NULL);
-    struct tm tmv;
-    gmtime_r(&now, &tmv);
-    strftime(buf, cap, "%Y-%m-%dT%H:%M:%SZ", &tmv);
-}
-
-int asp__exp_write_header(exp_run *r, int variable, asp_error *err)
-{
-    exp_study *st = r->st;
-    exp_prepared *p = r->p;
-    char started[32];
-    iso_now(started, sizeof started);
-    cJSON *h = cJSON_CreateObject();
-    cJSON_AddStringToObject(h, "type", "header");
-    cJSON_AddStringToObject(h, "format", "amgsplat-experiment-log 1");
-    cJSON_AddStringToObject(h, "subject", r->subject);
-    cJSON_AddStringToObject(h, "group", variable ? "variable" : "control");
-    cJSON_AddStringToObject(h, "test", asp_experiment_test_name(r->test));
-    cJSON_AddStringToObject(h, "run", r->run == 'A' ? "A" : "B");
-    cJSON_AddStringToObject(h, "condition", asp_experiment_condition_name(r->cond));
-    cJSON_AddNumberToObject(h, "seed", (double)st->desc->seed);
-    cJSON_AddStringToObject(h, "version", ASP_VERSION_STRING);
-    cJSON_AddBoolToObject(h, "observer", st->desc->observer != 0);
-    double screen[2] = {st->width, st->height};
-    cJSON_AddItemToObject(h, "screen", cJSON_CreateDoubleArray(screen, 2));
-    cJSON_AddStringToObject(h, "started", started);
-    if (p->scene.kind != 0) {
-        cJSON *path = cJSON_AddArrayToObject(h, "path");
-        for (size_t i = 0; path && i < p->world.path_count; i++)
-            cJSON_AddItemToArray(path, vec3(&p->world.path[3 * i]));
-        cJSON_AddNumberToObject(h, "half_width", p->world.half_width);
-    } else {
-        cJSON *c = cJSON_AddArrayToObject(h, "candidates");
-        for (size_t i = 0; c && i < st->scenes.candidate_count; i++)
-            cJSON_AddItemToArray(c, cJSON_CreateString(st->scenes.candidates[i].name));
-        cJSON_AddStringToObject(h, "answer_expected", p->model_name);
-    }
-    cJSON *d = cJSON_AddObjectToObject(h, "drawn");
-    if (d) {
-        cJSON_AddNumberToObject(d, "triangles", (double)p->triangles);
-        cJSON_AddNumberToObject(d, "points", (double)p->points);
-        cJSON_AddNumberToObject(d, "primitives", (double)p->primitives);
-    }
-    return asp__exp_log_write(&r->log, h, err);
-}
-
-int asp__exp_write_frame(exp_run *r, size_t i, double t, double ms, const float pos[3], const float dir[3],
-                       size_t drawn, const char *keys, const float *rot, asp_error *err)
-{
-    cJSON *f = cJSON_CreateObject();
-    cJSON_AddStringToObject(f, "type", "frame");
-    cJSON_AddNumberToObject(f, "i", (double)i);
-    cJSON_AddNumberToObject(f, "t", t);
-    cJSON_AddNumberToObject(f, "frame_ms", round(ms * 1000.0) / 1000.0);
-    cJSON_AddItemToObject(f, "pos", vec3(pos));
-    cJSON_AddItemToObject(f, "dir", vec3(dir));
-    cJSON_AddNumberToObject(f, "drawn", (double)drawn);
-    cJSON_AddStringToObject(f, "keys", keys);
-    if (rot) {
-        double d[2] = {rot[0], rot[1]};
-        cJSON_AddItemToObject(f, "rot", cJSON_CreateDoubleArray(d, 2));
-    }
-    r->frame_ms_sum += ms;
-    r->last_t = t;
-    r->res.frames++;
-    r->res.drawn = drawn;
-    return asp__exp_log_write(&r->log, f, err);
-}
-
-int asp__exp_write_event(exp_run *r, double t, const char *what, const char *text, asp_error *err)
-{
-    cJSON *e = cJSON_CreateObject();
-    cJSON_AddStringToObject(e, "type", "event");
-    cJSON_AddNumberToObject(e, "t", t);
-    cJSON_AddStringToObject(e, "what", what);
-    if (text)
-        cJSON_AddStringToObject(e, "text", text);
-    return asp__exp_log_write(&r->log, e, err);
-}
-
-/* ---------------------------------------------------------------- navigation */
-
-/*
- * Moves the walker or ship by one step and keeps it on the path: leaving it is
- * an off_path event (low speed) or a collision (high speed) and a bump back
- * inside (seed 004 2.3). The world does this, not the observer or the person.
- */
-int asp__exp_nav_move(exp_run *r, float *px, float *pz, float *pyaw, double turn, double speed, double dt, double t,
-                      float *along, asp_error *err)
-{
-    const asp_experiment_world *w = &r->p->world;
-    int high = r->test == ASP_EXPERIMENT_HIGHSPEED;
-    float x = *px, z = *pz, yaw = *pyaw;
-    int rc = 0;
-    yaw += (float)(turn * dt);
-    x += (float)(speed * dt) * sinf(yaw);
-    z += (float)(speed * dt) * cosf(yaw);
-    float pd[2];
-    float d = asp_experiment_path_nearest(w->path, w->path_count, x, z, along, pd);
-    if (d > w->half_width) {
-        /* bumped back inside (seed 004 2.3: off the path a warning, then back onto it) */
-        float nx = w->path[0], nz = w->path[2], best = INFINITY;
-        for (size_t s = 0; s < w->path_count; s++) {
-            float ddx = w->path[3 * s] - x, ddz = w->path[3 * s + 2] - z, dd = ddx * ddx + ddz * ddz;
-            if (dd < best) {
-                best = dd;
-                nx = w->path[3 * s];
-                nz = w->path[3 * s + 2];
-            }
-        }
-        x = nx + 0.6f * (x - nx) * w->half_width / d;
-        z = nz + 0.6f * (z - nz) * w->half_width / d;
-        /* a wall or the path's edge turns the heading halfway back along the path, as a ship slides along a wall */
-        float along_yaw = atan2f(pd[0], pd[1]), diff = along_yaw - yaw;
-        diff = atan2f(sinf(diff), cosf(diff));
-        yaw += 0.5f * diff;
-        r->res.off_path++;
-        rc = asp__exp_write_event(r, t, high ? "collision" : "off_path", NULL, err);
-    }
-    *px = x;
-    *pz = z;
-    *pyaw = yaw;
-    return rc;
-}
-
-/*
- * The observer walks (low speed) or flies (high speed) where it sees the
- * sandy path or canyon floor: it steers toward the look-ahead centroid of
- * those pixels, one frame late (the command from frame k acts in frame k+1),
- * and stops and turns to search when it sees none. The world, not the
- * observer, keeps it on the path: leaving it is an off_path event and a bump
- * back (seed 004 2.3), touching a canyon wall a collision.
- */
-static int run_navigation(exp_run *r, asp_error *err)
-{
-    exp_study *st = r->st;
-    exp_prepared *p = r->p;
-    const asp_experiment_world *w = &p->world;
-    int high = r->test == ASP_EXPERIMENT_HIGHSPEED;
-    float pitch = (high ? -8.0f : -14.0f) * DEG;
-    double dt = FIXED_DT;
-    double limit = p->scene.time_limit * (st->desc->short_tests ? 0.1 : 1.0);
-    size_t frames = (size_t)ceil(limit / dt);
-    /* a subject's manner: steering gain, noise and which way it searches */
-    double gain = 2.2 * (0.85 + 0.3 * asp__exp_uniform(&r->rng));
-    double noise = 0.04 + 0.04 * asp__exp_uniform(&r->rng);
-    double search = asp__exp_uniform(&r->rng) < 0.5 ? -1.0 : 1.0;
-    float x = w->path[0], z = w->path[2];
-    float yaw = atan2f(w->path[3] - w->path[0], w->path[5] - w->path[2]) + (float)(0.1 * gauss(&r->rng));
-    float steer_cmd = 0.0f, frac_cmd = 0.0f; // one frame late: before the first frame it has seen nothing, so it waits
-    asp_image img = {0};
-    char keys[4];
-    int rc = 0;
-    float along = 0.0f;
-    double t = 0.0;
-    for (size_t i = 0; i < frames && !rc; i++) {
-        float ground = asp_experiment_world_height(w, x, z);
-        float eye[3] = {x, ground + p->scene.eye_height, z};
-        float dir[3] = {sinf(yaw), 0.0f, cosf(yaw)};
-        asp_camera cam;
-        asp__exp_first_person(&cam, p->origin[r->cond], eye, yaw, pitch, (float)st->width / (float)st->height,
-                     1.5f * w->size);
-        double ms = 0.0;
-        size_t drawn = 0;
-        rc = asp__exp_draw(st, p, r->cond, &cam, asp__exp_sky, &img, &ms, &drawn, err);
-        if (rc)
-            break;
-        float frac = 0.0f, steer = 0.0f;
-        asp_experiment_see_path(&img, 0.45f, 1.0f, &frac, &steer);
-        /* act on what the previous frame showed */
-        int sees = frac_cmd > 0.01f;
-        double turn = sees ? -gain * (steer_cmd + noise * gauss(&r->rng)) : search * 0.8;
-        double max_turn = high ? 2.4 : 1.6; // radians per second: a ship turns faster than a walker
-        turn = turn > max_turn ? max_turn : turn < -max_turn ? -max_turn : turn;
-        double speed = sees ? p->scene.speed : 0.0;
-        size_t k = 0;
-        if (speed > 0.0)
-            keys[k++] = 'W';
-        if (turn > 0.05)
-            keys[k++] = 'A';
-        else if (turn < -0.05)
-            keys[k++] = 'D';
-        keys[k] = 0;
-        float logged[3] = {eye[0], ground, eye[2]};
-        rc = asp__exp_write_frame(r, i, t, ms, logged, dir, drawn, keys, NULL, err);
-        steer_cmd = steer;
-        frac_cmd = frac;
-        if (rc)
-            break;
-        if (st->desc->realtime)
-            dt = ms / 1000.0 < 1.0 / 240.0 ? 1.0 / 240.0 : ms / 1000.0 > 0.5 ? 0.5 : ms / 1000.0;
-        t += dt;
-        rc = asp__exp_nav_move(r, &x, &z, &yaw, turn, speed, dt, t, &along, err);
-        if (!rc && along >= 0.995f)
-            break;
-    }
-    asp_image_release(&img);
-    r->res.progress = along;
-    return rc;
-}
-
-/* ---------------------------------------------------------------- recognition */
-
-/*
- * The observer turns the object while unsure (it may rotate but not
- * approach: seed 004 2.3), comparing each frame's silhouette and colours with
- * the reference frames of every candidate; it presses Enter once the best
- * candidate's mean score leads the second by its threshold, and its naming
- * time grows with how unsure it still was, so both times depend on the picture.
- */
-static int run_recognition(exp_run *r, asp_error *err)
-{
-    exp_study *st = r->st;
-    exp_prepared *p = r->p;
-    size_t nc = st->scenes.candidate_count;
-    double dt = FIXED_DT, t = 0.0;
-    double limit = p->scene.time_limit * (st->desc->short_tests ? 0.25 : 1.0);
-    double threshold = 0.10 + 0.04 * asp__exp_uniform(&r->rng);
-    float yaw = (float)(360.0 * asp__exp_uniform(&r->rng)), pitch = 15.0f;
-    double turn_rate = 40.0 + 20.0 * asp__exp_uniform(&r->rng); // degrees per second
-    double sum[ASP_EXPERIMENT_MAX_CANDIDATES] = {0};
-    size_t seen = 0, best = 0;
-    double confidence = 0.0, t_recognised = -1.0, naming = 0.0;
-    asp_image img = {0};
-    int rc = 0;
-    for (size_t i = 0; !rc; i++) {
-        asp_camera cam;
-        asp__exp_object_camera(&cam, p, p->origin[r->cond], yaw, pitch, p->scene.distance_radii,
-                      (float)st->width / (float)st->height);
-        double ms = 0.0;
-        size_t drawn = 0;
-        rc = asp__exp_draw(st, p, r->cond, &cam, asp__exp_backdrop, &img, &ms, &drawn, err);
-        if (rc)
-            break;
-        int deciding = t_recognised < 0.0;
-        float eye[3];
-        asp_camera_eye(&cam, eye);
-        float dir[3] = {cam.target[0] - eye[0], cam.target[1] - eye[1], cam.target[2] - eye[2]};
-        float len = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-        for (int k = 0; k < 3; k++) {
-            dir[k] = len > 0.0f ? dir[k] / len : 0.0f;
-            eye[k] = (float)(eye[k] + p->origin[r->cond][k]);
-        }
-        float rot[2] = {yaw, pitch};
-        rc = asp__exp_write_frame(r, i, t, ms, eye, dir, drawn, deciding ? "D" : "", rot, err);
-        if (rc)
-            break;
-        if (deciding) {
-            exp_features f;
-            asp__exp_features(&img, asp__exp_backdrop, &f);
-            if (!f.empty) {
-                for (size_t c = 0; c < nc; c++) {
-                    float s = 0.0f;
-                    for (int y = 0; y < EXP_REF_YAWS; y++) {
-                        float v = asp__exp_feature_score(&f, &st->refs.f[c][y]);
-                        s = v > s ? v : s;
-                    }
-                    sum[c] += s;
-                }
-                seen++;
-            }
-            size_t b = 0, second = nc > 1 ? 1 : 0;
-            for (size_t c = 0; c < nc; c++)
-                if (sum[c] > sum[b])
-                    b = c;
-            for (size_t c = 0; c < nc; c++)
-                if (c != b && (second == b || sum[c] > sum[second]))
-                    second = c;
-            best = b;
-            confidence = seen && sum[b] > 0.0 ? (sum[b] - (nc > 1 ? sum[second] : 0.0)) / sum[b] : 0.0;
-            /* at least a quarter second of looking; then the lead must pass the threshold */
-            if ((seen >= 8 && confidence > threshold) || t + dt >= limit) {
-                t_recognised = t + dt;
-                naming = 0.7 + 0.08 * (double)strlen(st->scenes.candidates[b].name) +
-                         1.5 * (1.0 - fmin(1.0, confidence / (2.0 * threshold))) + 0.1 * fabs(gauss(&r->rng));
-                rc = asp__exp_write_event(r, t_recognised, "recognised", NULL, err);
-            } else {
-                yaw += (float)(turn_rate * dt);
-            }
-        } else if (t + dt >= t_recognised + naming) {
-            const char *answer = seen ? st->scenes.candidates[best].name : "unknown";
-            snprintf(r->res.answer, sizeof r->res.answer, "%s", answer);
-            r->res.correct = strcmp(answer, p->model_name) == 0;
-            r->res.recognition_s = t_recognised;
-            r->res.naming_s = t + dt - t_recognised;
-            rc = asp__exp_write_event(r, t + dt, "answer", answer, err);
-            t += dt;
-            break;
-        }
-        t += dt;
-    }
-    asp_image_release(&img);
-    return rc;
-}
-
-int asp__exp_append_answer(exp_run *r, const char *subject_dir, asp_error *err)
+/* a recognition run's answer, one line of the subject's answers.jsonl */
+static int append_answer(exp_run *r, const char *subject_dir, asp_error *err)
 {
     char path[4200];
     pathf(path, sizeof path, "%s/answers.jsonl", subject_dir);
@@ -494,24 +120,20 @@ static int run_one(exp_study *st, const char *subject, size_t subject_index, con
         return rc;
     rc = asp__exp_write_header(&r, variable, err);
     double t_end = 0.0;
-    if (!rc && !st->desc->observer)
-        rc = asp__exp_window_instructions(st, test, 0, err);
-    if (!rc && !st->aborted) {
-        if (st->desc->observer)
-            rc = test <= ASP_EXPERIMENT_NEAR ? run_recognition(&r, err) : run_navigation(&r, err);
-        else
-            rc = test <= ASP_EXPERIMENT_NEAR ? asp__exp_window_recognition(&r, err)
-                                             : asp__exp_window_navigation(&r, err);
-    } else if (!rc) {
+    exp_source *src = st->source;
+    if (!rc && src->ops->intro)
+        rc = src->ops->intro(src, test, 0, err);
+    if (!rc && !st->aborted)
+        rc = test <= ASP_EXPERIMENT_NEAR ? asp__exp_trial_recognition(&r, err) : asp__exp_trial_navigation(&r, err);
+    else if (!rc)
         rc = asp__exp_write_event(&r, 0.0, "abort", NULL, err);
-    }
     if (!rc) {
-        t_end = st->desc->observer ? (double)r.res.frames * FIXED_DT : r.last_t;
+        t_end = src->fixed_step ? (double)r.res.frames * FIXED_DT : r.last_t;
         rc = asp__exp_write_event(&r, t_end, "end", NULL, err);
     }
     asp__exp_log_close(&r.log);
     if (!rc && test <= ASP_EXPERIMENT_NEAR && r.res.answer[0])
-        rc = asp__exp_append_answer(&r, subject_dir, err);
+        rc = append_answer(&r, subject_dir, err);
     if (rc)
         return rc;
     r.res.mean_frame_ms = r.res.frames ? r.frame_ms_sum / (double)r.res.frames : 0.0;
@@ -521,49 +143,6 @@ static int run_one(exp_study *st, const char *subject, size_t subject_index, con
 }
 
 /* ---------------------------------------------------------------- study setup */
-
-static int make_references(exp_study *st, asp_error *err)
-{
-    st->refs.count = st->scenes.candidate_count;
-    int rc = 0;
-    for (size_t c = 0; c < st->scenes.candidate_count && !rc; c++) {
-        const asp_experiment_candidate *k = &st->scenes.candidates[c];
-        asp_mesh *mesh = NULL;
-        asp_render_material *mats = NULL;
-        asp_renderer *rend = NULL;
-        exp_prepared tmp;
-        memset(&tmp, 0, sizeof tmp);
-        rc = asp_mesh_load(k->model, &(asp_mesh_load_desc){.up = k->up}, st->ctx, &mesh, err);
-        if (!rc)
-            rc = asp_scene_mesh_frame(mesh, &tmp.frame, err);
-        if (!rc && !(mats = asp_calloc(st->ctx, mesh->material_count, sizeof *mats)))
-            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for materials");
-        asp_render_mesh rm;
-        if (!rc) {
-            asp_scene_mesh_describe(mesh, mats, &rm);
-            asp_mesh_renderer_desc md = {0};
-            memcpy(md.origin, mesh->origin, sizeof md.origin);
-            rc = asp_mesh_renderer_create(st->gl, &rm, &md, &rend, err);
-        }
-        for (int y = 0; y < EXP_REF_YAWS && !rc; y++) {
-            tmp.renderer[0] = rend;
-            asp_camera cam;
-            asp__exp_object_camera(&cam, &tmp, mesh->origin, 360.0f * (float)y / EXP_REF_YAWS, 15.0f, 0.0f,
-                          (float)st->width / (float)st->height);
-            asp_image img = {0};
-            double ms;
-            size_t drawn;
-            rc = asp__exp_draw(st, &tmp, ASP_EXPERIMENT_POLYGONS, &cam, asp__exp_backdrop, &img, &ms, &drawn, err);
-            if (!rc)
-                asp__exp_features(&img, asp__exp_backdrop, &st->refs.f[c][y]);
-            asp_image_release(&img);
-        }
-        asp_renderer_destroy(rend);
-        asp_free(st->ctx, mats);
-        asp_mesh_destroy(mesh);
-    }
-    return rc;
-}
 
 static int write_study(exp_study *st, char subjects[][32], size_t nsubjects, const char *path, asp_error *err)
 {
@@ -684,9 +263,9 @@ static int practice(exp_study *st, asp_error *err)
     r.cond = ASP_EXPERIMENT_POLYGONS;
     r.run = 'A';
     r.subject = "practice";
-    int rc = asp__exp_window_instructions(st, ASP_EXPERIMENT_LOWSPEED, 1, err);
+    int rc = st->source->ops->intro ? st->source->ops->intro(st->source, ASP_EXPERIMENT_LOWSPEED, 1, err) : 0;
     if (!rc && !st->aborted)
-        rc = asp__exp_window_navigation(&r, err); // r.log.fp NULL: nothing is written
+        rc = asp__exp_trial_navigation(&r, err); // r.log.fp NULL: nothing is written
     return rc;
 }
 
@@ -763,15 +342,14 @@ int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, 
     if (!rc)
         rc = make_dir(st->cache_dir, err);
     if (!rc)
-        rc = desc->observer ? asp_gl_context_create_headless(NULL, ctx, &st->gl, err)
-                            : asp__exp_window_open(st, err);
+        rc = desc->observer ? asp__exp_observer_open(st, &st->source, err) : asp__exp_person_open(st, &st->source, err);
     for (int t = 0; t < ASP_EXPERIMENT_TEST_COUNT && !rc; t++) {
         say(st, "preparing %s", asp_experiment_test_name((asp_experiment_test)t));
         rc = asp__exp_prepare(&st->scenes, (asp_experiment_test)t, st->cache_dir, desc->short_tests, st->gl, desc,
                               ctx, &st->prep[t], err);
     }
-    if (!rc && desc->observer)
-        rc = make_references(st, err);
+    if (!rc && st->source->ops->ready)
+        rc = st->source->ops->ready(st->source, err);
     pathf(path, sizeof path, "%s/study.json", desc->output_dir);
     if (!rc && !study_exists)
         rc = write_study(st, subjects, nsubjects, path, err);
@@ -799,7 +377,8 @@ int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, 
         say(st, "session stopped by Esc; what was recorded stays");
     for (int t = 0; t < ASP_EXPERIMENT_TEST_COUNT; t++)
         asp__exp_prepared_release(&st->prep[t]);
-    asp__exp_window_close(st);
+    if (st->source)
+        st->source->ops->close(st->source);
     asp_gl_context_destroy(st->gl);
     asp_free(ctx, st);
     asp_free(ctx, subjects);

@@ -104,6 +104,22 @@ static void linear_color(const uint8_t c[4], float out[4])
     out[3] = c[3] / 255.0f;
 }
 
+/* stb_easy_font's extent of text in font units; it takes a mutable string but only reads it */
+static void font_extent(const char *text, float *w, float *h)
+{
+    *w = (float)stb_easy_font_width((char *)text);
+    *h = (float)stb_easy_font_height((char *)text);
+}
+
+void asp_text_overlay_measure(const char *text, float scale, float *width, float *height)
+{
+    ASP_ASSERT(text && width && height);
+    float s = scale > 0 ? scale : 2.0f, tw, th;
+    font_extent(text, &tw, &th);
+    *width = tw * s + 6.0f * s; // the box's padding is 3 font units a side
+    *height = th * s + 6.0f * s;
+}
+
 int asp_text_overlay_draw(asp_text_overlay *o, const char *text, const asp_text_overlay_desc *desc,
                           asp_error *err)
 {
@@ -134,8 +150,9 @@ int asp_text_overlay_draw(asp_text_overlay *o, const char *text, const asp_text_
     char *copy = quads + cap;
     memcpy(copy, text, len + 1);
     int nq = len ? stb_easy_font_print(0, 0, copy, NULL, quads, (int)cap) : 0;
-    float tw = (float)stb_easy_font_width(copy), th = (float)stb_easy_font_height(copy);
-    float *verts = asp_alloc(&gl->actx, (size_t)(nq + 1) * 6 * FLOATS_PER_VERTEX * sizeof(float));
+    float tw, th;
+    font_extent(copy, &tw, &th);
+    float *verts = asp_alloc(&gl->actx, (size_t)(nq + 2) * 6 * FLOATS_PER_VERTEX * sizeof(float));
     if (!verts) {
         asp_free(&gl->actx, quads);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu characters of overlay text", len);
@@ -150,7 +167,16 @@ int asp_text_overlay_draw(asp_text_overlay *o, const char *text, const asp_text_
     float x0 = desc->x, y0 = desc->y;
     const float box[4][2] = {{x0, y0}, {x0 + tw * s + 2 * pad, y0}, {x0 + tw * s + 2 * pad, y0 + th * s + 2 * pad},
                              {x0, y0 + th * s + 2 * pad}};
-    float *v = put_quad(verts, box, bg);
+    float *v = verts;
+    size_t nverts = (size_t)(nq + 1) * 6;
+    if (desc->fill[3]) { // a text screen: the whole target first, blended as the box is
+        float fc[4];
+        linear_color(desc->fill, fc);
+        const float all[4][2] = {{0, 0}, {(float)w, 0}, {(float)w, (float)h}, {0, (float)h}};
+        v = put_quad(v, all, fc);
+        nverts += 6;
+    }
+    v = put_quad(v, box, bg);
     for (int q = 0; q < nq; q++) {
         float xy[4][2];
         for (int c = 0; c < 4; c++) {
@@ -161,7 +187,6 @@ int asp_text_overlay_draw(asp_text_overlay *o, const char *text, const asp_text_
         }
         v = put_quad(v, xy, fg);
     }
-    size_t nverts = (size_t)(nq + 1) * 6;
     asp__gl_clear_errors(gl);
     glNamedBufferData(o->vertices.id, (GLsizeiptr)(nverts * FLOATS_PER_VERTEX * sizeof(float)), verts,
                       GL_STREAM_DRAW);

@@ -180,3 +180,10 @@ assert len(A) == 1 and A[0]["answer"] == "horse" and A[0]["correct"] is True, A
 PY
 # the instruction screen as the window showed it: light text on a dark screen
 check "$T/pshots/instructions-near.png" "sum(1 for x in range(w) for y in range(h) if px(x, y)[0] > 200) > 500"
+# ... covering the whole window with the screen's colour, the text block centred and as wide as
+# fits (the text overlay's fill, measure and scale; 320 x 200 here)
+check "$T/pshots/instructions-near.png" "px(0, 0)[:3] == (30, 32, 40) and px(w - 1, h - 1)[:3] == (30, 32, 40)"
+lit="[(x, y) for x in range(w) for y in range(h) if px(x, y)[0] > 200]"
+check "$T/pshots/instructions-near.png" "abs(min(p[0] for p in $lit) - (w - 1 - max(p[0] for p in $lit))) <= 6"
+check "$T/pshots/instructions-near.png" "abs(min(p[1] for p in $lit) - (h - 1 - max(p[1] for p in $lit))) <= 10"
+check "$T/pshots/instructions-near.png" "max(p[0] for p in $lit) - min(p[0] for p in $lit) > 0.75 * w"
