@@ -2,8 +2,13 @@
  * t tests and summaries (src/stats/ttest.c, summary.c): GSL's t distribution
  * at known quantiles, and the seed's printed t values (seed 004 Tables 4.3,
  * 4.5, 4.7) recomputed from their summary figures; docs/experiment-analysis.md
- * explains each disagreement these tests pin down.
+ * explains each disagreement these tests pin down; and the one JSON writer of
+ * a t test (src/stats/ttest_json.c), whose keys the CLI and the report share.
  */
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
 #include "amgsplat/stats.h"
 #include "harness.h"
 
@@ -160,6 +165,53 @@ static void test_bad_input(void)
     CHECK(isnan(lo) && isnan(hi));
 }
 
+/* The keys of docs/experiment-analysis.md, in order; mu and samples only when asked; NaN is null. */
+static void test_json(void)
+{
+    asp_stats_summary s[2] = {fig(5, 7.6, 5.0), fig(6, -8.9, 23.6)};
+    asp_ttest_result r = run(5, 7.6, 5.0, 6, -8.9, 23.6, 0);
+    asp_error err = {0};
+    cJSON *o = NULL;
+    CHECK_OK(asp_stats_ttest_json(&r, NULL, &o, &err), &err);
+    static const char *const two[] = {"test", "diff", "se", "t", "df", "p_one", "p_greater", "p_less", "p_two",
+                                      "level", "diff_ci"};
+    const cJSON *k = o ? o->child : NULL;
+    for (size_t i = 0; i < sizeof two / sizeof *two; i++, k = k ? k->next : NULL)
+        CHECK_MSG(k && strcmp(k->string, two[i]) == 0, "key %zu: %s, expected %s", i, k ? k->string : "none", two[i]);
+    CHECK(k == NULL);
+    CHECK(strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(o, "test")), "pooled") == 0);
+    CHECK_NEAR(cJSON_GetObjectItem(o, "t")->valuedouble, r.t, 0);
+    CHECK_NEAR(cJSON_GetObjectItem(o, "p_one")->valuedouble, r.p_greater, 0); // 7.6 > -8.9: the upper tail
+    CHECK_NEAR(cJSON_GetArrayItem(cJSON_GetObjectItem(o, "diff_ci"), 1)->valuedouble, r.diff_hi, 0);
+    cJSON_Delete(o);
+
+    // the CLI's two samples with their intervals; Welch named by the result
+    r = run(5, 7.6, 5.0, 6, -8.9, 23.6, 1);
+    CHECK_OK(asp_stats_ttest_json(&r, &(asp_ttest_json_desc){.samples = s}, &o, &err), &err);
+    CHECK(strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(o, "test")), "welch") == 0);
+    CHECK(!cJSON_GetObjectItem(o, "mu"));
+    const cJSON *sa = cJSON_GetObjectItem(o, "samples");
+    CHECK(cJSON_GetArraySize(sa) == 2);
+    CHECK_NEAR(cJSON_GetObjectItem(cJSON_GetArrayItem(sa, 1), "sd")->valuedouble, 23.6, 0);
+    CHECK_NEAR(cJSON_GetArrayItem(cJSON_GetObjectItem(cJSON_GetArrayItem(sa, 0), "mean_ci"), 0)->valuedouble,
+               r.mean_lo[0], 0);
+    cJSON_Delete(o);
+
+    // one sample (the report's paired test): mu, one sample, the name given; a NaN figure prints as null
+    asp_ttest_result one = {0};
+    CHECK_OK(asp_stats_ttest_one(&s[0], 1.0, NULL, &one, &err), &err);
+    one.p_one = NAN;
+    asp_ttest_json_desc d = {.test = "paired", .one_sample = 1, .mu = 1.0, .samples = s};
+    CHECK_OK(asp_stats_ttest_json(&one, &d, &o, &err), &err);
+    CHECK(strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(o, "test")), "paired") == 0);
+    CHECK_NEAR(cJSON_GetObjectItem(o, "mu")->valuedouble, 1.0, 0);
+    CHECK(cJSON_GetArraySize(cJSON_GetObjectItem(o, "samples")) == 1);
+    char *text = cJSON_PrintUnformatted(o);
+    CHECK(text && strstr(text, "\"p_one\":null"));
+    cJSON_free(text);
+    cJSON_Delete(o);
+}
+
 TEST_MAIN(TEST_CASE(test_summary), TEST_CASE(test_known_quantiles), TEST_CASE(test_seed_table_4_7),
           TEST_CASE(test_seed_table_4_3), TEST_CASE(test_seed_table_4_5), TEST_CASE(test_one_sample),
-          TEST_CASE(test_bad_input))
+          TEST_CASE(test_bad_input), TEST_CASE(test_json))
