@@ -969,7 +969,7 @@ static double peak_rss_mb(void)
 }
 
 /* The frame of asp_cloud_frame over every rank: box centre, farthest point plus the largest disc radius. */
-static void frame_of(const asp__dist *d, const asp__dist_points *pts, double center[3], double *radius)
+static void frame_of(const asp__dist *d, const asp__dist_points *pts, asp_frame *frame)
 {
     double far2 = 0, all2 = 0, rmax = 0, rall = 0;
     double c[3];
@@ -994,8 +994,8 @@ static void frame_of(const asp__dist *d, const asp__dist_points *pts, double cen
                         : fmax(e[0], fmax(e[1], e[2])) / (double)pts->n_global;
     }
     for (int k = 0; k < 3; k++)
-        center[k] = c[k] + pts->origin[k];
-    *radius = sqrt(all2) + rall;
+        frame->center[k] = c[k] + pts->origin[k];
+    frame->radius = sqrt(all2) + rall;
 }
 
 typedef struct run {
@@ -1247,7 +1247,7 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
     if (out_path) {
         asp__dist_result res = {.pts = &r.pts, .tangent = r.tangent, .classifier = r.cls, .desc = &r.desc,
                                 .nlevels = r.h.nlevels, .level_size = r.h.sizes, .prolong = r.h.p};
-        frame_of(d, &r.pts, res.frame_center, &res.frame_radius);
+        frame_of(d, &r.pts, &res.frame);
         if ((rc = asp__dist_write_amg(d, &res, out_path, err)) != 0)
             goto done;
     }

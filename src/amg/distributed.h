@@ -28,6 +28,7 @@ typedef struct asp__dist_points {
     uint8_t *colors;      /* 4 * n_own, or NULL */
     float *radii;         /* n_own, or NULL */
     uint32_t *labels;     /* n_own, or NULL */
+    float *uvs;           /* 2 * n_own, or NULL */
     int has_alpha;
     asp_index *ghost_gid; /* n_ghost */
     float lo[3], hi[3];   /* bounding box of every rank's positions */
@@ -95,7 +96,7 @@ typedef struct asp__dist_result {
     size_t nlevels;
     const size_t *level_size;          /* global sizes */
     asp_amg_csr *const *prolong;       /* [1..nlevels-1]: local rows, global columns */
-    double frame_center[3], frame_radius;
+    asp_frame frame;                   /* asp_cloud_frame over every rank's points */
 } asp__dist_result;
 
 /* Writes the .amg (version 3) by rank 0 streaming every rank's part in order. Collective. */
