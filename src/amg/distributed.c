@@ -305,28 +305,13 @@ static unsigned long long sum_all(const asp__dist *d, unsigned long long v)
     return s;
 }
 
-/* Median |a_ij| of the off-diagonal entries (hierarchy.c: a log2 histogram), over every rank. */
+/* Median |a_ij| of the off-diagonal entries over every rank (level_rows.c's histogram, summed). */
 static double median_coupling(const asp__dist *d, const asp_amg_csr *a, size_t row0)
 {
-    unsigned long long hist[256] = {0}, all[256], cnt = 0;
-    for (size_t r = 0; r < a->rows; r++)
-        for (size_t k = a->row_ptr[r]; k < a->row_ptr[r + 1]; k++)
-            if (a->col[k] != row0 + r) {
-                int e = 0;
-                frexp(fabs(a->val[k]), &e);
-                e += 128;
-                hist[e < 0 ? 0 : e > 255 ? 255 : e]++;
-            }
-    MPI_Allreduce(hist, all, 256, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
-    for (int b = 0; b < 256; b++)
-        cnt += all[b];
-    unsigned long long acc = 0;
-    for (int b = 0; b < 256 && cnt; b++) {
-        acc += all[b];
-        if (2 * acc >= cnt)
-            return ldexp(0.75, b - 128);
-    }
-    return 0;
+    uint64_t hist[256] = {0}, all[256];
+    asp__amg_coupling_hist(a, row0, hist);
+    MPI_Allreduce(hist, all, 256, MPI_UINT64_T, MPI_SUM, d->comm);
+    return asp__amg_hist_median(all);
 }
 
 typedef struct wentry {
@@ -511,20 +496,6 @@ static int carry(const asp__dist *d, const asp_amg_csr *p, const size_t *nst, co
     return rc;
 }
 
-/* Value of column c in row r of m (columns sorted), or 0. */
-static double entry(const asp_amg_csr *m, size_t r, asp_index c)
-{
-    size_t lo = m->row_ptr[r], hi = m->row_ptr[r + 1];
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (m->col[mid] < c)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < m->row_ptr[r + 1] && m->col[lo] == c ? m->val[lo] : 0;
-}
-
 /*
  * hierarchy.c's crease test and filter_coarse on the local rows of ac: the
  * crease decision for (r, c) is taken in both rows from the same symmetric
@@ -552,15 +523,7 @@ static int filter(const asp__dist *d, const asp_amg_csr *ac, const asp_amg_csr *
         goto done;
     for (size_t r = 0; r < rows; r++) {
         cmean[r] = mass[r] > 0 ? cm[r] / mass[r] : 0;
-        best[r] = UINT32_MAX;
-        if (mass[r] < small) {
-            double v = 0;
-            for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++)
-                if (ac->col[k] != r0 + r && ac->val[k] < v) {
-                    v = ac->val[k];
-                    best[r] = ac->col[k];
-                }
-        }
+        best[r] = mass[r] < small ? asp__amg_strongest(ac, r, r0) : UINT32_MAX;
     }
     if ((rc = asp__dist_fetch(d, nst, best, sizeof *best, ac->col, nnz, bcol, err)) != 0)
         goto done;
@@ -570,39 +533,15 @@ static int filter(const asp__dist *d, const asp_amg_csr *ac, const asp_amg_csr *
         for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++) {
             if (ac->col[k] == r0 + r || ac->val[k] >= 0)
                 continue;
-            double f = entry(fc, r, ac->col[k]);
-            crease[k] = f < 0 && ac->val[k] / f < ratio * fmin(cmean[r], ccol[k]);
+            crease[k] = (uint8_t)asp__amg_crease(ac->val[k], asp__amg_csr_entry(fc, r, ac->col[k]), ratio, cmean[r],
+                                                 ccol[k]);
         }
-#define KEEP(r, k)                                                                                                    \
-    (ac->col[k] != r0 + (r) && ((-ac->val[k] >= cut && !crease[k]) || best[r] == ac->col[k] || bcol[k] == r0 + (r)))
-    size_t keep = 0;
-    for (size_t r = 0; r < rows; r++)
-        for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++)
-            keep += KEEP(r, k);
-    rc = asp_amg_csr_create(rows, ac->cols, keep + rows, &d->ctx, &m, err);
+    const asp__amg_filter keep = {.cut = cut, .crease = crease, .best = best, .best_col = bcol, .row0 = r0};
+    rc = asp_amg_csr_create(rows, ac->cols, asp__amg_filter_count(ac, &keep) + rows, &d->ctx, &m, err);
     if ((rc = asp__dist_agree(d, rc, err)) != 0)
         goto done;
-    size_t w = 0;
-    for (size_t r = 0; r < rows; r++) {
-        size_t diag = SIZE_MAX;
-        double sum = 0;
-        for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++) {
-            if (!KEEP(r, k) || ac->val[k] >= 0)
-                continue;
-            if (diag == SIZE_MAX && ac->col[k] > r0 + r)
-                diag = w++;
-            sum += ac->val[k];
-            m->col[w] = ac->col[k];
-            m->val[w++] = ac->val[k];
-        }
-        if (diag == SIZE_MAX)
-            diag = w++;
-        m->col[diag] = (asp_index)(r0 + r);
-        m->val[diag] = -sum;
-        m->row_ptr[r + 1] = w;
-    }
-#undef KEEP
-    *offdiag = (size_t)sum_all(d, w - rows);
+    const size_t w = asp__amg_filter_rows(ac, &keep, m);
+    *offdiag = (size_t)sum_all(d, w);
     *out = m;
     m = NULL;
 done:
