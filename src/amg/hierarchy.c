@@ -4,7 +4,9 @@
  * leaves the rows of unknowns without strong connections empty (a point with
  * no fan neighbour, or a whole disconnected part that coarsened to a single
  * unknown); such an unknown becomes an "orphan" that is carried unchanged to
- * every coarser level, so a disconnected part stays its own domain.
+ * every coarser level, so a disconnected part stays its own domain. The row
+ * kernels (repair, strongest coupling, crease test, filter) are level_rows.c's,
+ * shared with the distributed hierarchy (distributed_hierarchy.c).
  */
 #include <math.h>
 #include <string.h>
