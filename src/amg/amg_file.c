@@ -10,53 +10,85 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "amg/amg_format.h"
 #include "amg/internal.h"
 #include "util/atomic_file.h"
 #include "util/byte_io.h"
 #include "util/checksum.h"
 #include "util/banned.h"
 
-#define AMG_MAGIC "ASPAMG\r\n"
-/*
- * Version 3 appends the source point set's frame (asp_frame, 32 bytes) to the
- * header, so every representation of a model is framed by one sphere (issue
- * 12); version 2 files still load, their frame computed from the points.
- */
-enum { AMG_VERSION = 3, AMG_HEADER = 96, AMG_HEADER_V2 = 64, AMG_OPTIONS = 128 };
-/* point attributes a version-2 file may carry after the classifier */
-static const unsigned amg_attrs = ASP_ATTR_NORMALS | ASP_ATTR_COLORS | ASP_ATTR_RADII | ASP_ATTR_UVS | ASP_ATTR_LABELS;
+enum { AMG_VERSION = ASP__AMG_VERSION, AMG_HEADER = ASP__AMG_HEADER, AMG_HEADER_V2 = ASP__AMG_HEADER_V2,
+       AMG_OPTIONS = ASP__AMG_OPTIONS };
 
-/* Bytes per point of the optional attributes in attrs. */
-static uint64_t attr_bytes(unsigned attrs)
+const unsigned asp__amg_attr_bit[ASP__AMG_NATTRS] = {ASP_ATTR_NORMALS, ASP_ATTR_COLORS, ASP_ATTR_RADII, ASP_ATTR_UVS,
+                                                     ASP_ATTR_LABELS};
+const unsigned asp__amg_attr_size[ASP__AMG_NATTRS] = {12, 4, 4, 8, 4};
+
+uint64_t asp__amg_attr_bytes(unsigned attrs)
 {
-    return (attrs & ASP_ATTR_NORMALS ? 12u : 0u) + (attrs & ASP_ATTR_COLORS ? 4u : 0u) +
-           (attrs & ASP_ATTR_RADII ? 4u : 0u) + (attrs & ASP_ATTR_UVS ? 8u : 0u) + (attrs & ASP_ATTR_LABELS ? 4u : 0u);
+    uint64_t b = 0;
+    for (int i = 0; i < ASP__AMG_NATTRS; i++)
+        b += attrs & asp__amg_attr_bit[i] ? asp__amg_attr_size[i] : 0u;
+    return b;
+}
+
+void asp__amg_put_header(asp__crc_writer *w, const asp__amg_header *h)
+{
+    /* per point: positions, tangent normals and classifier (28 bytes) and the optional arrays */
+    uint64_t payload = (28 + asp__amg_attr_bytes(h->attrs)) * h->points + 8 + AMG_OPTIONS + 8 * h->nlevels;
+    for (size_t l = 1; l < h->nlevels; l++)
+        payload += 8 + 8 * ((uint64_t)h->level_size[l - 1] + 1);
+    payload += 12 * h->prolong_nnz;
+    asp__crc_put(w, ASP__AMG_MAGIC, 8);
+    asp__put_u32(w, AMG_VERSION);
+    asp__put_u32(w, AMG_HEADER);
+    asp__put_u64(w, h->points);
+    asp__put_u64(w, h->nlevels);
+    asp__put_u64(w, payload);
+    for (int a = 0; a < 3; a++)
+        asp__put_f64(w, h->origin[a]);
+    for (int a = 0; a < 3; a++)
+        asp__put_f64(w, h->frame.center[a]);
+    asp__put_f64(w, h->frame.radius);
+}
+
+void asp__amg_put_attr_set(asp__crc_writer *w, unsigned attrs)
+{
+    asp__put_u32(w, attrs);
+    asp__put_u32(w, 0);
+}
+
+void asp__amg_put_options(asp__crc_writer *w, const asp_amg_desc *d, const size_t *level_size, size_t nlevels)
+{
+    asp__put_f64(w, d->epsilon);
+    asp__put_u64(w, d->k_min);
+    asp__put_u64(w, d->k_max);
+    asp__put_u64(w, d->fan_k);
+    asp__put_u32(w, (uint32_t)d->classifier);
+    asp__put_u32(w, (uint32_t)d->coarsen);
+    asp__put_u32(w, (uint32_t)d->interp);
+    asp__put_u32(w, 0);
+    asp__put_f64(w, d->alpha);
+    asp__put_f64(w, d->beta);
+    asp__put_f64(w, d->strong_threshold);
+    asp__put_f64(w, d->trunc_factor);
+    asp__put_f64(w, d->drop_tol);
+    asp__put_u64(w, d->max_levels);
+    asp__put_u64(w, d->max_coarse);
+    asp__put_f64(w, d->weak_coupling);
+    asp__put_f64(w, d->crease_cut);
+    asp__put_u64(w, 0); /* reserved */
+    for (size_t l = 0; l < nlevels; l++)
+        asp__put_u64(w, level_size[l]);
 }
 
 /* Attributes the file stores: the input's normals only when they differ from the tangent normals. */
 static unsigned stored_attrs(const asp_amg *amg)
 {
-    unsigned a = asp_cloud_attrs(amg->cloud) & amg_attrs;
+    unsigned a = asp_cloud_attrs(amg->cloud) & ASP__AMG_ATTRS;
     if (!amg->input_normals)
         a &= ~(unsigned)ASP_ATTR_NORMALS;
     return a;
-}
-
-static int host_is_little_endian(void)
-{
-    const uint16_t one = 1;
-    return *(const uint8_t *)&one == 1;
-}
-
-static uint64_t payload_size(const asp_amg *amg)
-{
-    uint64_t n = amg->cloud->count;
-    uint64_t s = 7 * 4 * n + 8 + attr_bytes(stored_attrs(amg)) * n + AMG_OPTIONS + 8 * (uint64_t)amg->nlevels;
-    for (size_t l = 1; l < amg->nlevels; l++) {
-        const asp_amg_csr *p = amg->prolong[l];
-        s += 8 + 8 * ((uint64_t)p->rows + 1) + 12 * (uint64_t)p->row_ptr[p->rows];
-    }
-    return s;
 }
 
 /*
@@ -76,66 +108,31 @@ static int amg_reads_back(const char *tmp, void *user, asp_error *err)
 
 int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err)
 {
-    if (!host_is_little_endian())
+    if (!asp__amg_host_little_endian())
         return asp_error_set(err, ASP_EUNSUPPORTED, "cannot write '%s': .amg files are little-endian only", path);
     asp__atomic_file f;
     int rc = asp__atomic_open(&f, path, err);
     if (rc)
         return rc;
     asp__crc_writer w = {f.fp, 0, 0};
-    const size_t n = amg->cloud->count;
-    /* header: 64 bytes */
-    asp__crc_put(&w, AMG_MAGIC, 8);
-    asp__put_u32(&w, AMG_VERSION);
-    asp__put_u32(&w, AMG_HEADER);
-    asp__put_u64(&w, n);
-    asp__put_u64(&w, amg->nlevels);
-    asp__put_u64(&w, payload_size(amg));
-    for (int a = 0; a < 3; a++)
-        asp__put_f64(&w, amg->cloud->origin[a]);
-    for (int a = 0; a < 3; a++)
-        asp__put_f64(&w, amg->frame.center[a]);
-    asp__put_f64(&w, amg->frame.radius);
-    asp__crc_put(&w, amg->cloud->positions, 3 * n * sizeof(float));
+    const asp_cloud *c = amg->cloud;
+    const size_t n = c->count;
+    asp__amg_header h = {.points = n, .nlevels = amg->nlevels, .level_size = amg->level_size,
+                         .attrs = stored_attrs(amg), .frame = amg->frame};
+    memcpy(h.origin, c->origin, sizeof h.origin);
+    for (size_t l = 1; l < amg->nlevels; l++)
+        h.prolong_nnz += amg->prolong[l]->row_ptr[amg->prolong[l]->rows];
+    asp__amg_put_header(&w, &h);
+    asp__crc_put(&w, c->positions, 3 * n * sizeof(float));
     asp__crc_put(&w, amg->tangent, 3 * n * sizeof(float));
     asp__crc_put(&w, amg->classifier, n * sizeof(float));
     /* the input's attributes (version 2): a bit set, then one array per bit in this order */
-    const unsigned attrs = stored_attrs(amg);
-    const asp_cloud *c = amg->cloud;
-    asp__put_u32(&w, attrs);
-    asp__put_u32(&w, 0);
-    if (attrs & ASP_ATTR_NORMALS)
-        asp__crc_put(&w, c->normals, 3 * n * sizeof(float));
-    if (attrs & ASP_ATTR_COLORS)
-        asp__crc_put(&w, c->colors, 4 * n);
-    if (attrs & ASP_ATTR_RADII)
-        asp__crc_put(&w, c->radii, n * sizeof(float));
-    if (attrs & ASP_ATTR_UVS)
-        asp__crc_put(&w, c->uvs, 2 * n * sizeof(float));
-    if (attrs & ASP_ATTR_LABELS)
-        asp__crc_put(&w, c->labels, n * sizeof(uint32_t));
-    /* options block: 128 bytes, what produced the hierarchy */
-    const asp_amg_desc *d = &amg->desc;
-    asp__put_f64(&w, d->epsilon);
-    asp__put_u64(&w, d->k_min);
-    asp__put_u64(&w, d->k_max);
-    asp__put_u64(&w, d->fan_k);
-    asp__put_u32(&w, (uint32_t)d->classifier);
-    asp__put_u32(&w, (uint32_t)d->coarsen);
-    asp__put_u32(&w, (uint32_t)d->interp);
-    asp__put_u32(&w, 0);
-    asp__put_f64(&w, d->alpha);
-    asp__put_f64(&w, d->beta);
-    asp__put_f64(&w, d->strong_threshold);
-    asp__put_f64(&w, d->trunc_factor);
-    asp__put_f64(&w, d->drop_tol);
-    asp__put_u64(&w, d->max_levels);
-    asp__put_u64(&w, d->max_coarse);
-    asp__put_f64(&w, d->weak_coupling);
-    asp__put_f64(&w, d->crease_cut);
-    asp__put_u64(&w, 0); /* reserved */
-    for (size_t l = 0; l < amg->nlevels; l++)
-        asp__put_u64(&w, amg->level_size[l]);
+    asp__amg_put_attr_set(&w, h.attrs);
+    const void *const arrays[ASP__AMG_NATTRS] = {c->normals, c->colors, c->radii, c->uvs, c->labels};
+    for (int i = 0; i < ASP__AMG_NATTRS; i++)
+        if (h.attrs & asp__amg_attr_bit[i])
+            asp__crc_put(&w, arrays[i], asp__amg_attr_size[i] * n);
+    asp__amg_put_options(&w, &amg->desc, amg->level_size, amg->nlevels);
     for (size_t l = 1; l < amg->nlevels; l++) {
         const asp_amg_csr *p = amg->prolong[l];
         size_t nnz = p->row_ptr[p->rows];
@@ -274,7 +271,7 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
                              r->size, AMG_HEADER_V2 + 4);
     /* the size was checked: the header fields cannot fail */
     asp__byte_take(r, magic, 8, "the header");
-    if (memcmp(magic, AMG_MAGIC, 8) != 0)
+    if (memcmp(magic, ASP__AMG_MAGIC, 8) != 0)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': not an .amg file (bad magic)", r->path);
     asp__byte_take(r, &version, 4, "the header");
     asp__byte_take(r, &header, 4, "the header");
@@ -338,13 +335,13 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
     if ((rc = asp__byte_take(r, &attrs, 4, "the attribute set")) != 0)
         return rc;
     r->at -= 4;
-    if (attrs & ~(uint32_t)amg_attrs)
+    if (attrs & ~(uint32_t)ASP__AMG_ATTRS)
         return asp__byte_bad(r, "unknown point attribute bits");
     /* per-point data, options and one size per level must fit before anything per point is allocated */
-    if (payload < 28 * n + 8 + attr_bytes(attrs) * n + AMG_OPTIONS + 8 * nlevels) {
+    if (payload < 28 * n + 8 + asp__amg_attr_bytes(attrs) * n + AMG_OPTIONS + 8 * nlevels) {
         snprintf(msg, sizeof msg, "point attributes 0x%x of %llu points and %llu levels need %llu payload bytes, the "
                  "file has %llu", (unsigned)attrs, (unsigned long long)n, (unsigned long long)nlevels,
-                 (unsigned long long)(28 * n + 8 + attr_bytes(attrs) * n + AMG_OPTIONS + 8 * nlevels),
+                 (unsigned long long)(28 * n + 8 + asp__amg_attr_bytes(attrs) * n + AMG_OPTIONS + 8 * nlevels),
                  (unsigned long long)payload);
         return asp__byte_bad(r, msg);
     }
@@ -428,7 +425,7 @@ int asp_amg_load_memory(const void *data, size_t size, const char *name, const a
     const char *nm = name ? name : "<memory>";
     if (!out)
         return asp_error_set(err, ASP_EINVAL, "asp_amg_load_memory needs an output");
-    if (!host_is_little_endian())
+    if (!asp__amg_host_little_endian())
         return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': .amg files are little-endian only", nm);
     asp_amg *a;
     int rc = asp__amg_alloc(ctx, &a, err);
@@ -448,7 +445,7 @@ int asp_amg_load(const char *path, const asp_context *ctx, asp_amg **out, asp_er
 {
     if (!path || !out)
         return asp_error_set(err, ASP_EINVAL, "asp_amg_load needs a path and an output");
-    if (!host_is_little_endian())
+    if (!asp__amg_host_little_endian())
         return asp_error_set(err, ASP_EUNSUPPORTED, "cannot read '%s': .amg files are little-endian only", path);
     uint8_t *buf = NULL;
     size_t size = 0;

@@ -46,18 +46,17 @@ void asp_amg_csr_destroy(asp_amg_csr *m)
     asp_free(&ctx, m);
 }
 
-/* Value of a(r, c) by binary search in the sorted row; 0 when absent. */
-static double entry(const asp_amg_csr *a, size_t r, asp_index c)
+size_t asp__amg_csr_find(const asp_amg_csr *m, size_t r, asp_index c)
 {
-    size_t lo = a->row_ptr[r], hi = a->row_ptr[r + 1];
+    size_t lo = m->row_ptr[r], hi = m->row_ptr[r + 1];
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
-        if (a->col[mid] < c)
+        if (m->col[mid] < c)
             lo = mid + 1;
         else
             hi = mid;
     }
-    return lo < a->row_ptr[r + 1] && a->col[lo] == c ? a->val[lo] : 0.0;
+    return lo < m->row_ptr[r + 1] && m->col[lo] == c ? lo : SIZE_MAX;
 }
 
 void asp_amg_csr_check_stiffness(const asp_amg_csr *a, asp_amg_matrix_check *out)
@@ -79,7 +78,7 @@ void asp_amg_csr_check_stiffness(const asp_amg_csr *a, asp_amg_matrix_check *out
             offdiag = 1;
             if (a->val[k] > out->max_offdiag)
                 out->max_offdiag = a->val[k];
-            double asym = fabs(a->val[k] - entry(a, c, (asp_index)r));
+            double asym = fabs(a->val[k] - asp__amg_csr_entry(a, c, (asp_index)r));
             if (asym > out->max_asymmetry)
                 out->max_asymmetry = asym;
         }
@@ -87,7 +86,7 @@ void asp_amg_csr_check_stiffness(const asp_amg_csr *a, asp_amg_matrix_check *out
             out->empty_rows++;
         if (fabs(sum) > out->max_row_sum)
             out->max_row_sum = fabs(sum);
-        if (entry(a, r, (asp_index)r) == 0.0 && 0.0 < out->min_diag)
+        if (asp__amg_csr_entry(a, r, (asp_index)r) == 0.0 && 0.0 < out->min_diag)
             out->min_diag = 0.0;
     }
     if (out->max_offdiag == -INFINITY)

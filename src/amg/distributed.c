@@ -1,10 +1,12 @@
 /*
- * The decomposition on MPI ranks (issue 19; journal 2.1-2.3 as decompose.c):
- * Morton-ordered points with a halo, the serial kernels on each rank's points
- * and halo, the stiffness rows of owned points completed across rank borders,
- * the hierarchy level by level with hypre's distributed BoomerAMG and
- * hierarchy.c's repairs and cuts done on distributed rows, the basis
- * Psi^l = P^1 ... P^l as row-distributed products, and the .amg file.
+ * The decomposition on MPI ranks (issue 19; journal 2.1-2.3 as decompose.c),
+ * the driver of its stages: Morton-ordered points with a halo
+ * (distributed_points.c), the neighbourhood radius and epsilon over every
+ * rank, the serial kernels on each rank's points and halo, the stiffness rows
+ * of owned points completed across rank borders (distributed_rows.c), the
+ * hierarchy level by level (distributed_hierarchy.c, distributed_repair.c),
+ * the basis Psi^l = P^1 ... P^l (distributed_basis.c) and the .amg file
+ * (distributed_write.c).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -127,839 +129,6 @@ static int radii_and_epsilon(const asp__dist *d, const asp__dist_points *pts, as
     return rc;
 }
 
-static asp_index gid_of(const asp__dist *d, const asp__dist_points *pts, size_t local)
-{
-    return (asp_index)(local < pts->n_own ? pts->starts[d->rank] + local : pts->ghost_gid[local - pts->n_own]);
-}
-
-/* ---- stiffness rows across rank borders ---- */
-
-typedef struct triple {
-    asp_index row, col;
-    double v, fv;
-} triple;
-
-static int cmp_triple(const void *a, const void *b)
-{
-    const triple *x = a, *y = b;
-    if (x->row != y->row)
-        return x->row < y->row ? -1 : 1;
-    return x->col < y->col ? -1 : x->col > y->col;
-}
-
-/*
- * A = (A~ + A~^T) / 2 (journal eq. 6) for the owned rows. The local assembly
- * (ghosts without fans) already holds both halves between owned points and
- * A~_ij / 2 towards a ghost j; the other half, A~_ji / 2, is the value j's
- * owner has in row j, column i: each rank sends those to the owners. Then
- * stiffness.c's clamping and zero row sums (eq. 7) on the completed rows.
- */
-static int global_rows(const asp__dist *d, const asp__dist_points *pts, asp_amg_csr **take_a, asp_amg_csr **take_f,
-                       asp_amg_stiffness form, asp_amg_csr **ga, asp_amg_csr **gf, size_t *positive,
-                       asp_error *err)
-{
-    const asp_amg_csr *a = *take_a, *f = *take_f;
-    const int P = d->size, want_f = f != NULL;
-    const size_t n = pts->n_own, start = pts->starts[d->rank];
-    int *cnt = asp_calloc(&d->ctx, 4 * (size_t)P, sizeof *cnt);
-    if (!cnt)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for the stiffness exchange");
-    int *dis = cnt + P, *rcnt = cnt + 2 * P, *rdis = cnt + 3 * P;
-    size_t out_n = 0, own_n = 0;
-    for (size_t i = 0; i < n; i++)
-        for (size_t k = a->row_ptr[i]; k < a->row_ptr[i + 1]; k++) {
-            if (a->col[k] >= n)
-                cnt[asp__dist_owner(pts->starts, P, gid_of(d, pts, a->col[k]))]++, out_n++;
-            if (a->col[k] != i)
-                own_n++;
-        }
-    triple *snd = asp_alloc(&d->ctx, (out_n + 1) * sizeof *snd);
-    int *fill = asp_calloc(&d->ctx, (size_t)P, sizeof *fill);
-    for (int q = 1; q < P; q++)
-        dis[q] = dis[q - 1] + cnt[q - 1];
-    for (size_t i = 0; snd && fill && i < n; i++)
-        for (size_t k = a->row_ptr[i]; k < a->row_ptr[i + 1]; k++)
-            if (a->col[k] >= n) {
-                asp_index g = gid_of(d, pts, a->col[k]);
-                int o = asp__dist_owner(pts->starts, P, g);
-                snd[dis[o] + fill[o]++] = (triple){g, (asp_index)(start + i), a->val[k], f ? f->val[k] : 0};
-            }
-    asp_free(&d->ctx, fill);
-    MPI_Alltoall(cnt, 1, MPI_INT, rcnt, 1, MPI_INT, d->comm);
-    size_t got = 0;
-    for (int q = 0; q < P; q++) {
-        rdis[q] = (int)got;
-        got += (size_t)rcnt[q];
-    }
-    triple *all = asp_alloc(&d->ctx, (own_n + got + 1) * sizeof *all);
-    int ok = snd && all, allok = 0, rc = 0;
-    MPI_Allreduce(&ok, &allok, 1, MPI_INT, MPI_MIN, d->comm);
-    if (!allok) {
-        asp_free(&d->ctx, snd);
-        asp_free(&d->ctx, all);
-        asp_free(&d->ctx, cnt);
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu stiffness entries", own_n + got);
-    }
-    MPI_Datatype t;
-    MPI_Type_contiguous((int)sizeof(triple), MPI_BYTE, &t);
-    MPI_Type_commit(&t);
-    MPI_Alltoallv(snd, cnt, dis, t, all + own_n, rcnt, rdis, t, d->comm);
-    MPI_Type_free(&t);
-    asp_free(&d->ctx, snd);
-    asp_free(&d->ctx, cnt);
-    size_t w = 0;
-    for (size_t i = 0; i < n; i++)
-        for (size_t k = a->row_ptr[i]; k < a->row_ptr[i + 1]; k++)
-            if (a->col[k] != i)
-                all[w++] = (triple){(asp_index)(start + i), gid_of(d, pts, a->col[k]), a->val[k], f ? f->val[k] : 0};
-    /* every entry is in the triples now: the local matrices go before the global ones are made (issue 19) */
-    asp_amg_csr_destroy(*take_a);
-    asp_amg_csr_destroy(*take_f);
-    *take_a = *take_f = NULL;
-    a = f = NULL;
-    qsort(all, own_n + got, sizeof *all, cmp_triple);
-    const size_t total = own_n + got;
-    asp_amg_csr *A = NULL, *F = NULL;
-    rc = asp_amg_csr_create(n, pts->n_global, total + n, &d->ctx, &A, err);
-    if (!rc && want_f)
-        rc = asp_amg_csr_create(n, pts->n_global, total + n, &d->ctx, &F, err);
-    const int clamp = form != ASP_AMG_STIFFNESS_UNCLAMPED;
-    size_t pos_count = 0, k = 0;
-    w = 0;
-    for (size_t i = 0; !rc && i < n; i++) {
-        const asp_index gi = (asp_index)(start + i);
-        size_t diag_slot = SIZE_MAX;
-        double diag = 0, fdiag = 0;
-        while (k < total && all[k].row == gi) {
-            asp_index j = all[k].col;
-            double v = 0, fv = 0;
-            for (; k < total && all[k].row == gi && all[k].col == j; k++)
-                v += all[k].v, fv += all[k].fv;
-            if (v > 0) {
-                pos_count += j > gi;
-                if (clamp)
-                    continue;
-            }
-            if (v == 0)
-                continue;
-            if (diag_slot == SIZE_MAX && j > gi)
-                diag_slot = w++;
-            A->col[w] = j;
-            A->val[w] = v;
-            diag -= v;
-            if (F) {
-                F->col[w] = j;
-                F->val[w] = fv < 0 || !clamp ? fv : 0.0;
-                fdiag -= F->val[w];
-            }
-            w++;
-        }
-        if (diag_slot == SIZE_MAX)
-            diag_slot = w++;
-        A->col[diag_slot] = gi;
-        A->val[diag_slot] = diag;
-        A->row_ptr[i + 1] = w;
-        if (F) {
-            F->col[diag_slot] = gi;
-            F->val[diag_slot] = fdiag;
-            F->row_ptr[i + 1] = w;
-        }
-    }
-    asp_free(&d->ctx, all);
-    if (rc) {
-        asp_amg_csr_destroy(A);
-        asp_amg_csr_destroy(F);
-        return rc;
-    }
-    unsigned long long pc = pos_count, pall = 0;
-    MPI_Allreduce(&pc, &pall, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
-    *positive = (size_t)pall;
-    *ga = A;
-    *gf = F;
-    return 0;
-}
-
-/* ---- the hierarchy (hierarchy.c on distributed rows) ---- */
-
-typedef struct hier {
-    size_t nlevels;
-    size_t sizes[ASP_AMG_DIST_MAX_LEVELS];
-    size_t *starts[ASP_AMG_DIST_MAX_LEVELS]; /* partition of each level's unknowns */
-    asp_amg_csr *p[ASP_AMG_DIST_MAX_LEVELS]; /* [1..]: local rows (level l-1), global columns (level l) */
-    size_t repaired;
-} hier;
-
-static void hier_release(const asp_context *ctx, hier *h)
-{
-    for (size_t l = 0; l < ASP_AMG_DIST_MAX_LEVELS; l++) {
-        asp_free(ctx, h->starts[l]);
-        asp_amg_csr_destroy(h->p[l]);
-    }
-    memset(h, 0, sizeof *h);
-}
-
-static unsigned long long sum_all(const asp__dist *d, unsigned long long v)
-{
-    unsigned long long s = 0;
-    MPI_Allreduce(&v, &s, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
-    return s;
-}
-
-/* Median |a_ij| of the off-diagonal entries (hierarchy.c: a log2 histogram), over every rank. */
-static double median_coupling(const asp__dist *d, const asp_amg_csr *a, size_t row0)
-{
-    unsigned long long hist[256] = {0}, all[256], cnt = 0;
-    for (size_t r = 0; r < a->rows; r++)
-        for (size_t k = a->row_ptr[r]; k < a->row_ptr[r + 1]; k++)
-            if (a->col[k] != row0 + r) {
-                int e = 0;
-                frexp(fabs(a->val[k]), &e);
-                e += 128;
-                hist[e < 0 ? 0 : e > 255 ? 255 : e]++;
-            }
-    MPI_Allreduce(hist, all, 256, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
-    for (int b = 0; b < 256; b++)
-        cnt += all[b];
-    unsigned long long acc = 0;
-    for (int b = 0; b < 256 && cnt; b++) {
-        acc += all[b];
-        if (2 * acc >= cnt)
-            return ldexp(0.75, b - 128);
-    }
-    return 0;
-}
-
-typedef struct wentry {
-    asp_index c;
-    double v;
-} wentry;
-
-static int cmp_wentry(const void *a, const void *b)
-{
-    const wentry *x = a, *y = b;
-    return x->c < y->c ? -1 : x->c > y->c;
-}
-
-/*
- * Parallel RS coarsening leaves some rows of P empty at rank borders (an F
- * point whose strong couplings are all F points of another rank: 19 of 10005
- * rows on the second of 2 ranks, 20k bunny). Serially an empty row is a
- * disconnected point and becomes an orphan unknown (hierarchy.c), which never
- * merges again: these would stay separate domains up to L (45 unknowns at L
- * instead of 5). A row with couplings in a instead gets the mean of its
- * neighbours' P rows weighted by -a_ij, a convex combination of partitions of
- * unity, so the basis stays one; only rows without couplings become orphans.
- */
-static int fill_empty_rows(const asp__dist *d, asp_amg_csr **pp, const asp_amg_csr *a, const size_t *st,
-                           asp_error *err)
-{
-    asp_amg_csr *p = *pp;
-    const size_t r0 = st[d->rank];
-    size_t m = 0, extra = 0;
-    for (size_t r = 0; r < p->rows; r++)
-        if (p->row_ptr[r + 1] == p->row_ptr[r])
-            m += a->row_ptr[r + 1] - a->row_ptr[r];
-    asp_index *ids = asp_alloc(&d->ctx, (m + 1) * sizeof *ids);
-    int rc = ids ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
-    size_t w = 0;
-    for (size_t r = 0; !rc && r < p->rows; r++)
-        if (p->row_ptr[r + 1] == p->row_ptr[r])
-            for (size_t k = a->row_ptr[r]; k < a->row_ptr[r + 1]; k++)
-                ids[w++] = a->col[k];
-    asp_amg_csr *nb = NULL, *q = NULL;
-    if ((rc = asp__dist_agree(d, rc, err)) == 0)
-        rc = asp__dist_fetch_rows(d, st, p, ids, m, &nb, err);
-    asp_free(&d->ctx, ids);
-    if (rc)
-        return rc;
-    if (sum_all(d, m) == 0) {
-        asp_amg_csr_destroy(nb);
-        return 0;
-    }
-    extra = nb->row_ptr[nb->rows];
-    wentry *tmp = asp_alloc(&d->ctx, (extra + 1) * sizeof *tmp);
-    rc = tmp ? asp_amg_csr_create(p->rows, p->cols, p->row_ptr[p->rows] + extra, &d->ctx, &q, err)
-             : asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
-    size_t at = 0, o = 0; /* at: next fetched row; o: output entries */
-    for (size_t r = 0; !rc && r < p->rows; r++) {
-        if (p->row_ptr[r + 1] > p->row_ptr[r]) {
-            for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++) {
-                q->col[o] = p->col[k];
-                q->val[o++] = p->val[k];
-            }
-        } else {
-            size_t t = 0;
-            for (size_t k = a->row_ptr[r]; k < a->row_ptr[r + 1]; k++, at++) {
-                double wgt = a->col[k] != r0 + r && a->val[k] < 0 ? -a->val[k] : 0, s = 0;
-                for (size_t e = nb->row_ptr[at]; e < nb->row_ptr[at + 1]; e++)
-                    s += nb->val[e] > 0 ? nb->val[e] : 0;
-                if (!(wgt > 0 && s > 1e-12))
-                    continue;
-                for (size_t e = nb->row_ptr[at]; e < nb->row_ptr[at + 1]; e++)
-                    if (nb->val[e] > 0)
-                        tmp[t++] = (wentry){nb->col[e], wgt * nb->val[e] / s};
-            }
-            qsort(tmp, t, sizeof *tmp, cmp_wentry);
-            for (size_t e = 0; e < t; e++) {
-                if (o > q->row_ptr[r] && q->col[o - 1] == tmp[e].c) {
-                    q->val[o - 1] += tmp[e].v;
-                } else {
-                    q->col[o] = tmp[e].c;
-                    q->val[o++] = tmp[e].v;
-                }
-            }
-            /* renormalised with the rest in repair() */
-        }
-        q->row_ptr[r + 1] = o;
-    }
-    asp_free(&d->ctx, tmp);
-    asp_amg_csr_destroy(nb);
-    if ((rc = asp__dist_agree(d, rc, err)) != 0) {
-        asp_amg_csr_destroy(q);
-        return rc;
-    }
-    asp_amg_csr_destroy(p);
-    *pp = q;
-    return 0;
-}
-
-/* A coarse column in the repaired numbering: shifted by the orphans of the ranks before its owner. */
-typedef struct {
-    const size_t *cst, *ost;
-    int P;
-} orphan_shift;
-
-static asp_index shift_column(asp_index c, const void *arg)
-{
-    const orphan_shift *s = arg;
-    return (asp_index)(c + s->ost[asp__dist_owner(s->cst, s->P, c)]);
-}
-
-/*
- * hierarchy.c's repair on distributed rows (asp__amg_pou_rows): empty rows
- * become orphans, each a new coarse unknown numbered after its rank's hypre
- * unknowns, so the coarse partition becomes nst; columns are renumbered into
- * it (monotone, so rows stay sorted) and other rows renormalised.
- */
-static int repair(const asp__dist *d, asp_amg_csr **pp, const size_t *cst, size_t *nst, size_t *repaired,
-                  asp_error *err)
-{
-    const asp_amg_csr *p = *pp;
-    const int P = d->size;
-    const size_t orphans = asp__amg_empty_rows(p);
-    size_t *ost = asp_alloc(&d->ctx, ((size_t)P + 1) * sizeof *ost);
-    if (!ost || asp__dist_partition(d, orphans, ost)) {
-        asp_free(&d->ctx, ost);
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
-    }
-    for (int q = 0; q <= P; q++)
-        nst[q] = cst[q] + ost[q];
-    asp_amg_csr *qm;
-    int rc = asp_amg_csr_create(p->rows, nst[P], p->row_ptr[p->rows] + orphans, &d->ctx, &qm, err);
-    if (rc) {
-        asp_free(&d->ctx, ost);
-        return rc;
-    }
-    const orphan_shift shift = {cst, ost, P};
-    asp__amg_pou_rows(p, qm, (asp_index)(nst[d->rank] + (cst[d->rank + 1] - cst[d->rank])), shift_column, &shift,
-                      repaired);
-    asp_free(&d->ctx, ost);
-    asp_amg_csr_destroy(*pp);
-    *pp = qm;
-    return 0;
-}
-
-/* The coarse matrix in the repaired numbering, with an empty row per orphan. */
-static int renumber_coarse(const asp__dist *d, asp_amg_csr **pac, const size_t *cst, const size_t *nst,
-                           asp_error *err)
-{
-    const asp_amg_csr *ac = *pac;
-    const size_t rows = nst[d->rank + 1] - nst[d->rank];
-    asp_amg_csr *m;
-    int rc = asp_amg_csr_create(rows, nst[d->size], ac->row_ptr[ac->rows], &d->ctx, &m, err);
-    if (rc)
-        return rc;
-    for (size_t r = 0; r < ac->rows; r++) {
-        for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++) {
-            int o = asp__dist_owner(cst, d->size, ac->col[k]);
-            m->col[k] = (asp_index)(ac->col[k] - cst[o] + nst[o]);
-            m->val[k] = ac->val[k];
-        }
-        m->row_ptr[r + 1] = ac->row_ptr[r + 1];
-    }
-    for (size_t r = ac->rows; r < rows; r++)
-        m->row_ptr[r + 1] = m->row_ptr[r];
-    asp_amg_csr_destroy(*pac);
-    *pac = m;
-    return 0;
-}
-
-/* dst[J] = sum_r P_rJ src[r] (hierarchy.c's carry) with J on any rank. */
-static int carry(const asp__dist *d, const asp_amg_csr *p, const size_t *nst, const double *src, double *dst,
-                 asp_error *err)
-{
-    const size_t nnz = p->row_ptr[p->rows];
-    double *v = asp_alloc(&d->ctx, (nnz + 1) * sizeof *v);
-    if (!v)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
-    for (size_t r = 0; r < p->rows; r++)
-        for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++)
-            v[k] = p->val[k] * src[r];
-    memset(dst, 0, (nst[d->rank + 1] - nst[d->rank]) * sizeof *dst);
-    int rc = asp__dist_scatter_add(d, nst, p->col, v, nnz, dst, err);
-    asp_free(&d->ctx, v);
-    return rc;
-}
-
-/* Value of column c in row r of m (columns sorted), or 0. */
-static double entry(const asp_amg_csr *m, size_t r, asp_index c)
-{
-    size_t lo = m->row_ptr[r], hi = m->row_ptr[r + 1];
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (m->col[mid] < c)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < m->row_ptr[r + 1] && m->col[lo] == c ? m->val[lo] : 0;
-}
-
-/*
- * hierarchy.c's crease test and filter_coarse on the local rows of ac: the
- * crease decision for (r, c) is taken in both rows from the same symmetric
- * quantities (it was mirrored from the smaller index serially); the strongest
- * couplings of small unknowns come from their owners.
- */
-static int filter(const asp__dist *d, const asp_amg_csr *ac, const asp_amg_csr *fc, const size_t *nst,
-                  const double *mass, const double *cm, double cut, double ratio, double small, asp_amg_csr **out,
-                  size_t *offdiag, asp_error *err)
-{
-    const size_t rows = ac->rows, nnz = ac->row_ptr[rows], r0 = nst[d->rank];
-    double *cmean = asp_alloc(&d->ctx, (rows + 1) * sizeof *cmean), *ccol = NULL;
-    asp_index *best = asp_alloc(&d->ctx, (rows + 1) * sizeof *best), *bcol = NULL;
-    uint8_t *crease = NULL;
-    asp_amg_csr *m = NULL;
-    int rc = cmean && best ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
-    if (!rc) {
-        ccol = asp_alloc(&d->ctx, (nnz + 1) * sizeof *ccol);
-        bcol = asp_alloc(&d->ctx, (nnz + 1) * sizeof *bcol);
-        crease = asp_calloc(&d->ctx, nnz + 1, 1);
-        if (!ccol || !bcol || !crease)
-            rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
-    }
-    if ((rc = asp__dist_agree(d, rc, err)) != 0)
-        goto done;
-    for (size_t r = 0; r < rows; r++) {
-        cmean[r] = mass[r] > 0 ? cm[r] / mass[r] : 0;
-        best[r] = UINT32_MAX;
-        if (mass[r] < small) {
-            double v = 0;
-            for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++)
-                if (ac->col[k] != r0 + r && ac->val[k] < v) {
-                    v = ac->val[k];
-                    best[r] = ac->col[k];
-                }
-        }
-    }
-    if ((rc = asp__dist_fetch(d, nst, best, sizeof *best, ac->col, nnz, bcol, err)) != 0)
-        goto done;
-    if (fc && (rc = asp__dist_fetch(d, nst, cmean, sizeof *cmean, ac->col, nnz, ccol, err)) != 0)
-        goto done;
-    for (size_t r = 0; fc && r < rows; r++)
-        for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++) {
-            if (ac->col[k] == r0 + r || ac->val[k] >= 0)
-                continue;
-            double f = entry(fc, r, ac->col[k]);
-            crease[k] = f < 0 && ac->val[k] / f < ratio * fmin(cmean[r], ccol[k]);
-        }
-#define KEEP(r, k)                                                                                                    \
-    (ac->col[k] != r0 + (r) && ((-ac->val[k] >= cut && !crease[k]) || best[r] == ac->col[k] || bcol[k] == r0 + (r)))
-    size_t keep = 0;
-    for (size_t r = 0; r < rows; r++)
-        for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++)
-            keep += KEEP(r, k);
-    rc = asp_amg_csr_create(rows, ac->cols, keep + rows, &d->ctx, &m, err);
-    if ((rc = asp__dist_agree(d, rc, err)) != 0)
-        goto done;
-    size_t w = 0;
-    for (size_t r = 0; r < rows; r++) {
-        size_t diag = SIZE_MAX;
-        double sum = 0;
-        for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++) {
-            if (!KEEP(r, k) || ac->val[k] >= 0)
-                continue;
-            if (diag == SIZE_MAX && ac->col[k] > r0 + r)
-                diag = w++;
-            sum += ac->val[k];
-            m->col[w] = ac->col[k];
-            m->val[w++] = ac->val[k];
-        }
-        if (diag == SIZE_MAX)
-            diag = w++;
-        m->col[diag] = (asp_index)(r0 + r);
-        m->val[diag] = -sum;
-        m->row_ptr[r + 1] = w;
-    }
-#undef KEEP
-    *offdiag = (size_t)sum_all(d, w - rows);
-    *out = m;
-    m = NULL;
-done:
-    asp_amg_csr_destroy(m);
-    asp_free(&d->ctx, cmean);
-    asp_free(&d->ctx, ccol);
-    asp_free(&d->ctx, best);
-    asp_free(&d->ctx, bcol);
-    asp_free(&d->ctx, crease);
-    return rc;
-}
-
-/*
- * A level moves to rank 0 and is coarsened there as in one process (hypre's
- * own answer is BoomerAMGSetSeqThreshold) below 2048 unknowns per rank, and on
- * a few ranks below 65,536 unknowns in all. Measured on a 20k bunny, parallel
- * RS coarsening of a level with a few hundred unknowns per rank keeps nearly
- * every unknown at a rank border, so the coarse levels stopped shrinking (58
- * unknowns at L on 2 ranks, 5 serially). Above that, each border still adds
- * its own C points, and the coarse levels amplify any difference (RS is
- * greedy): on a 4M-point bunny with the per-rank rule alone, 4 ranks ended
- * with 58 unknowns on level 14 against 50 in one process; gathering below
- * 65,536 (level 6 on) gave 53, and 49 on 2 ranks. A level of 65,536 unknowns
- * costs rank 0 a few megabytes and well under a second. The global ids stay;
- * only the partition changes, to [0, N, N, ...].
- */
-enum { GATHER_BELOW_PER_RANK = 2048, GATHER_BELOW = 65536 };
-
-static size_t gather_below(int P)
-{
-    const size_t g = GATHER_BELOW_PER_RANK * (size_t)P;
-    return g > GATHER_BELOW ? g : GATHER_BELOW;
-}
-
-static int gather_level(const asp__dist *d, size_t *starts, asp_amg_csr **a, asp_amg_csr **f, double **mass,
-                        double **cm, asp_error *err)
-{
-    const size_t N = starts[d->size], m = d->rank == 0 ? N : 0;
-    asp_index *ids = asp_alloc(&d->ctx, (m + 1) * sizeof *ids);
-    double *m2 = asp_alloc(&d->ctx, (m + 1) * sizeof *m2), *c2 = asp_alloc(&d->ctx, (m + 1) * sizeof *c2);
-    asp_amg_csr *a2 = NULL, *f2 = NULL;
-    int rc = ids && m2 && c2 ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory gathering a level of %zu unknowns", N);
-    for (size_t i = 0; !rc && i < m; i++)
-        ids[i] = (asp_index)i;
-    if ((rc = asp__dist_agree(d, rc, err)) == 0)
-        rc = asp__dist_fetch_rows(d, starts, *a, ids, m, &a2, err);
-    if (!rc && *f)
-        rc = asp__dist_fetch_rows(d, starts, *f, ids, m, &f2, err);
-    if (!rc)
-        rc = asp__dist_fetch(d, starts, *mass, sizeof **mass, ids, m, m2, err);
-    if (!rc)
-        rc = asp__dist_fetch(d, starts, *cm, sizeof **cm, ids, m, c2, err);
-    asp_free(&d->ctx, ids);
-    if (rc) {
-        asp_free(&d->ctx, m2);
-        asp_free(&d->ctx, c2);
-        asp_amg_csr_destroy(a2);
-        asp_amg_csr_destroy(f2);
-        return rc;
-    }
-    asp_free(&d->ctx, *mass);
-    asp_free(&d->ctx, *cm);
-    *mass = m2;
-    *cm = c2;
-    *a = a2;
-    *f = f2;
-    for (int q = 1; q <= d->size; q++)
-        starts[q] = N;
-    return 0;
-}
-
-/* Takes *a0: destroyed (*a0 = NULL) once hypre holds its copy of the first level (the AMG stage's peak). */
-static int build_hierarchy(const asp__dist *d, const asp__dist_points *pts, asp_amg_csr **a0,
-                           const asp_amg_csr *f0, const float *cls, const asp_amg_desc *desc, hier *h, asp_error *err)
-{
-    const int P = d->size;
-    const size_t maxl = desc->max_levels < ASP_AMG_DIST_MAX_LEVELS ? desc->max_levels : ASP_AMG_DIST_MAX_LEVELS;
-    const int crease = desc->crease_cut > 0 && f0;
-    const asp_amg_csr *cur = *a0, *fcur = f0;
-    asp_amg_csr *owned = NULL, *fowned = NULL;
-    size_t n = pts->n_own, *cst = asp_alloc(&d->ctx, ((size_t)P + 1) * sizeof *cst);
-    double *mass = asp_alloc(&d->ctx, (n + 1) * sizeof *mass), *cm = asp_alloc(&d->ctx, (n + 1) * sizeof *cm);
-    int rc = cst && mass && cm ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
-    h->nlevels = 1;
-    h->sizes[0] = pts->n_global;
-    h->starts[0] = asp_alloc(&d->ctx, ((size_t)P + 1) * sizeof *h->starts[0]);
-    if (!h->starts[0])
-        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
-    else
-        memcpy(h->starts[0], pts->starts, ((size_t)P + 1) * sizeof *pts->starts);
-    if ((rc = asp__dist_agree(d, rc, err)) != 0)
-        goto done;
-    for (size_t i = 0; i < n; i++) {
-        mass[i] = 1.0;
-        cm[i] = cls[i];
-    }
-    const double cut = desc->weak_coupling > 0 ? desc->weak_coupling * median_coupling(d, *a0, pts->starts[d->rank]) : 0;
-    while (h->nlevels < maxl && h->sizes[h->nlevels - 1] > desc->max_coarse) {
-        const size_t l = h->nlevels;
-        size_t *st = h->starts[l - 1];
-        if (P > 1 && l >= 2 && h->sizes[l - 1] < gather_below(P) && st[1] < st[P]) {
-            asp_amg_csr *ga = (asp_amg_csr *)cur, *gf = (asp_amg_csr *)fcur;
-            if ((rc = gather_level(d, st, &ga, &gf, &mass, &cm, err)) != 0)
-                break;
-            asp_amg_csr_destroy(owned);
-            asp_amg_csr_destroy(fowned);
-            owned = ga;
-            cur = ga;
-            fowned = gf;
-            fcur = gf;
-        }
-        asp_amg_csr *p = NULL, *ac = NULL, *next = NULL, *fnext = NULL;
-        size_t *nst = asp_alloc(&d->ctx, ((size_t)P + 1) * sizeof *nst), offdiag = 0;
-        /* the first level: A^0 goes as soon as hypre has it; the rows P leaves empty come back for the fill */
-        asp_amg_csr *a_rows = NULL;
-        const int first = *a0 && cur == *a0;
-        rc = first ? asp__dist_coarsen_take(d, a0, st, desc, &p, &ac, cst, &a_rows, err)
-                   : asp__dist_coarsen(d, cur, st, desc, &p, &ac, cst, err);
-        if (first && !*a0)
-            cur = NULL; /* taken */
-        if (rc || !p) {
-            asp_amg_csr_destroy(a_rows);
-            asp_free(&d->ctx, nst);
-            break;
-        }
-        if (!nst)
-            rc = ASP_ENOMEM;
-        if ((rc = asp__dist_agree(d, rc ? asp_error_set(err, rc, "out of memory for the AMG hierarchy") : 0, err)))
-            goto level_fail;
-        rc = fill_empty_rows(d, &p, a_rows ? a_rows : cur, st, err);
-        asp_amg_csr_destroy(a_rows);
-        a_rows = NULL;
-        if (rc)
-            goto level_fail;
-        if ((rc = asp__dist_agree(d, repair(d, &p, cst, nst, &h->repaired, err), err)) != 0)
-            goto level_fail;
-        if ((rc = asp__dist_agree(d, renumber_coarse(d, &ac, cst, nst, err), err)) != 0)
-            goto level_fail;
-        const size_t nc = nst[d->rank + 1] - nst[d->rank];
-        double *m2 = asp_alloc(&d->ctx, (nc + 1) * sizeof *m2), *c2 = asp_alloc(&d->ctx, (nc + 1) * sizeof *c2);
-        rc = m2 && c2 ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
-        if ((rc = asp__dist_agree(d, rc, err)) == 0)
-            rc = carry(d, p, nst, mass, m2, err);
-        if (!rc)
-            rc = carry(d, p, nst, cm, c2, err);
-        if (!rc) {
-            asp_free(&d->ctx, mass);
-            asp_free(&d->ctx, cm);
-            mass = m2;
-            cm = c2;
-        } else {
-            asp_free(&d->ctx, m2);
-            asp_free(&d->ctx, c2);
-            goto level_fail;
-        }
-        if (crease && (rc = asp__dist_galerkin(d, p, st, nst, fcur, &fnext, err)) != 0)
-            goto level_fail;
-        rc = filter(d, ac, fnext, nst, mass, cm, cut, desc->crease_cut, 0.25 * (double)pts->n_global / (double)nst[P],
-                    &next, &offdiag, err);
-        if (rc)
-            goto level_fail;
-        asp_amg_csr_destroy(ac);
-        ac = NULL;
-        if (nst[P] >= h->sizes[l - 1]) { /* nothing left to merge */
-            asp_amg_csr_destroy(p);
-            asp_amg_csr_destroy(next);
-            asp_amg_csr_destroy(fnext);
-            asp_free(&d->ctx, nst);
-            break;
-        }
-        h->p[l] = p;
-        h->starts[l] = nst;
-        h->sizes[l] = nst[P];
-        h->nlevels++;
-        asp_amg_csr_destroy(owned);
-        owned = next;
-        cur = next;
-        if (fnext) {
-            asp_amg_csr_destroy(fowned);
-            fowned = fnext;
-            fcur = fnext;
-        }
-        if (offdiag == 0)
-            break;
-        continue;
-    level_fail:
-        asp_amg_csr_destroy(a_rows);
-        asp_amg_csr_destroy(p);
-        asp_amg_csr_destroy(ac);
-        asp_amg_csr_destroy(next);
-        asp_amg_csr_destroy(fnext);
-        asp_free(&d->ctx, nst);
-        break;
-    }
-    h->repaired = (size_t)sum_all(d, h->repaired);
-done:
-    asp_amg_csr_destroy(owned);
-    asp_amg_csr_destroy(fowned);
-    asp_free(&d->ctx, cst);
-    asp_free(&d->ctx, mass);
-    asp_free(&d->ctx, cm);
-    return rc;
-}
-
-/* ---- the basis and its domains, level by level ---- */
-
-static int cmp_index(const void *a, const void *b)
-{
-    asp_index x = *(const asp_index *)a, y = *(const asp_index *)b;
-    return x < y ? -1 : x > y;
-}
-
-/*
- * Psi^l = Psi^(l-1) P^l (journal 2.3). The rows of P^l for this rank's own
- * columns are at hand (Morton order keeps most columns local); the others
- * are fetched from their owners, sorted and deduplicated first.
- */
-static int next_basis(const asp__dist *d, const asp_amg_csr *psi, const asp_amg_csr *p, const size_t *pst,
-                      double drop, asp_amg_csr **out, asp_error *err)
-{
-    const size_t nnz = psi->row_ptr[psi->rows], lo = pst[d->rank], nloc = pst[d->rank + 1] - lo;
-    asp_index *cols = asp_alloc(&d->ctx, (nnz + 1) * sizeof *cols);
-    asp_amg_csr *fetched = NULL, *b = NULL, *a = NULL;
-    size_t m = 0;
-    int rc = cols ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for the basis");
-    for (size_t k = 0; cols && k < nnz; k++)
-        if (psi->col[k] < lo || psi->col[k] >= lo + nloc)
-            cols[m++] = psi->col[k];
-    if (cols) {
-        qsort(cols, m, sizeof *cols, cmp_index);
-        size_t u = 0;
-        for (size_t k = 0; k < m; k++)
-            if (u == 0 || cols[k] != cols[u - 1])
-                cols[u++] = cols[k];
-        m = u;
-    }
-    if ((rc = asp__dist_agree(d, rc, err)) != 0) {
-        asp_free(&d->ctx, cols);
-        return rc;
-    }
-    rc = asp__dist_fetch_rows(d, pst, p, cols, m, &fetched, err);
-    /* b: the local rows of P^l, then the fetched ones */
-    if (!rc)
-        rc = asp_amg_csr_create(nloc + m, p->cols, p->row_ptr[nloc] + fetched->row_ptr[m], &d->ctx, &b, err);
-    if (!rc) {
-        const size_t pn = p->row_ptr[nloc];
-        memcpy(b->row_ptr, p->row_ptr, (nloc + 1) * sizeof *b->row_ptr);
-        memcpy(b->col, p->col, pn * sizeof *b->col);
-        memcpy(b->val, p->val, pn * sizeof *b->val);
-        for (size_t r = 0; r < m; r++)
-            b->row_ptr[nloc + r + 1] = pn + fetched->row_ptr[r + 1];
-        memcpy(b->col + pn, fetched->col, fetched->row_ptr[m] * sizeof *b->col);
-        memcpy(b->val + pn, fetched->val, fetched->row_ptr[m] * sizeof *b->val);
-        rc = asp_amg_csr_create(psi->rows, nloc + m, nnz, &d->ctx, &a, err);
-    }
-    if (!rc) {
-        memcpy(a->row_ptr, psi->row_ptr, (psi->rows + 1) * sizeof *a->row_ptr);
-        memcpy(a->val, psi->val, nnz * sizeof *a->val);
-        for (size_t k = 0; k < nnz; k++) {
-            asp_index c = psi->col[k];
-            a->col[k] = c >= lo && c < lo + nloc
-                            ? (asp_index)(c - lo)
-                            : (asp_index)(nloc + (size_t)((asp_index *)bsearch(&c, cols, m, sizeof *cols, cmp_index) - cols));
-        }
-        rc = asp__amg_spgemm_pou(a, b, drop, &d->ctx, out, err);
-    }
-    asp_amg_csr_destroy(a);
-    asp_amg_csr_destroy(b);
-    asp_amg_csr_destroy(fetched);
-    asp_free(&d->ctx, cols);
-    return asp__dist_agree(d, rc, err);
-}
-
-/* A level's agreement figures (journal eq. 8, thesis eq. 2.5) over every rank. */
-static int level_figures(const asp__dist *d, const asp_amg_csr *psi, const size_t *cst, double tau,
-                         asp_amg_dist_level *lv, asp_error *err)
-{
-    const size_t nnz = psi->row_ptr[psi->rows], nc = cst[d->rank + 1] - cst[d->rank];
-    double *one = asp_alloc(&d->ctx, (nnz + psi->rows + 1) * sizeof *one), *inside = asp_calloc(&d->ctx, nc + 1, sizeof *inside);
-    double *strict = asp_calloc(&d->ctx, nc + 1, sizeof *strict);
-    asp_index *arg = asp_alloc(&d->ctx, (psi->rows + 1) * sizeof *arg);
-    int rc = one && inside && strict && arg ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for level figures");
-    if ((rc = asp__dist_agree(d, rc, err)) != 0)
-        goto done;
-    unsigned long long member = 0, outside = 0;
-    double pou = 0;
-    for (size_t x = 0; x < psi->rows; x++) {
-        double sum = 0, bv = -1;
-        int any = 0;
-        arg[x] = 0;
-        for (size_t k = psi->row_ptr[x]; k < psi->row_ptr[x + 1]; k++) {
-            sum += psi->val[k];
-            one[k] = psi->val[k] > tau;
-            member += psi->val[k] > tau;
-            any |= psi->val[k] > tau;
-            if (psi->val[k] > bv) { /* columns increase: ties keep the smaller index */
-                bv = psi->val[k];
-                arg[x] = psi->col[k];
-            }
-        }
-        outside += !any;
-        pou = fmax(pou, fabs(sum - 1.0));
-    }
-    if ((rc = asp__dist_scatter_add(d, cst, psi->col, one, nnz, inside, err)) != 0)
-        goto done;
-    for (size_t x = 0; x < psi->rows; x++)
-        one[x] = 1.0;
-    if ((rc = asp__dist_scatter_add(d, cst, arg, one, psi->rows, strict, err)) != 0)
-        goto done;
-    unsigned long long dom = 0, sdom = 0;
-    for (size_t c = 0; c < nc; c++) {
-        dom += inside[c] > 0;
-        sdom += strict[c] > 0;
-    }
-    unsigned long long points = sum_all(d, psi->rows);
-    lv->unknowns = cst[d->size];
-    lv->domains = (size_t)sum_all(d, dom);
-    lv->strict_domains = (size_t)sum_all(d, sdom);
-    lv->points_outside = (size_t)sum_all(d, outside);
-    lv->mean_domains_per_point = points ? (double)sum_all(d, member) / (double)points : 0;
-    MPI_Allreduce(&pou, &lv->max_pou_error, 1, MPI_DOUBLE, MPI_MAX, d->comm);
-done:
-    asp_free(&d->ctx, one);
-    asp_free(&d->ctx, inside);
-    asp_free(&d->ctx, strict);
-    asp_free(&d->ctx, arg);
-    return rc;
-}
-
-static int basis_figures(const asp__dist *d, const asp__dist_points *pts, const hier *h, const asp_amg_desc *desc,
-                         double tau, asp_amg_dist_info *info, asp_error *err)
-{
-    asp_amg_csr *psi = NULL;
-    const size_t n = pts->n_own;
-    int rc = asp_amg_csr_create(n, pts->n_global, n, &d->ctx, &psi, err);
-    for (size_t i = 0; !rc && i < n; i++) {
-        psi->col[i] = (asp_index)(pts->starts[d->rank] + i);
-        psi->val[i] = 1.0;
-        psi->row_ptr[i + 1] = i + 1;
-    }
-    if ((rc = asp__dist_agree(d, rc, err)) != 0)
-        return rc;
-    for (size_t l = 0; l < h->nlevels && !rc; l++) {
-        if (l > 0) {
-            asp_amg_csr *next = NULL;
-            rc = next_basis(d, psi, h->p[l], h->starts[l - 1], desc->drop_tol, &next, err);
-            if (rc)
-                break;
-            asp_amg_csr_destroy(psi);
-            psi = next;
-        }
-        rc = level_figures(d, psi, h->starts[l], tau, &info->level[l], err);
-    }
-    asp_amg_csr_destroy(psi);
-    return rc;
-}
-
 /* ---- the pipeline ---- */
 
 static double peak_rss_mb(void)
@@ -969,7 +138,7 @@ static double peak_rss_mb(void)
 }
 
 /* The frame of asp_cloud_frame over every rank: box centre, farthest point plus the largest disc radius. */
-static void frame_of(const asp__dist *d, const asp__dist_points *pts, double center[3], double *radius)
+static void frame_of(const asp__dist *d, const asp__dist_points *pts, asp_frame *frame)
 {
     double far2 = 0, all2 = 0, rmax = 0, rall = 0;
     double c[3];
@@ -994,8 +163,8 @@ static void frame_of(const asp__dist *d, const asp__dist_points *pts, double cen
                         : fmax(e[0], fmax(e[1], e[2])) / (double)pts->n_global;
     }
     for (int k = 0; k < 3; k++)
-        center[k] = c[k] + pts->origin[k];
-    *radius = sqrt(all2) + rall;
+        frame->center[k] = c[k] + pts->origin[k];
+    frame->radius = sqrt(all2) + rall;
 }
 
 typedef struct run {
@@ -1007,7 +176,7 @@ typedef struct run {
     asp__amg_nbhd nb;
     asp__amg_fans fans;
     asp_amg_csr *la, *lf, *a, *f;
-    hier h;
+    asp__dist_hier h;
 } run;
 
 static void run_release(run *r)
@@ -1023,7 +192,7 @@ static void run_release(run *r)
     asp_amg_csr_destroy(r->lf);
     asp_amg_csr_destroy(r->a);
     asp_amg_csr_destroy(r->f);
-    hier_release(ctx, &r->h);
+    asp__dist_hier_release(ctx, &r->h);
 }
 
 /* Neighbourhoods, classifier, fans and stiffness rows of the owned points (journal 2.1-2.2). */
@@ -1117,7 +286,7 @@ static int local_stages(run *r, asp_amg_dist_info *info, asp_error *err)
     unsigned long long nn = 0;
     for (size_t i = 0; i < n; i++)
         nn += r->nb.nn[i];
-    info->amg.mean_neighbourhood = (double)sum_all(d, nn) / (double)pts->n_global;
+    info->amg.mean_neighbourhood = (double)asp__dist_sum(d, nn) / (double)pts->n_global;
     double t = asp_time_now();
     r->cls = asp_alloc(&d->ctx, (nl + 1) * sizeof *r->cls);
     r->tangent = asp_alloc(&d->ctx, (3 * nl + 3) * sizeof *r->tangent);
@@ -1144,7 +313,7 @@ static int local_stages(run *r, asp_amg_dist_info *info, asp_error *err)
             r->fans.ntri[i] = 0; /* a halo point's row belongs to its owner */
         tri += r->fans.ntri[i];
     }
-    info->amg.mean_fan = (double)sum_all(d, tri) / (double)pts->n_global;
+    info->amg.mean_fan = (double)asp__dist_sum(d, tri) / (double)pts->n_global;
     info->amg.t_fans = asp_time_now() - t;
     t = asp_time_now();
     const int crease = r->desc.crease_cut > 0;
@@ -1154,7 +323,7 @@ static int local_stages(run *r, asp_amg_dist_info *info, asp_error *err)
     if ((rc = asp__dist_agree(d, rc, err)) != 0)
         return rc;
     asp__amg_fans_release(&d->ctx, &r->fans);
-    rc = global_rows(d, pts, &r->la, &r->lf, r->desc.stiffness, &r->a, &r->f, &info->amg.positive_offdiag, err);
+    rc = asp__dist_global_rows(d, pts, &r->la, &r->lf, r->desc.stiffness, &r->a, &r->f, &info->amg.positive_offdiag, err);
     if ((rc = asp__dist_agree(d, rc, err)) != 0)
         return rc;
     asp_amg_csr_destroy(r->la);
@@ -1163,8 +332,8 @@ static int local_stages(run *r, asp_amg_dist_info *info, asp_error *err)
     unsigned long long isolated = 0;
     for (size_t i = 0; i < n; i++)
         isolated += r->a->row_ptr[i + 1] - r->a->row_ptr[i] == 1;
-    info->amg.isolated_points = (size_t)sum_all(d, isolated);
-    info->amg.matrix_nnz = (size_t)sum_all(d, r->a->row_ptr[n]);
+    info->amg.isolated_points = (size_t)asp__dist_sum(d, isolated);
+    info->amg.matrix_nnz = (size_t)asp__dist_sum(d, r->a->row_ptr[n]);
     if (info->amg.isolated_points == pts->n_global)
         return asp_error_set(err, ASP_EDEGENERATE,
                              "cannot decompose %zu points: no point has a triangle fan (colinear or too sparse points)",
@@ -1221,11 +390,11 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
         goto done;
     asp_free(&d->ctx, r.radius); /* the halo is closed */
     r.radius = NULL;
-    inf.halo_points = (size_t)sum_all(d, r.pts.n_ghost);
+    inf.halo_points = (size_t)asp__dist_sum(d, r.pts.n_ghost);
     if ((rc = local_stages(&r, &inf, err)) != 0)
         goto done;
     t = asp_time_now();
-    rc = build_hierarchy(d, &r.pts, &r.a, r.f, r.cls, &r.desc, &r.h, err);
+    rc = asp__dist_build_hierarchy(d, &r.pts, &r.a, r.f, r.cls, &r.desc, &r.h, err);
     if ((rc = asp__dist_agree(d, rc, err)) != 0)
         goto done;
     asp_amg_csr_destroy(r.f);
@@ -1238,7 +407,7 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
     inf.amg.fan_k = r.desc.fan_k;
     inf.nlevels = r.h.nlevels;
     t = asp_time_now();
-    if (figures && (rc = basis_figures(d, &r.pts, &r.h, &r.desc, tau, &inf, err)) != 0)
+    if (figures && (rc = asp__dist_basis_figures(d, &r.pts, &r.h, &r.desc, tau, &inf, err)) != 0)
         goto done;
     for (size_t l = 0; !figures && l < r.h.nlevels; l++)
         inf.level[l].unknowns = r.h.sizes[l];
@@ -1247,7 +416,7 @@ int asp_amg_decompose_distributed(const char *in_path, const char *out_path, con
     if (out_path) {
         asp__dist_result res = {.pts = &r.pts, .tangent = r.tangent, .classifier = r.cls, .desc = &r.desc,
                                 .nlevels = r.h.nlevels, .level_size = r.h.sizes, .prolong = r.h.p};
-        frame_of(d, &r.pts, res.frame_center, &res.frame_radius);
+        frame_of(d, &r.pts, &res.frame);
         if ((rc = asp__dist_write_amg(d, &res, out_path, err)) != 0)
             goto done;
     }

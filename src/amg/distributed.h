@@ -28,6 +28,7 @@ typedef struct asp__dist_points {
     uint8_t *colors;      /* 4 * n_own, or NULL */
     float *radii;         /* n_own, or NULL */
     uint32_t *labels;     /* n_own, or NULL */
+    float *uvs;           /* 2 * n_own, or NULL */
     int has_alpha;
     asp_index *ghost_gid; /* n_ghost */
     float lo[3], hi[3];   /* bounding box of every rank's positions */
@@ -38,6 +39,8 @@ typedef struct asp__dist_points {
  * failing rank's code and message go to all. Collective.
  */
 int asp__dist_agree(const asp__dist *d, int rc, asp_error *err);
+/* The sum of every rank's v. Collective. */
+unsigned long long asp__dist_sum(const asp__dist *d, unsigned long long v);
 /* Owner rank of global id g in a partition starts[0..size]. */
 int asp__dist_owner(const size_t *starts, int size, size_t g);
 /* starts[0..size] of a partition where this rank holds local items. Collective. */
@@ -63,6 +66,67 @@ int asp__dist_read_sorted(const asp__dist *d, const char *path, asp__dist_points
 /* Appends copies of the other ranks' points within radius[i] of an owned point i. Collective. */
 int asp__dist_halo(const asp__dist *d, asp__dist_points *pts, const float *radius, asp_error *err);
 void asp__dist_points_release(const asp_context *ctx, asp__dist_points *pts);
+
+/* The global id of a rank's local point (owned, then halo). */
+static inline asp_index asp__dist_gid(const asp__dist *d, const asp__dist_points *pts, size_t local)
+{
+    return (asp_index)(local < pts->n_own ? pts->starts[d->rank] + local : pts->ghost_gid[local - pts->n_own]);
+}
+
+/* ---- distributed_rows.c ---- */
+
+/*
+ * The global stiffness rows of the owned points (*ga, and *gf with the crease test's C = 1 matrix)
+ * from the local assembly over points and halo (*take_a, *take_f: destroyed once their entries are
+ * exchanged); *positive counts the positive off-diagonal couplings over every rank. Collective.
+ */
+int asp__dist_global_rows(const asp__dist *d, const asp__dist_points *pts, asp_amg_csr **take_a,
+                          asp_amg_csr **take_f, asp_amg_stiffness form, asp_amg_csr **ga, asp_amg_csr **gf,
+                          size_t *positive, asp_error *err);
+
+/* ---- distributed_repair.c: one level's rows (P: local rows, global columns) ---- */
+
+/* Rows of P left empty where a (the level's rows, or those hypre gave back) has couplings: their mean. */
+int asp__dist_fill_empty_rows(const asp__dist *d, asp_amg_csr **pp, const asp_amg_csr *a, const size_t *st,
+                              asp_error *err);
+/* P's rows as a partition of unity; the coarse partition cst becomes nst with each rank's orphans. */
+int asp__dist_repair(const asp__dist *d, asp_amg_csr **pp, const size_t *cst, size_t *nst, size_t *repaired,
+                     asp_error *err);
+/* The coarse matrix in the repaired numbering nst, with an empty row per orphan. */
+int asp__dist_renumber_coarse(const asp__dist *d, asp_amg_csr **pac, const size_t *cst, const size_t *nst,
+                              asp_error *err);
+/* dst[J] = sum_r P_rJ src[r] for this rank's coarse unknowns J (partition nst). Collective. */
+int asp__dist_carry(const asp__dist *d, const asp_amg_csr *p, const size_t *nst, const double *src, double *dst,
+                    asp_error *err);
+/* The next level's matrix from the coarse one ac (and fc, the crease test's, or NULL). Collective. */
+int asp__dist_filter(const asp__dist *d, const asp_amg_csr *ac, const asp_amg_csr *fc, const size_t *nst,
+                     const double *mass, const double *cm, double cut, double ratio, double small, asp_amg_csr **out,
+                     size_t *offdiag, asp_error *err);
+
+/* ---- distributed_hierarchy.c ---- */
+
+typedef struct asp__dist_hier {
+    size_t nlevels;
+    size_t sizes[ASP_AMG_DIST_MAX_LEVELS];
+    size_t *starts[ASP_AMG_DIST_MAX_LEVELS]; /* partition of each level's unknowns */
+    asp_amg_csr *p[ASP_AMG_DIST_MAX_LEVELS]; /* [1..]: local rows (level l-1), global columns (level l) */
+    size_t repaired;
+} asp__dist_hier;
+
+/*
+ * The hierarchy on the global rows *a0 (taken: destroyed once hypre holds its copy of the first
+ * level) and f0 (the crease test's, or NULL), cls the owned points' classifier. Collective.
+ */
+int asp__dist_build_hierarchy(const asp__dist *d, const asp__dist_points *pts, asp_amg_csr **a0,
+                              const asp_amg_csr *f0, const float *cls, const asp_amg_desc *desc, asp__dist_hier *h,
+                              asp_error *err);
+void asp__dist_hier_release(const asp_context *ctx, asp__dist_hier *h);
+
+/* ---- distributed_basis.c ---- */
+
+/* Each level's basis and its figures into info->level[] (tau: the domain threshold). Collective. */
+int asp__dist_basis_figures(const asp__dist *d, const asp__dist_points *pts, const asp__dist_hier *h,
+                            const asp_amg_desc *desc, double tau, asp_amg_dist_info *info, asp_error *err);
 
 /* ---- hypre_distributed.c (hypre and MPI start-up) ---- */
 
@@ -95,7 +159,7 @@ typedef struct asp__dist_result {
     size_t nlevels;
     const size_t *level_size;          /* global sizes */
     asp_amg_csr *const *prolong;       /* [1..nlevels-1]: local rows, global columns */
-    double frame_center[3], frame_radius;
+    asp_frame frame;                   /* asp_cloud_frame over every rank's points */
 } asp__dist_result;
 
 /* Writes the .amg (version 3) by rank 0 streaming every rank's part in order. Collective. */

@@ -44,6 +44,13 @@ int asp__dist_owner(const size_t *starts, int size, size_t g)
     return lo;
 }
 
+unsigned long long asp__dist_sum(const asp__dist *d, unsigned long long v)
+{
+    unsigned long long s = 0;
+    MPI_Allreduce(&v, &s, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
+    return s;
+}
+
 int asp__dist_partition(const asp__dist *d, size_t local, size_t *starts)
 {
     unsigned long long mine = local, *all = asp_alloc(&d->ctx, (size_t)d->size * sizeof *all);

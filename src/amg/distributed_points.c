@@ -19,14 +19,16 @@
 /* One point on its way between ranks: the Morton key, its input index (ties), and every attribute kept. */
 typedef struct rec {
     uint64_t key, index;
-    float pos[3], nrm[3], radius;
+    float pos[3], nrm[3], radius, uv[2];
     uint32_t label;
     uint8_t rgba[4];
 } rec;
 
-enum { P_X, P_Y, P_Z, P_NX, P_NY, P_NZ, P_R, P_G, P_B, P_A, P_RADIUS, P_LABEL, P_COUNT };
-static const char *const prop_names[P_COUNT] = {"x",   "y",     "z",    "nx",    "ny",     "nz",
-                                                "red", "green", "blue", "alpha", "radius", "label"};
+/* P_U, P_V: the first pair of the names the serial PLY reader takes for uvs (src/io/ply_read.c) */
+enum { P_X, P_Y, P_Z, P_NX, P_NY, P_NZ, P_R, P_G, P_B, P_A, P_RADIUS, P_LABEL, P_U, P_V, P_S, P_T, P_TU, P_TV, P_COUNT };
+static const char *const prop_names[P_COUNT] = {"x",   "y",     "z",     "nx",     "ny", "nz", "red", "green", "blue",
+                                                "alpha", "radius", "label", "u",   "v",  "s",  "t",   "texture_u",
+                                                "texture_v"};
 
 typedef struct layout {
     size_t count, record, data_at;
@@ -130,6 +132,14 @@ static int read_layout(FILE *fp, const char *path, layout *lay, asp_error *err)
                     lay->type[p] = p == P_A && lay->type[P_A] == 1 ? lay->type[P_A] : 0;
             if (!lay->type[P_R])
                 lay->type[P_A] = 0;
+            /* uvs as the serial reader takes them: two floats of one type, u/v before s/t before texture_u/v */
+            int uv = P_U;
+            while (uv < P_COUNT && !((lay->type[uv] & T_FLOAT) && lay->type[uv] == lay->type[uv + 1]))
+                uv += 2;
+            for (int k = 0; k < 2; k++) {
+                lay->type[P_U + k] = uv < P_COUNT ? lay->type[uv + k] : 0;
+                lay->at[P_U + k] = uv < P_COUNT ? lay->at[uv + k] : 0;
+            }
             return 0;
         }
     }
@@ -185,6 +195,8 @@ static int read_range(const asp_context *ctx, FILE *fp, const char *path, const 
                 r->rgba[k] = lay->type[P_R + k] ? b[lay->at[P_R + k]] : 255;
             r->radius = lay->type[P_RADIUS] ? (float)load(b + lay->at[P_RADIUS], lay->type[P_RADIUS]) : 0.0f;
             r->label = lay->type[P_LABEL] ? (uint32_t)load(b + lay->at[P_LABEL], lay->type[P_LABEL]) : 0;
+            for (int k = 0; k < 2; k++)
+                r->uv[k] = lay->type[P_U + k] ? (float)load(b + lay->at[P_U + k], lay->type[P_U + k]) : 0.0f;
         }
         done += take;
     }
@@ -334,9 +346,11 @@ int asp__dist_read_sorted(const asp__dist *d, const char *path, asp__dist_points
         pts->radii = asp_alloc(ctx, (m + 1) * sizeof *pts->radii);
     if (lay.type[P_LABEL])
         pts->labels = asp_alloc(ctx, (m + 1) * sizeof *pts->labels);
+    if (lay.type[P_U])
+        pts->uvs = asp_alloc(ctx, (2 * m + 2) * sizeof *pts->uvs);
     pts->has_alpha = lay.type[P_A] != 0;
     rc = !pts->starts || !pts->pos || (lay.type[P_NX] && !pts->normals) || (lay.type[P_R] && !pts->colors) ||
-                 (lay.type[P_RADIUS] && !pts->radii) || (lay.type[P_LABEL] && !pts->labels)
+                 (lay.type[P_RADIUS] && !pts->radii) || (lay.type[P_LABEL] && !pts->labels) || (lay.type[P_U] && !pts->uvs)
              ? asp_error_set(err, ASP_ENOMEM, "out of memory for %zu points", m)
              : 0;
     if (!rc && asp__dist_partition(d, m, pts->starts))
@@ -351,6 +365,8 @@ int asp__dist_read_sorted(const asp__dist *d, const char *path, asp__dist_points
             pts->radii[i] = recs[i].radius;
         if (pts->labels)
             pts->labels[i] = recs[i].label;
+        if (pts->uvs)
+            memcpy(pts->uvs + 2 * i, recs[i].uv, sizeof recs[i].uv);
     }
     asp_free(&d->ctx, recs);
     return asp__dist_agree(d, rc, err);
@@ -603,6 +619,7 @@ void asp__dist_points_release(const asp_context *ctx, asp__dist_points *pts)
     asp_free(ctx, pts->colors);
     asp_free(ctx, pts->radii);
     asp_free(ctx, pts->labels);
+    asp_free(ctx, pts->uvs);
     asp_free(ctx, pts->ghost_gid);
     memset(pts, 0, sizeof *pts);
 }

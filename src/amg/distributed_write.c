@@ -1,6 +1,6 @@
 /*
- * The .amg file of a distributed decomposition (version 3, amg_file.c's
- * layout): rank 0 writes the header and streams every rank's part of each
+ * The .amg file of a distributed decomposition (amg_format.h's layout and
+ * header writer): rank 0 writes the header and streams every rank's part of each
  * array in rank order, in chunks of at most 4 MB, through the CRC writer
  * and the atomic temporary file. No rank holds more than its own part and
  * one chunk; the points are in the Morton order of the ranks. NEEDSWORK: at
@@ -11,13 +11,14 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "amg/amg_format.h"
 #include "amg/distributed.h"
 #include "util/atomic_file.h"
 #include "util/byte_io.h"
 #include "util/checksum.h"
 #include "util/banned.h"
 
-enum { AMG_VERSION = 3, AMG_HEADER = 96, CHUNK = 4 << 20, TAG = 7719 };
+enum { CHUNK = 4 << 20, TAG = 7719 };
 
 typedef struct stream {
     const asp__dist *d;
@@ -52,35 +53,6 @@ static void put_all(stream *s, const void *data, size_t bytes)
     }
 }
 
-static unsigned long long sum_all(const asp__dist *d, unsigned long long v)
-{
-    unsigned long long s = 0;
-    MPI_Allreduce(&v, &s, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
-    return s;
-}
-
-static void put_options(asp__crc_writer *w, const asp_amg_desc *o)
-{
-    asp__put_f64(w, o->epsilon);
-    asp__put_u64(w, o->k_min);
-    asp__put_u64(w, o->k_max);
-    asp__put_u64(w, o->fan_k);
-    asp__put_u32(w, (uint32_t)o->classifier);
-    asp__put_u32(w, (uint32_t)o->coarsen);
-    asp__put_u32(w, (uint32_t)o->interp);
-    asp__put_u32(w, 0);
-    asp__put_f64(w, o->alpha);
-    asp__put_f64(w, o->beta);
-    asp__put_f64(w, o->strong_threshold);
-    asp__put_f64(w, o->trunc_factor);
-    asp__put_f64(w, o->drop_tol);
-    asp__put_u64(w, o->max_levels);
-    asp__put_u64(w, o->max_coarse);
-    asp__put_f64(w, o->weak_coupling);
-    asp__put_f64(w, o->crease_cut);
-    asp__put_u64(w, 0);
-}
-
 int asp__dist_write_amg(const asp__dist *d, const asp__dist_result *res, const char *path, asp_error *err)
 {
     const asp__dist_points *pts = res->pts;
@@ -89,8 +61,7 @@ int asp__dist_write_amg(const asp__dist *d, const asp__dist_result *res, const c
     asp__crc_writer w = {NULL, 0, 0};
     stream s = {d, &w, NULL};
     int rc = 0;
-    const uint16_t one = 1;
-    if (*(const uint8_t *)&one != 1)
+    if (!asp__amg_host_little_endian())
         rc = asp_error_set(err, ASP_EUNSUPPORTED, "cannot write '%s': .amg files are little-endian only", path);
     if (!rc && d->rank == 0) {
         rc = asp__atomic_open(&f, path, err);
@@ -108,54 +79,33 @@ int asp__dist_write_amg(const asp__dist *d, const asp__dist_result *res, const c
         return rc;
     }
     /* the input's attributes as amg_file.c stores them: the normals only when the input had them */
-    const unsigned attrs = (pts->normals ? ASP_ATTR_NORMALS : 0u) | (pts->colors ? ASP_ATTR_COLORS : 0u) |
-                           (pts->radii ? ASP_ATTR_RADII : 0u) | (pts->labels ? ASP_ATTR_LABELS : 0u);
-    const uint64_t per_point = (attrs & ASP_ATTR_NORMALS ? 12u : 0u) + (attrs & ASP_ATTR_COLORS ? 4u : 0u) +
-                               (attrs & ASP_ATTR_RADII ? 4u : 0u) + (attrs & ASP_ATTR_LABELS ? 4u : 0u);
+    const void *const arrays[ASP__AMG_NATTRS] = {pts->normals, pts->colors, pts->radii, pts->uvs, pts->labels};
+    asp__amg_header h = {.points = pts->n_global, .nlevels = res->nlevels, .level_size = res->level_size};
+    for (int i = 0; i < ASP__AMG_NATTRS; i++)
+        h.attrs |= arrays[i] ? asp__amg_attr_bit[i] : 0u;
     unsigned long long nnz[ASP_AMG_DIST_MAX_LEVELS] = {0}, before[ASP_AMG_DIST_MAX_LEVELS] = {0};
-    const uint64_t N = pts->n_global;
-    uint64_t payload = 7 * 4 * N + 8 + per_point * N + 128 + 8 * (uint64_t)res->nlevels;
     for (size_t l = 1; l < res->nlevels; l++) {
         unsigned long long mine = res->prolong[l]->row_ptr[res->prolong[l]->rows];
-        nnz[l] = sum_all(d, mine);
+        MPI_Allreduce(&mine, &nnz[l], 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
         MPI_Exscan(&mine, &before[l], 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, d->comm);
         if (d->rank == 0)
             before[l] = 0;
-        payload += 8 + 8 * ((uint64_t)res->level_size[l - 1] + 1) + 12 * (uint64_t)nnz[l];
+        h.prolong_nnz += nnz[l];
     }
-    if (d->rank == 0) {
-        asp__crc_put(&w, "ASPAMG\r\n", 8);
-        asp__put_u32(&w, AMG_VERSION);
-        asp__put_u32(&w, AMG_HEADER);
-        asp__put_u64(&w, N);
-        asp__put_u64(&w, res->nlevels);
-        asp__put_u64(&w, payload);
-        for (int a = 0; a < 3; a++)
-            asp__put_f64(&w, pts->origin[a]);
-        for (int a = 0; a < 3; a++)
-            asp__put_f64(&w, res->frame_center[a]);
-        asp__put_f64(&w, res->frame_radius);
-    }
+    memcpy(h.origin, pts->origin, sizeof h.origin);
+    h.frame = res->frame;
+    if (d->rank == 0)
+        asp__amg_put_header(&w, &h);
     put_all(&s, pts->pos, 3 * n * sizeof(float));
     put_all(&s, res->tangent, 3 * n * sizeof(float));
     put_all(&s, res->classifier, n * sizeof(float));
-    if (d->rank == 0) {
-        asp__put_u32(&w, attrs);
-        asp__put_u32(&w, 0);
-    }
-    if (attrs & ASP_ATTR_NORMALS)
-        put_all(&s, pts->normals, 3 * n * sizeof(float));
-    if (attrs & ASP_ATTR_COLORS)
-        put_all(&s, pts->colors, 4 * n);
-    if (attrs & ASP_ATTR_RADII)
-        put_all(&s, pts->radii, n * sizeof(float));
-    if (attrs & ASP_ATTR_LABELS)
-        put_all(&s, pts->labels, n * sizeof(uint32_t));
-    if (d->rank == 0) {
-        put_options(&w, res->desc);
-        for (size_t l = 0; l < res->nlevels; l++)
-            asp__put_u64(&w, res->level_size[l]);
-    }
+    if (d->rank == 0)
+        asp__amg_put_attr_set(&w, h.attrs);
+    for (int i = 0; i < ASP__AMG_NATTRS; i++)
+        if (h.attrs & asp__amg_attr_bit[i])
+            put_all(&s, arrays[i], asp__amg_attr_size[i] * n);
+    if (d->rank == 0)
+        asp__amg_put_options(&w, res->desc, res->level_size, res->nlevels);
     for (size_t l = 1; l < res->nlevels; l++) {
         const asp_amg_csr *p = res->prolong[l];
         /* the row pointers shifted by the entries of the ranks before; rank 0 adds the leading 0 */

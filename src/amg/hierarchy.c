@@ -4,60 +4,15 @@
  * leaves the rows of unknowns without strong connections empty (a point with
  * no fan neighbour, or a whole disconnected part that coarsened to a single
  * unknown); such an unknown becomes an "orphan" that is carried unchanged to
- * every coarser level, so a disconnected part stays its own domain.
+ * every coarser level, so a disconnected part stays its own domain. The row
+ * kernels (repair, strongest coupling, crease test, filter) are level_rows.c's,
+ * shared with the distributed hierarchy (distributed_hierarchy.c).
  */
 #include <math.h>
 #include <string.h>
 
 #include "amg/internal.h"
 #include "util/banned.h"
-
-static double positive_sum(const asp_amg_csr *p, size_t r)
-{
-    double s = 0;
-    for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++)
-        if (p->val[k] > 0)
-            s += p->val[k];
-    return s;
-}
-
-size_t asp__amg_empty_rows(const asp_amg_csr *p)
-{
-    size_t n = 0;
-    for (size_t r = 0; r < p->rows; r++)
-        n += !(positive_sum(p, r) > 1e-12);
-    return n;
-}
-
-size_t asp__amg_pou_rows(const asp_amg_csr *p, asp_amg_csr *q, asp_index first_orphan,
-                         asp_index (*map)(asp_index c, const void *arg), const void *arg, size_t *repaired)
-{
-    size_t w = 0;
-    asp_index next_orphan = first_orphan;
-    for (size_t r = 0; r < p->rows; r++) {
-        const double s = positive_sum(p, r);
-        if (!(s > 1e-12)) {
-            q->col[w] = next_orphan++;
-            q->val[w++] = 1.0;
-            (*repaired)++;
-        } else {
-            /*
-             * Classical interpolation of a zero-row-sum M-matrix already sums
-             * to 1; truncation or a clamped negative weight does not, so
-             * renormalise (the correction is at rounding level otherwise).
-             */
-            if (fabs(s - 1.0) > 1e-9)
-                (*repaired)++;
-            for (size_t k = p->row_ptr[r]; k < p->row_ptr[r + 1]; k++)
-                if (p->val[k] > 0) {
-                    q->col[w] = map ? map(p->col[k], arg) : p->col[k];
-                    q->val[w++] = p->val[k] / s;
-                }
-        }
-        q->row_ptr[r + 1] = w;
-    }
-    return next_orphan - first_orphan;
-}
 
 /* Rebuilds p (hypre rows x hypre cols) with carried orphans (carried) and new ones; returns the new count. */
 static int repair_level(asp_amg_csr **pp, size_t carried, const asp_context *ctx, size_t *new_orphans,
@@ -84,19 +39,6 @@ static int repair_level(asp_amg_csr **pp, size_t carried, const asp_context *ctx
     return 0;
 }
 
-/* Column of the most negative off-diagonal entry of row r of a, or UINT32_MAX. */
-static asp_index strongest(const asp_amg_csr *a, size_t r)
-{
-    asp_index best = UINT32_MAX;
-    double v = 0;
-    for (size_t k = a->row_ptr[r]; k < a->row_ptr[r + 1]; k++)
-        if (a->col[k] != r && a->val[k] < v) {
-            v = a->val[k];
-            best = a->col[k];
-        }
-    return best;
-}
-
 /*
  * Crease test on a coarse level (journal 2.3: "domains stop at creases").
  * a_IJ / f_IJ, the Galerkin coupling of the classifier-weighted matrix over
@@ -120,9 +62,7 @@ static void crease_cuts(const asp_amg_csr *ac, const asp_amg_csr *fc, const doub
             cut[k] = 0;
             if (c <= r || ac->val[k] >= 0)
                 continue;
-            double f = dense[c];
-            /* no geometric coupling to compare with (f >= 0): keep, the test cannot tell */
-            if (f < 0 && ac->val[k] / f < ratio * fmin(cmean[r], cmean[c])) {
+            if (asp__amg_crease(ac->val[k], dense[c], ratio, cmean[r], cmean[c])) {
                 cut[k] = 1;
                 (*ncut)++;
             }
@@ -136,15 +76,8 @@ static void crease_cuts(const asp_amg_csr *ac, const asp_amg_csr *fc, const doub
             if (c >= r)
                 continue;
             /* mirror the decision of (c, r) */
-            size_t lo = ac->row_ptr[c], hi = ac->row_ptr[c + 1];
-            while (lo < hi) {
-                size_t mid = lo + (hi - lo) / 2;
-                if (ac->col[mid] < r)
-                    lo = mid + 1;
-                else
-                    hi = mid;
-            }
-            cut[k] = lo < ac->row_ptr[c + 1] && ac->col[lo] == r ? cut[lo] : 0;
+            const size_t m = asp__amg_csr_find(ac, c, (asp_index)r);
+            cut[k] = m == SIZE_MAX ? 0 : cut[m];
         }
 }
 
@@ -165,76 +98,26 @@ static int filter_coarse(const asp_amg_csr *ac, size_t size, double cut, const u
     if (!best)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the AMG hierarchy");
     for (size_t r = 0; r < ac->rows; r++)
-        best[r] = mass[r] < small ? strongest(ac, r) : UINT32_MAX;
-#define KEEP(r, k)                                                                                            \
-    (ac->col[k] != (r) && ((-ac->val[k] >= cut && !(crease && crease[k])) || best[r] == ac->col[k] ||       \
-                           best[ac->col[k]] == (r)))
-    size_t nnz = 0;
-    for (size_t r = 0; r < ac->rows; r++)
-        for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++)
-            nnz += KEEP(r, k);
+        best[r] = mass[r] < small ? asp__amg_strongest(ac, r, 0) : UINT32_MAX;
+    const asp__amg_filter keep = {.cut = cut, .crease = crease, .best = best};
     asp_amg_csr *m;
-    int rc = asp_amg_csr_create(size, size, nnz + size, ctx, &m, err);
+    int rc = asp_amg_csr_create(size, size, asp__amg_filter_count(ac, &keep) + size, ctx, &m, err);
     if (rc) {
         asp_free(ctx, best);
         return rc;
     }
-    size_t w = 0;
-    for (size_t r = 0; r < size; r++) {
-        size_t diag = SIZE_MAX;
-        double sum = 0;
-        if (r < ac->rows)
-            for (size_t k = ac->row_ptr[r]; k < ac->row_ptr[r + 1]; k++) {
-                /* a positive Galerkin entry is never kept: the matrix stays an M-matrix */
-                if (!KEEP(r, k) || ac->val[k] >= 0)
-                    continue;
-                if (diag == SIZE_MAX && ac->col[k] > r)
-                    diag = w++;
-                sum += ac->val[k];
-                m->col[w] = ac->col[k];
-                m->val[w++] = ac->val[k];
-            }
-        if (diag == SIZE_MAX)
-            diag = w++;
-        m->col[diag] = (asp_index)r;
-        m->val[diag] = -sum;
-        m->row_ptr[r + 1] = w;
-    }
-#undef KEEP
-    m->row_ptr[size] = w;
-    *offdiag = w - size;
+    *offdiag = asp__amg_filter_rows(ac, &keep, m);
     asp_free(ctx, best);
     *out = m;
     return 0;
 }
 
 /* Median |a_ij| over the off-diagonal entries: the scale of a coupling on this model. */
-static double median_coupling(const asp_amg_csr *a, const asp_context *ctx)
+static double median_coupling(const asp_amg_csr *a)
 {
-    size_t cnt = 0;
-    for (size_t r = 0; r < a->rows; r++)
-        for (size_t k = a->row_ptr[r]; k < a->row_ptr[r + 1]; k++)
-            cnt += a->col[k] != r;
-    if (cnt == 0)
-        return 0;
-    /* a histogram of log2 magnitudes is enough for a threshold scale and needs no sort */
-    size_t hist[256] = {0};
-    for (size_t r = 0; r < a->rows; r++)
-        for (size_t k = a->row_ptr[r]; k < a->row_ptr[r + 1]; k++)
-            if (a->col[k] != r) {
-                int e = 0;
-                frexp(fabs(a->val[k]), &e);
-                e += 128;
-                hist[e < 0 ? 0 : e > 255 ? 255 : e]++;
-            }
-    (void)ctx;
-    size_t acc = 0;
-    for (int b = 0; b < 256; b++) {
-        acc += hist[b];
-        if (2 * acc >= cnt)
-            return ldexp(0.75, b - 128); /* middle of the bin [2^(e-1), 2^e) */
-    }
-    return 0;
+    uint64_t hist[256] = {0};
+    asp__amg_coupling_hist(a, 0, hist);
+    return asp__amg_hist_median(hist);
 }
 
 /* Carries a per-unknown sum through P: dst[J] = sum_r P_rJ src[r] (mass, classifier mass). */
@@ -279,7 +162,7 @@ static int build(const asp_amg_csr *a0, asp_amg_csr **own_a0, const asp_amg_csr 
         mass[i] = 1.0;
         cm[i] = cls ? cls[i] : 1.0;
     }
-    const double cut = desc->weak_coupling > 0 ? desc->weak_coupling * median_coupling(a0, ctx) : 0;
+    const double cut = desc->weak_coupling > 0 ? desc->weak_coupling * median_coupling(a0) : 0;
     size_t cur_rows = n;
     while (levels < maxl && cur_rows > desc->max_coarse) {
         asp_amg_csr *praw = NULL, *araw = NULL, *next = NULL, *fnext = NULL;

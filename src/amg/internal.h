@@ -5,6 +5,8 @@
 #ifndef ASP_AMG_INTERNAL_H
 #define ASP_AMG_INTERNAL_H
 
+#include <stdint.h>
+
 #include "amgsplat/amg.h"
 
 struct asp_amg {
@@ -118,7 +120,12 @@ int asp__amg_build_hierarchy_take(asp_amg_csr **a0, asp_amg_csr **f0, const floa
                                   size_t *repaired, asp_error *err);
 
 /*
- * P^l's rows as a partition of unity (journal 2.3, hierarchy.c): each row of p keeps its positive
+ * ---- level_rows.c: the row kernels of a coarse level, for the serial and the distributed hierarchy ----
+ * Rows are a matrix's local rows whose first global row is row0 (0 in one process); columns global.
+ */
+
+/*
+ * P^l's rows as a partition of unity (journal 2.3): each row of p keeps its positive
  * weights over their sum; a row without any (sum <= 1e-12: a point hypre left without interpolation)
  * gets weight 1 on a new orphan unknown, numbered from first_orphan in row order. Columns go through
  * map (NULL: unchanged; it must be increasing, so rows stay sorted). q has p->rows rows or more and
@@ -129,6 +136,49 @@ size_t asp__amg_pou_rows(const asp_amg_csr *p, asp_amg_csr *q, asp_index first_o
                          asp_index (*map)(asp_index c, const void *arg), const void *arg, size_t *repaired);
 /* The rows of p that asp__amg_pou_rows turns into orphans. */
 size_t asp__amg_empty_rows(const asp_amg_csr *p);
+
+/* Adds the log2 magnitudes of the off-diagonal entries of a (rows from row0) to hist. */
+void asp__amg_coupling_hist(const asp_amg_csr *a, size_t row0, uint64_t hist[256]);
+/* The median magnitude of such a histogram (the middle of its bin), 0 when empty: the scale of a coupling. */
+double asp__amg_hist_median(const uint64_t hist[256]);
+/* Column of the most negative off-diagonal entry of local row r (global row row0 + r), or UINT32_MAX. */
+asp_index asp__amg_strongest(const asp_amg_csr *a, size_t r, size_t row0);
+/*
+ * The crease test of one coupling a (Galerkin product of the classifier-weighted matrix) against f
+ * (the same with C = 1): a / f is the mean classifier along the interface of unknowns I and J, cut
+ * when below ratio times the smaller of their interior means cmean_r, cmean_c (hierarchy.c).
+ */
+int asp__amg_crease(double a, double f, double ratio, double cmean_r, double cmean_c);
+
+/* What asp__amg_filter_rows keeps of a coarse matrix's rows (hierarchy.c's filter_coarse says why). */
+typedef struct asp__amg_filter {
+    double cut;                /* couplings weaker than this (absolute) go */
+    const uint8_t *crease;     /* per entry: cut by the crease test; NULL: none */
+    const asp_index *best;     /* per local row: asp__amg_strongest for a small unknown, else UINT32_MAX */
+    const asp_index *best_col; /* per entry: best of the column's unknown; NULL: best[col] (all rows local) */
+    size_t row0;
+} asp__amg_filter;
+/* The entries asp__amg_filter_rows keeps, diagonals aside. */
+size_t asp__amg_filter_count(const asp_amg_csr *ac, const asp__amg_filter *f);
+/*
+ * The next level's matrix: m's rows are ac's kept negative couplings plus a diagonal that makes
+ * each row sum to zero (eq. 7); rows of m past ac->rows hold the diagonal alone. m needs room for
+ * asp__amg_filter_count plus m->rows entries. Returns the off-diagonal entries written.
+ */
+size_t asp__amg_filter_rows(const asp_amg_csr *ac, const asp__amg_filter *f, asp_amg_csr *m);
+
+/*
+ * The position of column c in row r of m, whose columns increase within each row (binary search;
+ * csr.c), or SIZE_MAX when the row has no such column. The one entry lookup of src/amg.
+ */
+size_t asp__amg_csr_find(const asp_amg_csr *m, size_t r, asp_index c);
+
+/* m(r, c): 0 where the pattern has no entry. */
+static inline double asp__amg_csr_entry(const asp_amg_csr *m, size_t r, asp_index c)
+{
+    const size_t k = asp__amg_csr_find(m, r, c);
+    return k == SIZE_MAX ? 0.0 : m->val[k];
+}
 
 /* Galerkin product P^T F P (p: n x nc, f: n x n); columns within a row are not sorted. */
 int asp__amg_galerkin(const asp_amg_csr *p, const asp_amg_csr *f, const asp_context *ctx, asp_amg_csr **out,

@@ -3,7 +3,7 @@
 # (24000 points, 6 faces): levels within one, domain counts per level within 10% (3 where the serial
 # level has fewer than 30), partition of unity and every point in a domain on every level, the
 # coarsest level the 6 faces (the crease test works across rank borders), and the .amg it writes
-# loads in one process with the points, attributes and frame of the serial file.
+# loads in one process with the points, attributes and frame of the serial file, uvs included.
 # SKIPPED (77) where mpirun is missing or cannot start 2 ranks here.
 source "$(dirname "$0")/common.sh"
 A=$AMGSPLAT
@@ -75,6 +75,47 @@ assert o['level_sizes'] == s['level_sizes'], (o['level_sizes'], s['level_sizes']
 assert [l['domains'] for l in o['level_stats']] == [l['domains'] for l in s['level_stats']], 'domains differ'
 assert o['matrix_nnz'] == s['matrix_nnz'] and o['epsilon'] == s['epsilon'], (o['matrix_nnz'], s['matrix_nnz'])
 "
+
+# uvs (issue 26): the ranks read them as the serial reader does and the .amg keeps each with its
+# point; u and v are functions of the position here, so a uv that strayed to another point shows
+"$A" convert --ascii "$T/cube.ply" "$T/uv_ascii.ply" -q
+python3 - "$T/uv_ascii.ply" <<'PY'
+import sys
+p = sys.argv[1]
+lines = open(p).read().split("\n")
+end = lines.index("end_header")
+head = lines[:end] + ["property float s", "property float t", "end_header"]
+props = [l.split()[2] for l in lines[:end] if l.startswith("property")]
+x, y, z = (props.index(k) for k in "xyz")
+rows = []
+for l in lines[end + 1:]:
+    if l.strip():
+        v = l.split()
+        rows.append(l + " %.6g %.6g" % (float(v[x]) + 2 * float(v[y]), float(v[z]) - float(v[y])))
+open(p, "w").write("\n".join(head + rows) + "\n")
+PY
+"$A" convert "$T/uv_ascii.ply" "$T/uv.ply" -q
+"$A" decompose "$T/uv.ply" -o "$T/uv_serial.amg" -q
+"${MPI[@]}" "$A" decompose "$T/uv.ply" -o "$T/uv_mpi.amg" -q >"$T/uv.out" 2>"$T/uv.err" ||
+  fail "mpirun -np 2 decompose of a PLY with uvs failed: $(tail -5 "$T/uv.err")"
+python3 - "$T/uv_serial.amg" "$T/uv_mpi.amg" <<'PY'
+import struct, sys
+def uvs(path):
+    """(position, uv) pairs of an .amg (docs/cli/decompose.md): header, 28 bytes a point, attribute arrays"""
+    b = open(path, "rb").read()
+    header, n = struct.unpack_from("<I", b, 12)[0], struct.unpack_from("<Q", b, 16)[0]
+    pos = struct.unpack_from("<%df" % (3 * n), b, header)
+    at = header + 28 * n
+    attrs = struct.unpack_from("<I", b, at)[0]
+    assert attrs & 8, (path, "no uvs", attrs)
+    at += 8 + n * sum(size for bit, size in ((1, 12), (2, 4), (4, 4)) if attrs & bit)
+    uv = struct.unpack_from("<%df" % (2 * n), b, at)
+    return sorted((pos[3 * i:3 * i + 3], uv[2 * i:2 * i + 2]) for i in range(n))
+s, m = uvs(sys.argv[1]), uvs(sys.argv[2])
+assert len(s) == len(m) == 24000, (len(s), len(m))
+assert s == m, next((a, b) for a, b in zip(s, m) if a != b)
+assert any(u != (0.0, 0.0) for _, u in s), "every uv is zero"
+PY
 
 # what the ranks cannot read is refused on every rank with one message, and nothing is written
 "$A" convert --ascii "$T/cube.ply" "$T/ascii.ply" -q
