@@ -339,5 +339,5 @@ static void cleanup(void)
         unlink(dps_path);
 }
 
-TEST_MAIN(TEST_CASE(build_primitives), TEST_CASE(split_covers_every_point), TEST_CASE(setup),
-          TEST_CASE(hybrid_beats_primitives), TEST_CASE(teardown), TEST_CASE(cleanup))
+TEST_MAIN(TEST_CASE(build_primitives), TEST_CASE(split_covers_every_point), TEST_FIXTURE(setup),
+          TEST_CASE(hybrid_beats_primitives), TEST_FIXTURE(teardown), TEST_FIXTURE(cleanup))
