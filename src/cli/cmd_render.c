@@ -191,26 +191,16 @@ static int pick_domain_set(struct render_opts *o, asp_scene *s, asp_renderer_opt
 
 /*
  * --debug triangulation (thesis appendix C): the affine triangles are not stored in the .dps, so the
- * library makes them again from the decomposition the file names (asp_dps.source, tried as stored and
- * next to the .dps).
+ * library makes them again from the decomposition the file names (asp_dps_source_find).
  */
 static int debug_triangles(const char *path, const asp_scene *s, asp_renderer *r, const struct cli_env *env,
                            asp_error *err)
 {
-    const char *src = s->dps->source, *slash = strrchr(path, '/');
-    char alt[4096] = "";
-    if (src[0] && src[0] != '/' && slash)
-        snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - path), path, src);
-    const char *use = NULL;
+    char use[4096];
     asp_file_type t;
-    for (int k = 0; k < 2 && !use; k++) {
-        const char *c = k ? alt : src;
-        if (c[0] && asp_file_recognise(c, &t, NULL) == 0 && t.kind == ASP_FILE_AMG)
-            use = c;
-    }
-    if (!use)
+    if (asp_dps_source_find(s->dps, path, use, sizeof use, &t, NULL) != 0 || t.kind != ASP_FILE_AMG)
         return asp_error_set(err, ASP_EUNSUPPORTED, "--debug triangulation needs the .amg '%s' was built from; it "
-                             "names '%s' (build from an .amg: amgsplat decompose, then build)", path, src);
+                             "names '%s' (build from an .amg: amgsplat decompose, then build)", path, s->dps->source);
     asp_amg *amg = NULL;
     float *lines = NULL;
     size_t n = 0;
