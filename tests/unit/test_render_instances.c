@@ -308,4 +308,4 @@ static void test_bad_groups(void)
 }
 
 TEST_MAIN(TEST_FIXTURE(setup), TEST_FIXTURE(setup_files), TEST_CASE(test_two_cubes), TEST_CASE(test_occlusion),
-          TEST_CASE(test_culling), TEST_CASE(test_instanced_matches), TEST_CASE(test_bad_groups), TEST_CASE(remove_files), TEST_FIXTURE(teardown))
+          TEST_CASE(test_culling), TEST_CASE(test_instanced_matches), TEST_CASE(test_bad_groups), TEST_FIXTURE(remove_files), TEST_FIXTURE(teardown))
