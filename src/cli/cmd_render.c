@@ -25,7 +25,7 @@ static const char usage[] =
     "                      [--preset thesis|journal|pajarola|schwarz] [--kernel-rim 1|b] [--kernel-shape psi-e|psi-g]\n"
     "                      [--epsilon-uniform X] [--tolerance-area PCT] [--axes sqrt|lambda] [--cull-backfaces]\n"
     "                      [--depth-limit N] [--frame-ms T]\n"
-    "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict] [--level L-3] ...\n"
+    "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict|input] [--level L-3] ...\n"
     "       amgsplat render MESH -o OUT.png [--flat] [--texture IMG] [--renderer mesh|disc] ...\n"
     "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
     "                      dark-backface-soft|blend-all|no-blend|polygons] [--level L] [--alpha-ref X]\n"
