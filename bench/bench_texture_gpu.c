@@ -91,8 +91,7 @@ int main(int argc, char **argv)
     } methods[] = {{"affine", ASP_PRIM_AFFINE}, {"radial linear", ASP_PRIM_RADIAL}};
     for (size_t m = 0; m < 2; m++) {
         asp_prim_desc cpu = {.method = methods[m].method}, gpu = cpu;
-        gpu.fill = asp_prim_gpu_fill;
-        gpu.fill_user = gl;
+        asp_prim_gpu_fill_attach(&gpu, gl);
         asp_dps *a = NULL, *b = NULL;
         double tc = median_dpc(amg, level, &cpu, &ctx, runs, &a), tg = median_dpc(amg, level, &gpu, &ctx, runs, &b);
         if (a && b)

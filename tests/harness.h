@@ -95,16 +95,30 @@ static inline const char *asp_test_data(char *buf, size_t cap, const char *name)
 }
 
 typedef void (*asp_test_fn)(void);
-typedef struct { const char *name; asp_test_fn fn; } asp_test_case;
+typedef struct { const char *name; asp_test_fn fn; int fixture; } asp_test_case;
 
-#define TEST_CASE(fn) { #fn, fn }
+#define TEST_CASE(fn) { #fn, fn, 0 }
+/*
+ * A setup or teardown step (a GL context, a temporary directory): it runs in its place in the
+ * list but is no test, so it is not reported as one unless a check of it fails. A TEST_CASE
+ * that makes no check and skips nothing fails: a test that cannot fail is a defect (issue 26).
+ */
+#define TEST_FIXTURE(fn) { #fn, fn, 1 }
 
 static inline int asp_test_run(const char *file, const asp_test_case *cases, size_t n)
 {
     for (size_t i = 0; i < n; i++) {
         int before = asp_test_failures;
         int skips = asp_test_skips;
+        int checks = asp_test_checks;
         cases[i].fn();
+        if (!cases[i].fixture && asp_test_checks == checks && asp_test_skips == skips) {
+            asp_test_failures++;
+            fprintf(stderr, "%s: no checks made: a test that cannot fail is a defect (TEST_FIXTURE for a setup)\n",
+                    cases[i].name);
+        }
+        if (cases[i].fixture && asp_test_failures == before)
+            continue;
         fprintf(stderr, "%s %s\n",
                 asp_test_failures != before ? "FAIL" : asp_test_skips != skips ? "skip" : "ok  ", cases[i].name);
     }

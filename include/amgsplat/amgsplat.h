@@ -1,7 +1,8 @@
 /*
  * amgsplat: point-based rendering and extreme simplification by algebraic
  * multigrid domain primitives (Reniers & Telea 2006; Pajarola et al. 2003;
- * Schwarz 2004). This header includes the whole public API.
+ * Schwarz 2004). This header includes the whole public API: every header of
+ * include/amgsplat/ (tests/unit/test_core_umbrella.c checks that none is missing).
  */
 #ifndef AMGSPLAT_H
 #define AMGSPLAT_H
@@ -26,5 +27,7 @@
 #include "viewer.h"
 #include "output.h"
 #include "preset.h"
+#include "stats.h"
+#include "experiment.h"
 
 #endif

@@ -11,6 +11,7 @@
 #include "amg.h"
 #include "cloud.h"
 #include "image.h"
+#include "io.h"
 #include "mesh.h"
 
 #ifdef __cplusplus
@@ -112,7 +113,7 @@ typedef struct asp_prim_desc {
                                 points' bounding rectangle by this percentage (at most 1000) instead of the
                                 default margin of one point footprint on every side (0) */
     asp_prim_fill_fn fill;   /* NULL: textures on the CPU; else the fills go to fill(fill_user, ...) in batches
-                                (thesis 3.6; render.h asp_prim_gpu_fill); not with normal_map */
+                                (thesis 3.6; render.h asp_prim_gpu_fill_attach); not with normal_map */
     void *fill_user;
 } asp_prim_desc;
 
@@ -375,6 +376,21 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err);
  * asp_dps_load_memory. On failure *out is unchanged. Thread-safe.
  */
 int asp_dps_load(const char *path, const asp_context *ctx, asp_dps **out, asp_error *err);
+
+/**
+ * The file the .dps at dps_path was built from (dps->source, the input's name as
+ * amgsplat build was given it): the name as stored, then, when it is relative,
+ * the same name next to the .dps (a file moved with its source, or built from
+ * another directory). Writes the first candidate that exists and is recognised
+ * (asp_file_recognise) to out (capacity cap) and its type to *type (may be
+ * NULL); the caller checks the kind it needs. The one resolution for every
+ * reader of the source (the scene loader, render --debug triangulation).
+ * Returns 0, ASP_EUNSUPPORTED (the .dps names no source), ASP_EINVAL (a
+ * candidate longer than cap) or the first candidate's asp_file_recognise error
+ * (ASP_EIO when missing); out and *type unchanged on failure. Thread safe.
+ */
+int asp_dps_source_find(const asp_dps *dps, const char *dps_path, char *out, size_t cap, asp_file_type *type,
+                        asp_error *err);
 
 /**
  * Parses the bytes of a .dps file (size bytes at data, borrowed for the call;

@@ -800,9 +800,9 @@ typedef struct asp_prim_render_options {
 int asp_prim_renderer_set_debug_lines(asp_renderer *r, const float *lines, size_t segments, asp_error *err);
 
 /**
- * The texture fills of asp_prim_build on the GPU (thesis 3.6): an
- * asp_prim_fill_fn for asp_prim_desc.fill with fill_user = an
- * asp_gl_context (made current; use it from its thread only). A GL 4.5
+ * The texture fills of asp_prim_build on the GPU (thesis 3.6) on gl (made
+ * current; use it from its thread only); asp_prim_gpu_fill_attach hands it to
+ * asp_prim_build. A GL 4.5
  * compute shader computes per texel what the CPU's fill computes (the radial
  * sums of 3.3.2; the affine interpolation of 3.3.3 in the kept triangles and
  * the radial fringe outside), over the samples and triangles binned to the
@@ -811,8 +811,16 @@ int asp_prim_renderer_set_debug_lines(asp_renderer *r, const float *lines, size_
  * Returns 0, ASP_EGL (the shader or a GL call failed), ASP_EUNSUPPORTED (a
  * batch of 2^31 texels or more), ASP_ENOMEM.
  */
-int asp_prim_gpu_fill(void *gl_context, const asp_prim_fill_batch *batch, float *acc, float *f, uint8_t *covered,
+int asp_prim_gpu_fill(asp_gl_context *gl, const asp_prim_fill_batch *batch, float *acc, float *f, uint8_t *covered,
                       asp_error *err);
+
+/**
+ * Sets desc->fill and desc->fill_user so that asp_prim_build fills its textures with
+ * asp_prim_gpu_fill on gl, which must outlive the build (the library keeps a reference).
+ * prim's callback takes an untyped user pointer, as it knows no GL; this keeps the cast in
+ * one place, beside the function that knows what the pointer is.
+ */
+void asp_prim_gpu_fill_attach(asp_prim_desc *desc, asp_gl_context *gl);
 
 /** Default crease angle (degrees) of asp_prim_render_options.crease_angle. */
 #define ASP_PRIM_CREASE_ANGLE_DEFAULT 60.0f

@@ -6,6 +6,7 @@
 #define ASP_CLI_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include <cjson/cJSON.h>
@@ -90,6 +91,60 @@ void cli_progress_end(struct cli_env *env);
 int cli_check_output(const struct cli_env *env, const char *output, const char *format, int allow_bare,
                      const char *const *inputs, size_t ninputs);
 
+/*
+ * The options that pick and steer a renderer, declared once for render, view and eval (issue 26):
+ * renderer_options.c holds their names, placeholders, help and checks. A command takes the ones its
+ * mask names: cli_renderer_opts_init, cli_renderer_rows into its option table, cli_parse, then
+ * cli_renderer_check; what depends on the input (which renderer, which level) stays the command's.
+ * Each old spelling is accepted by every command that takes the option: --tau = --tolerance (view's
+ * name), --color = --color-by (view's name); giving both spellings is a usage error.
+ */
+enum cli_renderer_option {
+    CLI_RO_RENDERER = 1u << 0,    /* --renderer NAME */
+    CLI_RO_TOLERANCE = 1u << 1,   /* --tolerance PX, --tau PX */
+    CLI_RO_BUDGET = 1u << 2,      /* --budget N */
+    CLI_RO_LEVEL = 1u << 3,       /* --level L */
+    CLI_RO_COLOR_BY = 1u << 4,    /* --color-by MODE, --color MODE */
+    CLI_RO_METHOD = 1u << 5,      /* --method NAME (.dps blending) */
+    CLI_RO_ALPHA_REF = 1u << 6,   /* --alpha-ref X */
+    CLI_RO_CREASE = 1u << 7,      /* --crease-angle DEG|off */
+    CLI_RO_HYBRID = 1u << 8,      /* --hybrid */
+    CLI_RO_CULL = 1u << 9,        /* --cull-backfaces */
+    CLI_RO_DEPTH_LIMIT = 1u << 10, /* --depth-limit N */
+    CLI_RO_FRAME_MS = 1u << 11,   /* --frame-ms T */
+    CLI_RO_UNLIT = 1u << 12,      /* --unlit */
+    CLI_RO_TEXTURE = 1u << 13     /* --texture IMG */
+};
+
+struct cli_renderer_opts {
+    /* as given; NULL, NaN (the parser refuses non-finite numbers) or 0 when not */
+    const char *renderer, *level, *color_by, *color, *method, *crease_angle, *texture;
+    double tolerance, tau, alpha_ref, frame_ms;
+    size_t budget, depth_limit;
+    int hybrid, cull_backfaces, unlit;
+    /* set by cli_renderer_check */
+    const char *tolerance_name;      /* "--tolerance" or "--tau", as given, for the command's messages */
+    const char *color_by_name;       /* "--color-by" or "--color" */
+    int has_color;                   /* a colour mode was given: color_mode holds it */
+    asp_scene_amg_color color_mode;  /* classifier, domains (or "domain"), strict, input */
+    asp_prim_render_method method_kind; /* when method */
+    float alpha_ref_lib;             /* asp_prim_render_options.alpha_ref (-1: exactly 0) when alpha_ref */
+    double crease;                   /* degrees in (0, 180); -1 = off; 0 = not given */
+};
+
+/* The "not given" state of every field. */
+void cli_renderer_opts_init(struct cli_renderer_opts *o);
+/*
+ * Appends the rows of the options in `which` (CLI_RO_* bits), aliases included, to the option table
+ * rows (capacity cap entries, zero-terminated; stays so). The table then points into o.
+ */
+void cli_renderer_rows(struct cli_renderer_opts *o, unsigned which, struct cli_option *rows, size_t cap);
+/*
+ * Checks what was given of the options in `which` and sets the fields below the line; tolerance
+ * takes tau when that spelling was given. Returns 0, or 2 after printing the usage error.
+ */
+int cli_renderer_check(const struct cli_env *env, struct cli_renderer_opts *o, unsigned which);
+
 /* Parses "a,b[,c]" doubles into out (up to max); returns how many, -1 on junk. */
 int cli_parse_doubles(const char *s, double *out, int max);
 /* Parses --up: "y", "z", "x", "-y", "-z" or "-x" ("+y" = "y"); returns 0 or -1. */
@@ -100,6 +155,15 @@ int cli_parse_up(const char *s, asp_up_axis *out);
  * (0, 1e6] bounding-sphere radii (0 when not given: fit). Prints the usage error and returns 2.
  */
 int cli_parse_view(struct cli_env *env, const char *s, double *az, double *el, double *dist);
+/*
+ * The one colour grammar (--background of render, view and imgdiff; issue 26), the union of what each
+ * accepted before: "R,G,B" or "R,G,B,A", each channel a number in 0..255 as every list option reads it
+ * (cli_parse_doubles: 255, 255.0, 2.55e2; a fraction is rounded to the nearest level), or "#RRGGBB" /
+ * "#RRGGBBAA", exactly 6 or 8 hex digits of either case. Alpha defaults to 255; where allow_alpha is
+ * 0 (a window, imgdiff's opaque images) a fourth channel is refused. Writes out[4] and returns 0, or
+ * prints the usage error naming `option` and returns 2 (out unchanged).
+ */
+int cli_parse_colour(const struct cli_env *env, const char *option, const char *s, int allow_alpha, uint8_t out[4]);
 /* Parses "WxH"; returns 0 or -1. */
 int cli_parse_size2(const char *s, unsigned *w, unsigned *h);
 /*

@@ -45,6 +45,9 @@ static const char usage[] =
 
 enum { MAX_SIZES = 8, MAX_METHODS = 16 };
 
+/* The renderer options eval takes (renderer_options.c): the rest it sets itself, per representation. */
+#define EVAL_OPTIONS (CLI_RO_CREASE | CLI_RO_TEXTURE)
+
 static int parse_sizes(struct cli_env *env, const char *text, uint32_t *sizes, size_t *n)
 {
     double v[MAX_SIZES];
@@ -387,11 +390,12 @@ static int eval_instance_scene(const char *path, const char *dir, uint32_t size,
 
 int cmd_eval(int argc, char **argv, struct cli_env *env)
 {
-    const char *out_dir = NULL, *sizes_text = NULL, *methods_text = NULL, *texture = NULL, *crease_text = NULL,
-               *tolerances = NULL;
+    const char *out_dir = NULL, *sizes_text = NULL, *methods_text = NULL, *tolerances = NULL;
+    struct cli_renderer_opts r; // --crease-angle, --texture: shared with render and view (renderer_options.c)
+    cli_renderer_opts_init(&r);
     size_t views = 16, max_prims = 1000, frames = 5, points = 0;
     double elevation = 20;
-    const struct cli_option opts[] = {
+    struct cli_option opts[24] = {
         {"output", 'o', CLI_STRING, &out_dir, "DIR", "output directory (default eval-<model name>)"},
         {"views", 0, CLI_SIZE, &views, "N", "cameras around the model (default 16)"},
         {"sizes", 's', CLI_STRING, &sizes_text, "LIST", "square image sides, e.g. 128,256,512 (default 128,256)"},
@@ -400,17 +404,18 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
          "domain-primitive methods, 'all' or 'none' (default normalized,prefix,overlap,two-pass)"},
         {"frames", 0, CLI_SIZE, &frames, "N", "timed frames per figure, median (default 5)"},
         {"points", 'n', CLI_SIZE, &points, "N", "samples of a mesh or synthetic MODEL"},
-        {"texture", 0, CLI_STRING, &texture, "IMG", "texture of a mesh MODEL without material textures"},
         {"elevation", 0, CLI_DOUBLE, &elevation, "DEG", "views alternate +DEG and -DEG (default 20)"},
-        {"crease-angle", 0, CLI_STRING, &crease_text, "DEG|off", "clip reference splats and primitives at creases (default 60)"},
         {"tolerances", 0, CLI_STRING, &tolerances, "LIST", "scene files: splat tolerances in pixels (default 1,2,4,8)"},
         {0},
     };
+    cli_renderer_rows(&r, EVAL_OPTIONS, opts, sizeof opts / sizeof opts[0]);
     int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
     if (rc)
         return rc > 0 ? 0 : 2;
     if (npos != 1)
         return cli_usage_error(env, "expected one MODEL, got %d; see 'amgsplat eval -h'", npos);
+    if (cli_renderer_check(env, &r, EVAL_OPTIONS))
+        return 2;
     if (views < 1 || views > 256)
         return cli_usage_error(env, "--views expects 1..256, got %zu", views);
     if (frames < 1 || frames > 1000)
@@ -419,11 +424,10 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--max-primitives expects at least 1");
     if (!(elevation >= -90 && elevation <= 90) || elevation == 0)
         return cli_usage_error(env, "--elevation expects degrees in -90..90, not 0, got %g", elevation);
-    double crease = 0;
-    if (crease_text && strcmp(crease_text, "off") == 0)
-        crease = -1;
-    else if (crease_text && (cli_parse_doubles(crease_text, &crease, 1) != 1 || !(crease > 0 && crease < 90)))
-        return cli_usage_error(env, "--crease-angle expects degrees in (0, 90) or 'off', got '%s'", crease_text);
+    // the reference's splats clip too, and a point clip plane needs an angle below 90 degrees
+    double crease = r.crease;
+    if (!(crease < 90))
+        return cli_usage_error(env, "--crease-angle expects degrees in (0, 90) or 'off', got '%s'", r.crease_angle);
     uint32_t sizes[MAX_SIZES] = {128, 256};
     size_t nsizes = 2;
     if (sizes_text && parse_sizes(env, sizes_text, sizes, &nsizes))
@@ -450,7 +454,7 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
     asp_error err = {0};
     asp_cloud *cloud = NULL;
     asp_mesh *mesh = NULL;
-    rc = asp_eval_load_model_mesh(argv[0], points, texture, &env->ctx, &cloud, &mesh, &err);
+    rc = asp_eval_load_model_mesh(argv[0], points, r.texture, &env->ctx, &cloud, &mesh, &err);
     if (rc)
         return cli_fail(env, &err);
     int created = mkdir(dir, 0777) == 0;

@@ -46,7 +46,7 @@ int cmd_imgdiff(int argc, char **argv, struct cli_env *env)
     const char *background = NULL;
     int tolerance = 8;
     const struct cli_option opts[] = {
-        {"background", 'b', CLI_STRING, &background, "R,G,B", "background colour (0..255) of opaque images"},
+        {"background", 'b', CLI_STRING, &background, "R,G,B", "background colour (0..255 or #RRGGBB) of opaque images"},
         {"tolerance", 0, CLI_INT, &tolerance, "N", "levels per channel still counted as background (default 8)"},
         {0},
     };
@@ -55,15 +55,9 @@ int cmd_imgdiff(int argc, char **argv, struct cli_env *env)
         return rc > 0 ? 0 : 2;
     if (npos != 2)
         return cli_usage_error(env, "expected two images, got %d; see 'amgsplat imgdiff -h'", npos);
-    uint8_t bg[3];
-    if (background) {
-        double v[3];
-        if (cli_parse_doubles(background, v, 3) != 3 || v[0] < 0 || v[0] > 255 || v[1] < 0 || v[1] > 255 ||
-            v[2] < 0 || v[2] > 255)
-            return cli_usage_error(env, "--background expects R,G,B in 0..255, got '%s'", background);
-        for (int k = 0; k < 3; k++)
-            bg[k] = (uint8_t)v[k];
-    }
+    uint8_t bg[4];
+    if (background && cli_parse_colour(env, "--background", background, 0, bg))
+        return 2;
     if (tolerance < 0 || tolerance > 255)
         return cli_usage_error(env, "--tolerance expects 0..255, got %d", tolerance);
     asp_image a = {0}, b = {0};

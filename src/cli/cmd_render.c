@@ -25,7 +25,7 @@ static const char usage[] =
     "                      [--preset thesis|journal|pajarola|schwarz] [--kernel-rim 1|b] [--kernel-shape psi-e|psi-g]\n"
     "                      [--epsilon-uniform X] [--tolerance-area PCT] [--axes sqrt|lambda] [--cull-backfaces]\n"
     "                      [--depth-limit N] [--frame-ms T]\n"
-    "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict] [--level L-3] ...\n"
+    "       amgsplat render IN.amg -o OUT.png [--color-by classifier|domains|strict|input] [--level L-3] ...\n"
     "       amgsplat render MESH -o OUT.png [--flat] [--texture IMG] [--renderer mesh|disc] ...\n"
     "       amgsplat render IN.dps -o OUT.png [--method normalized|prefix|overlap|two-pass|dark-backface|\n"
     "                      dark-backface-soft|blend-all|no-blend|polygons] [--level L] [--alpha-ref X]\n"
@@ -52,48 +52,46 @@ static const char usage[] =
 
 enum { MAX_VIEWS = 256, MAX_SIDE = 16384 };
 
+/* The renderer options render takes (renderer_options.c), every one of them. */
+#define RENDER_OPTIONS                                                                                       \
+    (CLI_RO_RENDERER | CLI_RO_TOLERANCE | CLI_RO_BUDGET | CLI_RO_LEVEL | CLI_RO_COLOR_BY | CLI_RO_METHOD |   \
+     CLI_RO_ALPHA_REF | CLI_RO_CREASE | CLI_RO_HYBRID | CLI_RO_CULL | CLI_RO_DEPTH_LIMIT | CLI_RO_FRAME_MS | \
+     CLI_RO_UNLIT | CLI_RO_TEXTURE)
+
 struct render_opts {
+    /*
+     * the options render shares with view and eval (renderer_options.c): budget 0 = tau decides;
+     * cull_backfaces, depth_limit: seed 004 3.2.2, 3.2.5; frame_ms: simulated frame budget (issue 18
+     * item 5), tau settled per view; unlit: ASP_RENDER_UNLIT; hybrid: docs/hybrid.md
+     */
+    struct cli_renderer_opts r;
     const char *output;
     const char *size;
     const char *view;
-    const char *renderer;
     const char *background;
     const char *light;
     const char *kernel;
     const char *lighting;
-    const char *color_by;
-    const char *level;
     size_t views;
     size_t samples;
-    size_t budget; /* splat, square: splats per view (asp_renderer_set_budget); 0 = tau decides */
     int transparent;
     double fov;
     double radius_scale;
-    double tolerance;
     double epsilon;
     double point_size;
     int opaque;
-    int unlit; /* --unlit: the colours as they are, no shading (ASP_RENDER_UNLIT) */
-    const char *method;
     const char *preset; /* --preset: applied by cli_parse (docs/seeds.md) */
     const char *kernel_shape, *kernel_rim, *axes; /* seed 001 eq. 11-12, eq. 5-6 (docs/seeds.md) */
     double sigma, epsilon_uniform, tolerance_area; /* NaN: not given */
     unsigned splat_flags, hier_flags;
-    int cull_backfaces;  /* seed 004 3.2.2: normal-cone culling of hierarchy nodes */
-    size_t depth_limit;  /* seed 004 3.2.5: traversal depth limit (0 = none) */
-    double frame_ms;     /* simulated frame budget (issue 18 item 5): tau settled per view; 0 = off */
     asp_splat_kernel kernel_kind;
-    double alpha_ref;
     double transparency;
     double depth_window;
-    const char *crease_angle;
     const char *up;
-    const char *texture;
     int flat;
     int outline;
     int no_normal_map;
     int overlap_backfaces;
-    int hybrid;                /* --hybrid: primitives and points (docs/hybrid.md) */
     const char *hybrid_points; /* --hybrid-points: the points instead of the .dps's source */
     int no_overlap_backfaces; /* switches off a preset's --overlap-backfaces (issue 17) */
     const char *domains;      /* .dps: thresholded | strict (thesis appendix C "Domain Set") */
@@ -109,7 +107,6 @@ struct render_opts {
     int amg_input;
     int dps_input;
     int mesh_input;
-    asp_amg_color_mode color_mode;
     asp_prim_render_options prim;
     asp_up_axis up_axis;
     double point_crease; /* point inputs: crease angle of the clip planes, degrees; 0 = no clipping */
@@ -122,11 +119,11 @@ struct render_opts {
 static int load_scene(const char *path, const struct render_opts *o, const struct cli_env *env, asp_scene *s,
                       asp_error *err)
 {
-    asp_scene_desc d = {.level = o->level, .crease_angle = (float)o->point_crease,
-                        .crease_if_normals = o->point_crease_default, .texture = o->texture};
-    if (o->amg_input && o->color_by) {
-        d.amg_color = (asp_scene_amg_color)(o->color_mode + 1);
-        if (o->color_mode != ASP_AMG_COLOR_CLASSIFIER && !o->level)
+    asp_scene_desc d = {.level = o->r.level, .crease_angle = (float)o->point_crease,
+                        .crease_if_normals = o->point_crease_default, .texture = o->r.texture};
+    if (o->amg_input && o->r.color_by) {
+        d.amg_color = o->r.color_mode;
+        if ((o->r.color_mode == ASP_SCENE_AMG_DOMAINS || o->r.color_mode == ASP_SCENE_AMG_STRICT) && !o->r.level)
             d.level = "L-3";
     }
     return asp_scene_load(path, &d, &env->ctx, s, err);
@@ -139,7 +136,7 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
     r->splat = (asp_splat_renderer_desc){.kernel_a = o->kernel_abn[0], .kernel_b = o->kernel_abn[1],
                                          .kernel_n = o->kernel_abn[2],
                                          .epsilon = o->epsilon > 0 ? (float)o->epsilon : -1.0f, // 0 = no offset
-                                         .tolerance = (float)o->tolerance, .radius_scale = (float)o->radius_scale,
+                                         .tolerance = (float)o->r.tolerance, .radius_scale = (float)o->radius_scale,
                                          .lighting = o->light_mode,
                                          .mode = o->opaque ? ASP_SPLAT_OPAQUE : ASP_SPLAT_BLEND,
                                          .flags = o->splat_flags, .kernel = o->kernel_kind,
@@ -147,17 +144,17 @@ static void renderer_options(const struct render_opts *o, asp_renderer_options *
                                          .hier = {.flags = o->hier_flags}};
     if (!isnan(o->epsilon_uniform))
         r->splat.epsilon = (float)o->epsilon_uniform; // world units; 0 = the mean point splat
-    r->square = (asp_square_renderer_desc){.point_size = (float)o->point_size, .tolerance = (float)o->tolerance,
+    r->square = (asp_square_renderer_desc){.point_size = (float)o->point_size, .tolerance = (float)o->r.tolerance,
                                            .radius_scale = (float)o->radius_scale, .hier = {.flags = o->hier_flags},
-                                           .flags = o->cull_backfaces ? ASP_SPLAT_CULL_BACKFACES : 0u};
-    if (o->cull_backfaces)
+                                           .flags = o->r.cull_backfaces ? ASP_SPLAT_CULL_BACKFACES : 0u};
+    if (o->r.cull_backfaces)
         r->splat.flags |= ASP_SPLAT_CULL_BACKFACES;
     if (!isnan(o->tolerance_area)) // seed 001 5.1: tau in percent of the window (one view's) area
         r->splat.tolerance = r->square.tolerance = asp_render_tolerance_from_area(o->tolerance_area, o->width, o->height);
     r->prim = o->prim;
     r->hybrid = (asp_hybrid_desc){.prim = o->prim, .splat = r->splat};
     // the cut across .dps levels (issue 18): the same tolerance in pixels; 0 = the finest level everywhere
-    r->cut = (asp_cut_renderer_desc){.tolerance = o->tolerance > 0 ? (float)o->tolerance : -1.0f,
+    r->cut = (asp_cut_renderer_desc){.tolerance = o->r.tolerance > 0 ? (float)o->r.tolerance : -1.0f,
                                      .alpha_ref = o->prim.alpha_ref, .transparency = o->prim.transparency};
     r->mesh.flags = o->flat ? ASP_MESH_RENDER_FLAT : 0u;
 }
@@ -175,7 +172,7 @@ static int pick_domain_set(struct render_opts *o, asp_scene *s, asp_renderer_opt
         if (rc)
             return rc;
     }
-    if (s->dps->levels[s->dps_level].strict && !o->method)
+    if (s->dps->levels[s->dps_level].strict && !o->r.method)
         ropts->prim.method = o->prim.method = ASP_PRIM_RENDER_NO_BLEND;
     if (o->only_domain == SIZE_MAX)
         return 0;
@@ -191,26 +188,16 @@ static int pick_domain_set(struct render_opts *o, asp_scene *s, asp_renderer_opt
 
 /*
  * --debug triangulation (thesis appendix C): the affine triangles are not stored in the .dps, so the
- * library makes them again from the decomposition the file names (asp_dps.source, tried as stored and
- * next to the .dps).
+ * library makes them again from the decomposition the file names (asp_dps_source_find).
  */
 static int debug_triangles(const char *path, const asp_scene *s, asp_renderer *r, const struct cli_env *env,
                            asp_error *err)
 {
-    const char *src = s->dps->source, *slash = strrchr(path, '/');
-    char alt[4096] = "";
-    if (src[0] && src[0] != '/' && slash)
-        snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - path), path, src);
-    const char *use = NULL;
+    char use[4096];
     asp_file_type t;
-    for (int k = 0; k < 2 && !use; k++) {
-        const char *c = k ? alt : src;
-        if (c[0] && asp_file_recognise(c, &t, NULL) == 0 && t.kind == ASP_FILE_AMG)
-            use = c;
-    }
-    if (!use)
+    if (asp_dps_source_find(s->dps, path, use, sizeof use, &t, NULL) != 0 || t.kind != ASP_FILE_AMG)
         return asp_error_set(err, ASP_EUNSUPPORTED, "--debug triangulation needs the .amg '%s' was built from; it "
-                             "names '%s' (build from an .amg: amgsplat decompose, then build)", path, src);
+                             "names '%s' (build from an .amg: amgsplat decompose, then build)", path, s->dps->source);
     asp_amg *amg = NULL;
     float *lines = NULL;
     size_t n = 0;
@@ -238,26 +225,9 @@ static void warn_missing_textures(const asp_scene *s)
     }
 }
 
-static int parse_colour(struct cli_env *env, const char *s, uint8_t out[4])
-{
-    double v[4] = {0, 0, 0, 255};
-    int n = cli_parse_doubles(s, v, 4);
-    if (n < 3)
-        return cli_usage_error(env, "--background expects R,G,B or R,G,B,A in 0..255, got '%s'", s);
-    for (int i = 0; i < 4; i++) {
-        if (!(v[i] >= 0 && v[i] <= 255) || v[i] != floor(v[i]))
-            return cli_usage_error(env, "--background expects integers in 0..255, got '%s'", s);
-        out[i] = (uint8_t)v[i];
-    }
-    return 0;
-}
-
 /* Options of the hierarchy renderers and of .amg inputs. */
 static int parse_splat_options(struct cli_env *env, struct render_opts *o)
 {
-    // bounded: the renderers take floats, and 1e300 became inf there (issue #13)
-    if (!(o->tolerance >= 0 && o->tolerance <= 1e6))
-        return cli_usage_error(env, "--tolerance expects pixels in 0..1e6, got %g", o->tolerance);
     if (!(o->epsilon >= 0 && o->epsilon <= 1e6))
         return cli_usage_error(env, "--epsilon expects splat radii in 0..1e6, got %g", o->epsilon);
     if (!(o->point_size >= 0) || !(o->point_size <= 256))
@@ -303,24 +273,15 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
             return cli_usage_error(env, "--lighting expects gouraud, pixel or flat, got '%s'", o->lighting);
         o->light_mode = (asp_splat_lighting)found;
     }
-    static const char *const colorings[] = {"classifier", "domains", "strict"};
     if (o->dps_input) {
-        if (o->color_by && strcmp(o->color_by, "domain") != 0 && strcmp(o->color_by, "domains") != 0)
-            return cli_usage_error(env, "--color-by on a .dps input expects domain, got '%s'", o->color_by);
+        if (o->r.has_color && o->r.color_mode != ASP_SCENE_AMG_DOMAINS)
+            return cli_usage_error(env, "%s on a .dps input expects domain, got '%s'", o->r.color_by_name,
+                                   o->r.color_by);
         return 0;
     }
-    if (o->color_by) {
-        int found = -1;
-        for (int i = 0; i < 3; i++)
-            if (strcmp(o->color_by, colorings[i]) == 0)
-                found = i;
-        if (found < 0)
-            return cli_usage_error(env, "--color-by expects classifier, domains or strict, got '%s'", o->color_by);
-        o->color_mode = (asp_amg_color_mode)found;
-    }
-    if (o->color_by && !o->amg_input)
-        return cli_usage_error(env, "--color-by needs an .amg input (amgsplat decompose makes one)");
-    if (o->level && !(o->color_by && o->color_mode != ASP_AMG_COLOR_CLASSIFIER))
+    if (o->r.has_color && !o->amg_input)
+        return cli_usage_error(env, "%s needs an .amg input (amgsplat decompose makes one)", o->r.color_by_name);
+    if (o->r.level && !(o->r.color_mode == ASP_SCENE_AMG_DOMAINS || o->r.color_mode == ASP_SCENE_AMG_STRICT))
         return cli_usage_error(env, "--level needs --color-by domains or strict");
     return 0;
 }
@@ -329,38 +290,36 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
 static int parse_prim_options(struct cli_env *env, struct render_opts *o)
 {
     // NaN marks "not given": the option parser refuses non-finite values, so no user value collides with it
-    int given = o->method || o->domains || o->debug || o->only_domain != SIZE_MAX || !isnan(o->alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
+    int given = o->r.method || o->domains || o->debug || o->only_domain != SIZE_MAX || !isnan(o->r.alpha_ref) || !isnan(o->transparency) || !isnan(o->depth_window) || o->outline ||
                 o->no_normal_map || o->overlap_backfaces;
     if (!o->dps_input) {
         if (given)
             return cli_usage_error(env, "--method, --domains, --debug, --only-domain, --alpha-ref, --transparency, --depth-window, --outline, --overlap-backfaces and "
                                         "--no-normal-map need a .dps input (amgsplat build makes one)");
-        double deg = 0;
-        if (!o->crease_angle) {
+        if (!o->r.crease_angle) {
             // the default: discs and splats cut at creases sharper than 60 degrees, as the primitives
             // and eval's reference are, so one --view gives one silhouette whatever the file (issue 12:
             // octahedron points vs primitives IoU 0.936 unclipped, 0.981 clipped); points without
             // normals stay unclipped. The square renderer does not clip.
-            if (!(o->renderer && strcmp(o->renderer, "square") == 0)) {
+            if (!(o->r.renderer && strcmp(o->r.renderer, "square") == 0)) {
                 o->point_crease = ASP_PRIM_CREASE_ANGLE_DEFAULT;
                 o->point_crease_default = 1;
             }
             return 0;
         }
-        if (strcmp(o->crease_angle, "off") == 0)
-            return 0;
-        if (cli_parse_doubles(o->crease_angle, &deg, 1) != 1 || !(deg > 0 && deg < 90))
+        if (o->r.crease < 0)
+            return 0; // off
+        if (!(o->r.crease < 90))
             return cli_usage_error(env, "--crease-angle expects degrees in (0, 90) or 'off' for points, got '%s'",
-                                   o->crease_angle);
-        if (o->renderer && strcmp(o->renderer, "square") == 0)
+                                   o->r.crease_angle);
+        if (o->r.renderer && strcmp(o->r.renderer, "square") == 0)
             return cli_usage_error(env, "--crease-angle: the square renderer does not clip (use disc or splat)");
-        o->point_crease = deg;
+        o->point_crease = o->r.crease;
         return 0;
     }
     asp_prim_render_options *p = &o->prim;
-    asp_error err = {0, ""};
-    if (o->method && asp_prim_render_method_parse(o->method, &p->method, &err))
-        return cli_usage_error(env, "--method: %s", err.msg);
+    if (o->r.method)
+        p->method = o->r.method_kind;
     for (const char *d = o->debug; d && *d;) {
         size_t len = strcspn(d, ",");
         if (len == strlen("eigenvectors") && strncmp(d, "eigenvectors", len) == 0)
@@ -376,11 +335,8 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
     }
     if (o->domains && strcmp(o->domains, "thresholded") != 0 && strcmp(o->domains, "strict") != 0)
         return cli_usage_error(env, "--domains expects thresholded or strict, got '%s'", o->domains);
-    if (!isnan(o->alpha_ref)) {
-        if (!(o->alpha_ref >= 0 && o->alpha_ref <= 1))
-            return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
-        p->alpha_ref = o->alpha_ref > 0 ? (float)o->alpha_ref : -1.0f; // the library's "exactly 0"
-    }
+    if (!isnan(o->r.alpha_ref))
+        p->alpha_ref = o->r.alpha_ref_lib;
     if (!isnan(o->transparency)) {
         if (!(o->transparency > 0 && o->transparency <= 1))
             return cli_usage_error(env, "--transparency expects an opacity in (0, 1], got %g", o->transparency);
@@ -391,17 +347,9 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
             return cli_usage_error(env, "--depth-window expects world units >= 0, got %g", o->depth_window);
         p->depth_window = o->depth_window > 0 ? (float)o->depth_window : -1.0f; // 0 = no window
     }
-    if (o->crease_angle) {
-        double deg = 0;
-        if (strcmp(o->crease_angle, "off") == 0)
-            p->crease_angle = -1.0f;
-        else if (cli_parse_doubles(o->crease_angle, &deg, 1) == 1 && deg > 0 && deg < 180)
-            p->crease_angle = (float)deg;
-        else
-            return cli_usage_error(env, "--crease-angle expects degrees in (0, 180) or 'off', got '%s'",
-                                   o->crease_angle);
-    }
-    p->flags |= (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
+    if (o->r.crease_angle)
+        p->crease_angle = (float)o->r.crease; // -1: off
+    p->flags |= (o->outline ? ASP_PRIM_RENDER_OUTLINE : 0u) | (o->r.color_by ? ASP_PRIM_RENDER_COLOR_BY_DOMAIN : 0u) |
                (o->no_normal_map ? ASP_PRIM_RENDER_NO_NORMAL_MAP : 0u) |
                (o->overlap_backfaces ? ASP_PRIM_RENDER_OVERLAP_BACKFACES : 0u);
     return 0;
@@ -409,6 +357,10 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
 
 static int parse_options(struct cli_env *env, struct render_opts *o)
 {
+    if (cli_renderer_check(env, &o->r, RENDER_OPTIONS))
+        return 2;
+    if (isnan(o->r.tolerance))
+        o->r.tolerance = 1.0; // render's default tau, in pixels
     if (!o->output)
         return cli_usage_error(env, "missing -o OUT.png");
     if (o->up && cli_parse_up(o->up, &o->up_axis) != 0)
@@ -426,7 +378,7 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
         return cli_usage_error(env, "--samples expects 0..64, got %zu", o->samples);
     if (o->transparent && o->background)
         return cli_usage_error(env, "--background and --transparent exclude each other");
-    if (o->background && parse_colour(env, o->background, o->bg))
+    if (o->background && cli_parse_colour(env, "--background", o->background, 1, o->bg))
         return 2;
     if (o->transparent)
         memset(o->bg, 0, 4);
@@ -463,7 +415,7 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
     vs->min_count = SIZE_MAX;
     asp_render_desc desc = {.width = o->width, .height = o->height, .samples = (uint32_t)o->samples,
                             .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el,
-                            .flags = o->unlit ? ASP_RENDER_UNLIT : 0u};
+                            .flags = o->r.unlit ? ASP_RENDER_UNLIT : 0u};
     memcpy(desc.background, o->bg, 4);
     for (size_t i = 0; i < o->views; i++) {
         asp_camera cam;
@@ -507,7 +459,7 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     cJSON_AddNumberToObject(j, "points", (double)count);
     cJSON_AddStringToObject(j, "renderer", renderer);
     if (o->dps_input) {
-        cJSON_AddStringToObject(j, "method", o->hybrid ? "hybrid" : asp_prim_render_method_name(o->prim.method));
+        cJSON_AddStringToObject(j, "method", o->r.hybrid ? "hybrid" : asp_prim_render_method_name(o->prim.method));
         cJSON_AddStringToObject(j, "domains", asp_scene_dps_level(s)->strict ? "strict" : "thresholded");
         cJSON_AddNumberToObject(j, "level", asp_scene_dps_level(s)->level);
     }
@@ -517,8 +469,8 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     cJSON_AddNumberToObject(j, "primitives", (double)vs->last_count);
     cJSON_AddNumberToObject(j, "primitives_min", (double)vs->min_count);
     cJSON_AddNumberToObject(j, "primitives_max", (double)vs->max_count);
-    cJSON_AddItemToObject(j, "tolerance", cli_json_number("%g", lod && !o->budget ? o->tolerance : 0.0));
-    cJSON_AddNumberToObject(j, "budget", (double)o->budget);
+    cJSON_AddItemToObject(j, "tolerance", cli_json_number("%g", lod && !o->r.budget ? o->r.tolerance : 0.0));
+    cJSON_AddNumberToObject(j, "budget", (double)o->r.budget);
     cJSON_AddItemToObject(j, "view_ms", cli_json_number("%.3f", 1e3 * vs->seconds / (double)o->views));
     // the camera's sphere, so two inputs of one model can be checked to frame alike
     for (int k = 0; k < 3; k++)
@@ -535,7 +487,7 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     }
     if (vs->budget) { // the last view's simulated budget
         cJSON *b = cJSON_CreateObject();
-        cJSON_AddNumberToObject(b, "target_ms", o->frame_ms);
+        cJSON_AddNumberToObject(b, "target_ms", o->r.frame_ms);
         cJSON_AddItemToObject(b, "median_ms", cli_json_number("%.3f", vs->settled.median_ms));
         cJSON_AddItemToObject(b, "p10_ms", cli_json_number("%.3f", vs->settled.p10_ms));
         cJSON_AddItemToObject(b, "p90_ms", cli_json_number("%.3f", vs->settled.p90_ms));
@@ -588,18 +540,16 @@ static int print_scene_json(const struct cli_env *env, const struct render_opts 
 /* A scene of instances (instances.h): every source drawn by its row of the table, all in one frame. */
 static int render_instance_scene(const char *path, struct render_opts *o, struct cli_env *env)
 {
-    if (o->budget)
+    if (o->r.budget)
         return cli_usage_error(env, "--budget is per model; a scene takes --tolerance (every instance's cut)");
-    if (o->hybrid || o->hybrid_points)
+    if (o->r.hybrid || o->hybrid_points)
         return cli_usage_error(env, "--hybrid draws one .dps with its points; a scene's sources are drawn one by one");
-    if (o->frame_ms > 0)
+    if (o->r.frame_ms > 0)
         return cli_usage_error(env, "--frame-ms settles one model's cut; a scene takes --tolerance (every instance's cut)");
     const asp_renderer_kind *kind = NULL;
     asp_error err = {0, ""};
-    if (o->renderer && asp_renderer_kind_find(o->renderer, ASP_RENDER_INPUT_POINTS, &kind, &err))
+    if (o->r.renderer && asp_renderer_kind_find(o->r.renderer, ASP_RENDER_INPUT_POINTS, &kind, &err))
         return cli_usage_error(env, "--renderer is the scene's point sources' renderer: %s", err.msg);
-    if (o->depth_limit > 64)
-        return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o->depth_limit);
     if (o->up)
         return cli_usage_error(env, "--up: a scene is y-up (turn its instances with rotate_deg instead)");
     double t0 = asp_time_now();
@@ -613,19 +563,19 @@ static int render_instance_scene(const char *path, struct render_opts *o, struct
     struct view_stats vs = {SIZE_MAX, 0, 0, 0, NULL, {0}};
     asp_renderer_options ropts;
     renderer_options(o, &ropts);
-    asp_scene_desc d = {.level = o->level, .texture = o->texture};
+    asp_scene_desc d = {.level = o->r.level, .texture = o->r.texture};
     int rc = asp_instance_scene_load(path, &d, &env->ctx, &s, &err);
     for (size_t i = 0; !rc && i < s.source_count; i++)
         warn_missing_textures(&s.sources[i].scene);
     if (!rc)
         rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err);
     if (!rc)
-        rc = asp_instance_scene_renderer_create(gl, &s, o->renderer, &ropts, &env->ctx, &r, &err);
-    if (!rc && o->depth_limit)
-        rc = asp_renderer_set_lod(r, ropts.splat.tolerance, (uint32_t)o->depth_limit, &err);
+        rc = asp_instance_scene_renderer_create(gl, &s, o->r.renderer, &ropts, &env->ctx, &r, &err);
+    if (!rc && o->r.depth_limit)
+        rc = asp_renderer_set_lod(r, ropts.splat.tolerance, (uint32_t)o->r.depth_limit, &err);
     asp_render_desc desc = {.width = o->width, .height = o->height, .samples = (uint32_t)o->samples,
                             .light_azimuth = (float)o->light_az, .light_elevation = (float)o->light_el,
-                            .flags = o->unlit ? ASP_RENDER_UNLIT : 0u};
+                            .flags = o->r.unlit ? ASP_RENDER_UNLIT : 0u};
     memcpy(desc.background, s.has_background && !o->background && !o->transparent ? s.background : o->bg, 4);
     for (size_t i = 0; !rc && i < o->views; i++) {
         asp_camera cam;
@@ -675,18 +625,16 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
 {
     // NaN marks the .dps numbers as not given
     struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .width = 512, .height = 512,
-                            .az = 30.0, .el = 20.0, .tolerance = 1.0, .epsilon = 1.0, .alpha_ref = NAN,
+                            .az = 30.0, .el = 20.0, .epsilon = 1.0,
                             .sigma = NAN, .epsilon_uniform = NAN, .tolerance_area = NAN,
                             .transparency = NAN, .depth_window = NAN, .only_domain = SIZE_MAX, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
-    const struct cli_option opts[] = {
+    cli_renderer_opts_init(&o.r);
+    struct cli_option opts[80] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
         {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
         {"size", 0, CLI_STRING, &o.size, "WxH", "image size of one view (default 512x512)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "camera azimuth, elevation (degrees), distance in radii (default 30,20)"},
         {"views", 0, CLI_SIZE, &o.views, "N", "N views around the object in a contact sheet (default 1)"},
-        {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "how points are drawn: disc (default), splat, square; meshes: mesh (default); .dps: prim (default), cut (levels mixed by view)"},
-        {"tolerance", 0, CLI_DOUBLE, &o.tolerance, "PX", "splat, square, cut: screen tolerance tau in pixels (default 1; 0 = every point, finest level)"},
-        {"budget", 0, CLI_SIZE, &o.budget, "N", "splat, square: cut the hierarchy to N splats per view instead of a tolerance"},
         {"kernel", 0, CLI_STRING, &o.kernel, "A,B,N", "splat: kernel exp(-A (r/B)^N) (default 6,1.5,3)"},
         {"epsilon", 0, CLI_DOUBLE, &o.epsilon, "X", "splat: depth offset in splat radii for blending (default 1; 0 = none)"},
         {"epsilon-uniform", 0, CLI_DOUBLE, &o.epsilon_uniform, "X", "splat: one depth offset for all splats in world units, seed 001 5.3 (0 = the mean splat)"},
@@ -694,41 +642,31 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"sigma", 0, CLI_DOUBLE, &o.sigma, "X", "splat: psi-g's sigma in kernel radii (default 0.5)"},
         {"kernel-rim", 0, CLI_STRING, &o.kernel_rim, "1|b", "splat: the ellipse rim is the kernel's r = 1 (default) or r = b (seed 001 Fig. 11)"},
         {"tolerance-area", 0, CLI_DOUBLE, &o.tolerance_area, "PCT", "splat, square: tau in percent of the view's area (seed 001 5.1); replaces --tolerance"},
-        {"cull-backfaces", 0, CLI_FLAG, &o.cull_backfaces, NULL, "splat, square: drop subtrees whose normal cone faces away (seed 004 3.2.2)"},
-        {"depth-limit", 0, CLI_SIZE, &o.depth_limit, "N", "splat, square: traverse the hierarchy to depth N at most (seed 004 3.2.5; default 0: none)"},
-        {"frame-ms", 0, CLI_DOUBLE, &o.frame_ms, "T", "splat, square: simulated frame budget: redraw each view until tau holds T ms per frame, then render it"},
         {"axes", 0, CLI_STRING, &o.axes, "A", "splat, square: ellipse axis ratio sqrt (default) or lambda (seed 001 eq. 5-6)"},
         {"lighting", 0, CLI_STRING, &o.lighting, "MODE", "splat: gouraud (default), pixel or flat"},
         {"opaque", 0, CLI_FLAG, &o.opaque, NULL, "splat: opaque ellipses, no blending"},
-        {"unlit", 0, CLI_FLAG, &o.unlit, NULL, "colours as they are, no shading (the seeds' flat textured primitives; web viewer's light=off)"},
         {"point-size", 0, CLI_DOUBLE, &o.point_size, "PX", "square: fixed side in pixels (default 0: projected size)"},
-        {"color-by", 0, CLI_STRING, &o.color_by, "MODE", ".amg input: classifier, domains or strict; .dps input: domain"},
-        {"level", 0, CLI_STRING, &o.level, "L", ".amg: level of the domain colours (default L-3); .dps: level drawn (default the finest in the file)"},
-        {"method", 0, CLI_STRING, &o.method, "NAME", ".dps: how primitives blend (default normalized; see docs/render-methods.md)"},
-        {"alpha-ref", 0, CLI_DOUBLE, &o.alpha_ref, "X", ".dps: alpha test of the locks and the front layer, 0..1 (default 0.1)"},
         {"transparency", 0, CLI_DOUBLE, &o.transparency, "X", ".dps: global opacity scaling alpha, (0, 1] (default 1)"},
         {"depth-window", 0, CLI_DOUBLE, &o.depth_window, "X", ".dps: depth offset / window in world units (default: half the mean primitive radius)"},
-        {"crease-angle", 0, CLI_STRING, &o.crease_angle, "DEG|off", "cut at creases sharper than DEG (default 60; off = as the seeds): .dps primitives; points with normals: discs, splats"},
         {"outline", 0, CLI_FLAG, &o.outline, NULL, ".dps: draw the support rectangles' edges in green"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: light with the primitive normals even when the file has normal maps"},
-        {"hybrid", 0, CLI_FLAG, &o.hybrid, NULL, ".dps: the source points (seed 001 splats) where a primitive fails (docs/hybrid.md)"},
         {"hybrid-points", 0, CLI_STRING, &o.hybrid_points, "POINTS", ".dps: --hybrid with these points (point file or .amg) instead of the file's source"},
         {"domains", 0, CLI_STRING, &o.domains, "SET", ".dps built with --domains both: thresholded (default) or strict (drawn no-blend unless --method)"},
         {"debug", 0, CLI_STRING, &o.debug, "LIST", ".dps: debug drawings (thesis app. C): eigenvectors, texels, triangulation (needs the source .amg), comma-separated"},
         {"only-domain", 0, CLI_SIZE, &o.only_domain, "N", ".dps: draw primitive N of the level only (thesis app. C)"},
         {"overlap-backfaces", 0, CLI_FLAG, &o.overlap_backfaces, NULL, ".dps, overlap: also draw back-facing neighbours, as journal Fig. 10's pseudocode"},
         {"no-overlap-backfaces", 0, CLI_FLAG, &o.no_overlap_backfaces, NULL, ".dps, overlap: cull back faces (the default; turns off a preset's --overlap-backfaces)"},
-        {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 (default 255,255,255)"},
+        {"background", 0, CLI_STRING, &o.background, "R,G,B[,A]", "background colour, 0..255 or #RRGGBB[AA] (default 255,255,255)"},
         {"transparent", 0, CLI_FLAG, &o.transparent, NULL, "transparent background"},
         {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
         {"samples", 0, CLI_SIZE, &o.samples, "N", "multisamples per pixel, 0..64 (default 4)"},
         {"fov", 0, CLI_DOUBLE, &o.fov, "DEG", "vertical field of view (default 40)"},
         {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y (default), z (scans, CAD), x, -y, -z or -x"},
         {"flat", 0, CLI_FLAG, &o.flat, NULL, "mesh: light each triangle by its face normal (default: smooth vertex normals)"},
-        {"texture", 0, CLI_STRING, &o.texture, "IMG", "mesh: texture of materials that name none or whose file is missing"},
         {"radius-scale", 0, CLI_DOUBLE, &o.radius_scale, "X", "multiply every disc, ellipse or square size by X (default 1)"},
         {0},
     };
+    cli_renderer_rows(&o.r, RENDER_OPTIONS, opts, sizeof opts / sizeof opts[0]);
     int npos = 0;
     int prc = cli_parse(argc, argv, opts, usage, env, &npos);
     if (prc)
@@ -743,30 +681,30 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     // a scene takes the .dps options for its .dps sources (and its point sources stay unclipped)
     o.dps_input = type.kind == ASP_FILE_DPS || type.kind == ASP_FILE_SCENE;
     // a preset names the options of every input kind; those that do not fit this input are dropped
-    if (!o.dps_input && cli_from_preset(env, &o.method))
-        o.method = NULL;
+    if (!o.dps_input && cli_from_preset(env, &o.r.method))
+        o.r.method = NULL;
     if (!o.dps_input && cli_from_preset(env, &o.overlap_backfaces))
         o.overlap_backfaces = 0;
     if (o.no_overlap_backfaces && o.overlap_backfaces && !cli_from_preset(env, &o.overlap_backfaces))
         return cli_usage_error(env, "--overlap-backfaces and --no-overlap-backfaces exclude each other");
     if (o.no_overlap_backfaces)
         o.overlap_backfaces = 0;
-    if ((o.dps_input || type.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.renderer))
-        o.renderer = NULL;
+    if ((o.dps_input || type.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.r.renderer))
+        o.r.renderer = NULL;
     if (parse_options(env, &o))
         return 2;
     if (type.kind == ASP_FILE_SCENE)
         return render_instance_scene(argv[0], &o, env);
     if (o.hybrid_points)
-        o.hybrid = 1;
-    if (o.hybrid && !o.dps_input)
+        o.r.hybrid = 1;
+    if (o.r.hybrid && !o.dps_input)
         return cli_usage_error(env, "--hybrid needs a .dps input (amgsplat build makes one)");
     o.mesh_input = type.kind == ASP_FILE_MESH;
-    if ((o.flat || o.texture) && !o.mesh_input)
+    if ((o.flat || o.r.texture) && !o.mesh_input)
         return cli_usage_error(env, "--flat and --texture need a mesh input (OBJ, PLY with faces, OFF, STL, glTF, 3DS)");
     asp_error err = {0, ""};
     const asp_renderer_kind *kind = NULL;
-    if (o.dps_input && o.renderer && asp_renderer_kind_find(o.renderer, ASP_RENDER_INPUT_PRIMS, &kind, NULL))
+    if (o.dps_input && o.r.renderer && asp_renderer_kind_find(o.r.renderer, ASP_RENDER_INPUT_PRIMS, &kind, NULL))
         return cli_usage_error(env, "--renderer is for point inputs; a .dps input is drawn with --method, or with "
                                     "its levels mixed by view with --renderer cut");
     // a .hier is a hierarchy without its points: the splats draw it
@@ -774,23 +712,19 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     unsigned inputs = o.dps_input    ? (unsigned)ASP_RENDER_INPUT_PRIMS
                       : o.mesh_input ? (unsigned)(ASP_RENDER_INPUT_MESH | ASP_RENDER_INPUT_POINTS)
                                      : (unsigned)ASP_RENDER_INPUT_POINTS;
-    if (asp_renderer_kind_find(o.hybrid ? "hybrid" : o.dps_input ? (o.renderer ? o.renderer : "prim") : o.renderer ? o.renderer : dflt, inputs, &kind, &err))
+    if (asp_renderer_kind_find(o.r.hybrid ? "hybrid" : o.dps_input ? (o.r.renderer ? o.r.renderer : "prim") : o.r.renderer ? o.r.renderer : dflt, inputs, &kind, &err))
         return cli_usage_error(env, "%s", err.msg);
     // a PLY with faces holds its vertices as points; other meshes hold triangles only
     if (o.mesh_input && !(kind->inputs & ASP_RENDER_INPUT_MESH) && strcmp(type.format, "ply") != 0)
         return cli_usage_error(env, "renderer '%s' draws points; sample the mesh to points first (amgsplat sample "
                                     "'%s' -o points.ply) or draw it with --renderer mesh",
                                kind->name, argv[0]);
-    if ((o.depth_limit || o.cull_backfaces) && !kind->has_lod)
+    if ((o.r.depth_limit || o.r.cull_backfaces) && !kind->has_lod)
         return cli_usage_error(env, "--depth-limit and --cull-backfaces need --renderer splat or square");
-    if (o.depth_limit > 64)
-        return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o.depth_limit);
-    if (o.budget && !kind->has_lod)
+    if (o.r.budget && !kind->has_lod)
         return cli_usage_error(env, "--budget needs --renderer splat or square (the %s renderer draws every %s)",
                                kind->name, o.dps_input ? "primitive" : "point");
-    if (!(o.frame_ms >= 0 && o.frame_ms <= 1e6))
-        return cli_usage_error(env, "--frame-ms expects milliseconds in 0..1e6 (0 = off), got %g", o.frame_ms);
-    if (o.frame_ms > 0 && o.budget)
+    if (o.r.frame_ms > 0 && o.r.budget)
         return cli_usage_error(env, "--frame-ms sets the tolerance every frame: give no --budget");
     asp_frame_budget frame_budget;
     int no_lod = 0; // --frame-ms on a renderer without a level of detail: a usage error, found once it exists
@@ -810,7 +744,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     int rc = load_scene(argv[0], &o, env, &s, &err);
     if (!rc)
         warn_missing_textures(&s);
-    if (!rc && o.hybrid)
+    if (!rc && o.r.hybrid)
         rc = asp_scene_load_source_from(&s, o.hybrid_points, &err);
     if (!rc && s.dps && (rc = pick_domain_set(&o, &s, &ropts, &err)) != 0) {
         asp_error e = err;
@@ -824,12 +758,12 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     }
     if (!rc && (o.prim.flags & ASP_PRIM_RENDER_DEBUG_TRIANGULATION))
         rc = debug_triangles(argv[0], &s, r, env, &err);
-    if (!rc && o.budget)
-        rc = asp_renderer_set_budget(r, o.budget, &err);
-    if (!rc && o.depth_limit)
-        rc = asp_renderer_set_lod(r, kind->has_lod ? ropts.splat.tolerance : 0.0f, (uint32_t)o.depth_limit, &err);
-    if (!rc && o.frame_ms > 0) {
-        rc = asp_frame_budget_init(&frame_budget, &(asp_frame_budget_desc){.target_ms = o.frame_ms}, &err);
+    if (!rc && o.r.budget)
+        rc = asp_renderer_set_budget(r, o.r.budget, &err);
+    if (!rc && o.r.depth_limit)
+        rc = asp_renderer_set_lod(r, kind->has_lod ? ropts.splat.tolerance : 0.0f, (uint32_t)o.r.depth_limit, &err);
+    if (!rc && o.r.frame_ms > 0) {
+        rc = asp_frame_budget_init(&frame_budget, &(asp_frame_budget_desc){.target_ms = o.r.frame_ms}, &err);
         if (!rc && (rc = asp_frame_budget_apply(&frame_budget, r, &err)) == ASP_EUNSUPPORTED)
             no_lod = 1;
         vs.budget = &frame_budget;
@@ -854,7 +788,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     } else {
         cli_progress_end(env);
         asp_hybrid_counts hc = {0};
-        int hybrid = o.hybrid && asp_hybrid_renderer_counts(r, &hc, NULL) == 0;
+        int hybrid = o.r.hybrid && asp_hybrid_renderer_counts(r, &hc, NULL) == 0;
         if (env->json)
             status = print_json(env, &o, count, &s, gl, kind->name, result, &vs, seconds, hybrid ? &hc : NULL);
         else
@@ -863,7 +797,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                      "to '%s' (%ux%u) in %.2f s\n",
                      o.views, o.views > 1 ? "s" : "", count,
                      o.dps_input ? "domain primitives" : mesh_drawn ? "triangles" : "points",
-                     o.hybrid ? "hybrid" : o.dps_input ? asp_prim_render_method_name(o.prim.method) : kind->name,
+                     o.r.hybrid ? "hybrid" : o.dps_input ? asp_prim_render_method_name(o.prim.method) : kind->name,
                      vs.last_count,
                      1e3 * vs.seconds / (double)o.views, asp_gl_context_renderer(gl), o.output, result->width,
                      result->height, seconds);
@@ -872,7 +806,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                      hc.prims_kept, hc.prims_kept + hc.prims_replaced, hc.points_drawn, hc.points_total);
         if (!env->json && vs.budget)
             cli_info(env, "frame budget %g ms%s: tau %g px, %zu primitives, median %.1f ms (p10 %.1f, p90 %.1f) over the "
-                          "last frames of %zu\n", o.frame_ms,
+                          "last frames of %zu\n", o.r.frame_ms,
                      !vs.settled.settled ? " (not settled)"
                      : vs.settled.held   ? ""
                      : frame_budget.finest ? " (full detail is faster)"

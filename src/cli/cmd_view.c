@@ -31,32 +31,26 @@ static const char usage[] =
     "sets the screen tolerance every frame so a frame takes T ms (splat, square); --fly N draws\n"
     "N frames on a fixed path around the model.";
 
-static const char *const color_modes[] = {"classifier", "domains", "strict", "input"};
+/* The renderer options view takes (renderer_options.c). */
+#define VIEW_OPTIONS                                                                                     \
+    (CLI_RO_RENDERER | CLI_RO_TOLERANCE | CLI_RO_LEVEL | CLI_RO_COLOR_BY | CLI_RO_METHOD | CLI_RO_ALPHA_REF | \
+     CLI_RO_HYBRID | CLI_RO_CULL | CLI_RO_DEPTH_LIMIT | CLI_RO_FRAME_MS | CLI_RO_UNLIT | CLI_RO_TEXTURE)
 
 struct view_opts {
+    /* shared with render and eval: hybrid (docs/hybrid.md), cull_backfaces and depth_limit (seed 004
+       3.2.2, 3.2.5), frame_ms (issue 18 item 5) */
+    struct cli_renderer_opts r;
     const char *size;
     const char *view;
     const char *up;
-    const char *renderer;
-    const char *color;
-    const char *level;
-    const char *texture;
     const char *background;
     const char *screenshot;
     const char *keys;
-    const char *method;
     const char *preset; /* --preset: applied by cli_parse (docs/seeds.md) */
-    int hybrid;         /* .dps: primitives and their source points (docs/hybrid.md) */
-    int cull_backfaces; /* seed 004 3.2.2 */
-    size_t depth_limit; /* seed 004 3.2.5 */
-    double alpha_ref;
     size_t frames;
     size_t fly;             /* --fly N: scripted fly-through of N frames */
-    double frame_ms;        /* --frame-ms: frame budget (issue 18 item 5) */
     const char *stats_json;
     int overlay, no_overlay;
-    double tau;
-    int unlit;
     int verbose;
 };
 
@@ -67,7 +61,7 @@ static void log_line(void *user, const char *line)
         fprintf(stderr, "%s\n", line);
 }
 
-static int parse_into(struct cli_env *env, const char *path, const struct view_opts *o, asp_viewer_desc *d)
+static int parse_into(struct cli_env *env, const char *path, struct view_opts *o, asp_viewer_desc *d)
 {
     if (o->size && (cli_parse_size2(o->size, &d->width, &d->height) != 0 || d->width == 0 || d->height == 0 ||
                     d->width > 16384 || d->height > 16384))
@@ -83,62 +77,36 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
     }
     if (o->up && cli_parse_up(o->up, &d->up) != 0)
         return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
-    if (!(o->tau >= 0 && o->tau <= 1e6)) // a float below: 1e300 became "tolerance inf" (issue #13)
-        return cli_usage_error(env, "--tau expects pixels in 0..1e6, got %g", o->tau);
-    d->tolerance = (float)o->tau;
-    if (o->color) {
-        size_t m = sizeof color_modes / sizeof color_modes[0];
-        d->amg_color = (unsigned)m;
-        for (size_t i = 0; i < m; i++)
-            if (strcmp(o->color, color_modes[i]) == 0)
-                d->amg_color = (unsigned)i;
-        if (d->amg_color == m)
-            return cli_usage_error(env, "--color expects classifier, domains, strict or input, got '%s'", o->color);
-    }
-    if (o->background) {
-        double c[3];
-        if (cli_parse_doubles(o->background, c, 3) != 3)
-            return cli_usage_error(env, "--background expects R,G,B in 0..255, got '%s'", o->background);
-        for (int i = 0; i < 3; i++) {
-            if (!(c[i] >= 0 && c[i] <= 255) || c[i] != floor(c[i]))
-                return cli_usage_error(env, "--background expects integers in 0..255, got '%s'", o->background);
-            d->background[i] = (uint8_t)c[i];
-        }
-        d->background[3] = 255;
-    }
+    if (cli_renderer_check(env, &o->r, VIEW_OPTIONS))
+        return 2;
+    d->tolerance = isnan(o->r.tolerance) ? 0.0f : (float)o->r.tolerance;
+    if (o->r.has_color) // the viewer's modes in the order its c key cycles them (asp_viewer_desc.amg_color)
+        d->amg_color = o->r.color_mode == ASP_SCENE_AMG_INPUT ? 3u : (unsigned)o->r.color_mode - 1u;
+    if (o->background && cli_parse_colour(env, "--background", o->background, 0, d->background))
+        return 2;
     asp_file_type type = {ASP_FILE_UNKNOWN, "", 0};
     if (asp_file_recognise(path, &type, NULL) != 0)
         asp_file_type_of_name(path, &type, NULL);
     int dps = type.kind == ASP_FILE_DPS || type.kind == ASP_FILE_SCENE; // a scene's .dps sources take them
-    if (o->hybrid && type.kind == ASP_FILE_SCENE)
+    if (o->r.hybrid && type.kind == ASP_FILE_SCENE)
         return cli_usage_error(env, "--hybrid draws one .dps with its points, not a scene");
-    if (o->hybrid && (!dps || o->renderer))
+    if (o->r.hybrid && (!dps || o->r.renderer))
         return cli_usage_error(env, "--hybrid needs a .dps input and no --renderer (it is the renderer)");
-    if ((o->method || !isnan(o->alpha_ref)) && !dps)
+    if ((o->r.method || !isnan(o->r.alpha_ref)) && !dps)
         return cli_usage_error(env, "--method and --alpha-ref need a .dps input (amgsplat build makes one)");
-    if (o->method) {
-        asp_prim_render_method m;
-        asp_error merr = {0, ""};
-        if (asp_prim_render_method_parse(o->method, &m, &merr))
-            return cli_usage_error(env, "--method: %s", merr.msg);
-        d->prim_method = (unsigned)m;
-    }
-    if (!isnan(o->alpha_ref)) {
-        if (!(o->alpha_ref >= 0 && o->alpha_ref <= 1))
-            return cli_usage_error(env, "--alpha-ref expects a number in 0..1, got %g", o->alpha_ref);
-        d->prim_alpha_ref = o->alpha_ref > 0 ? (float)o->alpha_ref : -1.0f; // the library's "exactly 0"
-    }
-    if (o->depth_limit > 64)
-        return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o->depth_limit);
-    d->lod_flags = o->cull_backfaces ? ASP_SPLAT_CULL_BACKFACES : 0u;
-    d->depth_limit = (uint32_t)o->depth_limit;
-    d->renderer = o->hybrid ? "hybrid" : o->renderer;
-    d->amg_level = o->level;
-    d->texture = o->texture;
+    if (o->r.method)
+        d->prim_method = (unsigned)o->r.method_kind;
+    if (!isnan(o->r.alpha_ref))
+        d->prim_alpha_ref = o->r.alpha_ref_lib;
+    d->lod_flags = o->r.cull_backfaces ? ASP_SPLAT_CULL_BACKFACES : 0u;
+    d->depth_limit = (uint32_t)o->r.depth_limit;
+    d->renderer = o->r.hybrid ? "hybrid" : o->r.renderer;
+    d->amg_level = o->r.level;
+    d->texture = o->r.texture;
     d->frames = o->frames;
     d->screenshot = o->screenshot;
     d->keys = o->keys;
-    d->flags = (o->unlit ? ASP_VIEWER_UNLIT : 0u) | (o->verbose ? ASP_VIEWER_VERBOSE : 0u) |
+    d->flags = (o->r.unlit ? ASP_VIEWER_UNLIT : 0u) | (o->verbose ? ASP_VIEWER_VERBOSE : 0u) |
                (o->overlay ? ASP_VIEWER_OVERLAY : 0u) | (o->no_overlay ? ASP_VIEWER_NO_OVERLAY : 0u);
     if (o->overlay && o->no_overlay)
         return cli_usage_error(env, "--overlay and --no-overlay exclude each other");
@@ -148,9 +116,7 @@ static int parse_into(struct cli_env *env, const char *path, const struct view_o
         d->frames = o->fly;
         d->fly = 1;
     }
-    if (!(o->frame_ms >= 0 && o->frame_ms <= 1e6))
-        return cli_usage_error(env, "--frame-ms expects milliseconds in 0..1e6 (0 = off), got %g", o->frame_ms);
-    d->frame_ms = o->frame_ms;
+    d->frame_ms = o->r.frame_ms;
     if (o->stats_json && cli_check_output(env, o->stats_json, NULL, 0, (const char *const[]){path}, 1))
         return 2;
     d->stats_json = o->stats_json;
@@ -206,35 +172,25 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
 #else
 int cmd_view(int argc, char **argv, struct cli_env *env)
 {
-    struct view_opts o = {.alpha_ref = NAN}; // NaN: not given (the parser refuses non-finite values)
-    const struct cli_option opts[] = {
+    struct view_opts o = {0};
+    cli_renderer_opts_init(&o.r);
+    struct cli_option opts[48] = {
         {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
         {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "first view as in 'amgsplat render' (default 30,20)"},
         {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y (default), z (scans, CAD), x, -y, -z or -x"},
-        {"renderer", 0, CLI_STRING, &o.renderer, "NAME", "first renderer (default disc, mesh for meshes; 'h' in the window lists them)"},
-        {"cull-backfaces", 0, CLI_FLAG, &o.cull_backfaces, NULL, "splat, square: drop subtrees whose normal cone faces away (seed 004 3.2.2)"},
-        {"depth-limit", 0, CLI_SIZE, &o.depth_limit, "N", "splat, square: traverse the hierarchy to depth N at most (seed 004 3.2.5; 0 = none)"},
-        {"tau", 0, CLI_DOUBLE, &o.tau, "PX", "screen tolerance of the hierarchy renderers in pixels (default 0)"},
-        {"color", 0, CLI_STRING, &o.color, "MODE", ".amg: classifier (default), domains, strict or input"},
-        {"level", 0, CLI_STRING, &o.level, "L", ".amg: level for domain colours: L, L-2 or an index (default L); .dps: level drawn (default the finest in the file)"},
-        {"method", 0, CLI_STRING, &o.method, "NAME", ".dps: how primitives blend (default normalized; m cycles)"},
-        {"hybrid", 0, CLI_FLAG, &o.hybrid, NULL, ".dps: its source points where a primitive fails (docs/hybrid.md)"},
-        {"alpha-ref", 0, CLI_DOUBLE, &o.alpha_ref, "X", ".dps: alpha reference, 0..1 (default 0.1; ',' '.' step it)"},
-        {"texture", 0, CLI_STRING, &o.texture, "IMG", "mesh: texture of materials that name none or whose file is missing"},
-        {"unlit", 0, CLI_FLAG, &o.unlit, NULL, "start with lighting off"},
-        {"background", 0, CLI_STRING, &o.background, "R,G,B", "background colour, 0..255 (default 255,255,255)"},
+        {"background", 0, CLI_STRING, &o.background, "R,G,B", "background colour, 0..255 or #RRGGBB (default 255,255,255)"},
         {"verbose", 'v', CLI_FLAG, &o.verbose, NULL, "print frame time and primitive count once a second"},
         {"frames", 0, CLI_SIZE, &o.frames, "N", "scripted: draw N frames, then exit"},
         {"screenshot", 0, CLI_STRING, &o.screenshot, "OUT.png", "scripted: save the last frame"},
         {"keys", 0, CLI_STRING, &o.keys, "KEYS", "press these keys, one per frame, from the first frame on"},
-        {"frame-ms", 0, CLI_DOUBLE, &o.frame_ms, "T", "frame budget: set tau (then the depth limit) every frame so a frame takes T ms"},
         {"fly", 0, CLI_SIZE, &o.fly, "N", "scripted: N frames on a fixed path around and close to the model"},
         {"stats-json", 0, CLI_STRING, &o.stats_json, "OUT.json", "write every frame's time, tau, depth limit and count, with median, p10, p90"},
         {"overlay", 0, CLI_FLAG, &o.overlay, NULL, "start with the figures over the frame (i toggles; on with --frame-ms)"},
         {"no-overlay", 0, CLI_FLAG, &o.no_overlay, NULL, "start without them"},
         {0},
     };
+    cli_renderer_rows(&o.r, VIEW_OPTIONS, opts, sizeof opts / sizeof opts[0]);
     int npos = 0;
     int prc = cli_parse(argc, argv, opts, usage, env, &npos);
     if (prc)
@@ -245,10 +201,10 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
     asp_file_type ft = {ASP_FILE_UNKNOWN, "", 0};
     if (asp_file_recognise(argv[0], &ft, NULL) != 0)
         asp_file_type_of_name(argv[0], &ft, NULL);
-    if (ft.kind != ASP_FILE_DPS && cli_from_preset(env, &o.method))
-        o.method = NULL;
-    if ((ft.kind == ASP_FILE_DPS || ft.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.renderer))
-        o.renderer = NULL;
+    if (ft.kind != ASP_FILE_DPS && cli_from_preset(env, &o.r.method))
+        o.r.method = NULL;
+    if ((ft.kind == ASP_FILE_DPS || ft.kind == ASP_FILE_MESH) && cli_from_preset(env, &o.r.renderer))
+        o.r.renderer = NULL;
     asp_viewer_desc desc = {.log = log_line, .log_user = env};
     if (parse_into(env, argv[0], &o, &desc))
         return 2;

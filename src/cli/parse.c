@@ -369,6 +369,41 @@ int cli_parse_doubles(const char *s, double *out, int max)
     return n;
 }
 
+static int hex_digit(char c)
+{
+    return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+}
+
+int cli_parse_colour(const struct cli_env *env, const char *option, const char *s, int allow_alpha, uint8_t out[4])
+{
+    double v[4] = {0, 0, 0, 255};
+    int n = -1;
+    if (s[0] == '#') {
+        size_t len = strlen(s + 1);
+        if (len == 6 || len == 8) {
+            n = (int)len / 2;
+            for (int i = 0; i < n && n > 0; i++) {
+                int hi = hex_digit(s[1 + 2 * i]), lo = hex_digit(s[2 + 2 * i]);
+                if (hi < 0 || lo < 0)
+                    n = -1;
+                else
+                    v[i] = hi * 16 + lo;
+            }
+        }
+    } else {
+        n = cli_parse_doubles(s, v, 4);
+        for (int i = 0; i < n; i++)
+            if (!(v[i] >= 0 && v[i] <= 255))
+                n = -1;
+    }
+    if (n < 3 || (n == 4 && !allow_alpha))
+        return cli_usage_error(env, "%s expects R,G,B%s with channels in 0..255, or #RRGGBB%s, got '%s'", option,
+                               allow_alpha ? "[,A]" : "", allow_alpha ? "[AA]" : "", s);
+    for (int i = 0; i < 4; i++)
+        out[i] = (uint8_t)floor(v[i] + 0.5);
+    return 0;
+}
+
 int cli_parse_size2(const char *s, unsigned *w, unsigned *h)
 {
     char *end;

@@ -113,45 +113,29 @@ static int load_amg(asp_scene *s, const asp_scene_desc *d, asp_error *err)
     return load_clip_planes(s, d, err);
 }
 
-/* The source file a .dps names: as stored, then next to the .dps. Loads its points (world frame kept in origin). */
+/* The source file a .dps names (asp_dps_source_find). Loads its points (world frame kept in origin). */
 /* given: a point file or .amg the caller names instead of the .dps's source (render --hybrid-points) */
 static int load_dps_source_cloud(const asp_scene *s, const char *given, asp_cloud **out, asp_error *err)
 {
-    const char *src = given ? given : s->dps->source;
-    if (!src[0])
-        return asp_error_set(err, ASP_EUNSUPPORTED, "'%s' names no source file", s->path);
-    char alt[1024] = "";
-    const char *slash = strrchr(s->path, '/');
-    if (!given && src[0] != '/' && slash)
-        snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - s->path), s->path, src);
-    const char *tries[2] = {src, alt};
-    asp_error first = {0, ""};
-    for (int t = 0; t < 2; t++) {
-        if (!tries[t][0])
-            continue;
-        asp_error e = {0, ""};
-        asp_file_type type;
-        int rc = asp_file_recognise(tries[t], &type, &e);
-        if (!rc && type.kind == ASP_FILE_AMG) {
-            asp_amg *amg = NULL;
-            rc = asp_amg_load(tries[t], &s->ctx, &amg, &e);
-            if (!rc)
-                rc = asp_cloud_clone(asp_amg_cloud(amg), out, &e);
-            asp_amg_destroy(amg);
-        } else if (!rc && (type.kind == ASP_FILE_POINTS || strcmp(type.format, "ply") == 0)) {
-            rc = asp_cloud_load(tries[t], &s->ctx, out, &e);
-        } else if (!rc) {
-            rc = asp_error_set(&e, ASP_EUNSUPPORTED, "source '%s' of '%s' is a %s, not points", tries[t], s->path,
-                               asp_file_kind_name(type.kind));
-        }
+    char found[4096];
+    asp_file_type type;
+    int rc = given ? asp_file_recognise(given, &type, err)
+                   : asp_dps_source_find(s->dps, s->path, found, sizeof found, &type, err);
+    if (rc)
+        return rc;
+    const char *src = given ? given : found;
+    if (type.kind == ASP_FILE_AMG) {
+        asp_amg *amg = NULL;
+        rc = asp_amg_load(src, &s->ctx, &amg, err);
         if (!rc)
-            return 0;
-        if (!first.code)
-            first = e;
+            rc = asp_cloud_clone(asp_amg_cloud(amg), out, err);
+        asp_amg_destroy(amg);
+        return rc;
     }
-    if (err)
-        *err = first;
-    return first.code ? first.code : ASP_EIO;
+    if (type.kind == ASP_FILE_POINTS || strcmp(type.format, "ply") == 0)
+        return asp_cloud_load(src, &s->ctx, out, err);
+    return asp_error_set(err, ASP_EUNSUPPORTED, "source '%s' of '%s' is a %s, not points", src, s->path,
+                         asp_file_kind_name(type.kind));
 }
 
 /* The frame of a .dps that records none: its source points', else the level's own bounds. */

@@ -568,6 +568,40 @@ int asp_dps_load(const char *path, const asp_context *ctx, asp_dps **out, asp_er
     return rc;
 }
 
+int asp_dps_source_find(const asp_dps *dps, const char *dps_path, char *out, size_t cap, asp_file_type *type,
+                        asp_error *err)
+{
+    ASP_ASSERT(dps && dps_path && out && cap > 0);
+    const char *src = dps->source;
+    if (!src[0])
+        return asp_error_set(err, ASP_EUNSUPPORTED, "'%s' names no source file", dps_path);
+    char alt[4096] = "";
+    const char *slash = strrchr(dps_path, '/');
+    if (src[0] != '/' && slash)
+        snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - dps_path), dps_path, src);
+    const char *tries[2] = {src, alt};
+    asp_error first = {0, ""};
+    for (int t = 0; t < 2; t++) {
+        asp_file_type ft;
+        asp_error e = {0, ""};
+        if (!tries[t][0] || asp_file_recognise(tries[t], &ft, &e) != 0) {
+            if (!first.code && tries[t][0])
+                first = e;
+            continue;
+        }
+        if (strlen(tries[t]) >= cap)
+            return asp_error_set(err, ASP_EINVAL, "source '%s' of '%s' is longer than %zu bytes", tries[t], dps_path,
+                                 cap - 1);
+        snprintf(out, cap, "%s", tries[t]);
+        if (type)
+            *type = ft;
+        return 0;
+    }
+    if (err)
+        *err = first;
+    return first.code ? first.code : ASP_EIO;
+}
+
 static size_t mipmapped_rgba8(const asp_image *img)
 {
     return (size_t)img->width * img->height * 4 * 4 / 3;

@@ -233,4 +233,4 @@ static void test_threads(void)
 static void shutdown(void) { asp_amg_shutdown(); }
 
 TEST_MAIN(TEST_CASE(test_octahedron), TEST_CASE(test_bunny), TEST_CASE(test_fandisk), TEST_CASE(test_cow),
-          TEST_CASE(test_disconnected), TEST_CASE(test_threads), TEST_CASE(shutdown))
+          TEST_CASE(test_disconnected), TEST_CASE(test_threads), TEST_FIXTURE(shutdown))

@@ -166,4 +166,4 @@ static void test_take_refused(void)
 
 static void shutdown(void) { asp_amg_shutdown(); }
 
-TEST_MAIN(TEST_CASE(test_free_returns), TEST_CASE(test_budget), TEST_CASE(test_take_refused), TEST_CASE(shutdown))
+TEST_MAIN(TEST_CASE(test_free_returns), TEST_CASE(test_budget), TEST_CASE(test_take_refused), TEST_FIXTURE(shutdown))

@@ -154,4 +154,4 @@ static void shutdown(void)
     asp_amg_shutdown();
 }
 
-TEST_MAIN(TEST_CASE(test_sweep), TEST_CASE(test_moment_classifier), TEST_CASE(test_crease_cut_off), TEST_CASE(shutdown))
+TEST_MAIN(TEST_CASE(test_sweep), TEST_CASE(test_moment_classifier), TEST_CASE(test_crease_cut_off), TEST_FIXTURE(shutdown))

@@ -3,6 +3,7 @@
  * container, quads that are the renderer's support rectangles with its texture coordinates, and
  * UTM-size coordinates kept exact through the node translation.
  */
+#include <errno.h>
 #include <sys/stat.h>
 
 #include <cjson/cJSON.h>
@@ -323,7 +324,7 @@ static void setup(void)
 {
     const char *base = getenv("TMPDIR");
     snprintf(tmpdir, sizeof tmpdir, "%s/asp_export_gltf_%ld", base ? base : "/tmp", (long)getpid());
-    mkdir(tmpdir, 0700);
+    CHECK_MSG(mkdir(tmpdir, 0700) == 0 || errno == EEXIST, "cannot create '%s': %s", tmpdir, strerror(errno));
 }
 
 static void cleanup(void)
@@ -334,8 +335,5 @@ static void cleanup(void)
         fprintf(stderr, "could not remove %s\n", tmpdir);
 }
 
-static void test_setup(void) { setup(); CHECK(tmpdir[0] != '\0'); }
-static void test_cleanup(void) { cleanup(); CHECK(1); }
-
-TEST_MAIN(TEST_CASE(test_setup), TEST_CASE(test_gaussian_axes), TEST_CASE(test_dps_quads),
-          TEST_CASE(test_bad_arguments), TEST_CASE(test_points_utm), TEST_CASE(test_cleanup))
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_gaussian_axes), TEST_CASE(test_dps_quads),
+          TEST_CASE(test_bad_arguments), TEST_CASE(test_points_utm), TEST_FIXTURE(cleanup))

@@ -253,6 +253,6 @@ static void teardown(void)
     rmdir(dir);
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_by_magic), TEST_CASE(test_by_extension), TEST_CASE(test_upper_case_own_files),
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_by_magic), TEST_CASE(test_by_extension), TEST_CASE(test_upper_case_own_files),
           TEST_CASE(test_refusals), TEST_CASE(test_cloud_load_uses_it), TEST_CASE(test_truncated_heads),
-          TEST_CASE(teardown))
+          TEST_FIXTURE(teardown))

@@ -463,7 +463,7 @@ static void teardown(void)
     rmdir(dir);
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_obj_with_texture), TEST_CASE(test_missing_texture),
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_obj_with_texture), TEST_CASE(test_missing_texture),
           TEST_CASE(test_simple_formats), TEST_CASE(test_gltf_transform_embedded), TEST_CASE(test_errors),
           TEST_CASE(test_3ds_y_up), TEST_CASE(test_obj_upper_case_and_missing_texture), TEST_CASE(test_real_models),
-          TEST_CASE(teardown))
+          TEST_FIXTURE(teardown))

@@ -271,4 +271,4 @@ static void teardown(void)
 }
 
 TEST_MAIN(TEST_CASE(test_octahedron_affine), TEST_CASE(test_octahedron_radial), TEST_CASE(test_threads_identical),
-          TEST_CASE(test_options_rejected), TEST_CASE(teardown))
+          TEST_CASE(test_options_rejected), TEST_FIXTURE(teardown))

@@ -432,6 +432,6 @@ static void test_bad_planes(void)
     asp_cloud_destroy(c);
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_single_disc), TEST_CASE(test_octahedron), TEST_CASE(test_hier_and_opaque),
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_single_disc), TEST_CASE(test_octahedron), TEST_CASE(test_hier_and_opaque),
           TEST_CASE(test_bad_planes),
-          TEST_CASE(teardown))
+          TEST_FIXTURE(teardown))

@@ -234,5 +234,5 @@ static void test_cut_needs_links(void)
     dps = NULL;
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_cut_levels), TEST_CASE(test_cut_instances), TEST_CASE(test_cut_fade),
-          TEST_CASE(test_cut_needs_links), TEST_CASE(teardown))
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_cut_levels), TEST_CASE(test_cut_instances), TEST_CASE(test_cut_fade),
+          TEST_CASE(test_cut_needs_links), TEST_FIXTURE(teardown))

@@ -511,9 +511,9 @@ static void test_bad_input(void)
     asp_renderer_destroy(NULL);
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_context), TEST_CASE(test_debug_errors_collected),
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_context), TEST_CASE(test_debug_errors_collected),
           TEST_CASE(test_sphere_silhouette_iou), TEST_CASE(test_plane_uniformly_lit),
           TEST_CASE(test_depth_and_orientation), TEST_CASE(test_missing_attributes),
           TEST_CASE(test_transparent_multisampled),
           TEST_CASE(test_multisampled_subpixel_discs), TEST_CASE(test_deterministic), TEST_CASE(test_bad_input),
-          TEST_CASE(teardown))
+          TEST_FIXTURE(teardown))

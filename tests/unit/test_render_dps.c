@@ -562,6 +562,6 @@ static void test_bad_input(void)
     release_level(&t);
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_single_primitive), TEST_CASE(test_partition_of_unity),
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_single_primitive), TEST_CASE(test_partition_of_unity),
           TEST_CASE(test_visibility), TEST_CASE(test_dark_backface), TEST_CASE(test_outline_colors_normal_map),
-          TEST_CASE(test_deterministic), TEST_CASE(test_bad_input), TEST_CASE(teardown))
+          TEST_CASE(test_deterministic), TEST_CASE(test_bad_input), TEST_FIXTURE(teardown))

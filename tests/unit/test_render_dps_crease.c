@@ -206,4 +206,4 @@ static void test_bad_option(void)
     asp_image_release(&lv.atlas);
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_roof), TEST_CASE(test_bad_option), TEST_CASE(teardown))
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_roof), TEST_CASE(test_bad_option), TEST_FIXTURE(teardown))

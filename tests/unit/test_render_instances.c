@@ -307,5 +307,5 @@ static void test_bad_groups(void)
     asp_cloud_destroy(c);
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(setup_files), TEST_CASE(test_two_cubes), TEST_CASE(test_occlusion),
-          TEST_CASE(test_culling), TEST_CASE(test_instanced_matches), TEST_CASE(test_bad_groups), TEST_CASE(remove_files), TEST_CASE(teardown))
+TEST_MAIN(TEST_FIXTURE(setup), TEST_FIXTURE(setup_files), TEST_CASE(test_two_cubes), TEST_CASE(test_occlusion),
+          TEST_CASE(test_culling), TEST_CASE(test_instanced_matches), TEST_CASE(test_bad_groups), TEST_FIXTURE(remove_files), TEST_FIXTURE(teardown))

@@ -171,5 +171,5 @@ static void teardown(void)
     gl = NULL;
 }
 
-TEST_MAIN(TEST_CASE(test_weights), TEST_CASE(setup), TEST_CASE(test_blend_weights), TEST_CASE(test_uniform_epsilon),
-          TEST_CASE(teardown))
+TEST_MAIN(TEST_CASE(test_weights), TEST_FIXTURE(setup), TEST_CASE(test_blend_weights), TEST_CASE(test_uniform_epsilon),
+          TEST_FIXTURE(teardown))

@@ -321,6 +321,6 @@ static void test_bad_input(void)
     CHECK_MSG(strstr(err.msg, "vertex 2") != NULL, "message '%s'", err.msg);
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_textured_quad), TEST_CASE(test_mipmaps_linear_light),
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_textured_quad), TEST_CASE(test_mipmaps_linear_light),
           TEST_CASE(test_material_and_vertex_colours), TEST_CASE(test_frame_and_normals),
-          TEST_CASE(test_renderer_table), TEST_CASE(test_bad_input), TEST_CASE(teardown))
+          TEST_CASE(test_renderer_table), TEST_CASE(test_bad_input), TEST_FIXTURE(teardown))

@@ -245,5 +245,5 @@ static void cleanup(void)
         unlink(dps_path);
 }
 
-TEST_MAIN(TEST_CASE(build_primitives), TEST_CASE(setup), TEST_CASE(test_octahedron_methods), TEST_CASE(teardown),
-          TEST_CASE(cleanup))
+TEST_MAIN(TEST_CASE(build_primitives), TEST_FIXTURE(setup), TEST_CASE(test_octahedron_methods), TEST_FIXTURE(teardown),
+          TEST_FIXTURE(cleanup))

@@ -299,5 +299,5 @@ static void test_domain_set_both(void)
     asp_amg_shutdown();
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_debug_drawings), TEST_CASE(test_only_domain),
-          TEST_CASE(test_domain_set_both), TEST_CASE(teardown))
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_debug_drawings), TEST_CASE(test_only_domain),
+          TEST_CASE(test_domain_set_both), TEST_FIXTURE(teardown))

@@ -664,7 +664,7 @@ static void teardown(void)
     gl = NULL;
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(test_checker_no_holes), TEST_CASE(test_checker_oblique_lod),
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_checker_no_holes), TEST_CASE(test_checker_oblique_lod),
           TEST_CASE(test_coverage_matches_discs), TEST_CASE(test_count_and_tau), TEST_CASE(test_epsilon_z_buffer),
           TEST_CASE(test_lighting_modes), TEST_CASE(test_square_fixed_size), TEST_CASE(test_deterministic_and_hier),
-          TEST_CASE(test_bad_input), TEST_CASE(teardown))
+          TEST_CASE(test_bad_input), TEST_FIXTURE(teardown))

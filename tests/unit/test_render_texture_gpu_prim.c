@@ -86,8 +86,7 @@ static void test_gpu_equals_cpu(void)
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         asp_prim_desc cpu = cases[k].d, gpu = cases[k].d;
-        gpu.fill = asp_prim_gpu_fill;
-        gpu.fill_user = gl;
+        asp_prim_gpu_fill_attach(&gpu, gl);
         asp_dps *a = NULL, *b = NULL;
         CHECK_OK(asp_prim_build(amg, NULL, levels, 3, &cpu, NULL, NULL, &a, &err), ep(&err));
         CHECK_OK(asp_prim_build(amg, NULL, levels, 3, &gpu, NULL, NULL, &b, &err), ep(&err));
@@ -139,5 +138,5 @@ static void cleanup(void)
     asp_amg_shutdown();
 }
 
-TEST_MAIN(TEST_CASE(setup), TEST_CASE(decompose), TEST_CASE(test_gpu_equals_cpu), TEST_CASE(test_fill_errors),
-          TEST_CASE(cleanup), TEST_CASE(teardown))
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(decompose), TEST_CASE(test_gpu_equals_cpu), TEST_CASE(test_fill_errors),
+          TEST_FIXTURE(cleanup), TEST_FIXTURE(teardown))

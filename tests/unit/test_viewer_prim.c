@@ -1,5 +1,5 @@
 /*
- * The viewer's .dps input kind without a window (render/viewer_scene.c): the
+ * The viewer's .dps input kind without a window (src/viewer/scene_actions.c): the
  * level picked by --level and stepped by [ and ] (stopping at both ends), and
  * p loading the source points the file names (an .amg), moved into the
  * primitives' frame, or explaining why it cannot. Starts MPI (hypre).

@@ -1,5 +1,5 @@
 /*
- * The viewer's .amg input kind without a window (render/viewer_scene.c): the
+ * The viewer's .amg input kind without a window (src/viewer/scene_actions.c): the
  * points coloured by classifier, domains, strict domains or their own colours,
  * the [ and ] keys stepping levels and stopping at both ends, and errors for a
  * level out of range or input colours that are not there. Starts MPI (hypre).

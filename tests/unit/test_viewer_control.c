@@ -2,7 +2,7 @@
  * The viewer without a window: mouse interaction on the orbit camera (orbit
  * follows the drag, pan keeps the grabbed point under the cursor, dolly is
  * clamped), the tau ladder, the key table and option checking
- * (src/viewer/control.c, viewer.c). The .amg input: test_render_viewer_amg.c.
+ * (src/viewer/control.c, viewer.c). The .amg input: test_viewer_amg.c.
  */
 #include <math.h>
 
