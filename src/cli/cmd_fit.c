@@ -52,7 +52,8 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
 {
     const char *output = NULL, *reference = NULL, *texture = NULL, *level_name = NULL;
     size_t views = 64, holdout = 16, iterations = 60, size = 128, seed = 1;
-    double lambda = 0.0, smooth = 0.0;
+    double lambda = 0.0, smooth = 0.0, alpha_step = 0.0;
+    int alpha_rounds = 8;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output .dps"},
         {"reference", 'r', CLI_STRING, &reference, "SOURCE", "mesh or point set to match (default: the source)"},
@@ -63,8 +64,10 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
         {"size", 's', CLI_SIZE, &size, "PX", "image side in pixels (default 128)"},
         {"iterations", 'n', CLI_SIZE, &iterations, "N", "conjugate-gradient iterations (default 60)"},
         {"seed", 0, CLI_SIZE, &seed, "S", "rotates the view lattices (default 1)"},
-        {"lambda", 0, CLI_DOUBLE, &lambda, "X", "pull towards the unfitted texels (default 0.02)"},
-        {"smooth", 0, CLI_DOUBLE, &smooth, "X", "smoothness of the correction (default 0.5; negative: none)"},
+        {"lambda", 0, CLI_DOUBLE, &lambda, "X", "pull towards the unfitted texels (default 0.1)"},
+        {"smooth", 0, CLI_DOUBLE, &smooth, "X", "smoothness of the correction (default 4; negative: none)"},
+        {"alpha-rounds", 0, CLI_INT, &alpha_rounds, "N", "silhouette rounds on alpha (default 8; 0: colour only)"},
+        {"alpha-step", 0, CLI_DOUBLE, &alpha_step, "X", "largest alpha change per round (default 0.08)"},
         {0},
     };
     int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -80,6 +83,10 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--size must be 8 to 4096 pixels, got %zu", size);
     if (iterations < 1 || iterations > 10000)
         return cli_usage_error(env, "--iterations must be 1 to 10000, got %zu", iterations);
+    if (alpha_rounds < 0 || alpha_rounds > 100)
+        return cli_usage_error(env, "--alpha-rounds must be 0 to 100, got %d", alpha_rounds);
+    if (alpha_step < 0 || alpha_step > 1)
+        return cli_usage_error(env, "--alpha-step must be in 0..1, got %g", alpha_step);
     if (lambda < 0)
         return cli_usage_error(env, "--lambda must be >= 0, got %g", lambda);
     const char *inputs[] = {argv[0]};
@@ -114,6 +121,7 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
     asp_fit_reference ref = {.mesh = mesh, .cloud = amg ? asp_amg_cloud(amg) : cloud};
     asp_fit_desc desc = {.views = views, .holdout = holdout, .size = (uint32_t)size,
                          .iterations = (uint32_t)iterations, .seed = seed, .lambda = lambda, .smooth = smooth,
+                         .alpha_rounds = alpha_rounds ? alpha_rounds : -1, .alpha_step = alpha_step,
                          .log = log_stderr, .log_user = env};
     for (size_t l = first; l < last && !rc; l++) {
         char name[16];

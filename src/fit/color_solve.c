@@ -327,8 +327,8 @@ int asp_fit_color(asp_dps_level *lv, const double origin[3], const asp_fit_view 
     double t0 = asp_time_now();
     asp_fit_desc desc = desc_in ? *desc_in : (asp_fit_desc){0};
     uint32_t iterations = desc.iterations ? desc.iterations : 60;
-    double lambda = desc.lambda > 0 ? desc.lambda : 0.02;
-    double smooth = desc.smooth > 0 ? desc.smooth : desc.smooth < 0 ? 0.0 : 0.5;
+    double lambda = desc.lambda > 0 ? desc.lambda : 0.1;
+    double smooth = desc.smooth > 0 ? desc.smooth : desc.smooth < 0 ? 0.0 : 4.0;
     if (!lv || !views || !refs || nviews == 0 || !lv->prim_count)
         return asp_error_set(err, ASP_EINVAL, "cannot fit: no views or an empty level");
     int rc = check_refs(views, refs, nviews, "training", err);

@@ -20,6 +20,28 @@ typedef struct asp__fit_rows {
     size_t total;
 } asp__fit_rows;
 
+/* One fragment of a pixel: a front-facing support rectangle hit by the pixel centre's eye ray. */
+typedef struct asp__fit_frag {
+    uint32_t prim;
+    float a, shade;                /* bilinear alpha; the shade factor that multiplies the colour */
+    float tx, ty;                  /* atlas texel coordinates (texel i spans [i, i + 1)) */
+    double z, len;                 /* -z_eye and |eye point| */
+} asp__fit_frag;
+
+/* alpha_ref and the depth window resolved as the prim renderer resolves them. */
+void asp__fit_draw_resolve(const asp_dps_level *lv, const asp_fit_draw *in, asp_fit_draw *out, double *window);
+
+/*
+ * Fragments per pixel as CSR (first: width * height + 1, allocated through ctx; frags likewise), in
+ * primitive order; all = 0 keeps only alpha > 0 (what the blend sees), 1 every hit. draw resolved.
+ */
+int asp__fit_fragments(const asp_dps_level *lv, const double origin[3], const asp_fit_view *v,
+                       const asp_fit_draw *draw, int all, const asp_context *ctx, size_t **first,
+                       asp__fit_frag **frags, asp_error *err);
+
+/* GL_LINEAR taps of img at texel coordinates (tx, ty), clamped to the edge: indices and weights. */
+void asp__fit_bilinear(const asp_image *img, float tx, float ty, uint32_t idx[4], float wgt[4]);
+
 /* Rasterises lv seen from view into rows (zeroed on entry; free with asp__fit_rows_release). */
 int asp__fit_raster(const asp_dps_level *lv, const double origin[3], const asp_fit_view *view,
                     const asp_fit_draw *draw, const asp_context *ctx, asp__fit_rows *rows, asp_error *err);

@@ -20,13 +20,7 @@ typedef struct eye_prim {
     int x0, y0, x1, y1;            /* pixel box, inclusive; x1 < x0 when culled */
 } eye_prim;
 
-/* One fragment of a pixel. */
-typedef struct frag {
-    uint32_t prim;
-    float a, shade;
-    float tx, ty;                  /* atlas texel coordinates (texel i spans [i, i + 1)) */
-    double z, len;                 /* -z_eye and |eye point| */
-} frag;
+typedef asp__fit_frag frag;
 
 float asp__fit_srgb_to_linear(uint8_t v)
 {
@@ -136,7 +130,7 @@ static void eye_prims(const asp_dps_level *lv, const double origin[3], const asp
 }
 
 /* Bilinear lookup of channel ch (0..3) of an RGBA8 image as unorm, clamped to the edge. */
-static void bilinear(const asp_image *img, float tx, float ty, uint32_t idx[4], float wgt[4])
+void asp__fit_bilinear(const asp_image *img, float tx, float ty, uint32_t idx[4], float wgt[4])
 {
     float x = tx - 0.5f, y = ty - 0.5f;
     float fx = floorf(x), fy = floorf(y);
@@ -156,7 +150,7 @@ static float sample_alpha(const asp_image *img, float tx, float ty)
 {
     uint32_t idx[4];
     float w[4], a = 0;
-    bilinear(img, tx, ty, idx, w);
+    asp__fit_bilinear(img, tx, ty, idx, w);
     for (int k = 0; k < 4; k++)
         a += w[k] * (float)img->pixels[4 * (size_t)idx[k] + 3] * (1.0f / 255.0f);
     return a;
@@ -167,7 +161,7 @@ static float normal_map_shade(const asp_dps_level *lv, const asp_fit_view *v, fl
 {
     uint32_t idx[4];
     float w[4], m[3] = {0, 0, 0};
-    bilinear(&lv->normal_atlas, tx, ty, idx, w);
+    asp__fit_bilinear(&lv->normal_atlas, tx, ty, idx, w);
     for (int k = 0; k < 4; k++)
         for (int a = 0; a < 3; a++)
             m[a] += w[k] * (float)lv->normal_atlas.pixels[4 * (size_t)idx[k] + a] * (1.0f / 255.0f);
@@ -203,7 +197,7 @@ static int hit(const asp_dps_level *lv, const asp_fit_view *v, const asp_fit_dra
         f->shade = normal_map_shade(lv, v, f->tx, f->ty, (float)e->shade);
     f->z = -p[2];
     f->len = sqrt(dot3(p, p));
-    return f->a > 0;
+    return 1;
 }
 
 static double default_window(const asp_dps_level *lv)
@@ -216,7 +210,7 @@ static double default_window(const asp_dps_level *lv)
 
 /* Fragments per pixel, as CSR: ff[p] .. ff[p + 1] - 1 in frags, in primitive order. */
 static int gather(const asp_dps_level *lv, const asp_fit_view *v, const asp_fit_draw *draw, const eye_prim *e,
-                  const asp_context *ctx, size_t **first_out, frag **frags_out, asp_error *err)
+                  int all, const asp_context *ctx, size_t **first_out, frag **frags_out, asp_error *err)
 {
     size_t np = (size_t)v->width * v->height;
     size_t *first = asp_calloc(ctx, np + 1, sizeof *first);
@@ -233,7 +227,7 @@ static int gather(const asp_dps_level *lv, const asp_fit_view *v, const asp_fit_
                     double nx = 2 * (x + 0.5) / v->width - 1;
                     double d[3] = {nx / v->proj[0], ny / v->proj[5], -1};
                     frag f;
-                    if (!hit(lv, v, draw, q, i, d, &f))
+                    if (!hit(lv, v, draw, q, i, d, &f) || !(all || f.a > 0))
                         continue;
                     size_t p = (size_t)y * v->width + (size_t)x;
                     if (sweep == 0)
@@ -262,23 +256,38 @@ static int gather(const asp_dps_level *lv, const asp_fit_view *v, const asp_fit_
     return 0;
 }
 
-int asp__fit_raster(const asp_dps_level *lv, const double origin[3], const asp_fit_view *v,
-                    const asp_fit_draw *draw_in, const asp_context *ctx, asp__fit_rows *rows, asp_error *err)
+void asp__fit_draw_resolve(const asp_dps_level *lv, const asp_fit_draw *in, asp_fit_draw *out, double *window)
+{
+    *out = in ? *in : (asp_fit_draw){0};
+    if (!(out->alpha_ref > 0))
+        out->alpha_ref = out->alpha_ref < 0 ? 0.0f : 0.1f;
+    *window = out->depth_window > 0 ? out->depth_window : out->depth_window < 0 ? 0 : default_window(lv);
+}
+
+int asp__fit_fragments(const asp_dps_level *lv, const double origin[3], const asp_fit_view *v,
+                       const asp_fit_draw *draw, int all, const asp_context *ctx, size_t **first,
+                       asp__fit_frag **frags, asp_error *err)
 {
     if (!lv->prim_count || !v->width || !v->height || !lv->atlas.width)
         return asp_error_set(err, ASP_EINVAL, "cannot rasterise: empty level or zero image size");
-    asp_fit_draw draw = *draw_in;
-    if (!(draw.alpha_ref > 0))
-        draw.alpha_ref = draw.alpha_ref < 0 ? 0.0f : 0.1f;
-    double window = draw.depth_window > 0 ? draw.depth_window : draw.depth_window < 0 ? 0 : default_window(lv);
     eye_prim *e = asp_alloc(ctx, lv->prim_count * sizeof *e);
     if (!e)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu primitives", lv->prim_count);
-    eye_prims(lv, origin, v, draw.unlit, e);
+    eye_prims(lv, origin, v, draw->unlit, e);
+    int rc = gather(lv, v, draw, e, all, ctx, first, frags, err);
+    asp_free(ctx, e);
+    return rc;
+}
+
+int asp__fit_raster(const asp_dps_level *lv, const double origin[3], const asp_fit_view *v,
+                    const asp_fit_draw *draw_in, const asp_context *ctx, asp__fit_rows *rows, asp_error *err)
+{
+    asp_fit_draw draw;
+    double window;
+    asp__fit_draw_resolve(lv, draw_in, &draw, &window);
     size_t *ff = NULL;
     frag *frags = NULL;
-    int rc = gather(lv, v, &draw, e, ctx, &ff, &frags, err);
-    asp_free(ctx, e);
+    int rc = asp__fit_fragments(lv, origin, v, &draw, 0, ctx, &ff, &frags, err);
     if (rc)
         return rc;
     size_t np = (size_t)v->width * v->height;
@@ -315,7 +324,7 @@ int asp__fit_raster(const asp_dps_level *lv, const double origin[3], const asp_f
                 continue;
             uint32_t idx[4];
             float w[4];
-            bilinear(&lv->atlas, fp[k].tx, fp[k].ty, idx, w);
+            asp__fit_bilinear(&lv->atlas, fp[k].tx, fp[k].ty, idx, w);
             double s = fp[k].a * fp[k].shade / sum;
             for (int j = 0; j < 4; j++) {
                 if (w[j] == 0)

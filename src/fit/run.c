@@ -173,12 +173,16 @@ int asp_fit_run(asp_gl_context *gl, asp_dps *dps, size_t level, const asp_fit_re
     if (!rc)
         rc = level_ssim(gl, lv, origin, cams + nv, refs + nv, nh, size, ctx, &ssim_before, err);
     asp_fit_stats st = {0};
+    size_t sil_before = 0, sil_after = 0;
+    if (!rc && desc.alpha_rounds >= 0)
+        rc = asp_fit_alpha(lv, origin, views, refs, nv, &desc, ctx, &sil_before, &sil_after, err);
     if (!rc)
         rc = asp_fit_color(lv, origin, views, refs, nv, views + nv, refs + nv, nh, &desc, ctx, &st, err);
     if (!rc)
         rc = level_ssim(gl, lv, origin, cams + nv, refs + nv, nh, size, ctx, &ssim_after, err);
     if (!rc) {
         st.ssim_before = ssim_before, st.ssim_after = ssim_after;
+        st.silhouette_before = sil_before, st.silhouette_after = sil_after;
         if (stats)
             *stats = st;
     }
