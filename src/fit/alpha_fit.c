@@ -22,6 +22,8 @@
 
 enum { GROW = 0, SHRINK = 1, HOLD = 2 };
 
+#define GROW_MIN 0.02f
+
 typedef struct vote {
     uint32_t texel;
     uint32_t kind;
@@ -68,7 +70,9 @@ static void view_vote(const asp_dps_level *lv, const double origin[3], const asp
         for (size_t k = 0; k < nf; k++) {
             if (f[k].a > draw->alpha_ref && (front == SIZE_MAX || f[k].z < f[front].z))
                 front = k;
-            if (nearest == SIZE_MAX || f[k].z < f[nearest].z)
+            // growth only where the domain's basis function already reaches (alpha > 0): the empty
+            // corners of a rectangle grown over a neighbour's pixels showed as dust in held-out views
+            if (f[k].a > GROW_MIN && (nearest == SIZE_MAX || f[k].z < f[nearest].z))
                 nearest = k;
         }
         int want = ref->pixels[4 * p + 3] != 0, have = front != SIZE_MAX;
