@@ -102,6 +102,36 @@ static int simplify(const asp_mesh *m, size_t target, asp_mesh **out, asp_error 
     return asp_error_set(err, ASP_EDEGENERATE, "cannot simplify to %zu triangles", target);
 }
 
+/* meshoptimizer at <= limit GPU bytes (asp_mesh_gpu_bytes, as eval's mesh-bytes row): the triangle target bisected. */
+static int simplify_bytes(const asp_mesh *m, size_t limit, asp_mesh **out, asp_error *err)
+{
+    size_t lo = 0, hi = m->triangle_count;
+    asp_mesh *best = NULL;
+    while (lo + 1 < hi && !(lo && hi - lo <= lo / 100)) {
+        size_t t = lo + (hi - lo) / 2;
+        asp_mesh *s = NULL;
+        int rc = asp_mesh_simplify(
+            m, &(asp_mesh_simplify_desc){.target_triangles = t, .flags = ASP_MESH_SIMPLIFY_SLOPPY_FALLBACK}, NULL,
+            &s, NULL, err);
+        if (rc) {
+            asp_mesh_destroy(best);
+            return rc;
+        }
+        if (asp_mesh_gpu_bytes(s, NULL) <= limit) {
+            asp_mesh_destroy(best);
+            best = s;
+            lo = t;
+        } else {
+            asp_mesh_destroy(s);
+            hi = t;
+        }
+    }
+    if (!best)
+        return asp_error_set(err, ASP_EDEGENERATE, "no simplification within %zu bytes", limit);
+    *out = best;
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 4) {
@@ -137,13 +167,18 @@ int main(int argc, char **argv)
     }
     const char *model = strrchr(argv[1], '/') ? strrchr(argv[1], '/') + 1 : argv[1];
     printf("model,level,primitives,triangles,size,ssim_unfitted,ssim_fitted,ssim_mesh,fitted_beats_mesh,"
-           "unfitted_beats_mesh,fitted_beats_unfitted,views,cpu_gl_ssim_min\n");
+           "unfitted_beats_mesh,fitted_beats_unfitted,views,cpu_gl_ssim_min,fitted_bytes,bytes_triangles,"
+           "ssim_mesh_bytes,fitted_beats_mesh_bytes\n");
     static const uint32_t sizes[2] = {128, 256};
     for (size_t l = 0; l < fit->level_count; l++) {
         const asp_dps_level *lu = &unfit->levels[l], *lf = &fit->levels[l];
         asp_mesh *simple = NULL;
         if (simplify(mesh, lf->prim_count, &simple, &err))
             return fail("simplify", &err);
+        size_t fbytes = asp_dps_level_gpu_bytes(lf, NULL);
+        asp_mesh *eqb = NULL;
+        if (simplify_bytes(mesh, fbytes, &eqb, &err))
+            return fail("simplify to bytes", &err);
         char name[16];
         asp_dps_level_name(fit, l, name);
         // the CPU rasteriser the fit solves with against GL, crease clipping off
@@ -168,8 +203,8 @@ int main(int argc, char **argv)
         for (int si = 0; si < 2; si++) {
             uint32_t size = sizes[si];
             asp_image refs[MAX_VIEWS];
-            double su[MAX_VIEWS], sf[MAX_VIEWS], sm[MAX_VIEWS];
-            asp_renderer *rm = NULL, *ru = NULL, *rf = NULL, *rs = NULL;
+            double su[MAX_VIEWS], sf[MAX_VIEWS], sm[MAX_VIEWS], sb[MAX_VIEWS];
+            asp_renderer *rm = NULL, *ru = NULL, *rf = NULL, *rs = NULL, *rb = NULL;
             char pu[512], pf[512], ps[512], pr[512];
             snprintf(pu, sizeof pu, "%s/%s-%s-unfitted", png_dir ? png_dir : ".", model, name);
             snprintf(pf, sizeof pf, "%s/%s-%s-fitted", png_dir ? png_dir : ".", model, name);
@@ -198,17 +233,24 @@ int main(int argc, char **argv)
                 rc = render_ssim(gl, rf, cams, refs, nviews, size, sf, png_dir ? pf : NULL, &err);
             if (!rc)
                 rc = render_ssim(gl, rs, cams, refs, nviews, size, sm, png_dir ? ps : NULL, &err);
+            if (!rc)
+                rc = make_renderer(gl, "mesh", NULL, eqb, origin, 0, &rb, &err);
+            if (!rc)
+                rc = render_ssim(gl, rb, cams, refs, nviews, size, sb, NULL, &err);
             if (rc)
                 return fail("render", &err);
-            printf("%s,%s,%zu,%zu,%u,%.4f,%.4f,%.4f,%zu,%zu,%zu,%zu,%.4f\n", model, name, lf->prim_count,
-                   simple->triangle_count, size, mean(su, nviews), mean(sf, nviews), mean(sm, nviews),
-                   wins(sf, sm, nviews), wins(su, sm, nviews), wins(sf, su, nviews), nviews, cpu_gl);
+            printf("%s,%s,%zu,%zu,%u,%.4f,%.4f,%.4f,%zu,%zu,%zu,%zu,%.4f,%zu,%zu,%.4f,%zu\n", model, name,
+                   lf->prim_count, simple->triangle_count, size, mean(su, nviews), mean(sf, nviews), mean(sm, nviews),
+                   wins(sf, sm, nviews), wins(su, sm, nviews), wins(sf, su, nviews), nviews, cpu_gl, fbytes,
+                   eqb->triangle_count, mean(sb, nviews), wins(sf, sb, nviews));
             fflush(stdout);
             asp_renderer_destroy(rm), asp_renderer_destroy(ru), asp_renderer_destroy(rf), asp_renderer_destroy(rs);
+            asp_renderer_destroy(rb);
             for (size_t v = 0; v < nviews; v++)
                 asp_image_release(&refs[v]);
         }
         asp_mesh_destroy(simple);
+        asp_mesh_destroy(eqb);
     }
     asp_gl_context_destroy(gl);
     asp_dps_destroy(unfit), asp_dps_destroy(fit);

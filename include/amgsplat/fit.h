@@ -75,6 +75,8 @@ typedef struct asp_fit_desc {
     double smooth;           /* weight of the squared differences of neighbouring texels' corrections, same
                                 scale (0 = 4; < 0 = none; bunny 351 primitives at 256 px: 0.5 lost
                                 SSIM to the unfitted level on 13 of 16 held-out views, 4 won all 16) */
+    uint64_t texels;         /* asp_fit_run: texel budget of the level (asp_fit_budget) before fitting; 0 = keep */
+    size_t bytes;            /* asp_fit_run: GPU-byte budget (asp_dps_level_gpu_bytes); 0 = keep */
     int alpha_rounds;        /* asp_fit_run: silhouette rounds of asp_fit_alpha before the colour (0 = 8; < 0 = none) */
     double alpha_step;       /* largest alpha change of a texel per round (0 = 0.08) */
     asp_fit_draw draw;
@@ -128,6 +130,18 @@ int asp_fit_alpha(asp_dps_level *lv, const double origin[3], const asp_fit_view 
                   size_t nviews, const asp_fit_desc *desc, const asp_context *ctx, size_t *mismatch_before,
                   size_t *mismatch_after, asp_error *err);
 
+/**
+ * The texel budget: scales every texture of lv by one factor (aspect kept, at
+ * least 4x4, never up), the largest for which the level holds at most texels
+ * texels and at most bytes GPU bytes (asp_dps_level_gpu_bytes; either 0 = no
+ * limit), then resamples them (asp_dps_level_resize, pad texels of padding).
+ * Fit afterwards: the budget decides the resolution, the fit the texels.
+ * Returns 0, ASP_EINVAL (no budget, or one below 4x4 texels a primitive),
+ * ASP_EUNSUPPORTED, ASP_ENOMEM.
+ */
+int asp_fit_budget(asp_dps_level *lv, uint64_t texels, size_t bytes, uint32_t pad, const asp_context *ctx,
+                   asp_error *err);
+
 /** The source a fit matches: a mesh (its own render) or a point set (its blended splats). */
 typedef struct asp_fit_reference {
     const asp_mesh *mesh;    /* drawn by the mesh renderer; or NULL */
@@ -138,8 +152,9 @@ typedef struct asp_fit_reference {
  * The whole fit of dps->levels[level]: desc->views training cameras and
  * desc->holdout held-out cameras (asp_fit_directions, framed on dps->frame as
  * asp_camera_frame frames every representation), reference images of ref
- * rendered through gl (current on this thread), then asp_fit_alpha (unless
- * desc->alpha_rounds < 0) and asp_fit_color. The held-out SSIM of
+ * rendered through gl (current on this thread), then the texel budget
+ * (asp_fit_budget, when desc->texels or desc->bytes), asp_fit_alpha (unless
+ * desc->alpha_rounds < 0) and asp_fit_color. ssim_before is the level as given. The held-out SSIM of
  * the GL renders before and after go to stats. Needs GL (ASP_EUNSUPPORTED
  * "built without GL" otherwise); errors as asp_fit_color, ASP_EGL.
  */

@@ -6,7 +6,8 @@
 static const char usage[] =
     "usage: amgsplat fit IN.dps -o OUT.dps [--reference SOURCE] [--texture IMG] [--level L]\n"
     "                    [--views V] [--holdout H] [--size PX] [--iterations N] [--seed S]\n"
-    "                    [--lambda X] [--smooth X] [--json]\n"
+    "                    [--lambda X] [--smooth X] [--texels N | --bytes B] [--alpha-rounds N]\n"
+    "                    [--alpha-step X] [--json]\n"
     "\n"
     "Fits the colour texels of every level (or --level L) so that the level drawn by the\n"
     "default (normalized) method matches reference images of SOURCE from V views spread\n"
@@ -14,7 +15,9 @@ static const char usage[] =
     "else a point set's blended splats (points, or the .amg's points). SOURCE defaults to\n"
     "the file the .dps was built from. H further views, not used in fitting, report the\n"
     "gain (mean squared error of linear RGB, and SSIM of the default render). Geometry and\n"
-    "alpha (the basis functions) are not changed. Progress and the loss go to stderr.";
+    "alpha inside the surface are not changed; alpha near the silhouette is fitted first.\n"
+    "--texels/--bytes scale every texture down to a budget before fitting. Progress and the\n"
+    "loss go to stderr.";
 
 #include <stdio.h>
 #include <string.h>
@@ -54,6 +57,7 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
     size_t views = 64, holdout = 16, iterations = 60, size = 128, seed = 1;
     double lambda = 0.0, smooth = 0.0, alpha_step = 0.0;
     int alpha_rounds = 8;
+    size_t texels = 0, bytes = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output .dps"},
         {"reference", 'r', CLI_STRING, &reference, "SOURCE", "mesh or point set to match (default: the source)"},
@@ -66,6 +70,8 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
         {"seed", 0, CLI_SIZE, &seed, "S", "rotates the view lattices (default 1)"},
         {"lambda", 0, CLI_DOUBLE, &lambda, "X", "pull towards the unfitted texels (default 0.1)"},
         {"smooth", 0, CLI_DOUBLE, &smooth, "X", "smoothness of the correction (default 4; negative: none)"},
+        {"texels", 0, CLI_SIZE, &texels, "N", "texel budget per level: textures scaled down to fit, then fitted"},
+        {"bytes", 0, CLI_SIZE, &bytes, "B", "GPU-byte budget per level (as info and eval count them)"},
         {"alpha-rounds", 0, CLI_INT, &alpha_rounds, "N", "silhouette rounds on alpha (default 8; 0: colour only)"},
         {"alpha-step", 0, CLI_DOUBLE, &alpha_step, "X", "largest alpha change per round (default 0.08)"},
         {0},
@@ -121,6 +127,7 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
     asp_fit_reference ref = {.mesh = mesh, .cloud = amg ? asp_amg_cloud(amg) : cloud};
     asp_fit_desc desc = {.views = views, .holdout = holdout, .size = (uint32_t)size,
                          .iterations = (uint32_t)iterations, .seed = seed, .lambda = lambda, .smooth = smooth,
+                         .texels = texels, .bytes = bytes,
                          .alpha_rounds = alpha_rounds ? alpha_rounds : -1, .alpha_step = alpha_step,
                          .log = log_stderr, .log_user = env};
     for (size_t l = first; l < last && !rc; l++) {
@@ -143,6 +150,10 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
             cJSON_AddItemToObject(o, "holdout_after", cli_json_number("%.9g", st.holdout_after));
             cJSON_AddItemToObject(o, "ssim_before", cli_json_number("%.6f", st.ssim_before));
             cJSON_AddItemToObject(o, "ssim_after", cli_json_number("%.6f", st.ssim_after));
+            cJSON_AddNumberToObject(o, "texels", (double)dps->levels[l].texels);
+            cJSON_AddNumberToObject(o, "bytes", (double)asp_dps_level_gpu_bytes(&dps->levels[l], NULL));
+            cJSON_AddNumberToObject(o, "silhouette_before", (double)st.silhouette_before);
+            cJSON_AddNumberToObject(o, "silhouette_after", (double)st.silhouette_after);
             cJSON_AddNumberToObject(o, "texels_seen", (double)st.texels_seen);
             cJSON_AddNumberToObject(o, "pixels", (double)st.pixels);
             cJSON_AddNumberToObject(o, "iterations", st.iterations);

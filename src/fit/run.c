@@ -174,6 +174,8 @@ int asp_fit_run(asp_gl_context *gl, asp_dps *dps, size_t level, const asp_fit_re
         rc = level_ssim(gl, lv, origin, cams + nv, refs + nv, nh, size, ctx, &ssim_before, err);
     asp_fit_stats st = {0};
     size_t sil_before = 0, sil_after = 0;
+    if (!rc && (desc.texels || desc.bytes))
+        rc = asp_fit_budget(lv, desc.texels, desc.bytes, dps->desc.padding ? dps->desc.padding : 2, ctx, err);
     if (!rc && desc.alpha_rounds >= 0)
         rc = asp_fit_alpha(lv, origin, views, refs, nv, &desc, ctx, &sil_before, &sil_after, err);
     if (!rc)
