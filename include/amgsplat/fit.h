@@ -94,7 +94,7 @@ typedef struct asp_fit_stats {
     size_t texels_seen;               /* texels with data */
     size_t pixels;                    /* covered training pixels */
     uint32_t iterations;
-    double seconds;
+    double seconds;                   /* asp_fit_color: the solve; asp_fit_run: the whole call */
 } asp_fit_stats;
 
 /**

@@ -243,7 +243,8 @@ static int solve(const system *s, const asp_fit_desc *desc, uint32_t iterations,
     for (size_t i = 0; i < n; i++)
         z[i] = m[i] * r[i], p[i] = z[i];
     double rz = dot(s, r, z, partial), rz0 = rz;
-    log_line(desc, "fit: iteration %.0f: training loss %.6g (mean squared error of linear RGB)", 0.0, data_loss(s, d, zr));
+    log_line(desc, "fit: iteration %.0f: training loss %.6g (mean squared error of linear RGB)", 0.0,
+             data_loss(s, d, zr));
     uint32_t it = 0;
     for (; it < iterations && rz > 1e-14 * rz0 && rz > 0; it++) {
         apply_a(s, p, zr, q);

@@ -136,6 +136,7 @@ static int level_ssim(asp_gl_context *gl, const asp_dps_level *lv, const double 
 int asp_fit_run(asp_gl_context *gl, asp_dps *dps, size_t level, const asp_fit_reference *ref,
                 const asp_fit_desc *desc_in, const asp_context *ctx, asp_fit_stats *stats, asp_error *err)
 {
+    double t0 = asp_time_now();
     asp_fit_desc desc = desc_in ? *desc_in : (asp_fit_desc){0};
     size_t nv = desc.views ? desc.views : 64, nh = desc.holdout ? desc.holdout : 16;
     uint32_t size = desc.size ? desc.size : 128;
@@ -185,6 +186,7 @@ int asp_fit_run(asp_gl_context *gl, asp_dps *dps, size_t level, const asp_fit_re
     if (!rc) {
         st.ssim_before = ssim_before, st.ssim_after = ssim_after;
         st.silhouette_before = sil_before, st.silhouette_after = sil_after;
+        st.seconds = asp_time_now() - t0; // the whole fit: references, budget, alpha, colour, the SSIM renders
         if (stats)
             *stats = st;
     }

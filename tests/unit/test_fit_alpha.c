@@ -94,7 +94,8 @@ static void test_budget(void)
         for (uint32_t y = 0; y < h[i]; y++)
             differ += memcmp(same.atlas.pixels + 4 * ((size_t)(same.prims[i].tex_y + y) * same.atlas.width +
                                                       same.prims[i].tex_x),
-                             lv.atlas.pixels + 4 * ((size_t)(lv.prims[i].tex_y + y) * lv.atlas.width + lv.prims[i].tex_x),
+                             lv.atlas.pixels +
+                                 4 * ((size_t)(lv.prims[i].tex_y + y) * lv.atlas.width + lv.prims[i].tex_x),
                              4 * (size_t)w[i]) != 0;
     CHECK_MSG(differ == 0, "%zu texture rows differ after a resize to the same sizes", differ);
     free(same.prims);
