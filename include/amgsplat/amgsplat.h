@@ -21,6 +21,7 @@
 #include "prim.h"
 #include "export.h"
 #include "render.h"
+#include "fit.h"
 #include "scene.h"
 #include "instances.h"
 #include "scene_renderer.h"

@@ -476,6 +476,17 @@ int asp_dps_level_pick(const asp_dps_level *src, size_t prim, const asp_context 
                        asp_error *err);
 
 /**
+ * Resamples every primitive's texture of lv to tex_w[i] x tex_h[i] texels (each 1..16384; box filter
+ * when shrinking, colour averaged in linear light; bilinear-like when growing), alpha and the normal
+ * atlas alike, and packs them into a new atlas with pad texels of clamp-to-edge padding, as the
+ * build does; geometry is kept (texel becomes the mean of the two edge lengths). Used by the texel
+ * budget of asp_fit (issue 27). Returns 0, ASP_EINVAL, ASP_EUNSUPPORTED (atlas over 16384 a side),
+ * ASP_ENOMEM; lv is unchanged on failure. Thread-safe on distinct levels.
+ */
+int asp_dps_level_resize(asp_dps_level *lv, const uint32_t *tex_w, const uint32_t *tex_h, uint32_t pad,
+                         const asp_context *ctx, asp_error *err);
+
+/**
  * The kept Delaunay triangles of the affine method (thesis 3.3.3, Fig. 3.8)
  * of every primitive of dps->levels[index], for the thesis viewer's
  * triangulation drawing (appendix C). The triangles are not stored in a

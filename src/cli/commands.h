@@ -19,6 +19,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env);
 int cmd_view(int argc, char **argv, struct cli_env *env);
 int cmd_eval(int argc, char **argv, struct cli_env *env);
 int cmd_simplify(int argc, char **argv, struct cli_env *env);
+int cmd_fit(int argc, char **argv, struct cli_env *env);
 int cmd_bench_paper(int argc, char **argv, struct cli_env *env);
 int cmd_export(int argc, char **argv, struct cli_env *env);
 int cmd_scene(int argc, char **argv, struct cli_env *env);

@@ -26,6 +26,7 @@ static const struct cli_command commands[] = {
     {"decompose", cmd_decompose, "multiscale AMG decomposition of a point set into domains"},
     {"simplify", cmd_simplify, "simplify a mesh to N triangles (meshoptimizer), keeping UVs and textures"},
     {"build", cmd_build, "domain primitives (textured polygons) of AMG levels into a .dps file"},
+    {"fit", cmd_fit, "fit the textures of .dps levels to images of their source (mesh or points)"},
     {"export", cmd_export, "glTF 2.0 (.glb/.gltf) of domain primitives, point sets and hierarchies"},
     {"view", cmd_view, "open a window on points or an .amg decomposition (interactive viewer)"},
     {"eval", cmd_eval, "measure every representation against the reference: PSNR, SSIM, IoU, frame time"},
