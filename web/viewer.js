@@ -378,16 +378,18 @@ class Viewer {
 
   // The splats of a points node: per point its ellipse axes u a, v b from the Gaussian
   // (rotation columns x, y; semi-axes 2 sigma, export.md), colour (linear), normal. Attributes are
-  // read through getX.. (which undo KHR_mesh_quantization's normalized integers); quantised
-  // positions get the node's scale here, so the splat mesh carries the translation only.
+  // read through getX.. (which undo KHR_mesh_quantization's normalized integers); the centres get
+  // the node's transform here (translation, and the scale that undoes the 16-bit positions), as
+  // the splat shader works in the scene's frame without a model matrix.
   splatPasses(points) {
     const g = points.geometry, n = g.attributes.position.count;
     const rot = g.attributes['khr_gaussian_splatting:rotation'], scale = g.attributes['khr_gaussian_splatting:scale'];
-    const P = g.attributes.position, N = g.attributes.normal, s = points.scale;
+    const P = g.attributes.position, N = g.attributes.normal, at = new THREE.Vector3();
+    points.updateMatrix();
     const U = new Float32Array(3 * n), V = new Float32Array(3 * n), C = new Float32Array(4 * n);
     const centers = new Float32Array(3 * n), normals = new Float32Array(3 * n);
     for (let i = 0; i < n; i++) {
-      centers.set([P.getX(i) * s.x, P.getY(i) * s.y, P.getZ(i) * s.z], 3 * i);
+      centers.set(at.fromBufferAttribute(P, i).applyMatrix4(points.matrix).toArray(), 3 * i);
       if (N) normals.set([N.getX(i), N.getY(i), N.getZ(i)], 3 * i);
       const x = rot.getX(i), y = rot.getY(i), z = rot.getZ(i), w = rot.getW(i);
       const a = 2 * Math.exp(scale.getX(i)), b = 2 * Math.exp(scale.getY(i));
@@ -417,7 +419,7 @@ class Viewer {
     });
     const mesh = new THREE.Mesh(geo, depth);
     mesh.frustumCulled = false;
-    mesh.position.copy(points.position); // the node's (origin-free) translation
+    // at the identity: the centres already hold the node's transform (uEye is in the same frame)
     return { mesh, points, depth, accum, uniforms };
   }
 
