@@ -63,8 +63,8 @@ int asp__gltf_init(asp__gltf *g, const char *path, const char *generator_note, c
     g->materials = cJSON_CreateArray();
     g->meshes = cJSON_CreateArray();
     g->nodes = cJSON_CreateArray();
-    if (!g->root || !asset || !g->extensions_used || !g->extensions_required || !g->buffer_views || !g->accessors || !g->images ||
-        !g->textures || !g->samplers || !g->materials || !g->meshes || !g->nodes) {
+    if (!g->root || !asset || !g->extensions_used || !g->extensions_required || !g->buffer_views || !g->accessors ||
+        !g->images || !g->textures || !g->samplers || !g->materials || !g->meshes || !g->nodes) {
         asp__gltf_release(g);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the glTF document of '%s'", path);
     }
@@ -73,8 +73,8 @@ int asp__gltf_init(asp__gltf *g, const char *path, const char *generator_note, c
 
 void asp__gltf_release(asp__gltf *g)
 {
-    cJSON *arrays[] = {g->extensions_used, g->extensions_required, g->buffer_views, g->accessors, g->images, g->textures,
-                       g->samplers, g->materials, g->meshes, g->nodes};
+    cJSON *arrays[] = {g->extensions_used, g->extensions_required, g->buffer_views, g->accessors, g->images,
+                       g->textures, g->samplers, g->materials, g->meshes, g->nodes};
     // arrays not yet moved into root are owned here (finish_json clears those it moves)
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         cJSON_Delete(arrays[i]);
