@@ -322,7 +322,8 @@ static void test_points_utm(void)
         CHECK_NEAR(sh[3 * 37 + 0] * 0.2820947917738781 + 0.5, 37 / 255.0, 1e-6);
     glb_free(&g);
     // without splats: plain points, no extension
-    CHECK_OK(asp_gltf_export_cloud(c, path, &(asp_gltf_desc){.flags = ASP_GLTF_NO_SPLATS | ASP_GLTF_PLAIN}, NULL, &st, &err), &err);
+    CHECK_OK(asp_gltf_export_cloud(c, path, &(asp_gltf_desc){.flags = ASP_GLTF_NO_SPLATS | ASP_GLTF_PLAIN}, NULL, &st,
+                                   &err), &err);
     if (glb_read(path, &g) == 0)
         CHECK(cJSON_GetObjectItemCaseSensitive(g.json, "extensionsUsed") == NULL);
     glb_free(&g);
@@ -401,7 +402,8 @@ static void test_points_compact(void)
     float scale[3 * N], sh[3 * N];
     bad = bad || !ppos || decode_view(&gc, (int)num(ac, "POSITION"), q, N, 8) ||
           decode_view(&gc, (int)num(ac, "NORMAL"), nrm, N, 4) || decode_view(&gc, (int)num(ac, "COLOR_0"), col, N, 4) ||
-          decode_view(&gc, (int)num(ac, names[1]), rot, N, 8) || decode_view(&gc, (int)num(ac, names[2]), scale, N, 12) ||
+          decode_view(&gc, (int)num(ac, names[1]), rot, N, 8) ||
+          decode_view(&gc, (int)num(ac, names[2]), scale, N, 12) ||
           decode_view(&gc, (int)num(ac, names[3]), op, N, 4) || decode_view(&gc, (int)num(ac, names[4]), sh, N, 12);
     CHECK_MSG(!bad, "compact views do not decode");
     const cJSON *node = at(gc.json, "nodes", 0);
