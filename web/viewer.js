@@ -7,6 +7,9 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+// EXT_meshopt_compression (amgsplat export's default for points, docs/cli/export.md): the decoder
+// three ships (meshoptimizer's WebAssembly decoder, filters included)
+import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 
 const status = { ready: false, error: null, info: null };
 window.amgsplatViewer = status;
@@ -261,6 +264,7 @@ class Viewer {
 
   async open(buffer, name, resourcePath = '') {
     const loader = new GLTFLoader();
+    loader.setMeshoptDecoder(MeshoptDecoder);
     const gltf = await loader.parseAsync(buffer, resourcePath);
     this.gltf = gltf;
     // an unlit material (KHR_materials_unlit) becomes a MeshBasicMaterial, which drops the
@@ -373,12 +377,20 @@ class Viewer {
   }
 
   // The splats of a points node: per point its ellipse axes u a, v b from the Gaussian
-  // (rotation columns x, y; semi-axes 2 sigma, export.md), colour (linear), normal.
+  // (rotation columns x, y; semi-axes 2 sigma, export.md), colour (linear), normal. Attributes are
+  // read through getX.. (which undo KHR_mesh_quantization's normalized integers); the centres get
+  // the node's transform here (translation, and the scale that undoes the 16-bit positions), as
+  // the splat shader works in the scene's frame without a model matrix.
   splatPasses(points) {
     const g = points.geometry, n = g.attributes.position.count;
     const rot = g.attributes['khr_gaussian_splatting:rotation'], scale = g.attributes['khr_gaussian_splatting:scale'];
+    const P = g.attributes.position, N = g.attributes.normal, at = new THREE.Vector3();
+    points.updateMatrix();
     const U = new Float32Array(3 * n), V = new Float32Array(3 * n), C = new Float32Array(4 * n);
+    const centers = new Float32Array(3 * n), normals = new Float32Array(3 * n);
     for (let i = 0; i < n; i++) {
+      centers.set(at.fromBufferAttribute(P, i).applyMatrix4(points.matrix).toArray(), 3 * i);
+      if (N) normals.set([N.getX(i), N.getY(i), N.getZ(i)], 3 * i);
       const x = rot.getX(i), y = rot.getY(i), z = rot.getZ(i), w = rot.getW(i);
       const a = 2 * Math.exp(scale.getX(i)), b = 2 * Math.exp(scale.getY(i));
       U.set([(1 - 2 * (y * y + z * z)) * a, 2 * (x * y + w * z) * a, 2 * (x * z - w * y) * a], 3 * i);
@@ -389,10 +401,9 @@ class Viewer {
     const geo = new THREE.InstancedBufferGeometry();
     // the equilateral triangle around the unit circle (splat_renderer.c)
     geo.setAttribute('position', new THREE.Float32BufferAttribute([-1.7320508, -1, 0, 1.7320508, -1, 0, 0, 2, 0], 3));
-    geo.setAttribute('center', new THREE.InstancedBufferAttribute(g.attributes.position.array.slice(0, 3 * n), 3));
+    geo.setAttribute('center', new THREE.InstancedBufferAttribute(centers, 3));
     geo.setAttribute('axisU', new THREE.InstancedBufferAttribute(U, 3));
     geo.setAttribute('axisV', new THREE.InstancedBufferAttribute(V, 3));
-    const normals = g.attributes.normal ? g.attributes.normal.array.slice(0, 3 * n) : new Float32Array(3 * n);
     geo.setAttribute('splatNormal', new THREE.InstancedBufferAttribute(normals, 3));
     geo.setAttribute('splatColor', new THREE.InstancedBufferAttribute(C, 4));
     geo.instanceCount = n;
@@ -408,7 +419,7 @@ class Viewer {
     });
     const mesh = new THREE.Mesh(geo, depth);
     mesh.frustumCulled = false;
-    mesh.position.copy(points.position); // the node's (origin-free) translation
+    // at the identity: the centres already hold the node's transform (uEye is in the same frame)
     return { mesh, points, depth, accum, uniforms };
   }
 

@@ -23,7 +23,9 @@ typedef enum asp_gltf_alpha_mode {
 enum asp_gltf_flags {
     ASP_GLTF_LIT = 1 << 0,           /* primitives: metallic-roughness material instead of KHR_materials_unlit */
     ASP_GLTF_NO_NORMAL_MAP = 1 << 1, /* primitives: leave the level's normal map out */
-    ASP_GLTF_NO_SPLATS = 1 << 2      /* points: plain POINTS, no KHR_gaussian_splatting attributes */
+    ASP_GLTF_NO_SPLATS = 1 << 2,     /* points: plain POINTS, no KHR_gaussian_splatting attributes */
+    ASP_GLTF_PLAIN = 1 << 3          /* points: float attributes, uncompressed (no KHR_mesh_quantization,
+                                        no EXT_meshopt_compression), in input order */
 };
 
 /** Options; the zero value means the defaults. */
@@ -71,13 +73,20 @@ int asp_gltf_export_dps(const asp_dps *dps, const char *path, const asp_gltf_des
                         asp_error *err);
 
 /**
- * Writes the points of hier (its point splats, in input order) to path as
- * glTF POINTS: POSITION, NORMAL, COLOR_0 (linear RGBA), and unless
- * ASP_GLTF_NO_SPLATS the ellipses of seed 001 as a KHR_gaussian_splatting
- * primitive (asp_gltf_gaussian_from_ellipse): ROTATION, SCALE, OPACITY and
- * SH_DEGREE_0_COEF_0, the extension in extensionsUsed only. Positions are
- * relative to the hierarchy's origin (asp_hier_origin), kept in the node's
- * translation; the frame asp_hier_frame in scene.extras.amgsplat.
+ * Writes the points of hier (its point splats) to path as glTF POINTS:
+ * POSITION, NORMAL, COLOR_0 (linear RGBA), and unless ASP_GLTF_NO_SPLATS the
+ * ellipses of seed 001 as a KHR_gaussian_splatting primitive
+ * (asp_gltf_gaussian_from_ellipse): ROTATION, SCALE, OPACITY and
+ * SH_DEGREE_0_COEF_0, that extension in extensionsUsed only. By default the
+ * attributes are quantised (KHR_mesh_quantization: positions 16-bit in the
+ * points' box, which the node's translation and uniform scale undo; normals
+ * octahedral 8-bit; colours and opacity 8-bit; rotations 12-bit quaternions;
+ * scales and SH exponential-filtered floats) and compressed with
+ * meshoptimizer's vertex codec (EXT_meshopt_compression), points in
+ * meshopt_spatialSortRemap order; both extensions are required.
+ * ASP_GLTF_PLAIN writes float attributes in input order, as glTF core.
+ * Positions are relative to the hierarchy's origin (asp_hier_origin), kept
+ * in the node's translation; the frame asp_hier_frame in scene.extras.amgsplat.
  * Errors, file kinds and stats as asp_gltf_export_dps. Thread-safe.
  */
 int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,

@@ -5,14 +5,16 @@
  */
 static const char usage[] =
     "usage: amgsplat export IN -o OUT.glb|OUT.gltf [--level L[,L...]|all] [--alpha-mode blend|mask]\n"
-    "                       [--alpha-cutoff X] [--lit] [--no-normal-map] [--no-splats] [--json]\n"
+    "                       [--alpha-cutoff X] [--lit] [--no-normal-map] [--no-splats] [--plain]\n"
+    "                       [--json]\n"
     "\n"
     "Writes glTF 2.0: one binary .glb, or a .gltf with OUT.bin and OUT_<image>.png beside it.\n"
     "A .dps becomes one textured quad per domain primitive (its support rectangle, as amgsplat\n"
     "render draws it), the atlas as PNG in baseColorTexture, alpha blended (or masked), double-\n"
     "sided, unlit (KHR_materials_unlit) unless --lit, the normal map as normalTexture; each level\n"
     "a node and a scene named by level. A point set (.ply, .xyz, ...) or .hier becomes POINTS with\n"
-    "POSITION, NORMAL, COLOR_0 and seed 001's splat ellipses as KHR_gaussian_splatting Gaussians.\n"
+    "POSITION, NORMAL, COLOR_0 and seed 001's splat ellipses as KHR_gaussian_splatting Gaussians,\n"
+    "quantised (KHR_mesh_quantization) and compressed (EXT_meshopt_compression) unless --plain.\n"
     "Positions are relative to the model's origin, kept in the node translation.";
 
 #include <stdio.h>
@@ -27,7 +29,7 @@ static const char usage[] =
 struct export_opts {
     const char *output, *level, *alpha_mode;
     double alpha_cutoff;
-    int lit, no_normal_map, no_splats;
+    int lit, no_normal_map, no_splats, plain;
 };
 
 /* --level "L-6,L" or "all" into indices of dps->levels; returns the count, 0 on error (printed). */
@@ -91,6 +93,7 @@ static int print_result(const struct cli_env *env, const char *in, const char *o
             cJSON_AddBoolToObject(j, "unlit", !(d->flags & ASP_GLTF_LIT));
         } else {
             cJSON_AddBoolToObject(j, "gaussian_splats", !(d->flags & ASP_GLTF_NO_SPLATS));
+            cJSON_AddBoolToObject(j, "compressed", !(d->flags & ASP_GLTF_PLAIN));
         }
         return cli_json_print(env, j);
     }
@@ -128,7 +131,7 @@ static int check_options(struct cli_env *env, const struct export_opts *o, asp_g
         return cli_usage_error(env, "--alpha-cutoff needs --alpha-mode mask");
     d->alpha_cutoff = (float)o->alpha_cutoff;
     d->flags = (o->lit ? ASP_GLTF_LIT : 0u) | (o->no_normal_map ? ASP_GLTF_NO_NORMAL_MAP : 0u) |
-               (o->no_splats ? ASP_GLTF_NO_SPLATS : 0u);
+               (o->no_splats ? ASP_GLTF_NO_SPLATS : 0u) | (o->plain ? ASP_GLTF_PLAIN : 0u);
     return 0;
 }
 
@@ -195,6 +198,8 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
         {"lit", 0, CLI_FLAG, &o.lit, NULL, ".dps: PBR material (lit by the viewer) instead of KHR_materials_unlit"},
         {"no-normal-map", 0, CLI_FLAG, &o.no_normal_map, NULL, ".dps: leave the normal map out"},
         {"no-splats", 0, CLI_FLAG, &o.no_splats, NULL, "points: plain POINTS without the KHR_gaussian_splatting ellipses"},
+        {"plain", 0, CLI_FLAG, &o.plain, NULL, "points: float attributes, uncompressed, in input order (default: "
+                                                "quantised, meshopt-compressed)"},
         {0},
     };
     int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -224,5 +229,7 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
                                     "inputs");
     if (is_dps && o.no_splats)
         return cli_usage_error(env, "--no-splats is for point inputs");
+    if (is_dps && o.plain)
+        return cli_usage_error(env, "--plain is for point inputs (primitive levels are always written plain)");
     return is_dps ? export_dps(env, in, &o, &d) : export_points(env, in, type.kind == ASP_FILE_HIER, &o, &d);
 }

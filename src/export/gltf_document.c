@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include <meshoptimizer.h>
 #include <stb/stb_image_write.h>
 
 #include "export/internal.h"
@@ -53,6 +54,7 @@ int asp__gltf_init(asp__gltf *g, const char *path, const char *generator_note, c
         cJSON_AddStringToObject(asset, "generator", gen);
     }
     g->extensions_used = cJSON_CreateArray();
+    g->extensions_required = cJSON_CreateArray();
     g->buffer_views = cJSON_CreateArray();
     g->accessors = cJSON_CreateArray();
     g->images = cJSON_CreateArray();
@@ -61,8 +63,8 @@ int asp__gltf_init(asp__gltf *g, const char *path, const char *generator_note, c
     g->materials = cJSON_CreateArray();
     g->meshes = cJSON_CreateArray();
     g->nodes = cJSON_CreateArray();
-    if (!g->root || !asset || !g->extensions_used || !g->buffer_views || !g->accessors || !g->images ||
-        !g->textures || !g->samplers || !g->materials || !g->meshes || !g->nodes) {
+    if (!g->root || !asset || !g->extensions_used || !g->extensions_required || !g->buffer_views || !g->accessors ||
+        !g->images || !g->textures || !g->samplers || !g->materials || !g->meshes || !g->nodes) {
         asp__gltf_release(g);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the glTF document of '%s'", path);
     }
@@ -71,8 +73,8 @@ int asp__gltf_init(asp__gltf *g, const char *path, const char *generator_note, c
 
 void asp__gltf_release(asp__gltf *g)
 {
-    cJSON *arrays[] = {g->extensions_used, g->buffer_views, g->accessors, g->images, g->textures,
-                       g->samplers, g->materials, g->meshes, g->nodes};
+    cJSON *arrays[] = {g->extensions_used, g->extensions_required, g->buffer_views, g->accessors, g->images,
+                       g->textures, g->samplers, g->materials, g->meshes, g->nodes};
     // arrays not yet moved into root are owned here (finish_json clears those it moves)
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         cJSON_Delete(arrays[i]);
@@ -143,6 +145,54 @@ int asp__gltf_view(asp__gltf *g, const void *data, size_t size, int target)
         cJSON_AddNumberToObject(v, "byteLength", (double)size);
         if (target)
             cJSON_AddNumberToObject(v, "target", target);
+    }
+    return asp__gltf_append(g, g->buffer_views, v);
+}
+
+int asp__gltf_view_meshopt(asp__gltf *g, const void *data, size_t count, size_t stride, const char *filter)
+{
+    ASP_ASSERT(stride % 4 == 0 && stride > 0 && stride <= 256);
+    size_t bound = meshopt_encodeVertexBufferBound(count, stride);
+    unsigned char *enc = asp_alloc(g->ctx, bound);
+    if (!enc) {
+        g->failed = 1;
+        return -1;
+    }
+    size_t size = meshopt_encodeVertexBuffer(enc, bound, data, count, stride);
+    // EXT_meshopt_compression decodes vertex codec version 0 only (header byte 0xa0); Debian's 0.18
+    // writes it, a later library might default to version 1, which the extension's decoders refuse
+    size_t offset = 0;
+    if (size == 0 || enc[0] != 0xa0 || bin_append(g, enc, size, &offset)) {
+        asp_free(g->ctx, enc);
+        g->failed = 1;
+        return -1;
+    }
+    asp_free(g->ctx, enc);
+    size_t raw = count * stride;
+    cJSON *v = cJSON_CreateObject();
+    cJSON *ext = v ? cJSON_AddObjectToObject(cJSON_AddObjectToObject(v, "extensions"), "EXT_meshopt_compression")
+                   : NULL;
+    if (ext) {
+        // the view proper (what a decoder fills) in the data-less fallback buffer 1
+        cJSON_AddNumberToObject(v, "buffer", 1);
+        cJSON_AddNumberToObject(v, "byteOffset", (double)g->fallback_size);
+        cJSON_AddNumberToObject(v, "byteLength", (double)raw);
+        cJSON_AddNumberToObject(v, "byteStride", (double)stride);
+        cJSON_AddNumberToObject(v, "target", ASP__GL_ARRAY_BUFFER);
+        cJSON_AddNumberToObject(ext, "buffer", 0);
+        cJSON_AddNumberToObject(ext, "byteOffset", (double)offset);
+        cJSON_AddNumberToObject(ext, "byteLength", (double)size);
+        cJSON_AddNumberToObject(ext, "byteStride", (double)stride);
+        cJSON_AddNumberToObject(ext, "count", (double)count);
+        cJSON_AddStringToObject(ext, "mode", "ATTRIBUTES");
+        if (filter && strcmp(filter, "NONE") != 0)
+            cJSON_AddStringToObject(ext, "filter", filter);
+    }
+    g->fallback_size += (raw + 3) & ~(size_t)3;
+    asp__gltf_require_extension(g, "EXT_meshopt_compression");
+    if (v && !ext) {
+        cJSON_Delete(v);
+        v = NULL;
     }
     return asp__gltf_append(g, g->buffer_views, v);
 }
@@ -285,6 +335,19 @@ void asp__gltf_use_extension(asp__gltf *g, const char *name)
         g->failed = 1;
 }
 
+void asp__gltf_require_extension(asp__gltf *g, const char *name)
+{
+    asp__gltf_use_extension(g, name);
+    cJSON *e;
+    cJSON_ArrayForEach(e, g->extensions_required)
+    {
+        if (cJSON_IsString(e) && strcmp(e->valuestring, name) == 0)
+            return;
+    }
+    if (!cJSON_AddItemToArray(g->extensions_required, cJSON_CreateString(name)))
+        g->failed = 1;
+}
+
 cJSON *asp__gltf_extras(const char *kind, const char *source, const double origin[3], const asp_frame *frame)
 {
     cJSON *extras = cJSON_CreateObject();
@@ -324,8 +387,21 @@ static int finish_json(asp__gltf *g)
         cJSON_AddStringToObject(b, "uri", uri);
     }
     cJSON_AddItemToArray(buffers, b);
+    if (g->fallback_size) {
+        // EXT_meshopt_compression's fallback buffer: the decoded views' home, no uri, no data
+        cJSON *f = cJSON_CreateObject();
+        cJSON *fe = f ? cJSON_AddObjectToObject(cJSON_AddObjectToObject(f, "extensions"), "EXT_meshopt_compression")
+                      : NULL;
+        if (!fe || !cJSON_AddItemToArray(buffers, f)) {
+            cJSON_Delete(f);
+            return -1;
+        }
+        cJSON_AddNumberToObject(f, "byteLength", (double)g->fallback_size);
+        cJSON_AddTrueToObject(fe, "fallback");
+    }
     struct { const char *name; cJSON **array; } parts[] = {
-        {"extensionsUsed", &g->extensions_used}, {"bufferViews", &g->buffer_views}, {"accessors", &g->accessors},
+        {"extensionsUsed", &g->extensions_used}, {"extensionsRequired", &g->extensions_required},
+        {"bufferViews", &g->buffer_views}, {"accessors", &g->accessors},
         {"images", &g->images}, {"samplers", &g->samplers}, {"textures", &g->textures},
         {"materials", &g->materials}, {"meshes", &g->meshes}, {"nodes", &g->nodes}};
     for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++) {

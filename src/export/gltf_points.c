@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include <meshoptimizer.h>
+
 #include "export/internal.h"
 #include "util/banned.h"
 
@@ -113,6 +115,21 @@ static void fill_points(const asp_hier *hier, point_arrays *a, int splats)
     }
 }
 
+static void splat_extension(asp__gltf *g, cJSON *attrs, cJSON *pr, const int acc[4])
+{
+    cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:ROTATION", acc[0]);
+    cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:SCALE", acc[1]);
+    cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:OPACITY", acc[2]);
+    cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:SH_DEGREE_0_COEF_0", acc[3]);
+    cJSON *ext = cJSON_AddObjectToObject(pr, "extensions");
+    cJSON *k = cJSON_AddObjectToObject(ext, "KHR_gaussian_splatting");
+    cJSON_AddStringToObject(k, "kernel", "ellipse");
+    cJSON_AddStringToObject(k, "colorSpace", "srgb_rec709_display");
+    cJSON_AddStringToObject(k, "projection", "perspective");
+    cJSON_AddStringToObject(k, "sortingMethod", "cameraDistance");
+    asp__gltf_use_extension(g, "KHR_gaussian_splatting");
+}
+
 static int add_points_mesh(asp__gltf *g, const point_arrays *a, size_t n, int splats)
 {
     int pos = asp__gltf_accessor(g, asp__gltf_view(g, a->pos, n * 12, ASP__GL_ARRAY_BUFFER), ASP__GL_FLOAT, n,
@@ -137,17 +154,7 @@ static int add_points_mesh(asp__gltf *g, const point_arrays *a, size_t n, int sp
         int sh = asp__gltf_accessor(g, asp__gltf_view(g, a->sh0, n * 12, ASP__GL_ARRAY_BUFFER), ASP__GL_FLOAT, n,
                                     "VEC3", 0, NULL, NULL);
         ok = ok && rot >= 0 && sc >= 0 && op >= 0 && sh >= 0;
-        cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:ROTATION", rot);
-        cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:SCALE", sc);
-        cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:OPACITY", op);
-        cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:SH_DEGREE_0_COEF_0", sh);
-        cJSON *ext = cJSON_AddObjectToObject(pr, "extensions");
-        cJSON *k = cJSON_AddObjectToObject(ext, "KHR_gaussian_splatting");
-        cJSON_AddStringToObject(k, "kernel", "ellipse");
-        cJSON_AddStringToObject(k, "colorSpace", "srgb_rec709_display");
-        cJSON_AddStringToObject(k, "projection", "perspective");
-        cJSON_AddStringToObject(k, "sortingMethod", "cameraDistance");
-        asp__gltf_use_extension(g, "KHR_gaussian_splatting");
+        splat_extension(g, attrs, pr, (const int[4]){rot, sc, op, sh});
     }
     cJSON_AddItemToObject(pr, "attributes", attrs);
     cJSON_AddNumberToObject(pr, "mode", 0); // POINTS
@@ -156,6 +163,117 @@ static int add_points_mesh(asp__gltf *g, const point_arrays *a, size_t n, int sp
     cJSON_AddStringToObject(mesh, "name", "points");
     int m = asp__gltf_append(g, g->meshes, mesh);
     return ok && m >= 0 ? m : -1;
+}
+
+/* The compact points' node transform: world offset = translation + scale * q (q: 16-bit position). */
+typedef struct compact_node {
+    double translation[3], scale;
+} compact_node;
+
+/*
+ * The compact form (issue 32, the encodings of gltfpack): points in meshopt_spatialSortRemap order
+ * (neighbours next to each other is what the vertex codec's byte deltas compress), then
+ *  POSITION  VEC3 unsigned short (stride 8): q = round((p - lo) / s), s = the box's longest side / 65535,
+ *            the same s on all axes so that the node's scale leaves normals and splat shapes unskewed;
+ *  NORMAL    VEC3 byte normalized (stride 4) through the OCTAHEDRAL filter (8 bits): three.js's
+ *            MeshoptDecoder undoes the filter, so the page sees plain int8 xyz (KHR_mesh_quantization);
+ *  COLOR_0   VEC4 unsigned byte normalized, linear (8 bits, gltfpack's choice);
+ *  ROTATION  VEC4 short normalized (stride 8) through the QUATERNION filter (12 bits);
+ *  SCALE     VEC3 float, EXPONENTIAL filter (12-bit mantissa: ln sigma to ~0.1 %);
+ *  OPACITY   unsigned byte normalized (stride 4: vertex attributes are 4-byte aligned);
+ *  SH0       VEC3 float, EXPONENTIAL filter (10-bit mantissa: below half an 8-bit colour step).
+ * Each view is one vertex stream of EXT_meshopt_compression (mode ATTRIBUTES).
+ */
+static int add_points_compact(asp__gltf *g, const point_arrays *a, size_t n, int splats, const double origin[3],
+                              compact_node *node)
+{
+    unsigned *remap = asp_alloc(NULL, n * sizeof *remap);
+    uint8_t *buf = asp_alloc(NULL, n * 16);
+    float *tmp = asp_alloc(NULL, n * 16);
+    int mesh = -1;
+    if (!remap || !buf || !tmp) {
+        g->failed = 1;
+        goto done;
+    }
+    meshopt_spatialSortRemap(remap, a->pos, n, 12); // remap[input index] = output index
+    double side = 0;
+    for (int k = 0; k < 3; k++) {
+        side = fmax(side, (double)a->hi[k] - a->lo[k]);
+        node->translation[k] = origin[k] + a->lo[k];
+    }
+    double s = side > 0 ? side / 65535.0 : 1.0;
+    node->scale = s;
+    uint16_t *q = (uint16_t *)buf;
+    float qmin[3] = {65535, 65535, 65535}, qmax[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        uint16_t *o = q + 4 * (size_t)remap[i];
+        for (int k = 0; k < 3; k++) {
+            double v = fmin(fmax(rint(((double)a->pos[3 * i + k] - a->lo[k]) / s), 0.0), 65535.0);
+            o[k] = (uint16_t)v;
+            qmin[k] = fminf(qmin[k], (float)v);
+            qmax[k] = fmaxf(qmax[k], (float)v);
+        }
+        o[3] = 0;
+    }
+    int pos = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, q, n, 8, "NONE"), ASP__GL_UNSIGNED_SHORT, n, "VEC3",
+                                 0, qmin, qmax);
+    for (size_t i = 0; i < n; i++) {
+        float *o = tmp + 4 * (size_t)remap[i];
+        memcpy(o, a->nrm + 3 * i, 12);
+        o[3] = 0;
+    }
+    meshopt_encodeFilterOct(buf, n, 4, 8, tmp);
+    int nrm = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, buf, n, 4, "OCTAHEDRAL"), ASP__GL_BYTE, n, "VEC3", 1,
+                                 NULL, NULL);
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 4; k++) // 16-bit linear to 8-bit linear
+            buf[4 * (size_t)remap[i] + k] = (uint8_t)((a->color[4 * i + k] * 255u + 32767u) / 65535u);
+    int col = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, buf, n, 4, "NONE"), ASP__GL_UNSIGNED_BYTE, n, "VEC4",
+                                 1, NULL, NULL);
+    cJSON *attrs = cJSON_CreateObject(), *pr = cJSON_CreateObject();
+    cJSON_AddNumberToObject(attrs, "POSITION", pos);
+    cJSON_AddNumberToObject(attrs, "NORMAL", nrm);
+    cJSON_AddNumberToObject(attrs, "COLOR_0", col);
+    int ok = pos >= 0 && nrm >= 0 && col >= 0;
+    if (splats) {
+        int acc[4];
+        for (size_t i = 0; i < n; i++)
+            memcpy(tmp + 4 * (size_t)remap[i], a->rot + 4 * i, 16);
+        meshopt_encodeFilterQuat(buf, n, 8, 12, tmp);
+        acc[0] = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, buf, n, 8, "QUATERNION"), ASP__GL_SHORT, n, "VEC4",
+                                    1, NULL, NULL);
+        for (size_t i = 0; i < n; i++)
+            memcpy(tmp + 3 * (size_t)remap[i], a->scale + 3 * i, 12);
+        meshopt_encodeFilterExp(buf, n, 12, 12, tmp);
+        acc[1] = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, buf, n, 12, "EXPONENTIAL"), ASP__GL_FLOAT, n,
+                                    "VEC3", 0, NULL, NULL);
+        memset(buf, 0, n * 4);
+        for (size_t i = 0; i < n; i++)
+            buf[4 * (size_t)remap[i]] = (uint8_t)lrintf(a->opacity[i] * 255.0f);
+        acc[2] = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, buf, n, 4, "NONE"), ASP__GL_UNSIGNED_BYTE, n,
+                                    "SCALAR", 1, NULL, NULL);
+        for (size_t i = 0; i < n; i++)
+            memcpy(tmp + 3 * (size_t)remap[i], a->sh0 + 3 * i, 12);
+        meshopt_encodeFilterExp(buf, n, 12, 10, tmp);
+        acc[3] = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, buf, n, 12, "EXPONENTIAL"), ASP__GL_FLOAT, n,
+                                    "VEC3", 0, NULL, NULL);
+        ok = ok && acc[0] >= 0 && acc[1] >= 0 && acc[2] >= 0 && acc[3] >= 0;
+        splat_extension(g, attrs, pr, acc);
+    }
+    asp__gltf_require_extension(g, "KHR_mesh_quantization");
+    cJSON_AddItemToObject(pr, "attributes", attrs);
+    cJSON_AddNumberToObject(pr, "mode", 0); // POINTS
+    cJSON *m = cJSON_CreateObject();
+    cJSON_AddItemToArray(cJSON_AddArrayToObject(m, "primitives"), pr);
+    cJSON_AddStringToObject(m, "name", "points");
+    mesh = asp__gltf_append(g, g->meshes, m);
+    if (!ok)
+        mesh = -1;
+done:
+    asp_free(NULL, remap);
+    asp_free(NULL, buf);
+    asp_free(NULL, tmp);
+    return mesh;
 }
 
 int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,
@@ -189,13 +307,19 @@ int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_
         goto done;
     }
     fill_points(hier, &a, splats);
-    int mesh = add_points_mesh(&g, &a, n, splats);
+    int plain = (d->flags & ASP_GLTF_PLAIN) != 0;
+    compact_node cn = {{0, 0, 0}, 1};
+    int mesh = plain ? add_points_mesh(&g, &a, n, splats) : add_points_compact(&g, &a, n, splats, st.origin, &cn);
     char name[64];
     snprintf(name, sizeof name, "points (%zu)", n);
     cJSON *node = cJSON_CreateObject();
     cJSON_AddStringToObject(node, "name", name);
     cJSON_AddNumberToObject(node, "mesh", mesh);
-    cJSON_AddItemToObject(node, "translation", asp__gltf_numbers(st.origin, 3));
+    cJSON_AddItemToObject(node, "translation", asp__gltf_numbers(plain ? st.origin : cn.translation, 3));
+    if (!plain) {
+        double sc[3] = {cn.scale, cn.scale, cn.scale};
+        cJSON_AddItemToObject(node, "scale", asp__gltf_numbers(sc, 3));
+    }
     if (mesh < 0 || asp__gltf_append(&g, g.nodes, node) < 0) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the glTF document of '%s'", path);
         goto done;

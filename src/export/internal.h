@@ -14,6 +14,7 @@
 enum {
     ASP__GL_BYTE = 5120,
     ASP__GL_UNSIGNED_BYTE = 5121,
+    ASP__GL_SHORT = 5122,
     ASP__GL_UNSIGNED_SHORT = 5123,
     ASP__GL_UNSIGNED_INT = 5125,
     ASP__GL_FLOAT = 5126,
@@ -32,6 +33,8 @@ typedef struct asp__gltf_png {
 typedef struct asp__gltf {
     cJSON *root;
     cJSON *buffer_views, *accessors, *images, *textures, *samplers, *materials, *meshes, *nodes, *extensions_used;
+    cJSON *extensions_required;
+    size_t fallback_size; /* bytes of buffer 1, EXT_meshopt_compression's fallback (no data): 0 = none */
     uint8_t *bin;
     size_t bin_size, bin_capacity;
     asp__gltf_png *pngs;
@@ -49,6 +52,15 @@ void asp__gltf_release(asp__gltf *g);
 
 /* Appends size bytes as a buffer view (target 0 = none); returns its index or -1 (out of memory). */
 int asp__gltf_view(asp__gltf *g, const void *data, size_t size, int target);
+/*
+ * Appends count elements of stride bytes (stride % 4 == 0, <= 256) as a vertex buffer view
+ * compressed with meshoptimizer's vertex codec (EXT_meshopt_compression, mode ATTRIBUTES;
+ * filter "NONE", "OCTAHEDRAL", "QUATERNION" or "EXPONENTIAL" names the meshopt_encodeFilter*
+ * already applied to data). The view itself lies in the fallback buffer 1 (no data, the
+ * extension's "fallback": true), the compressed bytes in buffer 0; the extension is required.
+ * Returns the view's index or -1 (out of memory, or a codec version the extension does not know).
+ */
+int asp__gltf_view_meshopt(asp__gltf *g, const void *data, size_t count, size_t stride, const char *filter);
 /* An accessor over a whole view; min/max (ncomp values each) may be NULL. Returns its index or -1. */
 int asp__gltf_accessor(asp__gltf *g, int view, int component_type, size_t count, const char *type, int normalized,
                        const float *min, const float *max);
@@ -58,6 +70,8 @@ int asp__gltf_image(asp__gltf *g, const uint8_t *rgba, uint32_t width, uint32_t 
 int asp__gltf_texture(asp__gltf *g, int image);
 /* Adds name to extensionsUsed once. */
 void asp__gltf_use_extension(asp__gltf *g, const char *name);
+/* Adds name to extensionsUsed and extensionsRequired once (a viewer without it cannot show the file). */
+void asp__gltf_require_extension(asp__gltf *g, const char *name);
 /* Adds obj to the array (ownership moves); returns its index or -1. */
 int asp__gltf_append(asp__gltf *g, cJSON *array, cJSON *obj);
 /* A cJSON array of n floats (doubles kept exact). */

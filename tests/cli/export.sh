@@ -30,12 +30,13 @@ print('property uchar red\nproperty uchar green\nproperty uchar blue\nend_header
 for i in range(400):
     print('%.3f %.3f 312.125 %d 90 200' % (500000.003 + 0.01 * (i % 20), 5000000.001 + 0.01 * (i // 20), i % 256))
 " >"$T/utm.ply"
-"$AMGSPLAT" export "$T/utm.ply" -o "$T/utm.glb" --json >"$T/utm.json"
+# --plain: float offsets from the origin in the node translation, input order (issue 16's layout)
+"$AMGSPLAT" export "$T/utm.ply" -o "$T/utm.glb" --plain --json >"$T/utm.json"
 glb_json "$T/utm.glb" >"$T/utm.gltf.json"
 python3 -c "
 import json, sys
 r = json.load(open(sys.argv[1])); g = json.load(open(sys.argv[2]))
-assert r['points'] == 400 and r['files'] == 1 and r['gaussian_splats'], r
+assert r['points'] == 400 and r['files'] == 1 and r['gaussian_splats'] and not r['compressed'], r
 t = g['nodes'][0]['translation']
 assert t == r['origin'] and abs(t[0] - 500000) < 1 and abs(t[1] - 5000000) < 1, (t, r['origin'])
 acc = g['accessors'][g['meshes'][0]['primitives'][0]['attributes']['POSITION']]
@@ -45,10 +46,45 @@ assert abs(acc['max'][0] - acc['min'][0] - 0.19) < 1e-6, acc
 assert g['extensionsUsed'] == ['KHR_gaussian_splatting'] and 'extensionsRequired' not in g, g.get('extensionsUsed')
 " "$T/utm.json" "$T/utm.gltf.json" || fail "UTM export: $(cat "$T/utm.json")"
 validate "$T/utm.glb"
+# the default (issue 32): 16-bit positions in the points' box, which the node's translation (origin + box
+# minimum) and uniform scale (longest side / 65535) undo; meshopt-compressed views in buffer 0 whose
+# decoded form lives in the data-less fallback buffer 1; both extensions required
+"$AMGSPLAT" export "$T/utm.ply" -o "$T/utmc.glb" --json >"$T/utmc.json"
+glb_json "$T/utmc.glb" >"$T/utmc.gltf.json"
+python3 -c "
+import json, sys
+r = json.load(open(sys.argv[1])); g = json.load(open(sys.argv[2]))
+assert r['points'] == 400 and r['compressed'] and r['gaussian_splats'], r
+n = g['nodes'][0]; t = n['translation']; s = n['scale']
+assert s[0] == s[1] == s[2] and abs(s[0] - 0.19 / 65535) < 1e-9, s
+acc = g['accessors'][g['meshes'][0]['primitives'][0]['attributes']['POSITION']]
+assert acc['componentType'] == 5123 and acc['min'] == [0, 0, 0] and acc['max'][0] == 65535, acc
+# world = translation + scale * q: the box's corners are the first and last point to a micrometre
+assert abs(t[0] - 500000.003) < 1e-6 and abs(t[1] - 5000000.001) < 1e-6 and abs(t[2] - 312.125) < 1e-6, t
+assert abs(t[0] + s[0] * acc['max'][0] - 500000.193) < 1e-6 and abs(t[1] + s[1] * acc['max'][1] - 5000000.191) < 3e-6, (t, acc)
+assert sorted(g['extensionsRequired']) == ['EXT_meshopt_compression', 'KHR_mesh_quantization'], g['extensionsRequired']
+assert 'KHR_gaussian_splatting' in g['extensionsUsed']
+fb = g['buffers'][1]
+assert 'uri' not in fb and fb['extensions']['EXT_meshopt_compression']['fallback'] is True, fb
+for v in g['bufferViews']:
+    e = v['extensions']['EXT_meshopt_compression']
+    assert v['buffer'] == 1 and e['buffer'] == 0 and e['mode'] == 'ATTRIBUTES' and e['count'] == 400, v
+    assert v['byteLength'] == e['count'] * e['byteStride'] == e['count'] * v['byteStride'] and v['byteStride'] % 4 == 0, v
+    assert v['byteOffset'] + v['byteLength'] <= fb['byteLength'] and e['byteOffset'] + e['byteLength'] <= g['buffers'][0]['byteLength'], v
+filters = {k: g['bufferViews'][g['accessors'][a]['bufferView']]['extensions']['EXT_meshopt_compression'].get('filter')
+           for k, a in g['meshes'][0]['primitives'][0]['attributes'].items()}
+assert filters['NORMAL'] == 'OCTAHEDRAL' and filters['KHR_gaussian_splatting:ROTATION'] == 'QUATERNION', filters
+assert filters['KHR_gaussian_splatting:SCALE'] == 'EXPONENTIAL' and filters['POSITION'] is None, filters
+" "$T/utmc.json" "$T/utmc.gltf.json" || fail "compact UTM export: $(cat "$T/utmc.json")"
+validate "$T/utmc.glb"
+"$AMGSPLAT" export "$T/utm.ply" -o "$T/utmc.gltf" -q
+validate "$T/utmc.gltf"
 # without the splat attributes the points are plain glTF: no error at all, even those of the
 # attributes this validator release does not know (KHR_gaussian_splatting:*)
-"$AMGSPLAT" export "$T/utm.ply" -o "$T/plain.glb" --no-splats -q
+"$AMGSPLAT" export "$T/utm.ply" -o "$T/plain.glb" --no-splats --plain -q
 validate "$T/plain.glb" --strict
+"$AMGSPLAT" export "$T/utm.ply" -o "$T/nosplat.glb" --no-splats -q
+validate "$T/nosplat.glb" --strict
 if [[ -d "$web/node_modules/gltf-validator" ]] && command -v node >/dev/null; then
   node "$web/test/validate.mjs" "$T/utm.glb" --strict >/dev/null 2>&1 && fail "--strict accepted the splat attributes"
 fi
@@ -82,6 +118,18 @@ print(min(lv, key=lambda l: (abs(l['unknowns'] - 400), l['level']))['name'])")
   "$AMGSPLAT" export "$T/b.dps" -o "$T/mask.glb" --alpha-mode mask -q
   "$AMGSPLAT" export "$T/multi.dps" -o "$T/multi.glb" -q
   "$AMGSPLAT" export "$T/bunny.ply" -o "$T/points.glb" -q
+  "$AMGSPLAT" export "$T/bunny.ply" -o "$T/points_plain.glb" --plain --json >"$T/pp.json"
+  "$AMGSPLAT" export "$T/bunny.ply" -o "$T/points_c.glb" --json >"$T/pc.json"
+  "$AMGSPLAT" export "$T/bunny.ply" -o "$T/points_ns.glb" --no-splats --json >"$T/pn.json"
+  # issue 32's sizes are for 1M points (docs/web.md: 10.7 and 4.9 bytes a point); 30,000 points lie
+  # 33 times sparser, so the deltas the codec keeps are larger: 13.1 and 6.3 bytes a point measured
+  python3 -c "
+import json, sys
+p, c, n = (json.load(open(f)) for f in sys.argv[1:4])
+assert p['bytes'] / p['points'] > 75 and c['points'] == n['points'] == 30000, (p, c)
+assert c['bytes'] / c['points'] <= 14.5 and n['bytes'] / n['points'] <= 7.5, (c['bytes'], n['bytes'])
+print('bunny 30000 points: plain %.1f, compact %.2f, without splats %.2f bytes a point' % tuple(r['bytes'] / 30000 for r in (p, c, n)))
+" "$T/pp.json" "$T/pc.json" "$T/pn.json" || fail "compact sizes: $(cat "$T/pc.json" "$T/pn.json")"
   for f in b bn multi mask points; do glb_json "$T/$f.glb" >"$T/$f.gltf.json"; done
   python3 -c "
 import json, sys
@@ -120,6 +168,7 @@ c = [(a + b) / 2 for a, b in zip(i['bbox_min'], i['bbox_max'])]
 assert sum((x - y) ** 2 for x, y in zip(c, f['center'])) ** 0.5 < 0.25 * f['radius'], (c, f)
 " "$T/info.json" "$T/b.gltf.json" || fail "assimp's view of b.glb: $(cat "$T/info.json")"
   [[ -s "$T/bn.bin" && -s "$T/bn_${level}_atlas.png" && -s "$T/bn_${level}_normal.png" ]] || fail "bn.gltf: files missing"
+  expect_fail 2 "--plain is for point inputs" "$AMGSPLAT" export "$T/b.dps" -o "$T/x.glb" --plain
   expect_fail 1 "no level 'L-9'" "$AMGSPLAT" export "$T/multi.dps" -o "$T/x.glb" --level L-9
   expect_fail 2 "names level 'L-4' twice" "$AMGSPLAT" export "$T/multi.dps" -o "$T/x.glb" --level L-4,L-4
   "$AMGSPLAT" export "$T/multi.dps" -o "$T/two.glb" --level L-2,L-6 --json >"$T/two.json"
@@ -131,7 +180,8 @@ assert r['nodes'] == 2 and r['primitives'] > 18 + 96, r" "$T/two.json" ||
   head -c 5000 "$T/b.dps" >"$T/cut.dps"
   expect_fail 1 "cut.dps" "$AMGSPLAT" export "$T/cut.dps" -o "$T/x.glb"
   [[ ! -e "$T/x.glb" ]] || fail "a failed export left an output file"
-  for f in b.glb bn.glb bn.gltf mask.glb multi.glb points.glb; do validate "$T/$f"; done
+  for f in b.glb bn.glb bn.gltf mask.glb multi.glb points.glb points_plain.glb; do validate "$T/$f"; done
+  validate "$T/points_ns.glb" --strict
 
   # a .hier (written by tools/seed_hier: no command saves one)
   seed_hier="$(dirname "$AMGSPLAT")/seed_hier"

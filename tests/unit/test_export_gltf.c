@@ -1,12 +1,15 @@
 /*
  * glTF export (issue 16): the Gaussian of a splat ellipse (KHR_gaussian_splatting), the GLB
  * container, quads that are the renderer's support rectangles with its texture coordinates, and
- * UTM-size coordinates kept exact through the node translation.
+ * UTM-size coordinates kept exact through the node translation; the compact points (issue 32:
+ * KHR_mesh_quantization + EXT_meshopt_compression) decoded with meshoptimizer's own decoder give
+ * back the plain export's values within their quantisation steps.
  */
 #include <errno.h>
 #include <sys/stat.h>
 
 #include <cjson/cJSON.h>
+#include <meshoptimizer.h>
 
 #include "amgsplat/amgsplat.h"
 #include "harness.h"
@@ -84,6 +87,12 @@ static const float *accessor_floats(const glb *g, int index, size_t *count)
     *count = (size_t)num(a, "count");
     size_t off = (size_t)num(v, "byteOffset");
     return off % 4 == 0 && off + (size_t)num(v, "byteLength") <= g->bin_size ? (const float *)(g->bin + off) : NULL;
+}
+
+static double srgb_to_linear_ref(uint8_t c)
+{
+    double x = c / 255.0;
+    return x <= 0.04045 ? x / 12.92 : pow((x + 0.055) / 1.055, 2.4);
 }
 
 static void test_gaussian_axes(void)
@@ -268,7 +277,8 @@ static void test_points_utm(void)
     }
     char path[600];
     asp_gltf_stats st = {0};
-    CHECK_OK(asp_gltf_export_cloud(c, tmp_path(path, sizeof path, "utm.glb"), NULL, NULL, &st, &err), &err);
+    const asp_gltf_desc plain = {.flags = ASP_GLTF_PLAIN}; // float offsets in input order: read directly
+    CHECK_OK(asp_gltf_export_cloud(c, tmp_path(path, sizeof path, "utm.glb"), &plain, NULL, &st, &err), &err);
     CHECK(st.points == 400 && st.origin[0] == 500000.0 && st.origin[1] == 5000000.0);
     glb g;
     if (glb_read(path, &g)) {
@@ -313,10 +323,133 @@ static void test_points_utm(void)
         CHECK_NEAR(sh[3 * 37 + 0] * 0.2820947917738781 + 0.5, 37 / 255.0, 1e-6);
     glb_free(&g);
     // without splats: plain points, no extension
-    CHECK_OK(asp_gltf_export_cloud(c, path, &(asp_gltf_desc){.flags = ASP_GLTF_NO_SPLATS}, NULL, &st, &err), &err);
+    CHECK_OK(asp_gltf_export_cloud(c, path, &(asp_gltf_desc){.flags = ASP_GLTF_NO_SPLATS | ASP_GLTF_PLAIN}, NULL, &st,
+                                   &err), &err);
     if (glb_read(path, &g) == 0)
         CHECK(cJSON_GetObjectItemCaseSensitive(g.json, "extensionsUsed") == NULL);
     glb_free(&g);
+    asp_cloud_destroy(c);
+}
+
+/* Decodes the EXT_meshopt_compression view of accessor index into out (count x stride bytes). */
+static int decode_view(const glb *g, int index, void *out, size_t count, size_t stride)
+{
+    const cJSON *a = at(g->json, "accessors", index);
+    const cJSON *v = at(g->json, "bufferViews", (int)num(a, "bufferView"));
+    const cJSON *e = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(v, "extensions"),
+                                                      "EXT_meshopt_compression");
+    if (!e || num(e, "count") != (double)count || num(e, "byteStride") != (double)stride || num(v, "buffer") != 1)
+        return -1;
+    size_t off = (size_t)num(e, "byteOffset"), len = (size_t)num(e, "byteLength");
+    if (off + len > g->bin_size || meshopt_decodeVertexBuffer(out, count, stride, g->bin + off, len) != 0)
+        return -1;
+    const cJSON *f = cJSON_GetObjectItemCaseSensitive(e, "filter");
+    const char *filter = cJSON_IsString(f) ? f->valuestring : "NONE";
+    if (strcmp(filter, "OCTAHEDRAL") == 0)
+        meshopt_decodeFilterOct(out, count, stride);
+    else if (strcmp(filter, "QUATERNION") == 0)
+        meshopt_decodeFilterQuat(out, count, stride);
+    else if (strcmp(filter, "EXPONENTIAL") == 0)
+        meshopt_decodeFilterExp(out, count, stride);
+    return 0;
+}
+
+static void test_points_compact(void)
+{
+    enum { N = 400 };
+    asp_cloud *c = NULL;
+    asp_error err = {0};
+    CHECK_OK(asp_cloud_create(N, ASP_ATTR_NORMALS | ASP_ATTR_COLORS, NULL, &c, &err), &err);
+    if (!c)
+        return;
+    c->origin[0] = 500000.0;
+    c->origin[1] = 5000000.0;
+    for (size_t i = 0; i < N; i++) {
+        // a wavy 20 x 20 grid: normals, colours and splat shapes all vary
+        double x = 0.01 * (double)(i % 20), y = 0.01 * (double)(i / 20), z = 0.004 * sin(40 * x) * cos(30 * y);
+        c->positions[3 * i] = (float)x;
+        c->positions[3 * i + 1] = (float)y;
+        c->positions[3 * i + 2] = (float)z;
+        double nx = -0.16 * cos(40 * x) * cos(30 * y), ny = 0.12 * sin(40 * x) * sin(30 * y);
+        double nl = sqrt(nx * nx + ny * ny + 1);
+        c->normals[3 * i] = (float)(nx / nl);
+        c->normals[3 * i + 1] = (float)(ny / nl);
+        c->normals[3 * i + 2] = (float)(1 / nl);
+        uint8_t rgba[4] = {(uint8_t)(i % 256), (uint8_t)(7 * i % 256), 200, 255};
+        memcpy(c->colors + 4 * i, rgba, 4);
+    }
+    char pp[600], cp[600];
+    asp_gltf_stats sp = {0}, sc = {0};
+    CHECK_OK(asp_gltf_export_cloud(c, tmp_path(pp, sizeof pp, "plain.glb"), &(asp_gltf_desc){.flags = ASP_GLTF_PLAIN},
+                                   NULL, &sp, &err), &err);
+    CHECK_OK(asp_gltf_export_cloud(c, tmp_path(cp, sizeof cp, "compact.glb"), NULL, NULL, &sc, &err), &err);
+    CHECK_MSG(sc.file_bytes * 2 < sp.file_bytes, "compact %zu bytes, plain %zu", sc.file_bytes, sp.file_bytes);
+    glb gp, gc;
+    int bad = glb_read(pp, &gp) | glb_read(cp, &gc);
+    CHECK(!bad);
+    const cJSON *ap = cJSON_GetObjectItemCaseSensitive(at(at(gp.json, "meshes", 0), "primitives", 0), "attributes");
+    const cJSON *ac = cJSON_GetObjectItemCaseSensitive(at(at(gc.json, "meshes", 0), "primitives", 0), "attributes");
+    static const char *names[5] = {"NORMAL", "KHR_gaussian_splatting:ROTATION", "KHR_gaussian_splatting:SCALE",
+                                   "KHR_gaussian_splatting:OPACITY", "KHR_gaussian_splatting:SH_DEGREE_0_COEF_0"};
+    const float *plain[6] = {NULL};
+    size_t n = 0;
+    for (int k = 0; !bad && k < 5; k++)
+        plain[k] = accessor_floats(&gp, (int)num(ap, names[k]), &n);
+    const float *ppos = bad ? NULL : accessor_floats(&gp, (int)num(ap, "POSITION"), &n);
+    uint16_t q[4 * N];
+    int8_t nrm[4 * N];
+    uint8_t col[4 * N], op[4 * N];
+    int16_t rot[4 * N];
+    float scale[3 * N], sh[3 * N];
+    bad = bad || !ppos || decode_view(&gc, (int)num(ac, "POSITION"), q, N, 8) ||
+          decode_view(&gc, (int)num(ac, "NORMAL"), nrm, N, 4) || decode_view(&gc, (int)num(ac, "COLOR_0"), col, N, 4) ||
+          decode_view(&gc, (int)num(ac, names[1]), rot, N, 8) ||
+          decode_view(&gc, (int)num(ac, names[2]), scale, N, 12) ||
+          decode_view(&gc, (int)num(ac, names[3]), op, N, 4) || decode_view(&gc, (int)num(ac, names[4]), sh, N, 12);
+    CHECK_MSG(!bad, "compact views do not decode");
+    const cJSON *node = at(gc.json, "nodes", 0);
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(node, "translation");
+    double s = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(node, "scale"), 0)->valuedouble;
+    double worst_pos = 0, worst_nrm = 0, worst_rot = 0, worst_scale = 0, worst_sh = 0;
+    int worst_col = 0, seen[N] = {0}, matched = 0;
+    for (size_t j = 0; !bad && j < N; j++) {
+        double w[3];
+        for (int k = 0; k < 3; k++)
+            w[k] = cJSON_GetArrayItem(t, k)->valuedouble + s * q[4 * j + k] - c->origin[k];
+        // which input point: the grid cell (positions are exact to s / 2 = 2 micrometres)
+        long ix = lround(w[0] / 0.01), iy = lround(w[1] / 0.01);
+        if (ix < 0 || ix >= 20 || iy < 0 || iy >= 20 || seen[iy * 20 + ix]++)
+            continue;
+        size_t i = (size_t)(iy * 20 + ix);
+        matched++;
+        double dot = 0, ql = 0;
+        for (int k = 0; k < 3; k++) {
+            worst_pos = fmax(worst_pos, fabs(w[k] - ppos[3 * i + k]));
+            worst_nrm = fmax(worst_nrm, fabs(fmax(nrm[4 * j + k] / 127.0, -1.0) - plain[0][3 * i + k]));
+            worst_scale = fmax(worst_scale, fabs(scale[3 * j + k] - plain[2][3 * i + k]));
+            worst_sh = fmax(worst_sh, fabs(sh[3 * j + k] - plain[4][3 * i + k]));
+            // linear colour: 8 bits of the 16-bit plain value
+            int want = (int)lrint(srgb_to_linear_ref(c->colors[4 * i + k]) * 255.0);
+            worst_col = abs(col[4 * j + k] - want) > worst_col ? abs(col[4 * j + k] - want) : worst_col;
+        }
+        for (int k = 0; k < 4; k++) {
+            dot += rot[4 * j + k] / 32767.0 * plain[1][4 * i + k];
+            ql += (rot[4 * j + k] / 32767.0) * (rot[4 * j + k] / 32767.0);
+        }
+        worst_rot = fmax(worst_rot, 1 - fabs(dot) / sqrt(ql)); // q and -q are one rotation
+        CHECK(fabs(op[4 * j] / 255.0 - plain[3][i]) < 1e-6);
+    }
+    CHECK_MSG(matched == N, "%d of %d compact points matched a grid point", matched, N);
+    CHECK_MSG(worst_pos <= 0.51 * s + 1e-9, "position error %g (step %g)", worst_pos, s);
+    CHECK_MSG(worst_nrm < 0.02, "normal error %g (8-bit octahedral)", worst_nrm);
+    CHECK_MSG(worst_col <= 1, "colour error %d of 255", worst_col);
+    CHECK_MSG(worst_rot < 1e-5, "rotation 1 - |q.q'| = %g (12-bit quaternion)", worst_rot);
+    CHECK_MSG(worst_scale < 0.01, "ln sigma error %g (12-bit exponential)", worst_scale);
+    CHECK_MSG(worst_sh < 0.01, "SH0 error %g (10-bit exponential; an sRGB step is 0.014)", worst_sh);
+    const cJSON *req = cJSON_GetObjectItemCaseSensitive(gc.json, "extensionsRequired");
+    CHECK(cJSON_GetArraySize(req) == 2);
+    glb_free(&gp);
+    glb_free(&gc);
     asp_cloud_destroy(c);
 }
 
@@ -336,4 +469,5 @@ static void cleanup(void)
 }
 
 TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_gaussian_axes), TEST_CASE(test_dps_quads),
-          TEST_CASE(test_bad_arguments), TEST_CASE(test_points_utm), TEST_FIXTURE(cleanup))
+          TEST_CASE(test_bad_arguments), TEST_CASE(test_points_utm), TEST_CASE(test_points_compact),
+          TEST_FIXTURE(cleanup))
