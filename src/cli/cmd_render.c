@@ -454,6 +454,7 @@ struct view_stats {
     double seconds; /* all asp_render_to_image calls, read-back included */
     asp_frame_budget *budget;        /* --frame-ms: settled before each view, from the last view's state */
     asp_frame_budget_result settled; /* the last view's */
+    const char *compute_path;        /* --renderer compute: the atomics that drew (asp_compute_renderer_path) */
 };
 
 /* Renders the views into tiles[0 .. views-1], every one framed by the scene's frame (asp_camera_frame). */
@@ -484,6 +485,7 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
             return rc;
         vs->seconds += asp_time_now() - t0;
         vs->last_count = asp_renderer_count(r);
+        vs->compute_path = asp_compute_renderer_path(r);
         vs->min_count = vs->last_count < vs->min_count ? vs->last_count : vs->min_count;
         vs->max_count = vs->last_count > vs->max_count ? vs->last_count : vs->max_count;
         rc = asp_progress(&env->ctx, "render", (double)(i + 1) / (double)o->views);
@@ -513,6 +515,8 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     }
     cJSON_AddStringToObject(j, "gl_renderer", asp_gl_context_renderer(gl));
     cJSON_AddStringToObject(j, "gl_backend", asp_gl_context_backend(gl));
+    if (vs->compute_path)
+        cJSON_AddStringToObject(j, "compute_path", vs->compute_path);
     int lod = strcmp(renderer, "disc") && strcmp(renderer, "prim") && strcmp(renderer, "mesh");
     cJSON_AddNumberToObject(j, "primitives", (double)vs->last_count);
     cJSON_AddNumberToObject(j, "primitives_min", (double)vs->min_count);
