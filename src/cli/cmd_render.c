@@ -614,7 +614,7 @@ static int render_instance_scene(const char *path, struct render_opts *o, struct
     asp_image tiles[MAX_VIEWS];
     asp_image sheet = {0, 0, NULL};
     memset(tiles, 0, sizeof tiles);
-    struct view_stats vs = {SIZE_MAX, 0, 0, 0, NULL, {0}};
+    struct view_stats vs = {SIZE_MAX, 0, 0, 0, NULL, {0}, NULL};
     asp_renderer_options ropts;
     renderer_options(o, &ropts);
     asp_scene_desc d = {.level = o->level, .texture = o->texture};
@@ -807,7 +807,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     asp_image tiles[MAX_VIEWS];
     asp_image sheet = {0, 0, NULL};
     memset(tiles, 0, sizeof tiles);
-    struct view_stats vs = {0, 0, 0, 0, NULL, {0}};
+    struct view_stats vs = {0, 0, 0, 0, NULL, {0}, NULL};
     asp_renderer_options ropts;
     renderer_options(&o, &ropts);
     asp_render_source src;
