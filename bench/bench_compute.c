@@ -5,12 +5,15 @@
  * frames each (glFinish-synchronised, the camera turning), points/s and the ratios compute
  * opaque / disc and compute blended / splat. Prints GL_VENDOR, GL_RENDERER and which atomics the
  * compute renderer used. Timings never fail anything.
- * usage: bench_compute [points=1e6,1e7] [size=1024] [frames=5] [splat_max=1e7]
+ * Beside the wall time, the process's CPU time per frame (all threads): on a machine shared by
+ * other jobs llvmpipe's wall time measures the contention, its CPU time the renderer.
+ * usage: bench_compute [points=1e6,1e7] [size=1024] [frames=5] [splat_max=1e7] [which=co,cb,disc,splat]
  *   points: comma-separated sizes; splat_max: the largest N the splat renderer is run at (its
- *   hierarchy build dominates beyond), 0 = never.
+ *   hierarchy build dominates beyond), 0 = never; which: the renderers to run.
  */
 #include <epoxy/gl.h>
 #include <stdio.h>
+#include <sys/resource.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -20,6 +23,26 @@
 enum { MAX_SIZES = 8, MAX_FRAMES = 100 };
 enum { R_COMPUTE_OPAQUE, R_COMPUTE_BLEND, R_DISC, R_SPLAT, R_COUNT };
 static const char *names[R_COUNT] = {"compute opaque", "compute blended", "disc", "splat"};
+static const char *keys[R_COUNT] = {"co", "cb", "disc", "splat"};
+
+/* CPU seconds of the process so far, every thread (llvmpipe's too). */
+static double cpu_seconds(void)
+{
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (double)u.ru_utime.tv_sec + 1e-6 * (double)u.ru_utime.tv_usec + (double)u.ru_stime.tv_sec +
+           1e-6 * (double)u.ru_stime.tv_usec;
+}
+
+/* Whether key is an entry of the comma-separated list. */
+static int listed(const char *list, const char *key)
+{
+    size_t n = strlen(key);
+    for (const char *p = list; (p = strstr(p, key)) != NULL; p += n)
+        if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == '\0'))
+            return 1;
+    return 0;
+}
 
 static int make(asp_gl_context *gl, int which, const asp_cloud *cloud, asp_renderer **r, asp_error *err)
 {
@@ -38,8 +61,8 @@ static int make(asp_gl_context *gl, int which, const asp_cloud *cloud, asp_rende
     return kind->create(gl, &src, &o, NULL, r, err);
 }
 
-/* Median seconds per frame of r, or a negative value after printing the error. */
-static double time_frames(asp_gl_context *gl, asp_renderer *r, uint32_t size, int frames)
+/* Median seconds per frame of r and the mean CPU seconds per frame (*cpu), or a negative value after printing the error. */
+static double time_frames(asp_gl_context *gl, asp_renderer *r, uint32_t size, int frames, double *cpu)
 {
     asp_error err;
     asp_camera cam;
@@ -49,6 +72,7 @@ static double time_frames(asp_gl_context *gl, asp_renderer *r, uint32_t size, in
     double t[MAX_FRAMES];
     // one warm-up frame: shader compilation and target allocation happen on first use
     int rc = asp_render_frame(gl, r, &cam, &desc, &err);
+    double c0 = cpu_seconds();
     for (int f = 0; f < frames && !rc; f++) {
         cam.azimuth += 360.0f / (float)frames;
         double a = asp_time_now();
@@ -59,6 +83,7 @@ static double time_frames(asp_gl_context *gl, asp_renderer *r, uint32_t size, in
         fprintf(stderr, "bench_compute: %s\n", err.msg);
         return -1;
     }
+    *cpu = (cpu_seconds() - c0) / frames;
     return bench_median(t, frames);
 }
 
@@ -85,9 +110,11 @@ int main(int argc, char **argv)
     uint32_t size = argc > 2 ? (uint32_t)atoi(argv[2]) : 1024;
     int frames = argc > 3 ? atoi(argv[3]) : 5;
     double splat_max = argc > 4 ? atof(argv[4]) : 1e7;
+    const char *which = argc > 5 ? argv[5] : "co,cb,disc,splat";
     if (parse_sizes(argc > 1 ? argv[1] : "1e6,1e7", sizes, &nsizes) || size < 16 || size > 8192 || frames < 1 ||
-        frames > MAX_FRAMES || argc > 5) {
-        fprintf(stderr, "usage: bench_compute [points=1e6,1e7] [size=1024] [frames=5] [splat_max=1e7]\n");
+        frames > MAX_FRAMES || argc > 6) {
+        fprintf(stderr, "usage: bench_compute [points=1e6,1e7] [size=1024] [frames=5] [splat_max=1e7] "
+                        "[which=co,cb,disc,splat]\n");
         return 2;
     }
     asp_gl_context *gl = bench_gl_headless("bench_compute");
@@ -109,6 +136,8 @@ int main(int argc, char **argv)
         printf("%zu points (generated in %.1f s)\n", n, asp_time_now() - t0);
         double rate[R_COUNT] = {0};
         for (int w = 0; w < R_COUNT; w++) {
+            if (!listed(which, keys[w]))
+                continue;
             if (w == R_SPLAT && (double)n > splat_max) {
                 printf("  %-16s skipped (N > splat_max %.3g: the hierarchy build dominates)\n", names[w], splat_max);
                 continue;
@@ -122,7 +151,8 @@ int main(int argc, char **argv)
                 break;
             }
             double create = asp_time_now() - c0;
-            double t = time_frames(gl, r, size, frames);
+            double cpu = 0;
+            double t = time_frames(gl, r, size, frames, &cpu);
             const char *path = asp_compute_renderer_path(r);
             size_t drawn = asp_renderer_count(r);
             asp_renderer_destroy(r);
@@ -131,8 +161,9 @@ int main(int argc, char **argv)
                 break;
             }
             rate[w] = (double)n / t;
-            printf("  %-16s %9.2f ms  %9.2f M points/s  (%zu drawn, create %.1f s%s%s)\n", names[w], 1e3 * t,
-                   rate[w] * 1e-6, drawn, create, path ? ", path " : "", path ? path : "");
+            printf("  %-16s %9.2f ms  %9.2f M points/s  cpu %9.2f ms/frame  (%zu drawn, create %.1f s%s%s)\n",
+                   names[w], 1e3 * t, rate[w] * 1e-6, 1e3 * cpu, drawn, create, path ? ", path " : "",
+                   path ? path : "");
         }
         if (rate[R_DISC] > 0 && rate[R_COMPUTE_OPAQUE] > 0)
             printf("  ratio compute opaque / disc    %.2f\n", rate[R_COMPUTE_OPAQUE] / rate[R_DISC]);

@@ -35,7 +35,7 @@ enum {
     GROUP = 256,         /* threads per workgroup */
     SMALL_PIXELS = 64,   /* footprints (pixel-centre bounding boxes) above this go to the big list */
     BIG_GROUPS = 1024,   /* workgroups of the big-list dispatch, striding over the list */
-    SPLAT_WORDS = 8,     /* 32 bytes per splat: centre, colour, oct normal, oct major axis, a, b */
+    SPLAT_WORDS = 8,     /* 32 bytes per splat: centre, colour, the axes a u and b v, oct normal */
     FIXED_ONE = 65536    /* the fixed-point unit of the blended sums */
 };
 
@@ -50,13 +50,13 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     "layout(std430, binding = 3) buffer Color { uint color[]; };\n"                                    \
     "layout(std430, binding = 4) buffer Big { uint big_count; uint big_pad[3]; uvec4 big[]; };\n"      \
     FB64_DECL                                                                                          \
-    "uniform mat4 u_view;\n"                                                                           \
-    "uniform mat4 u_proj;\n"                                                                           \
+    /* in the splats' own frame: the eye, the view direction, the unit direction towards the light */ \
+    "uniform vec3 u_eye;\n"                                                                            \
+    "uniform vec3 u_view_dir;\n"                                                                       \
     "uniform mat4 u_mvp;\n"                                                                            \
     "uniform vec3 u_light;\n"                                                                          \
     "uniform int u_unlit;\n"                                                                           \
     "uniform ivec2 u_size;\n"                                                                          \
-    "uniform float u_scale;\n"                                                                         \
     "uniform int u_persp;\n"                                                                           \
     "uniform int u_pass;\n"                                                                            \
     "uniform int u_big;\n"                                                                             \
@@ -73,101 +73,109 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     "uniform int u_has_colors;\n"                                                                      \
     "uniform vec4 u_default_color;\n"                                                                  \
     "shared bool s_visible;\n"                                                                         \
+    "shared float s_scale;\n"                                                                         \
     "vec3 oct_decode(vec2 e) {\n"                                                                      \
     "    vec3 v = vec3(e, 1.0 - abs(e.x) - abs(e.y));\n"                                               \
     "    if (v.z < 0.0)\n"                                                                             \
     "        v.xy = (1.0 - abs(v.yx)) * vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);\n"     \
     "    return normalize(v);\n"                                                                       \
     "}\n"                                                                                              \
-    "vec3 srgb_to_linear(vec3 c) {\n"                                                                  \
-    "    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));\n" \
+    /* 256 entries: sRGB byte to linear light, so no pow() per splat */                               \
+    "uniform float u_lut[256];\n"                                                                      \
+    /*                                                                                                 \
+     * One splat as the map from its ellipse coordinates q (in semi-axes) to homogeneous pixel         \
+     * coordinates: S [q, 1] = clip.w (x, y, 1), the columns of S being the projected axes a u, b v    \
+     * and centre c. Its inverse takes a pixel centre to [q, 1] / clip.w, so the coverage test of a    \
+     * pixel is three multiply-adds and a comparison, exact as the raster renderers' interpolated      \
+     * ellipse coordinates; the window depth of the plane is affine in the pixel (dz).                 \
+     */                                                                                                \
+    "struct sp { mat3 inv; vec3 dz; float s2; uint pk; vec3 rgb; ivec2 lo, hi; };\n"                   \
+    "vec3 screen_h(vec4 v) {\n"                                                                        \
+    "    return vec3(0.5 * float(u_size.x) * (v.x + v.w), 0.5 * float(u_size.y) * (v.y + v.w), v.w);\n" \
     "}\n"                                                                                              \
-    "vec3 linear_to_srgb(vec3 c) {\n"                                                                  \
-    "    c = clamp(c, 0.0, 1.0);\n"                                                                    \
-    "    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));\n" \
-    "}\n"                                                                                              \
-    /* one splat in eye space, its shaded linear colour and the pixel-centre box of its footprint */   \
-    "struct sp { vec3 c, n, u, v; float a, b, s; vec3 rgb; ivec2 lo, hi; };\n"                        \
-    "bool setup(uvec4 r0, uvec4 r1, out sp s) {\n"                                                     \
-    "    s.c = (u_view * vec4(uintBitsToFloat(r0.xyz), 1.0)).xyz;\n"                                   \
-    "    mat3 m = mat3(u_view);\n"                                                                     \
-    "    s.n = normalize(m * oct_decode(unpackSnorm2x16(r1.x)));\n"                                    \
-    "    vec3 u = m * oct_decode(unpackSnorm2x16(r1.y));\n"                                            \
-    "    s.u = normalize(u - dot(u, s.n) * s.n);\n"                                                    \
-    "    s.v = cross(s.n, s.u);\n"                                                                     \
-    "    s.a = max(uintBitsToFloat(r1.z) * u_radius_scale * u_scale, 1e-30);\n"                        \
-    "    s.b = max(uintBitsToFloat(r1.w) * u_radius_scale * u_scale, 1e-30);\n"                        \
-    "    s.s = u_support;\n"                                                                           \
-    "    vec4 col = u_has_colors != 0 ? unpackUnorm4x8(r0.w) : u_default_color;\n"                     \
-    "    float shade = u_unlit != 0 ? 1.0 : 0.25 + 0.75 * abs(dot(s.n, u_light));\n"                   \
-    "    s.rgb = srgb_to_linear(col.rgb) * shade;\n"                                                   \
-    /* the bounding rectangle of the ellipse, projected: its corners are cc +- cu +- cv */              \
-    "    vec4 cc = u_proj * vec4(s.c, 1.0);\n"                                                         \
-    "    vec4 cu = u_proj * vec4(s.u * (s.a * s.s), 0.0);\n"                                           \
-    "    vec4 cv = u_proj * vec4(s.v * (s.b * s.s), 0.0);\n"                                           \
-    "    vec2 lo = vec2(1e30), hi = vec2(-1e30);\n"                                                    \
-    "    int behind = 0;\n"                                                                            \
-    "    for (int k = 0; k < 4; k++) {\n"                                                              \
-    "        vec4 q = cc + ((k & 1) != 0 ? cu : -cu) + ((k & 2) != 0 ? cv : -cv);\n"                   \
-    "        if (q.w <= 1e-6 * abs(cc.w) || q.w <= 0.0) { behind++; continue; }\n"                     \
-    "        vec2 p = (q.xy / q.w * 0.5 + 0.5) * vec2(u_size);\n"                                      \
-    "        lo = min(lo, p); hi = max(hi, p);\n"                                                      \
+    "bool setup(uvec4 r0, uvec4 r1, float scale, out sp s) {\n"                                       \
+    "    vec3 c = uintBitsToFloat(r0.xyz);\n"                                                          \
+    "    vec2 e0 = unpackSnorm2x16(r1.x), e1 = unpackSnorm2x16(r1.y), e2 = unpackSnorm2x16(r1.z);\n"    \
+    "    float k = scale * u_radius_scale;\n"                                                          \
+    "    vec3 au = vec3(e0, e1.x) * k, bv = vec3(e1.y, e2) * k;\n"                                     \
+    "    s.s2 = u_support * u_support;\n"                                                              \
+    "    vec4 cc = u_mvp * vec4(c, 1.0);\n"                                                            \
+    "    vec4 cu = u_mvp * vec4(au, 0.0);\n"                                                           \
+    "    vec4 cv = u_mvp * vec4(bv, 0.0);\n"                                                           \
+    "    mat3 S = mat3(screen_h(cu), screen_h(cv), screen_h(cc));\n"                                   \
+    /*                                                                                                 \
+     * The tight pixel box: the support circle |q| = s is the conic diag(1, 1, -s^2), its tangent     \
+     * lines the dual conic D = S diag(1, 1, -1 / s^2) S^T in pixels; the vertical tangents x = X     \
+     * solve D00 - 2 X D02 + X^2 D22 = 0 (and y likewise). D22 >= 0: the ellipse reaches the eye      \
+     * plane and its projection is unbounded, so the whole screen is tested.                          \
+     */                                                                                                \
+    "    vec3 s0 = S[0], s1 = S[1], s2 = S[2] * inversesqrt(s.s2);\n"                                  \
+    "    float d00 = s0.x * s0.x + s1.x * s1.x - s2.x * s2.x;\n"                                       \
+    "    float d11 = s0.y * s0.y + s1.y * s1.y - s2.y * s2.y;\n"                                       \
+    "    float d22 = s0.z * s0.z + s1.z * s1.z - s2.z * s2.z;\n"                                       \
+    "    float d02 = s0.x * s0.z + s1.x * s1.z - s2.x * s2.z;\n"                                       \
+    "    float d12 = s0.y * s0.z + s1.y * s1.z - s2.y * s2.z;\n"                                       \
+    "    vec2 lo = vec2(0.0), hi = vec2(u_size);\n"                                                    \
+    "    if (d22 < 0.0) {\n"                                                                           \
+    "        if (!(cc.w > 0.0))\n"                                                                     \
+    "            return false;\n"                                                                      \
+    "        vec2 mid = vec2(d02, d12) / d22;\n"                                                       \
+    "        vec2 ext = sqrt(max(vec2(d02 * d02 - d00 * d22, d12 * d12 - d11 * d22), 0.0)) / abs(d22);\n" \
+    "        lo = mid - ext; hi = mid + ext;\n"                                                      \
     "    }\n"                                                                                          \
-    "    if (behind == 4)\n"                                                                           \
-    "        return false;\n"                                                                          \
-    /* a rectangle crossing the eye plane projects unbounded: test the whole screen */                  \
-    "    if (behind > 0) { lo = vec2(0.0); hi = vec2(u_size); }\n"                                     \
     "    lo = max(lo, vec2(-1.0)); hi = min(hi, vec2(u_size) + 1.0);\n"                                \
     "    s.lo = max(ivec2(ceil(lo - 0.5)), ivec2(0));\n"                                               \
     "    s.hi = min(ivec2(floor(hi - 0.5)), u_size - 1);\n"                                            \
-    "    return s.lo.x <= s.hi.x && s.lo.y <= s.hi.y;\n"                                               \
-    "}\n"                                                                                              \
-    "float window_depth(vec3 p) {\n"                                                                   \
-    "    float zc = u_proj[2][2] * p.z + u_proj[3][2];\n"                                              \
-    "    float wc = u_proj[2][3] * p.z + u_proj[3][3];\n"                                              \
-    "    return wc > 0.0 ? zc / wc * 0.5 + 0.5 : -1.0;\n"                                              \
-    "}\n"                                                                                              \
-    /* pixel (x, y): its ray against the ellipse's plane, then the pass's atomic */                    \
-    "void pixel(sp s, uint pk, int x, int y) {\n"                                                  \
-    "    vec2 ndc = (vec2(x, y) + 0.5) / vec2(u_size) * 2.0 - 1.0;\n"                                  \
-    "    vec3 o, d;\n"                                                                                 \
-    "    if (u_persp != 0) {\n"                                                                        \
-    "        o = vec3(0.0);\n"                                                                         \
-    "        d = vec3((ndc.x + u_proj[2][0]) / u_proj[0][0], (ndc.y + u_proj[2][1]) / u_proj[1][1], -1.0);\n" \
-    "    } else {\n"                                                                                   \
-    "        o = vec3((ndc.x - u_proj[3][0]) / u_proj[0][0], (ndc.y - u_proj[3][1]) / u_proj[1][1], 0.0);\n" \
-    "        d = vec3(0.0, 0.0, -1.0);\n"                                                              \
-    "    }\n"                                                                                          \
-    "    float den = dot(s.n, d);\n"                                                                   \
-    "    if (abs(den) < 1e-12)\n"                                                                      \
-    "        return;\n"                                                                                \
-    "    vec3 p = o + (dot(s.n, s.c - o) / den) * d;\n"                                                \
-    "    vec3 dp = p - s.c;\n"                                                                         \
-    "    vec2 q = vec2(dot(dp, s.u) / s.a, dot(dp, s.v) / s.b);\n"                                     \
-    "    float r2 = dot(q, q);\n"                                                                      \
-    "    if (!(r2 <= s.s * s.s))\n"                                                                    \
-    "        return;\n"                                                                                \
-    "    uint i = uint(y) * uint(u_size.x) + uint(x);\n"                                               \
+    "    if (s.lo.x > s.hi.x || s.lo.y > s.hi.y)\n"                                                    \
+    "        return false;\n"                                                                          \
+    "    float det = determinant(S);\n"                                                                \
+    /* edge-on: the raster renderers' triangle has no area either */                                    \
+    "    if (!(abs(det) > 0.0))\n"                                                                     \
+    "        return false;\n"                                                                          \
+    "    s.inv = inverse(S);\n"                                                                        \
+    "    s.dz = 0.5 * (vec3(cu.z, cv.z, cc.z) * s.inv) + vec3(0.0, 0.0, 0.5);\n"                       \
     "    if (u_pass == 2) {\n"                                                                         \
-    /* seed 001 Fig. 15: the depth pass moves the surface away from the eye by epsilon */               \
-    "        vec3 ray = u_persp != 0 ? p : d;\n"                                                       \
-    "        float len = u_epsilon * (u_eps_uniform != 0 ? u_scale : s.a);\n"        \
-    "        p += len * normalize(ray);\n"                                                             \
+    /* seed 001 Fig. 15: the depth pass moves the splat away from the eye by epsilon along the         \
+       projector of its centre (the raster renderer moves each corner along its own) */                \
+    "        vec3 ray = u_persp != 0 ? c - u_eye : u_view_dir;\n"                                      \
+    "        float len = u_epsilon * (u_eps_uniform != 0 ? 1.0 : length(au));\n"                          \
+    "        vec4 co = cc + u_mvp * vec4(len * normalize(ray), 0.0);\n"                                   \
+    "        s.dz.z += 0.5 * (co.z / co.w - cc.z / cc.w);\n"                                           \
     "    }\n"                                                                                          \
-    "    float z = window_depth(p);\n"                                                                 \
+    "    s.pk = 0u;\n"                                                                                 \
+    "    s.rgb = vec3(0.0);\n"                                                                         \
+    "    if (u_pass == 1 || u_pass == 3 || u_pass == 4) {\n"                                           \
+    "        uint col = u_has_colors != 0 ? r0.w : packUnorm4x8(u_default_color);\n"                   \
+    "        vec3 n = oct_decode(unpackSnorm2x16(r1.w));\n"                                              \
+    "        float shade = u_unlit != 0 ? 1.0 : 0.25 + 0.75 * abs(dot(n, u_light));\n"                 \
+    /* opaque: the sRGB bytes and the shade, turned into light once per pixel by the resolve */          \
+    "        s.pk = (col & 0x00FFFFFFu) | (uint(shade * 255.0 + 0.5) << 24);\n"                        \
+    "        if (u_pass == 3)\n"                                                                       \
+    "            s.rgb = vec3(u_lut[col & 255u], u_lut[(col >> 8) & 255u], u_lut[(col >> 16) & 255u]) * shade;\n" \
+    "    }\n"                                                                                          \
+    "    return true;\n"                                                                               \
+    "}\n"                                                                                              \
+    /* pixel (x, y) against the splat, then the pass's atomic */                                       \
+    "void pixel(sp s, int x, int y) {\n"                                                               \
+    "    vec3 pc = vec3(float(x) + 0.5, float(y) + 0.5, 1.0);\n"                                       \
+    "    vec3 h = s.inv * pc;\n"                                                                       \
+    "    if (!(h.z > 0.0) || !(dot(h.xy, h.xy) <= s.s2 * h.z * h.z))\n"                                \
+    "        return;\n"                                                                                \
+    "    float z = dot(s.dz, pc);\n"                                                                   \
     "    if (!(z >= 0.0 && z <= 1.0))\n"                                                               \
     "        return;\n"                                                                                \
+    "    uint i = uint(y) * uint(u_size.x) + uint(x);\n"                                               \
     "    uint zb = floatBitsToUint(z);\n"                                                              \
     "    if (u_pass == 0 || u_pass == 2) {\n"                                                          \
     "        atomicMin(depth[i], zb);\n"                                                               \
     "    } else if (u_pass == 1) {\n"                                                                  \
     "        if (zb == depth[i])\n"                                                                    \
-    "            color[i] = pk;\n"                                                                 \
+    "            color[i] = s.pk;\n"                                                                   \
     "    } else if (u_pass == 3) {\n"                                                                  \
     "        if (zb > depth[i])\n"                                                                     \
     "            return;\n"                                                                            \
     /* the same formula as asp_splat_kernel_weight */                                                   \
-    "        float r = min(sqrt(r2), s.s) * u_kscale;\n"                                               \
+    "        float r = min(length(h.xy) / h.z, u_support) * u_kscale;\n"                               \
     "        float w = u_kgauss != 0 ? exp(-r * r / (2.0 * u_ksigma * u_ksigma)) : exp(-u_ka * pow(r / u_kb, u_kn));\n" \
     "        uvec3 c = uvec3(s.rgb * (w * 65536.0) + 0.5);\n"                                          \
     "        if (c.r != 0u) atomicAdd(color[4u * i], c.r);\n"                                          \
@@ -184,13 +192,12 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     "        uint n = min(big_count, u_big_cap);\n"                                                    \
     "        for (uint e = gl_WorkGroupID.x; e < n; e += gl_NumWorkGroups.x) {\n"                      \
     "            sp s;\n"                                                                              \
-    "            if (!setup(big[2u * e], big[2u * e + 1u], s))\n"                                      \
+    "            if (!setup(big[3u * e], big[3u * e + 1u], uintBitsToFloat(big[3u * e + 2u].x), s))\n"                                      \
     "                continue;\n"                                                                      \
-    "            uint pk = packUnorm4x8(vec4(linear_to_srgb(s.rgb), 1.0));\n"                      \
     "            int w = s.hi.x - s.lo.x + 1;\n"                                                       \
     "            uint count = uint(w) * uint(s.hi.y - s.lo.y + 1);\n"                                  \
     "            for (uint k = lid; k < count; k += 256u)\n"                                           \
-    "                pixel(s, pk, s.lo.x + int(k % uint(w)), s.lo.y + int(k / uint(w)));\n"        \
+    "                pixel(s, s.lo.x + int(k % uint(w)), s.lo.y + int(k / uint(w)));\n"        \
     "        }\n"                                                                                      \
     "        return;\n"                                                                                \
     "    }\n"                                                                                          \
@@ -205,7 +212,8 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     "            neg += ivec3(lessThan(q.xyz, vec3(-q.w)));\n"                                    \
     "            pos += ivec3(greaterThan(q.xyz, vec3(q.w)));\n"                                  \
     "        }\n"                                                                                      \
-    "        s_visible = all(lessThan(neg, ivec3(8))) && all(lessThan(pos, ivec3(8)));\n"                                              \
+    "        s_visible = all(lessThan(neg, ivec3(8))) && all(lessThan(pos, ivec3(8)));\n"               \
+    "        s_scale = boxes[2u * batch].w;\n"                                              \
     "    }\n"                                                                                          \
     "    barrier();\n"                                                                                 \
     "    if (!s_visible)\n"                                                                            \
@@ -215,20 +223,19 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     "    for (uint j = first + lid; j < last; j += 256u) {\n"                                          \
     "        uvec4 r0 = splats[2u * j], r1 = splats[2u * j + 1u];\n"                                   \
     "        sp s;\n"                                                                                  \
-    "        if (!setup(r0, r1, s))\n"                                                                 \
+    "        if (!setup(r0, r1, s_scale, s))\n"                                                                 \
     "            continue;\n"                                                                          \
     "        int w = s.hi.x - s.lo.x + 1, h = s.hi.y - s.lo.y + 1;\n"                                  \
     "        if (w * h > 64) {\n"                                                                      \
     "            if (u_append != 0) {\n"                                                               \
     "                uint e = atomicAdd(big_count, 1u);\n"                                             \
-    "                if (e < u_big_cap) { big[2u * e] = r0; big[2u * e + 1u] = r1; }\n"               \
+    "                if (e < u_big_cap) { big[3u * e] = r0; big[3u * e + 1u] = r1; big[3u * e + 2u] = uvec4(floatBitsToUint(s_scale)); }\n"               \
     "            }\n"                                                                                  \
     "            continue;\n"                                                                          \
     "        }\n"                                                                                      \
-    "        uint pk = u_pass == 1 || u_pass == 4 ? packUnorm4x8(vec4(linear_to_srgb(s.rgb), 1.0)) : 0u;\n" \
     "        for (int y = s.lo.y; y <= s.hi.y; y++)\n"                                                 \
     "            for (int x = s.lo.x; x <= s.hi.x; x++)\n"                                             \
-    "                pixel(s, pk, x, y);\n"                                                        \
+    "                pixel(s, x, y);\n"                                                        \
     "    }\n"                                                                                          \
     "}\n"
 
@@ -243,7 +250,7 @@ static const char *compute32_src = "#version 450 core\n" COMPUTE_GLSL;
 #define FB64_DECL "layout(std430, binding = 5) buffer Fb64 { uint64_t fb64[]; };\n"
 #define FB64_PASS                                                                  \
     "    else if (u_pass == 4)\n"                                                  \
-    "        atomicMin(fb64[i], packUint2x32(uvec2(pk, zb)));\n"
+    "        atomicMin(fb64[i], packUint2x32(uvec2(s.pk, zb)));\n"
 static const char *compute64_src = "#version 450 core\n"
                                    "#extension GL_ARB_gpu_shader_int64 : require\n"
                                    "#extension GL_NV_shader_atomic_int64 : require\n" COMPUTE_GLSL;
@@ -284,7 +291,8 @@ static const char *resolve_vertex_src =
     "        FETCH_OPAQUE\n"                                                                           \
     "        if (z == 0xFFFFFFFFu)\n"                                                                  \
     "            discard;\n"                                                                           \
-    "        rgb = srgb_to_linear(unpackUnorm4x8(c).rgb);\n"                                           \
+    "        vec4 cs = unpackUnorm4x8(c);\n"                                                          \
+    "        rgb = srgb_to_linear(cs.rgb) * cs.a;\n"                                           \
     "    }\n"                                                                                          \
     "    gl_FragDepth = uintBitsToFloat(z);\n"                                                         \
     "    o_color = vec4(rgb, 1.0);\n"                                                                  \
@@ -300,14 +308,14 @@ static const char *resolve64_src =
     "#define FETCH_OPAQUE if (u_mode == 1) { uvec2 v = unpackUint2x32(fb64[i]); z = v.y; c = v.x; } "
     "else { z = depth[i]; c = color[i]; }\n" RESOLVE_GLSL;
 
-enum { U_VIEW, U_PROJ, U_MVP, U_LIGHT, U_UNLIT, U_SIZE, U_SCALE, U_PERSP, U_PASS, U_BIG, U_APPEND, U_BATCH0,
+enum { U_EYE, U_VIEW_DIR, U_MVP, U_LIGHT, U_UNLIT, U_SIZE, U_PERSP, U_PASS, U_BIG, U_APPEND, U_BATCH0,
        U_POINTS, U_BIG_CAP, U_SUPPORT, U_RADIUS_SCALE, U_EPSILON, U_EPS_UNIFORM, U_KA, U_KB, U_KN, U_KSCALE,
-       U_KSIGMA, U_KGAUSS, U_HAS_COLORS, U_DEFAULT_COLOR, U_COUNT };
+       U_KSIGMA, U_KGAUSS, U_HAS_COLORS, U_DEFAULT_COLOR, U_LUT, U_COUNT };
 static const char *uniform_names[U_COUNT] = {
-    "u_view", "u_proj", "u_mvp", "u_light", "u_unlit", "u_size", "u_scale", "u_persp", "u_pass",
+    "u_eye", "u_view_dir", "u_mvp", "u_light", "u_unlit", "u_size", "u_persp", "u_pass",
     "u_big", "u_append", "u_batch0", "u_points", "u_big_cap", "u_support", "u_radius_scale", "u_epsilon",
     "u_eps_uniform", "u_ka", "u_kb", "u_kn", "u_kscale", "u_ksigma", "u_kgauss", "u_has_colors",
-    "u_default_color"};
+    "u_default_color", "u_lut"};
 
 typedef struct compute_renderer {
     asp_renderer base; // first, so an asp_renderer * is a compute_renderer *
@@ -378,10 +386,11 @@ static int ensure_framebuffer(compute_renderer *c, uint32_t w, uint32_t h, asp_e
     return 0;
 }
 
-/* The uniform scale of the view's linear part (scenes fold a model with a uniform scale into it). */
-static float view_scale(const float *v)
+static void normalize3(float *v)
 {
-    return sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; k++)
+        v[k] = l > 0 ? v[k] / l : 0.0f;
 }
 
 static void mat4_mul(const float *a, const float *b, float *out)
@@ -428,13 +437,22 @@ static int compute_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     const GLint *u = c->u;
     float mvp[16];
     mat4_mul(f->proj, f->view, mvp);
-    glProgramUniformMatrix4fv(p, u[U_VIEW], 1, GL_FALSE, f->view);
-    glProgramUniformMatrix4fv(p, u[U_PROJ], 1, GL_FALSE, f->proj);
+    // the light and the view direction into the splats' frame: the transposed rotation of the view
+    float light[3], dir[3];
+    for (int j = 0; j < 3; j++) {
+        light[j] = 0;
+        for (int i = 0; i < 3; i++)
+            light[j] += f->view[4 * j + i] * f->light_eye[i];
+        dir[j] = -f->view[4 * j + 2];
+    }
+    normalize3(light);
+    normalize3(dir);
+    glProgramUniform3fv(p, u[U_EYE], 1, f->eye);
+    glProgramUniform3fv(p, u[U_VIEW_DIR], 1, dir);
     glProgramUniformMatrix4fv(p, u[U_MVP], 1, GL_FALSE, mvp);
-    glProgramUniform3fv(p, u[U_LIGHT], 1, f->light_eye);
+    glProgramUniform3fv(p, u[U_LIGHT], 1, light);
     glProgramUniform1i(p, u[U_UNLIT], (f->flags & ASP_RENDER_UNLIT) ? 1 : 0);
     glProgramUniform2i(p, u[U_SIZE], (GLint)f->width, (GLint)f->height);
-    glProgramUniform1f(p, u[U_SCALE], view_scale(f->view));
     // a perspective projection has -1 in row 3 of column 2; an orthographic one 0
     glProgramUniform1i(p, u[U_PERSP], f->proj[11] != 0.0f);
 
@@ -498,18 +516,6 @@ static uint32_t oct_pack(const float v[3])
     return ((uint32_t)qx & 0xFFFFu) | (((uint32_t)qy & 0xFFFFu) << 16);
 }
 
-/* One splat record: centre, colour, normal, major axis, semi-axes (the GPU layout of the shader). */
-static void pack_splat(uint32_t *w, const float c[3], const uint8_t col[4], const float n[3], const float u[3],
-                       float a, float b)
-{
-    memcpy(w, c, 12);
-    w[3] = (uint32_t)col[0] | (uint32_t)col[1] << 8 | (uint32_t)col[2] << 16 | (uint32_t)col[3] << 24;
-    w[4] = oct_pack(n);
-    w[5] = oct_pack(u);
-    memcpy(w + 6, &a, 4);
-    memcpy(w + 7, &b, 4);
-}
-
 /* A unit vector perpendicular to unit n. */
 static void tangent_of(const float n[3], float t[3])
 {
@@ -520,6 +526,95 @@ static void tangent_of(const float n[3], float t[3])
     float l = sqrtf(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
     for (int d = 0; d < 3; d++)
         t[d] = l > 0 ? t[d] / l : (d == 0);
+}
+
+/* Two values in [-1, 1] as GLSL's packSnorm2x16. */
+static uint32_t snorm2(float x, float y)
+{
+    int32_t qx = (int32_t)lroundf(fminf(fmaxf(x, -1.0f), 1.0f) * 32767.0f);
+    int32_t qy = (int32_t)lroundf(fminf(fmaxf(y, -1.0f), 1.0f) * 32767.0f);
+    return ((uint32_t)qx & 0xFFFFu) | (((uint32_t)qy & 0xFFFFu) << 16);
+}
+
+/* One splat of the source in drawing order: centre, colour, unit normal, the axes a u and b v. */
+typedef struct src_splat {
+    float c[3], n[3], au[3], bv[3];
+    const uint8_t *col;
+} src_splat;
+
+typedef struct source {
+    const asp_hier_splat *leaves; /* the hierarchy's point splats, or NULL */
+    const asp_cloud *cloud;       /* else the cloud's discs, in order[] */
+    const uint32_t *order;
+    const uint8_t *default_color;
+} source;
+
+static void source_get(const source *src, size_t i, src_splat *o)
+{
+    if (src->leaves) {
+        const asp_hier_splat *h = &src->leaves[i];
+        for (int d = 0; d < 3; d++) {
+            o->c[d] = h->center[d];
+            o->n[d] = h->normal[d];
+            o->au[d] = h->a * h->u[d];
+            o->bv[d] = h->b * h->v[d];
+        }
+        o->col = h->color;
+        return;
+    }
+    const asp_cloud *cl = src->cloud;
+    size_t k = src->order[i];
+    const float *n = cl->normals + 3 * k;
+    float t[3];
+    tangent_of(n, t);
+    const float b[3] = {n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]};
+    float r = cl->radii[k];
+    for (int d = 0; d < 3; d++) {
+        o->c[d] = cl->positions[3 * k + d];
+        o->n[d] = n[d];
+        o->au[d] = r * t[d];
+        o->bv[d] = r * b[d];
+    }
+    o->col = cl->colors ? cl->colors + 4 * k : src->default_color;
+}
+
+/*
+ * The records and batch boxes of src's n splats: each batch's axes quantised to 16 bits of the
+ * batch's largest axis length (its box's w), its box grown by that length times grow.
+ */
+static void pack_batches(const source *src, size_t n, float grow, uint32_t *w, float *boxes)
+{
+    for (size_t b = 0; b * BATCH < n; b++) {
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, r = 0;
+        size_t end = (b + 1) * BATCH < n ? (b + 1) * BATCH : n;
+        src_splat sp;
+        for (size_t i = b * BATCH; i < end; i++) {
+            source_get(src, i, &sp);
+            for (int d = 0; d < 3; d++) {
+                lo[d] = fminf(lo[d], sp.c[d]), hi[d] = fmaxf(hi[d], sp.c[d]);
+                r = fmaxf(r, fmaxf(fabsf(sp.au[d]), fabsf(sp.bv[d])));
+            }
+        }
+        float inv = r > 0 ? 1.0f / r : 0.0f;
+        for (size_t i = b * BATCH; i < end; i++) {
+            source_get(src, i, &sp);
+            uint32_t *o = w + SPLAT_WORDS * i;
+            memcpy(o, sp.c, 12);
+            o[3] = (uint32_t)sp.col[0] | (uint32_t)sp.col[1] << 8 | (uint32_t)sp.col[2] << 16 |
+                   (uint32_t)sp.col[3] << 24;
+            o[4] = snorm2(sp.au[0] * inv, sp.au[1] * inv);
+            o[5] = snorm2(sp.au[2] * inv, sp.bv[0] * inv);
+            o[6] = snorm2(sp.bv[1] * inv, sp.bv[2] * inv);
+            o[7] = oct_pack(sp.n);
+        }
+        // a component of the axes is at most r; the support's reach at most sqrt(3) r
+        for (int d = 0; d < 3; d++) {
+            boxes[8 * b + d] = lo[d] - 1.7320508f * r * grow;
+            boxes[8 * b + 4 + d] = hi[d] + 1.7320508f * r * grow;
+        }
+        boxes[8 * b + 3] = r;
+        boxes[8 * b + 7] = 0;
+    }
 }
 
 /* Spreads the low 10 bits of v to every third bit (Morton code). */
@@ -583,64 +678,35 @@ static uint32_t *morton_order(asp_context *a, const asp_cloud *cloud)
     return order;
 }
 
-/* Bounding boxes of the batches, each grown by its splats' largest semi-axis (times the support and scale). */
-static void batch_boxes(const uint32_t *w, size_t n, float grow, float *boxes)
-{
-    for (size_t b = 0; b * BATCH < n; b++) {
-        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, r = 0;
-        size_t end = (b + 1) * BATCH < n ? (b + 1) * BATCH : n;
-        for (size_t i = b * BATCH; i < end; i++) {
-            float c[3], a;
-            memcpy(c, w + SPLAT_WORDS * i, 12);
-            memcpy(&a, w + SPLAT_WORDS * i + 6, 4);
-            for (int d = 0; d < 3; d++)
-                lo[d] = fminf(lo[d], c[d]), hi[d] = fmaxf(hi[d], c[d]);
-            r = fmaxf(r, a);
-        }
-        for (int d = 0; d < 3; d++) {
-            boxes[8 * b + d] = lo[d] - r * grow;
-            boxes[8 * b + 4 + d] = hi[d] + r * grow;
-        }
-        boxes[8 * b + 3] = boxes[8 * b + 7] = 0;
-    }
-}
-
 /*
- * The splat records: the hierarchy's leaves in its (octree) order, or the cloud's discs (normal, radius)
- * in Morton order. *out: points * SPLAT_WORDS words.
+ * The splat records and batch boxes: the hierarchy's leaves in its (octree) order, or the cloud's
+ * discs (normal, radius) in Morton order. *out: points * SPLAT_WORDS words, *boxes_out 8 floats a batch.
  */
 static int build_records(asp_context *a, const asp_cloud *cloud, const asp_hier *hier, const uint8_t dflt[4],
-                         uint32_t **out, size_t *count, asp_error *err)
+                         float grow, uint32_t **out, float **boxes_out, size_t *count, asp_error *err)
 {
     static const uint8_t grey[4] = {200, 200, 200, 255};
-    const uint8_t *dc = dflt && (dflt[0] || dflt[1] || dflt[2] || dflt[3]) ? dflt : grey;
+    source src = {.cloud = cloud};
+    src.default_color = dflt && (dflt[0] || dflt[1] || dflt[2] || dflt[3]) ? dflt : grey;
     size_t n = hier ? asp_hier_point_count(hier) : cloud->count;
+    size_t batches = (n + BATCH - 1) / BATCH;
     uint32_t *w = asp_alloc(a, n * SPLAT_WORDS * 4);
-    if (!w)
+    float *boxes = asp_alloc(a, batches * 8 * sizeof(float));
+    uint32_t *order = NULL;
+    if (hier)
+        src.leaves = asp_hier_splats(hier) + asp_hier_node_count(hier);
+    else if (w && boxes)
+        src.order = order = morton_order(a, cloud);
+    if (!w || !boxes || (!hier && !order)) {
+        asp_free(a, w);
+        asp_free(a, boxes);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu compute splats (%zu bytes)", n,
                              n * SPLAT_WORDS * 4);
-    if (hier) {
-        const asp_hier_splat *s = asp_hier_splats(hier) + asp_hier_node_count(hier);
-        for (size_t i = 0; i < n; i++)
-            pack_splat(w + SPLAT_WORDS * i, s[i].center, s[i].color, s[i].normal, s[i].u, s[i].a, s[i].b);
-    } else {
-        uint32_t *order = morton_order(a, cloud);
-        if (!order) {
-            asp_free(a, w);
-            return asp_error_set(err, ASP_ENOMEM, "out of memory for the Morton order of %zu points", n);
-        }
-        for (size_t i = 0; i < n; i++) {
-            size_t k = order[i];
-            const float *nn = cloud->normals + 3 * k;
-            float t[3];
-            tangent_of(nn, t);
-            float r = cloud->radii[k];
-            pack_splat(w + SPLAT_WORDS * i, cloud->positions + 3 * k, cloud->colors ? cloud->colors + 4 * k : dc,
-                       nn, t, r, r);
-        }
-        asp_free(a, order);
     }
+    pack_batches(&src, n, grow, w, boxes);
+    asp_free(a, order);
     *out = w;
+    *boxes_out = boxes;
     *count = n;
     return 0;
 }
@@ -703,17 +769,17 @@ static void set_static_uniforms(compute_renderer *c, const asp_splat_renderer_de
         col[k] = given ? dc[k] / 255.0f : (k < 3 ? 200.0f / 255.0f : 1.0f);
     glProgramUniform4fv(p, u[U_DEFAULT_COLOR], 1, col);
     glProgramUniform1ui(p, u[U_BIG_CAP], c->big_cap);
+    float lut[256];
+    for (int k = 0; k < 256; k++)
+        lut[k] = asp__srgb_to_linear((uint8_t)k);
+    glProgramUniform1fv(p, u[U_LUT], 256, lut);
 }
 
-static int upload(compute_renderer *c, const uint32_t *w, size_t n, float grow, asp_error *err)
+static int upload(compute_renderer *c, const uint32_t *w, const float *boxes, size_t n, asp_error *err)
 {
     asp_gl_context *gl = c->base.gl;
     c->points = n;
     c->batches = (n + BATCH - 1) / BATCH;
-    float *boxes = asp_alloc(&gl->actx, c->batches * 8 * sizeof(float));
-    if (!boxes)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory for %zu batch boxes", c->batches);
-    batch_boxes(w, n, grow, boxes);
     // a storage binding holds at most GL_MAX_SHADER_STORAGE_BLOCK_SIZE bytes: whole batches per chunk
     GLint64 max_block = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
@@ -732,9 +798,8 @@ static int upload(compute_renderer *c, const uint32_t *w, size_t n, float grow, 
     glCreateBuffers(1, &c->boxes.id);
     glNamedBufferStorage(c->boxes.id, (GLsizeiptr)(c->batches * 8 * sizeof(float)), boxes, 0);
     glCreateBuffers(1, &c->big.id);
-    glNamedBufferStorage(c->big.id, (GLsizeiptr)(16 + (size_t)c->big_cap * SPLAT_WORDS * 4), NULL,
-                         GL_DYNAMIC_STORAGE_BIT);
-    asp_free(&gl->actx, boxes);
+    // a big-list entry is the record and its batch's axis scale: 48 bytes
+    glNamedBufferStorage(c->big.id, (GLsizeiptr)(16 + (size_t)c->big_cap * 48), NULL, GL_DYNAMIC_STORAGE_BIT);
     char what[80];
     snprintf(what, sizeof what, "upload %zu compute splats", n);
     return asp__gl_check(gl, what, err);
@@ -766,6 +831,11 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     int rc = cloud ? asp_cloud_validate(cloud, err) : 0;
     if (rc)
         return rc;
+    size_t total = hier ? asp_hier_point_count(hier) : cloud->count;
+    // the Morton order indexes points with 32 bits
+    if (total > (size_t)UINT32_MAX)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot draw %zu points with compute shaders (at most %u)",
+                             total, UINT32_MAX);
     rc = asp__gl_ensure_current(gl, err);
     if (rc)
         return rc;
@@ -779,21 +849,19 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     }
     asp_context *a = &gl->actx;
     uint32_t *words = NULL;
+    float *boxes = NULL;
     size_t n = 0;
-    rc = build_records(a, hier ? NULL : cloud, hier, desc->default_color, &words, &n, err);
+    float radius_scale = desc->radius_scale > 0 ? desc->radius_scale : 1.0f;
+    rc = build_records(a, hier ? NULL : cloud, hier, desc->default_color, radius_scale, &words, &boxes, &n, err);
     int has_colors = hier ? (asp_hier_flags(hier) & ASP_HIER_HAS_COLORS) != 0 : cloud->colors != NULL;
     if (owned)
         asp_hier_destroy(owned);
     if (rc)
         return rc;
-    if (n > (size_t)UINT32_MAX / SPLAT_WORDS) {
-        asp_free(a, words);
-        return asp_error_set(err, ASP_EUNSUPPORTED, "cannot draw %zu points with compute shaders (at most %u)", n,
-                             UINT32_MAX / SPLAT_WORDS);
-    }
     compute_renderer *c = asp_calloc(a, 1, sizeof *c);
     if (!c) {
         asp_free(a, words);
+        asp_free(a, boxes);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for a compute renderer");
     }
     c->base.vt = &compute_vtable;
@@ -802,16 +870,28 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     c->opaque = desc->mode == ASP_SPLAT_OPAQUE;
     c->use64 = c->opaque && has_gl_extension("GL_NV_shader_atomic_int64") &&
                has_gl_extension("GL_ARB_gpu_shader_int64");
-    const char *csrc = c->use64 ? compute64_src : compute32_src;
-    rc = compile_compute(gl, c->use64 ? "64-bit" : "32-bit", csrc, &c->program, err);
-    if (!rc)
-        rc = asp__gl_program_create(gl, "compute resolve", resolve_vertex_src, c->use64 ? resolve64_src : resolve32_src,
-                                    &c->resolve, err);
-    if (!rc) {
-        float rs = desc->radius_scale > 0 ? desc->radius_scale : 1.0f;
-        rc = upload(c, words, n, rs, err);
+    if (c->use64) {
+        // a driver that lists the extensions but fails the shaders still draws, by the 32-bit path
+        asp_error e64;
+        if (compile_compute(gl, "64-bit", compute64_src, &c->program, &e64) ||
+            asp__gl_program_create(gl, "compute resolve (64-bit)", resolve_vertex_src, resolve64_src, &c->resolve,
+                                   &e64)) {
+            asp__gl_program_destroy(&c->program);
+            asp__gl_program_destroy(&c->resolve);
+            asp__gl_clear_errors(gl);
+            c->use64 = 0;
+        }
     }
+    rc = 0;
+    if (!c->use64) {
+        rc = compile_compute(gl, "32-bit", compute32_src, &c->program, err);
+        if (!rc)
+            rc = asp__gl_program_create(gl, "compute resolve", resolve_vertex_src, resolve32_src, &c->resolve, err);
+    }
+    if (!rc)
+        rc = upload(c, words, boxes, n, err);
     asp_free(a, words);
+    asp_free(a, boxes);
     if (rc) {
         compute_destroy(&c->base);
         return rc;
