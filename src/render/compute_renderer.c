@@ -457,6 +457,9 @@ static int compute_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     glProgramUniform1i(p, u[U_PERSP], f->proj[11] != 0.0f);
 
     static const GLuint far_bits = 0xFFFFFFFFu, zero = 0;
+    // a previous draw's resolve may still be queued (llvmpipe bins draws, runs dispatches at once):
+    // it must read these buffers before they are cleared (scenes draw the renderer once per instance)
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glClearNamedBufferData(c->depth.id, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &far_bits);
     if (c->use64)
         glClearNamedBufferData(c->fb64.id, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &far_bits);
