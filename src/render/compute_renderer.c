@@ -11,7 +11,7 @@
  *  - blended (seed 001 5.3-5.4): atomicMin of the epsilon-offset depth (5.3, Fig. 15), then
  *    atomicAdd of (psi c, psi) in 16.16 fixed point for the splats within epsilon of it (eq. 10),
  *    then the division (eq. 9) in the resolve.
- * The splats go in batches of ASP__COMPUTE_BATCH in Morton order (the hierarchy's octree order,
+ * The splats go in batches of BATCH in Morton order (the hierarchy's octree order,
  * or a Morton sort of the cloud); one workgroup takes one batch and drops it when its bounding
  * box is outside the view frustum before any point is read. Footprints of more than
  * SMALL_PIXELS pixels go to a list that a second dispatch draws with one workgroup per splat, so
@@ -19,8 +19,10 @@
  * A full-screen fragment pass (the resolve) writes colour and depth into the caller's
  * framebuffer, so the result composes with other renderers and the caller's sRGB and
  * multisampling as the raster renderers' output does.
- * Not done: the hierarchy's LOD (every leaf is drawn), per-batch coordinate quantisation (a splat
- * is 32 bytes of floats), clip planes, per-pixel lighting (leaves' splats light per splat).
+ * A splat is 32 bytes: its centre as floats, colour, an octahedral normal, and its axes a u and
+ * b v quantised to 16 bits of the largest axis length in its batch (kept with the batch's box).
+ * Not done: the hierarchy's LOD (every leaf is drawn), quantised centres, clip planes, per-pixel
+ * lighting (a leaf's splat has one normal, so Gouraud and flat agree and pixel lights per splat).
  */
 #include <math.h>
 #include <stdio.h>
@@ -30,20 +32,23 @@
 #include "render/internal.h"
 #include "util/banned.h"
 
+/* Constants shared by C and GLSL (STR makes them GLSL text). */
+#define BATCH 10240     /* splats per batch = per workgroup of the main dispatch */
+#define GROUP 256       /* invocations per workgroup */
+#define SMALL_PIXELS 64 /* footprints (pixel-centre boxes) above this go to the big list */
+#define FIXED_ONE 65536 /* the fixed-point unit of the blended sums */
+#define STR_(x) #x
+#define STR(x) STR_(x)
 enum {
-    BATCH = 10240,       /* splats per batch = per workgroup of the main dispatch */
-    GROUP = 256,         /* threads per workgroup */
-    SMALL_PIXELS = 64,   /* footprints (pixel-centre bounding boxes) above this go to the big list */
-    BIG_GROUPS = 1024,   /* workgroups of the big-list dispatch, striding over the list */
-    SPLAT_WORDS = 8,     /* 32 bytes per splat: centre, colour, the axes a u and b v, oct normal */
-    FIXED_ONE = 65536    /* the fixed-point unit of the blended sums */
+    BIG_GROUPS = 1024, /* workgroups of the big-list dispatch, striding over the list */
+    SPLAT_WORDS = 8    /* 32 bytes per splat: centre, colour, the axes a u and b v, oct normal */
 };
 
 /* The passes of the compute program (u_pass). */
 enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLOR64 };
 
 #define COMPUTE_GLSL                                                                                   \
-    "layout(local_size_x = 256) in;\n"                                                                 \
+    "layout(local_size_x = " STR(GROUP) ") in;\n"                                                                 \
     "layout(std430, binding = 0) readonly buffer Splats { uvec4 splats[]; };\n"                        \
     "layout(std430, binding = 1) readonly buffer Boxes { vec4 boxes[]; };\n"                           \
     "layout(std430, binding = 2) buffer Depth { uint depth[]; };\n"                                    \
@@ -175,11 +180,11 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     /* the same formula as asp_splat_kernel_weight */                                                   \
     "        float r = min(length(h.xy) / h.z, u_support) * u_kscale;\n"                               \
     "        float w = u_kgauss != 0 ? exp(-r * r / (2.0 * u_ksigma * u_ksigma)) : exp(-u_ka * pow(r / u_kb, u_kn));\n" \
-    "        uvec3 c = uvec3(s.rgb * (w * 65536.0) + 0.5);\n"                                          \
+    "        uvec3 c = uvec3(s.rgb * (w * " STR(FIXED_ONE) ".0) + 0.5);\n"                                          \
     "        if (c.r != 0u) atomicAdd(color[4u * i], c.r);\n"                                          \
     "        if (c.g != 0u) atomicAdd(color[4u * i + 1u], c.g);\n"                                     \
     "        if (c.b != 0u) atomicAdd(color[4u * i + 2u], c.b);\n"                                     \
-    "        atomicAdd(color[4u * i + 3u], max(uint(w * 65536.0 + 0.5), 1u));\n"                      \
+    "        atomicAdd(color[4u * i + 3u], max(uint(w * " STR(FIXED_ONE) ".0 + 0.5), 1u));\n"                      \
     "    }\n"                                                                                          \
     FB64_PASS                                                                                          \
     "}\n"                                                                                              \
@@ -194,7 +199,7 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     "                continue;\n"                                                                      \
     "            int w = s.hi.x - s.lo.x + 1;\n"                                                       \
     "            uint count = uint(w) * uint(s.hi.y - s.lo.y + 1);\n"                                  \
-    "            for (uint k = lid; k < count; k += 256u)\n"                                           \
+    "            for (uint k = lid; k < count; k += " STR(GROUP) "u)\n"                                           \
     "                pixel(s, s.lo.x + int(k % uint(w)), s.lo.y + int(k / uint(w)));\n"        \
     "        }\n"                                                                                      \
     "        return;\n"                                                                                \
@@ -216,15 +221,15 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     "    if (any(equal(neg, ivec3(8))) || any(equal(pos, ivec3(8))))\n"                                \
     "        return;\n"                                                                                \
     "    float scale = b0.w;\n"                                                                        \
-    "    uint first = gl_WorkGroupID.x * 10240u;\n"                                                    \
-    "    uint last = min(first + 10240u, u_points);\n"                                                 \
-    "    for (uint j = first + lid; j < last; j += 256u) {\n"                                          \
+    "    uint first = gl_WorkGroupID.x * " STR(BATCH) "u;\n"                                                    \
+    "    uint last = min(first + " STR(BATCH) "u, u_points);\n"                                                 \
+    "    for (uint j = first + lid; j < last; j += " STR(GROUP) "u) {\n"                                          \
     "        uvec4 r0 = splats[2u * j], r1 = splats[2u * j + 1u];\n"                                   \
     "        sp s;\n"                                                                                  \
     "        if (!setup(r0, r1, scale, s))\n"                                                                 \
     "            continue;\n"                                                                          \
     "        int w = s.hi.x - s.lo.x + 1, h = s.hi.y - s.lo.y + 1;\n"                                  \
-    "        if (w * h > 64) {\n"                                                                      \
+    "        if (w * h > " STR(SMALL_PIXELS) ") {\n"                                                                      \
     "            if (u_append != 0) {\n"                                                               \
     "                uint e = atomicAdd(big_count, 1u);\n"                                             \
     "                if (e < u_big_cap) { big[3u * e] = r0; big[3u * e + 1u] = r1; big[3u * e + 2u] = uvec4(floatBitsToUint(scale)); }\n"               \
