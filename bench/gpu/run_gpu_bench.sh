@@ -33,6 +33,10 @@ fi
         [ -d "$d" ] && libpath=$libpath:$d
     done
     echo "== library path: $libpath"
+    # where the driver's EGL pieces are, for a run that does not reach NVIDIA
+    echo "== EGL vendor files: $(ls /usr/share/glvnd/egl_vendor.d /etc/glvnd/egl_vendor.d \
+        /usr/local/nvidia/share/glvnd/egl_vendor.d 2>/dev/null | tr '\n' ' ')"
+    echo "== libEGL_nvidia: $( (ldconfig -p 2>/dev/null | grep -o '/[^ ]*libEGL_nvidia[^ ]*'; ls /usr/local/nvidia/lib64/libEGL_nvidia* 2>/dev/null) | sort -u | tr '\n' ' ')"
     echo "== bench_compute ${POINTS:-1e6,1e7,1e8} ${SIZE:-1024} ${FRAMES:-9} ${SPLAT_MAX:-1e7}"
     timeout "${LIMIT_S:-240}" "$pk/ld-linux-x86-64.so.2" --library-path "$libpath" "$pk/bench_compute" \
         "${POINTS:-1e6,1e7,1e8}" "${SIZE:-1024}" "${FRAMES:-9}" "${SPLAT_MAX:-1e7}"
