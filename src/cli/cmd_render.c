@@ -340,8 +340,8 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
             // the default: discs and splats cut at creases sharper than 60 degrees, as the primitives
             // and eval's reference are, so one --view gives one silhouette whatever the file (issue 12:
             // octahedron points vs primitives IoU 0.936 unclipped, 0.981 clipped); points without
-            // normals stay unclipped. The square renderer does not clip.
-            if (!(o->renderer && strcmp(o->renderer, "square") == 0)) {
+            // normals stay unclipped. The square and compute renderers do not clip.
+            if (!(o->renderer && (strcmp(o->renderer, "square") == 0 || strcmp(o->renderer, "compute") == 0))) {
                 o->point_crease = ASP_PRIM_CREASE_ANGLE_DEFAULT;
                 o->point_crease_default = 1;
             }
@@ -352,8 +352,9 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
         if (cli_parse_doubles(o->crease_angle, &deg, 1) != 1 || !(deg > 0 && deg < 90))
             return cli_usage_error(env, "--crease-angle expects degrees in (0, 90) or 'off' for points, got '%s'",
                                    o->crease_angle);
-        if (o->renderer && strcmp(o->renderer, "square") == 0)
-            return cli_usage_error(env, "--crease-angle: the square renderer does not clip (use disc or splat)");
+        if (o->renderer && (strcmp(o->renderer, "square") == 0 || strcmp(o->renderer, "compute") == 0))
+            return cli_usage_error(env, "--crease-angle: the %s renderer does not clip (use disc or splat)",
+                                   o->renderer);
         o->point_crease = deg;
         return 0;
     }

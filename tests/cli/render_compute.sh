@@ -67,3 +67,6 @@ python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); assert d["comput
 "$A" render "$T/torus.ply" -o "$T/j.png" --size 64x64 --json >"$T/j"
 python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); assert "compute_path" not in d, d' "$T/j" ||
   fail "disc has no compute_path: $(cat "$T/j")"
+
+# what it does not draw is refused, not ignored: crease clip planes
+expect_fail 2 "the compute renderer does not clip" "$A" render "$T/torus.ply" -o "$T/x.png" --renderer compute --crease-angle 30
