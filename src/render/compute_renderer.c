@@ -170,7 +170,10 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     "    uint i = uint(y) * uint(u_size.x) + uint(x);\n"                                               \
     "    uint zb = floatBitsToUint(z);\n"                                                              \
     "    if (u_pass == 0 || u_pass == 2) {\n"                                                          \
-    "        atomicMin(depth[i], zb);\n"                                                               \
+    /* a plain read first: most splats are behind the minimum so far, and the depth only decreases,  \
+       so a stale read costs one atomic, never a wrong result */                                       \
+    "        if (zb < depth[i])\n"                                                                     \
+    "            atomicMin(depth[i], zb);\n"                                                           \
     "    } else if (u_pass == 1) {\n"                                                                  \
     "        if (zb == depth[i])\n"                                                                    \
     "            color[i] = s.pk;\n"                                                                   \
