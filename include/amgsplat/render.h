@@ -533,6 +533,13 @@ typedef struct asp_renderer_stats {
 /** Fills *out for any renderer (disc: count = points, the rest 0). Thread rules of the renderer. */
 void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out);
 
+/**
+ * Which way the compute renderer (renderer table row "compute", issue 28) draws: "opaque-atomic64"
+ * (one 64-bit atomicMin pass, GL_NV_shader_atomic_int64), "opaque-atomic32" (32-bit depth then
+ * colour), "blend-atomic32" (seed 001's blended splats); NULL for any other renderer.
+ */
+const char *asp_compute_renderer_path(const asp_renderer *r);
+
 /* ------------------------------------------------------------------------ */
 /* Frame budget: the tolerance that holds a frame time (issue 18 item 5)    */
 /* ------------------------------------------------------------------------ */

@@ -300,8 +300,8 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
             // the default: discs and splats cut at creases sharper than 60 degrees, as the primitives
             // and eval's reference are, so one --view gives one silhouette whatever the file (issue 12:
             // octahedron points vs primitives IoU 0.936 unclipped, 0.981 clipped); points without
-            // normals stay unclipped. The square renderer does not clip.
-            if (!(o->r.renderer && strcmp(o->r.renderer, "square") == 0)) {
+            // normals stay unclipped. The square and compute renderers do not clip.
+            if (!(o->r.renderer && (strcmp(o->r.renderer, "square") == 0 || strcmp(o->r.renderer, "compute") == 0))) {
                 o->point_crease = ASP_PRIM_CREASE_ANGLE_DEFAULT;
                 o->point_crease_default = 1;
             }
@@ -312,8 +312,9 @@ static int parse_prim_options(struct cli_env *env, struct render_opts *o)
         if (!(o->r.crease < 90))
             return cli_usage_error(env, "--crease-angle expects degrees in (0, 90) or 'off' for points, got '%s'",
                                    o->r.crease_angle);
-        if (o->r.renderer && strcmp(o->r.renderer, "square") == 0)
-            return cli_usage_error(env, "--crease-angle: the square renderer does not clip (use disc or splat)");
+        if (o->r.renderer && (strcmp(o->r.renderer, "square") == 0 || strcmp(o->r.renderer, "compute") == 0))
+            return cli_usage_error(env, "--crease-angle: the %s renderer does not clip (use disc or splat)",
+                                   o->r.renderer);
         o->point_crease = o->r.crease;
         return 0;
     }
@@ -406,6 +407,7 @@ struct view_stats {
     double seconds; /* all asp_render_to_image calls, read-back included */
     asp_frame_budget *budget;        /* --frame-ms: settled before each view, from the last view's state */
     asp_frame_budget_result settled; /* the last view's */
+    const char *compute_path;        /* --renderer compute: the atomics that drew (asp_compute_renderer_path) */
 };
 
 /* Renders the views into tiles[0 .. views-1], every one framed by the scene's frame (asp_camera_frame). */
@@ -436,6 +438,7 @@ static int render_views(asp_gl_context *gl, asp_renderer *r, const asp_scene *s,
             return rc;
         vs->seconds += asp_time_now() - t0;
         vs->last_count = asp_renderer_count(r);
+        vs->compute_path = asp_compute_renderer_path(r);
         vs->min_count = vs->last_count < vs->min_count ? vs->last_count : vs->min_count;
         vs->max_count = vs->last_count > vs->max_count ? vs->last_count : vs->max_count;
         rc = asp_progress(&env->ctx, "render", (double)(i + 1) / (double)o->views);
@@ -465,6 +468,8 @@ static int print_json(const struct cli_env *env, const struct render_opts *o, si
     }
     cJSON_AddStringToObject(j, "gl_renderer", asp_gl_context_renderer(gl));
     cJSON_AddStringToObject(j, "gl_backend", asp_gl_context_backend(gl));
+    if (vs->compute_path)
+        cJSON_AddStringToObject(j, "compute_path", vs->compute_path);
     int lod = strcmp(renderer, "disc") && strcmp(renderer, "prim") && strcmp(renderer, "mesh");
     cJSON_AddNumberToObject(j, "primitives", (double)vs->last_count);
     cJSON_AddNumberToObject(j, "primitives_min", (double)vs->min_count);
@@ -560,7 +565,7 @@ static int render_instance_scene(const char *path, struct render_opts *o, struct
     asp_image tiles[MAX_VIEWS];
     asp_image sheet = {0, 0, NULL};
     memset(tiles, 0, sizeof tiles);
-    struct view_stats vs = {SIZE_MAX, 0, 0, 0, NULL, {0}};
+    struct view_stats vs = {SIZE_MAX, 0, 0, 0, NULL, {0}, NULL};
     asp_renderer_options ropts;
     renderer_options(o, &ropts);
     asp_scene_desc d = {.level = o->r.level, .texture = o->r.texture};
@@ -737,7 +742,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     asp_image tiles[MAX_VIEWS];
     asp_image sheet = {0, 0, NULL};
     memset(tiles, 0, sizeof tiles);
-    struct view_stats vs = {0, 0, 0, 0, NULL, {0}};
+    struct view_stats vs = {0, 0, 0, 0, NULL, {0}, NULL};
     asp_renderer_options ropts;
     renderer_options(&o, &ropts);
     asp_render_source src;

@@ -69,9 +69,17 @@ static EGLContext create_context(EGLDisplay dpy, unsigned flags, const char *dpy
 {
     EGLConfig config = EGL_NO_CONFIG_KHR;
     if (!has_ext(dpy_ext, "EGL_KHR_no_config_context") && !has_ext(dpy_ext, "EGL_MESA_configless_context")) {
-        const EGLint want[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+        /*
+         * EGL_SURFACE_TYPE defaults to EGL_WINDOW_BIT, which no config of a display without windows
+         * has (NVIDIA's EGL device platform): ask for pbuffer configs, then for any (mask 0).
+         */
+        const EGLint want[2][5] = {{EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_NONE},
+                                   {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE}};
         EGLint n = 0;
-        if (!eglChooseConfig(dpy, want, &config, 1, &n) || n < 1)
+        for (int i = 0; i < 2 && n < 1; i++)
+            if (!eglChooseConfig(dpy, want[i], &config, 1, &n))
+                n = 0;
+        if (n < 1)
             return EGL_NO_CONTEXT;
     }
     // EGL 1.5 spells the debug request as a boolean, EGL_KHR_create_context as a flag bit

@@ -110,6 +110,10 @@ static int make_cut(asp_gl_context *gl, const asp_render_source *src, const asp_
     return asp_cut_renderer_create(gl, src->dps, &d, out, err);
 }
 
+/* compute_renderer.c: points drawn by compute shaders (issue 28) */
+int asp__compute_renderer_make(asp_gl_context *gl, const asp_render_source *src, const asp_renderer_options *o,
+                               const asp_context *ctx, asp_renderer **out, asp_error *err);
+
 static const asp_renderer_kind kinds[] = {
     {"disc", "points", ASP_RENDER_INPUT_POINTS, 0, make_disc},
     {"splat", "splats", ASP_RENDER_INPUT_POINTS, 1, make_splat},
@@ -118,6 +122,7 @@ static const asp_renderer_kind kinds[] = {
     {"mesh", "triangles", ASP_RENDER_INPUT_MESH, 0, make_mesh},
     {"hybrid", "primitives and splats", ASP_RENDER_INPUT_PRIMS, 0, make_hybrid},
     {"cut", "primitives", ASP_RENDER_INPUT_PRIMS, 0, make_cut},
+    {"compute", "points", ASP_RENDER_INPUT_POINTS, 0, asp__compute_renderer_make},
 };
 enum { N_KINDS = sizeof kinds / sizeof kinds[0] };
 

@@ -58,7 +58,7 @@ check "$T/zoom.png" "fg > 0.62"
 view "$T/sphere.ply" --frames 4 --keys dzwr --screenshot "$T/reset.png" --size 160x120 --view 0,0 -q
 at_least "$(metric "$T/reset.png" "$T/ref0.png" psnr)" 40 "r key resets the view"
 
-# Renderers: 2 = splat, 3 = square (the hierarchy renderers), n cycles back to disc. The splats cover
+# Renderers: 2 = splat, 3 = square (the hierarchy renderers), 8 = compute, n cycles back to disc. The splats cover
 # the same silhouette as the discs; tau = 0 draws every point, a larger tau fewer splats, and the
 # +/- keys reach the same cut as --tau.
 view "$T/sphere.ply" --frames 3 --keys 2 --screenshot "$T/splat.png" --size 160x120 --view 0,0 --json -q >"$T/splat.json"
@@ -76,8 +76,9 @@ view "$T/sphere.ply" --frames 11 --renderer splat --tau 16 --keys ----------- --
 view "$T/sphere.ply" --frames 2 --keys 3 --screenshot "$T/square.png" --size 160x120 --view 0,0 --json -q >"$T/sq.json"
 [[ "$(field "$T/sq.json" renderer)" == square && "$(field "$T/sq.json" count)" == 3000 ]] || fail "3 key: $(cat "$T/sq.json")"
 at_least "$(metric "$T/square.png" "$T/ref0.png" iou)" 0.85 "square vs disc silhouette"
-view "$T/sphere.ply" --frames 4 --keys nnn --screenshot "$T/cycle.png" --size 160x120 --view 0,0 --json -q >"$T/cycle.json"
-[[ "$(field "$T/cycle.json" renderer)" == disc ]] || fail "n x 3 ends at $(field "$T/cycle.json" renderer)"
+# the point renderers of the table: disc, splat, square, compute (issue 28), then disc again
+view "$T/sphere.ply" --frames 5 --keys nnnn --screenshot "$T/cycle.png" --size 160x120 --view 0,0 --json -q >"$T/cycle.json"
+[[ "$(field "$T/cycle.json" renderer)" == disc ]] || fail "n x 4 ends at $(field "$T/cycle.json" renderer)"
 [[ "$(metric "$T/cycle.png" "$T/ref0.png" psnr)" == inf ]] || fail "disc after a cycle differs from render"
 view "$T/sphere.ply" --frames 2 --keys 4+ --size 64x48 2>"$T/r4.err"
 grep -qF "renderer 'prim' unavailable: renderer 'prim' cannot draw points input" "$T/r4.err" &&
