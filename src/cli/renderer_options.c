@@ -21,7 +21,7 @@ void cli_renderer_rows(struct cli_renderer_opts *o, unsigned which, struct cli_o
         unsigned bit;
         struct cli_option row;
     } table[] = {
-        {CLI_RO_RENDERER, {"renderer", 0, CLI_STRING, &o->renderer, "NAME", "how points are drawn: disc (default), splat, square; meshes: mesh (default); .dps: prim (default), cut (levels mixed by view); in the viewer, h lists them"}},
+        {CLI_RO_RENDERER, {"renderer", 0, CLI_STRING, &o->renderer, "NAME", "how points are drawn: disc (default), splat, square, compute (compute shaders); meshes: mesh (default); .dps: prim (default), cut (levels mixed by view); in the viewer, h lists them"}},
         {CLI_RO_TOLERANCE, {"tolerance", 0, CLI_DOUBLE, &o->tolerance, "PX", "splat, square, cut: screen tolerance tau in pixels (render: default 1; view: 0; 0 = every point, finest level)"}},
         {CLI_RO_TOLERANCE, {"tau", 0, CLI_DOUBLE, &o->tau, "PX", "the same as --tolerance"}},
         {CLI_RO_BUDGET, {"budget", 0, CLI_SIZE, &o->budget, "N", "splat, square: cut the hierarchy to N splats per view instead of a tolerance"}},
