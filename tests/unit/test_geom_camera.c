@@ -1,11 +1,12 @@
 /*
- * Orbit camera math (render/camera.c): view frame conventions, projection of
- * known points to known pixels, and asp_camera_fit keeping a bounding sphere
- * inside the frustum while touching its nearer sides.
+ * Orbit camera math (src/geom/camera.c, camera.h; no GL, so the no-GL build
+ * runs it too): view frame conventions, projection of known points to known
+ * pixels, and asp_camera_fit keeping a bounding sphere inside the frustum
+ * while touching its nearer sides.
  */
 #include <math.h>
 
-#include "amgsplat/render.h"
+#include "amgsplat/camera.h"
 #include "harness.h"
 
 static const double deg = 3.14159265358979323846 / 180.0;
