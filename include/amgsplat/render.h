@@ -792,6 +792,9 @@ int asp_prim_render_method_parse(const char *name, asp_prim_render_method *out, 
 /* Hybrid: primitives where they hold, points where they fail (issue 18)    */
 /* ------------------------------------------------------------------------ */
 
+/* Which primitives hold is GL-free: asp_hybrid_split in prim.h, whose thresholds (and ASP_HYBRID_*
+ * defaults) the last three fields of asp_hybrid_desc pass on. */
+
 /** Options of the hybrid renderer; the zero value means defaults. */
 typedef struct asp_hybrid_desc {
     asp_prim_render_options prim;   /* alpha_ref, depth_window, crease_angle, flags (outline and colour by domain
