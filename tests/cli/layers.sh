@@ -32,6 +32,18 @@ header_offenders() {
 render_allowed="render.h scene_renderer.h core.h cloud.h image.h hier.h prim.h camera.h"
 camera_allowed="core.h cloud.h"
 
+# table_offenders FILE...: tables a file compares (vt == &x / vt != &x) that are not its own static
+# table: the public calls dispatch through the table's entries instead (STYLE.md 9b, renderer.c),
+# and only a kind's own calls check that a handle is theirs
+table_offenders() {
+  local f t
+  for f in "$@"; do
+    for t in $(grep -oE 'vt[[:space:]]*[!=]=[[:space:]]*&[A-Za-z_0-9]+' "$f" | sed 's/.*&//' | sort -u); do
+      grep -E "^static const asp__renderer_vtable $t( =|;)" "$f" >/dev/null || echo "$(basename "$f"): $t"
+    done
+  done
+}
+
 # the checks themselves must catch a violation coming back
 mkdir -p "$T/render" "$T/include"
 printf '#include "render/internal.h"\n#include "amgsplat/io.h"\n' >"$T/render/x.c"
@@ -44,10 +56,17 @@ planted=$(header_offenders "$render_allowed" "$T/include/scene_renderer.h" "$T/i
 [[ $planted == $'scene_renderer.h:3: instances.h\nrender_x.h:2: mesh.h\nrender_x.h:3: eval.h\nrender_x.h:4: amg.h' ]] ||
   fail "the render header check misses planted includes: $planted"
 
+printf 'static const asp__renderer_vtable own_vtable;\nint f(asp_renderer *r) { return r->vt == &own_vtable || r->vt != &asp__other_vtable; }\n' \
+  >"$T/render/z.c"
+[[ $(table_offenders "$T/render/z.c") == "z.c: asp__other_vtable" ]] || fail "the table check misses a planted comparison"
+
 [[ -d "$src/render" ]] || fail "no $src/render"
 found=$(offenders "$src/render")
 [[ -z "$found" ]] || fail "src/render/ reaches above or around its layer: $found"
 echo "src/render/: no io, amg, mesh, scene, instances, viewer, eval or experiment includes"
+found=$(table_offenders "$src"/render/*.c)
+[[ -z "$found" ]] || fail "src/render/ compares another kind's renderer table instead of calling its entries: $found"
+echo "src/render/: every table comparison is a kind checking its own handle"
 
 headers=("$inc"/render*.h "$inc/scene_renderer.h")
 for h in "${headers[@]}"; do [[ -r $h ]] || fail "no render header $h"; done
