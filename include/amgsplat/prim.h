@@ -48,7 +48,7 @@ typedef enum asp_prim_domain_set {
 /**
  * The texture fills of a batch of primitives, for a texture builder outside
  * the library's CPU path (thesis 3.6: on the graphics hardware,
- * asp_prim_gpu_fill in render.h). Primitive k has samples
+ * asp_prim_gpu_fill_set in render.h). Primitive k has samples
  * sample_first[k] .. sample_first[k + 1] - 1 and a w[k] x h[k] texel grid
  * stored from texel texel_first[k] on, row by row; sample s lies at (x[s],
  * y[s]) in texel units (texel i spans [i, i + 1)), footprint radius r[s]
@@ -112,7 +112,7 @@ typedef struct asp_prim_desc {
                                 points' bounding rectangle by this percentage (at most 1000) instead of the
                                 default margin of one point footprint on every side (0) */
     asp_prim_fill_fn fill;   /* NULL: textures on the CPU; else the fills go to fill(fill_user, ...) in batches
-                                (thesis 3.6; render.h asp_prim_gpu_fill); not with normal_map */
+                                (thesis 3.6; render.h asp_prim_gpu_fill_set); not with normal_map */
     void *fill_user;
 } asp_prim_desc;
 

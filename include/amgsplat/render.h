@@ -720,19 +720,20 @@ typedef struct asp_prim_render_options {
 int asp_prim_renderer_set_debug_lines(asp_renderer *r, const float *lines, size_t segments, asp_error *err);
 
 /**
- * The texture fills of asp_prim_build on the GPU (thesis 3.6): an
- * asp_prim_fill_fn for asp_prim_desc.fill with fill_user = an
- * asp_gl_context (made current; use it from its thread only). A GL 4.5
- * compute shader computes per texel what the CPU's fill computes (the radial
- * sums of 3.3.2; the affine interpolation of 3.3.3 in the kept triangles and
- * the radial fringe outside), over the samples and triangles binned to the
- * texel's 8 x 8 cell, in the CPU's order and in double precision; the
- * library reads f back and finishes on the CPU as the thesis proposes.
- * Returns 0, ASP_EGL (the shader or a GL call failed), ASP_EUNSUPPORTED (a
- * batch of 2^31 texels or more), ASP_ENOMEM.
+ * Makes asp_prim_build with desc do its texture fills on the GPU of gl
+ * (thesis 3.6): sets desc->fill and desc->fill_user (the typed gl stands
+ * behind prim's untyped callback pointer, so no caller passes a void *). gl
+ * must outlive the build and is made current by it; use it from its thread
+ * only. Each fill: a GL 4.5 compute shader computes per texel what the
+ * CPU's fill computes (the radial sums of 3.3.2; the affine interpolation of
+ * 3.3.3 in the kept triangles and the radial fringe outside), over the
+ * samples and triangles binned to the texel's 8 x 8 cell, in the CPU's order
+ * and in double precision; the library reads f back and finishes on the CPU
+ * as the thesis proposes. A fill fails asp_prim_build with ASP_EGL (the
+ * shader or a GL call failed), ASP_EUNSUPPORTED (a batch of 2^31 texels or
+ * more) or ASP_ENOMEM.
  */
-int asp_prim_gpu_fill(void *gl_context, const asp_prim_fill_batch *batch, float *acc, float *f, uint8_t *covered,
-                      asp_error *err);
+void asp_prim_gpu_fill_set(asp_prim_desc *desc, asp_gl_context *gl);
 
 /** Default crease angle (degrees) of asp_prim_render_options.crease_angle. */
 #define ASP_PRIM_CREASE_ANGLE_DEFAULT 60.0f

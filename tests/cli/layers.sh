@@ -5,7 +5,8 @@
 # and render's public headers (render*.h, scene_renderer.h) include only render's own headers and
 # those of the modules below it that render draws from (core, cloud, image, hier, prim, camera),
 # never eval (scene.h, instances.h, eval.h), io (io.h, mesh.h) or amg (amg.h) headers. camera.h,
-# the GL-free camera render and eval share, includes core headers only.
+# the GL-free camera render and eval share, includes core headers only. And no file in src/render
+# compares another kind's renderer table: callers call the table's entries (STYLE.md 9b).
 source "$(dirname "$0")/common.sh"
 
 src="${ASP_TEST_SRC:?}/../src"
