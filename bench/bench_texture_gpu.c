@@ -3,7 +3,7 @@
  * the bunny with N points, decomposes it once, and prints for the affine and
  * the radial method the median construction time (dpc: planes, textures,
  * atlas, neighbours) of the level nearest TARGET primitives built on the CPU
- * (THREADS threads) and with asp_prim_gpu_fill, their ratio, and the largest
+ * (THREADS threads) and with asp_prim_gpu_fill_set, their ratio, and the largest
  * per-texel difference of the atlases. Timings never decide pass or fail.
  * Usage: bench_texture_gpu [N=100000] [TARGET=400] [RUNS=5] [THREADS=0].
  */
@@ -91,7 +91,7 @@ int main(int argc, char **argv)
     } methods[] = {{"affine", ASP_PRIM_AFFINE}, {"radial linear", ASP_PRIM_RADIAL}};
     for (size_t m = 0; m < 2; m++) {
         asp_prim_desc cpu = {.method = methods[m].method}, gpu = cpu;
-        asp_prim_gpu_fill_attach(&gpu, gl);
+        asp_prim_gpu_fill_set(&gpu, gl);
         asp_dps *a = NULL, *b = NULL;
         double tc = median_dpc(amg, level, &cpu, &ctx, runs, &a), tg = median_dpc(amg, level, &gpu, &ctx, runs, &b);
         if (a && b)

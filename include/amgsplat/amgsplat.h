@@ -13,6 +13,7 @@
 #include "io.h"
 #include "mesh.h"
 #include "geom.h"
+#include "camera.h"
 #include "sample.h"
 #include "eval.h"
 #include "hier.h"

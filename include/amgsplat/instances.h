@@ -9,6 +9,7 @@
 #ifndef AMGSPLAT_INSTANCES_H
 #define AMGSPLAT_INSTANCES_H
 
+#include "camera.h"
 #include "scene.h"
 
 #ifdef __cplusplus
@@ -121,6 +122,18 @@ size_t asp_instance_scene_models(const asp_instance_scene *s, size_t source, flo
 /** Instances of source in s. Pure. */
 size_t asp_instance_scene_count(const asp_instance_scene *s, size_t source);
 
+/**
+ * The camera of a scene: its "camera" when given and orbit is 0 (eye,
+ * target, fov_y or fov_y_default), else asp_camera_frame of s->frame at
+ * azimuth and elevation (degrees) and distance_radii (0 = fit), fov_y_default. The frame of the returned camera is
+ * the scene's world centred on s->frame.center (the origin the scene
+ * renderer draws in: pass it to asp_instance_scene_models). Near and far
+ * planes hold the whole scene (asp_camera_clip_to_sphere). Pure (camera.h
+ * maths, no GL: the same camera in every build).
+ */
+void asp_instance_scene_camera(const asp_instance_scene *s, int orbit, float aspect, float fov_y_default,
+                               float azimuth, float elevation, float distance_radii, asp_camera *cam);
+
 /** Options of asp_instance_field; the zero value means defaults. */
 typedef struct asp_instance_field_desc {
     size_t instances; /* how many; 0 = 100 */
@@ -153,7 +166,7 @@ int asp_instance_field(const asp_scene *model, const char *source_name, const as
  * with points (point files, .amg, .hier; NULL = "disc"; a .hier, which has
  * no points for discs, is drawn by "splat" then), "prim" for .dps files and
  * "mesh" for meshes. Draw with a camera of
- * asp_instance_scene_camera (scene_renderer.h). s must outlive the renderer (hierarchies are
+ * asp_instance_scene_camera. s must outlive the renderer (hierarchies are
  * shared). Makes gl current. Returns 0; ASP_EINVAL (an unknown
  * point_renderer); a source renderer's errors prefixed with its name;
  * ASP_EUNSUPPORTED (a build without GL); ASP_ENOMEM. *out is unchanged on

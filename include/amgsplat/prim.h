@@ -49,7 +49,7 @@ typedef enum asp_prim_domain_set {
 /**
  * The texture fills of a batch of primitives, for a texture builder outside
  * the library's CPU path (thesis 3.6: on the graphics hardware,
- * asp_prim_gpu_fill in render.h). Primitive k has samples
+ * asp_prim_gpu_fill_set in render.h). Primitive k has samples
  * sample_first[k] .. sample_first[k + 1] - 1 and a w[k] x h[k] texel grid
  * stored from texel texel_first[k] on, row by row; sample s lies at (x[s],
  * y[s]) in texel units (texel i spans [i, i + 1)), footprint radius r[s]
@@ -113,7 +113,7 @@ typedef struct asp_prim_desc {
                                 points' bounding rectangle by this percentage (at most 1000) instead of the
                                 default margin of one point footprint on every side (0) */
     asp_prim_fill_fn fill;   /* NULL: textures on the CPU; else the fills go to fill(fill_user, ...) in batches
-                                (thesis 3.6; render.h asp_prim_gpu_fill_attach); not with normal_map */
+                                (thesis 3.6; render.h asp_prim_gpu_fill_set); not with normal_map */
     void *fill_user;
 } asp_prim_desc;
 
@@ -509,6 +509,86 @@ int asp_prim_normalise_parse(const char *name, asp_prim_normalise *out, asp_erro
 const char *asp_prim_method_name(asp_prim_method m);
 const char *asp_prim_shape_name(asp_prim_shape s);
 const char *asp_prim_normalise_name(asp_prim_normalise n);
+
+/* ---- GL-free maths of drawing a level: its bounds, and the hybrid's split (issue 26) ---- */
+/*
+ * These need no GL but the level's types, so they live here, below render (STYLE.md 9b): eval
+ * frames a .dps without a recorded frame with the same code in the no-GL build, and the hybrid
+ * renderer (render.h) and tools share one split. src/prim/level_bounds.c, src/prim/hybrid_select.c.
+ */
+
+/**
+ * Bounding sphere of the support rectangles of level in the frame centred on
+ * origin (NULL = world origin): centre of their corners' bounding box and the
+ * largest corner distance from it. Returns 0, ASP_EDEGENERATE (no primitives,
+ * or all corners at one point) or ASP_EFORMAT (non-finite values); outputs
+ * are unchanged on failure. Thread safe; no GL.
+ */
+int asp_prim_level_bounding_sphere(const asp_dps_level *level, const double origin[3], float center[3],
+                                   float *radius, asp_error *err);
+
+/*
+ * Defaults of asp_hybrid_split_desc (and so of the hybrid renderer,
+ * asp_hybrid_desc in render.h), chosen by measurement (docs/hybrid.md): a
+ * primitive is replaced by its domain's points when the Psi-weighted RMS
+ * distance of those points to its plane exceeds ERROR_LIMIT times its radius
+ * sqrt(half_u half_v), or when more than TURNED_LIMIT of its domain (Psi
+ * weighted) has normals more than 45 degrees from its own; a point is drawn
+ * when the kept primitives near it (facing its way, within 2 error + 2
+ * spacings of it) have Psi summing below COVERAGE_MIN.
+ */
+#define ASP_HYBRID_ERROR_LIMIT 0.15f
+#define ASP_HYBRID_TURNED_LIMIT 0.4f
+#define ASP_HYBRID_COVERAGE_MIN 0.3f
+
+/** asp_hybrid_split's point_cover value of a point drawn as a point. */
+#define ASP_HYBRID_DRAWN UINT32_MAX
+
+/** Thresholds of asp_hybrid_split; the zero value means the defaults above. */
+typedef struct asp_hybrid_split_desc {
+    float error_limit;  /* 0 = ASP_HYBRID_ERROR_LIMIT; else > 0 */
+    float turned_limit; /* 0 = ASP_HYBRID_TURNED_LIMIT; else > 0 */
+    float coverage_min; /* 0 = ASP_HYBRID_COVERAGE_MIN; else > 0 */
+} asp_hybrid_split_desc;
+
+/** What asp_hybrid_split decided. */
+typedef struct asp_hybrid_counts {
+    size_t prims_kept, prims_replaced;
+    size_t points_drawn, points_total;
+} asp_hybrid_counts;
+
+/**
+ * Decides per primitive of level whether it is kept or replaced by points,
+ * and per point of points (the level's source points, in their local frame
+ * centred on points->origin) whether a kept primitive stands for it. The
+ * domain of primitive i is the points projecting onto texels of its texture
+ * with alpha (= Psi_i) > tau = 0.05 (journal eq. 8), within half the
+ * primitive's radius of its plane and not facing away from it (normal dot >
+ * -0.1, when points has normals). Writes prim_replaced[i] (1 = replaced;
+ * level->prim_count entries), point_cover[j] (points->count entries): the
+ * kept primitive of largest Psi standing for point j, or ASP_HYBRID_DRAWN;
+ * prim_score[i] (optional, NULL = not wanted): max(relative error /
+ * error_limit, turned share / turned_limit), replaced when > 1 (INFINITY
+ * for a primitive with no domain point). Coverage holds by construction:
+ * every point is either drawn or in the domain of the kept primitive
+ * point_cover names. counts may be NULL. Returns 0; ASP_EINVAL (a negative or
+ * non-finite threshold); ASP_EDEGENERATE (no primitives or points); ASP_EFORMAT (no
+ * atlas, a texture rectangle outside it, an empty rectangle); ASP_ENOMEM.
+ * Cost: primitives x points bounding-sphere tests; OpenMP threads of ctx.
+ * Thread safe, no GL.
+ */
+int asp_hybrid_split(const asp_dps_level *level, const asp_cloud *points, const asp_hybrid_split_desc *desc,
+                     const asp_context *ctx, uint8_t *restrict prim_replaced, uint32_t *restrict point_cover,
+                     float *restrict prim_score, asp_hybrid_counts *counts, asp_error *err);
+
+/**
+ * Psi of primitive prim of level at point x (frame centred on origin, NULL =
+ * world origin) with normal (NULL = any) as asp_hybrid_split reads it: the
+ * alpha of the texel under x's projection when x is in the primitive's
+ * domain, else 0. For tests and tools. Thread safe, no GL.
+ */
+float asp_hybrid_domain_weight(const asp_dps_level *level, size_t prim, const double origin[3], const float x[3],
+                               const float normal[3]);
 
 #ifdef __cplusplus
 }

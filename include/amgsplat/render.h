@@ -8,12 +8,13 @@
  * Threading: a GL context belongs to one thread at a time. Every function that
  * takes an asp_gl_context (or an asp_renderer made from one) must be called
  * from the thread that created it; different contexts may be used from
- * different threads concurrently. The camera functions are pure math and
+ * different threads concurrently. The camera (camera.h) is pure math and
  * thread safe.
  */
 #ifndef AMGSPLAT_RENDER_H
 #define AMGSPLAT_RENDER_H
 
+#include "camera.h"
 #include "cloud.h"
 #include "hier.h"
 #include "image.h"
@@ -128,84 +129,7 @@ void *asp_gl_context_window(const asp_gl_context *gl);
  */
 int asp_gl_context_read_window(asp_gl_context *gl, asp_image *out, asp_error *err);
 
-/* ------------------------------------------------------------------------ */
-/* Orbit camera (no GL; thread safe)                                        */
-/* ------------------------------------------------------------------------ */
-
-/**
- * Orbit camera around target, y up. The eye sits at
- *   target + distance * (cos(el) sin(az), sin(el), cos(el) cos(az))
- * so azimuth 0, elevation 0 looks from +z towards -z with +x to the right;
- * azimuth turns counter-clockwise seen from +y (90 looks from +x), elevation is
- * the angle above the horizon (90 looks straight down; the image "up" then
- * points away from the azimuth direction, so no singularity). Perspective
- * projection with vertical field of view fov_y. Caller-owned plain struct.
- */
-/* asp_up_axis (which world axis points up) is declared in cloud.h: mesh loading records it too. */
-
-typedef struct asp_camera {
-    float target[3];
-    float azimuth;    /* degrees */
-    float elevation;  /* degrees, -90..90 */
-    float distance;   /* eye to target, world units, > 0 */
-    float fov_y;      /* vertical field of view, degrees, in (0, 180) */
-    float aspect;     /* viewport width / height, > 0 */
-    float z_near, z_far;
-    asp_up_axis up;   /* world axis shown upright at elevation 0; azimuth turns around it */
-} asp_camera;
-
-/** Defaults: target 0, azimuth 0, elevation 0, distance 3, fov_y 40, aspect 1, near 0.01, far 100, up +y. */
-void asp_camera_init(asp_camera *cam);
-
-/**
- * Points the camera at a bounding sphere (center, radius > 0) and sets distance
- * so the sphere exactly fills the view: its silhouette cone touches the nearer
- * pair of frustum sides (top/bottom when aspect >= 1). Keeps azimuth,
- * elevation and fov_y, sets aspect, and sets near/far with
- * asp_camera_clip_to_sphere. To move closer or further afterwards, change
- * distance and call asp_camera_clip_to_sphere again.
- */
-void asp_camera_fit(asp_camera *cam, const float center[3], float radius, float aspect);
-
-/**
- * The one camera framing of every representation of a model (points, .amg,
- * .dps, .hier, and later meshes): fits cam to frame (a world-space sphere,
- * asp_frame in cloud.h, recorded in the files) seen in a renderer whose local
- * frame is centred on origin (the cloud's origin, asp_prim_renderer_desc.origin;
- * NULL = world origin), as asp_camera_fit with aspect. distance_radii > 0 puts
- * the eye at that many frame radii from the centre instead of fitting. Keeps
- * azimuth, elevation, fov_y and up. frame->radius must be > 0. Thread safe.
- */
-void asp_camera_frame(asp_camera *cam, const asp_frame *frame, const double origin[3], float aspect,
-                      float distance_radii);
-
-/** The distance asp_camera_fit would choose for radius with cam's fov_y and aspect. */
-float asp_camera_fit_distance(const asp_camera *cam, float radius);
-
-/**
- * Sets z_near/z_far so the sphere (center, radius) lies between them from the
- * current eye, with 1% slack; if the eye is inside, z_near = 0.001 * (distance
- * to center + radius) so the 24-bit depth buffer keeps its precision.
- */
-void asp_camera_clip_to_sphere(asp_camera *cam, const float center[3], float radius);
-
-/** Eye position in world units. */
-void asp_camera_eye(const asp_camera *cam, float eye[3]);
-
-/** View matrix (world to eye; eye looks down -z), column-major: m[col * 4 + row]. */
-void asp_camera_view_matrix(const asp_camera *cam, float m[16]);
-
-/** OpenGL perspective matrix (eye to clip, NDC z in -1..1), column-major. */
-void asp_camera_projection_matrix(const asp_camera *cam, float m[16]);
-
-/**
- * Projects world point p into a width x height image: out[0] = x in pixels
- * from the left edge, out[1] = y in pixels from the top edge (pixel (i, j)
- * covers [i, i+1) x [j, j+1), matching asp_image rows), out[2] = window depth
- * in 0..1 (0 on the near plane). Returns 1 if p is in front of the eye (then
- * out is filled, even when outside the image), else 0 and out is unchanged.
- */
-int asp_camera_project(const asp_camera *cam, const float p[3], uint32_t width, uint32_t height, float out[3]);
+/* The orbit camera (asp_camera, asp_camera_*) is GL-free: camera.h, included above. */
 
 /* ------------------------------------------------------------------------ */
 /* Renderers                                                                */
@@ -807,27 +731,20 @@ typedef struct asp_prim_render_options {
 int asp_prim_renderer_set_debug_lines(asp_renderer *r, const float *lines, size_t segments, asp_error *err);
 
 /**
- * The texture fills of asp_prim_build on the GPU (thesis 3.6) on gl (made
- * current; use it from its thread only); asp_prim_gpu_fill_attach hands it to
- * asp_prim_build. A GL 4.5
- * compute shader computes per texel what the CPU's fill computes (the radial
- * sums of 3.3.2; the affine interpolation of 3.3.3 in the kept triangles and
- * the radial fringe outside), over the samples and triangles binned to the
- * texel's 8 x 8 cell, in the CPU's order and in double precision; the
- * library reads f back and finishes on the CPU as the thesis proposes.
- * Returns 0, ASP_EGL (the shader or a GL call failed), ASP_EUNSUPPORTED (a
- * batch of 2^31 texels or more), ASP_ENOMEM.
+ * Makes asp_prim_build with desc do its texture fills on the GPU of gl
+ * (thesis 3.6): sets desc->fill and desc->fill_user (the typed gl stands
+ * behind prim's untyped callback pointer, so no caller passes a void *). gl
+ * must outlive the build and is made current by it; use it from its thread
+ * only. Each fill: a GL 4.5 compute shader computes per texel what the
+ * CPU's fill computes (the radial sums of 3.3.2; the affine interpolation of
+ * 3.3.3 in the kept triangles and the radial fringe outside), over the
+ * samples and triangles binned to the texel's 8 x 8 cell, in the CPU's order
+ * and in double precision; the library reads f back and finishes on the CPU
+ * as the thesis proposes. A fill fails asp_prim_build with ASP_EGL (the
+ * shader or a GL call failed), ASP_EUNSUPPORTED (a batch of 2^31 texels or
+ * more) or ASP_ENOMEM.
  */
-int asp_prim_gpu_fill(asp_gl_context *gl, const asp_prim_fill_batch *batch, float *acc, float *f, uint8_t *covered,
-                      asp_error *err);
-
-/**
- * Sets desc->fill and desc->fill_user so that asp_prim_build fills its textures with
- * asp_prim_gpu_fill on gl, which must outlive the build (the library keeps a reference).
- * prim's callback takes an untyped user pointer, as it knows no GL; this keeps the cast in
- * one place, beside the function that knows what the pointer is.
- */
-void asp_prim_gpu_fill_attach(asp_prim_desc *desc, asp_gl_context *gl);
+void asp_prim_gpu_fill_set(asp_prim_desc *desc, asp_gl_context *gl);
 
 /** Default crease angle (degrees) of asp_prim_render_options.crease_angle. */
 #define ASP_PRIM_CREASE_ANGLE_DEFAULT 60.0f
@@ -875,16 +792,6 @@ int asp_prim_renderer_set_options(asp_renderer *r, const asp_prim_render_options
 int asp_prim_renderer_options(const asp_renderer *r, asp_prim_render_options *out, asp_error *err);
 
 /**
- * Bounding sphere of the support rectangles of level in the frame centred on
- * origin (NULL = world origin): centre of their corners' bounding box and the
- * largest corner distance from it. Returns 0, ASP_EDEGENERATE (no primitives,
- * or all corners at one point) or ASP_EFORMAT (non-finite values); outputs
- * are unchanged on failure. Thread safe; no GL.
- */
-int asp_prim_level_bounding_sphere(const asp_dps_level *level, const double origin[3], float center[3],
-                                   float *radius, asp_error *err);
-
-/**
  * Method names: "normalized", "prefix", "overlap", "two-pass",
  * "dark-backface", "dark-backface-soft", "blend-all", "no-blend", "polygons"
  * (the enum order). asp_prim_render_method_name returns NULL past the last,
@@ -897,21 +804,8 @@ int asp_prim_render_method_parse(const char *name, asp_prim_render_method *out, 
 /* Hybrid: primitives where they hold, points where they fail (issue 18)    */
 /* ------------------------------------------------------------------------ */
 
-/*
- * Defaults of asp_hybrid_desc, chosen by measurement (docs/hybrid.md): a
- * primitive is replaced by its domain's points when the Psi-weighted RMS
- * distance of those points to its plane exceeds ERROR_LIMIT times its radius
- * sqrt(half_u half_v), or when more than TURNED_LIMIT of its domain (Psi
- * weighted) has normals more than 45 degrees from its own; a point is drawn
- * when the kept primitives near it (facing its way, within 2 error + 2
- * spacings of it) have Psi summing below COVERAGE_MIN.
- */
-#define ASP_HYBRID_ERROR_LIMIT 0.15f
-#define ASP_HYBRID_TURNED_LIMIT 0.4f
-#define ASP_HYBRID_COVERAGE_MIN 0.3f
-
-/** asp_hybrid_split's point_cover value of a point drawn as a point. */
-#define ASP_HYBRID_DRAWN UINT32_MAX
+/* Which primitives hold is GL-free: asp_hybrid_split in prim.h, whose thresholds (and ASP_HYBRID_*
+ * defaults) the last three fields of asp_hybrid_desc pass on. */
 
 /** Options of the hybrid renderer; the zero value means defaults. */
 typedef struct asp_hybrid_desc {
@@ -927,45 +821,6 @@ typedef struct asp_hybrid_desc {
     float turned_limit;             /* 0 = ASP_HYBRID_TURNED_LIMIT; else > 0 */
     float coverage_min;             /* 0 = ASP_HYBRID_COVERAGE_MIN; else > 0 */
 } asp_hybrid_desc;
-
-/** What asp_hybrid_split decided. */
-typedef struct asp_hybrid_counts {
-    size_t prims_kept, prims_replaced;
-    size_t points_drawn, points_total;
-} asp_hybrid_counts;
-
-/**
- * Decides per primitive of level whether it is kept or replaced by points,
- * and per point of points (the level's source points, in their local frame
- * centred on points->origin) whether a kept primitive stands for it. The
- * domain of primitive i is the points projecting onto texels of its texture
- * with alpha (= Psi_i) > tau = 0.05 (journal eq. 8), within half the
- * primitive's radius of its plane and not facing away from it (normal dot >
- * -0.1, when points has normals). Writes prim_replaced[i] (1 = replaced;
- * level->prim_count entries), point_cover[j] (points->count entries): the
- * kept primitive of largest Psi standing for point j, or ASP_HYBRID_DRAWN;
- * prim_score[i] (optional, NULL = not wanted): max(relative error /
- * error_limit, turned share / turned_limit), replaced when > 1 (INFINITY
- * for a primitive with no domain point). Coverage holds by construction:
- * every point is either drawn or in the domain of the kept primitive
- * point_cover names. counts may be NULL. Returns 0; ASP_EINVAL (a negative or
- * non-finite threshold); ASP_EDEGENERATE (no primitives or points); ASP_EFORMAT (no
- * atlas, a texture rectangle outside it, an empty rectangle); ASP_ENOMEM.
- * Cost: primitives x points bounding-sphere tests; OpenMP threads of ctx.
- * Thread safe, no GL.
- */
-int asp_hybrid_split(const asp_dps_level *level, const asp_cloud *points, const asp_hybrid_desc *desc,
-                     const asp_context *ctx, uint8_t *restrict prim_replaced, uint32_t *restrict point_cover,
-                     float *restrict prim_score, asp_hybrid_counts *counts, asp_error *err);
-
-/**
- * Psi of primitive prim of level at point x (frame centred on origin, NULL =
- * world origin) with normal (NULL = any) as asp_hybrid_split reads it: the
- * alpha of the texel under x's projection when x is in the primitive's
- * domain, else 0. For tests and tools. Thread safe, no GL.
- */
-float asp_hybrid_domain_weight(const asp_dps_level *level, size_t prim, const double origin[3], const float x[3],
-                               const float normal[3]);
 
 /**
  * A renderer drawing level's kept primitives (asp_hybrid_split) and, in
@@ -1147,7 +1002,14 @@ typedef struct asp_renderer_options {
     asp_cut_renderer_desc cut;       /* origin comes from the source */
 } asp_renderer_options;
 
-/** One row of the renderer table. */
+/**
+ * One row of the renderer table (src/render/renderer_table.c). Adding a
+ * renderer kind is one new file, src/render/<kind>_renderer.c, that fills the
+ * renderer interface's function table (src/render/internal.h says which
+ * entries are required and what a NULL optional entry means), plus one row
+ * here with its make adapter; no other file learns of the kind, since every
+ * public call on an asp_renderer dispatches through that table.
+ */
 typedef struct asp_renderer_kind {
     const char *name;   /* "disc", "splat", "square", "prim", "mesh", "hybrid" */
     const char *noun;   /* what asp_renderer_count counts: "points", "splats", "primitives", "triangles" */

@@ -2,13 +2,13 @@
  * amgsplat scene renderer (issue 18 item 4): one asp_renderer drawing many
  * instances of several source renderers, each placed by a model matrix, in
  * one frame with one shared depth buffer, so render, view and eval draw a
- * scene of instances (instances.h) like a single model. Render knows no
- * files: the caller hands over renderers and matrices.
+ * scene of instances (instances.h, eval) like a single model. Render knows no
+ * files: the caller hands over renderers and matrices, so this header
+ * includes render's own headers only (tests/cli/layers.sh checks it).
  */
 #ifndef AMGSPLAT_SCENE_RENDERER_H
 #define AMGSPLAT_SCENE_RENDERER_H
 
-#include "instances.h"
 #include "render.h"
 
 #ifdef __cplusplus
@@ -46,17 +46,6 @@ typedef struct asp_scene_renderer_group {
  */
 int asp_scene_renderer_create(asp_gl_context *gl, const asp_scene_renderer_group *groups, size_t group_count,
                               asp_renderer **out, asp_error *err);
-
-/**
- * The camera of a scene: its "camera" when given and orbit is 0 (eye,
- * target, fov_y or fov_y_default), else asp_camera_frame of s->frame at
- * azimuth and elevation (degrees) and distance_radii (0 = fit), fov_y_default. The frame of the returned camera is
- * the scene's world centred on s->frame.center (the origin the scene
- * renderer draws in: pass it to asp_instance_scene_models). Near and far
- * planes hold the whole scene (asp_camera_clip_to_sphere). Pure.
- */
-void asp_instance_scene_camera(const asp_instance_scene *s, int orbit, float aspect, float fov_y_default,
-                               float azimuth, float elevation, float distance_radii, asp_camera *cam);
 
 /** Instances the scene renderer drew in its last frame (the rest were outside the frustum); 0 for others. */
 size_t asp_scene_renderer_drawn(const asp_renderer *r);

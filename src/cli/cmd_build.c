@@ -279,7 +279,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
 #ifdef ASP_HAVE_GL
     asp_gl_context *gl = NULL;
     if (!rc && gpu && (rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err)) == 0) {
-        asp_prim_gpu_fill_attach(&desc, gl); // thesis 3.6: the fills on the graphics hardware
+        asp_prim_gpu_fill_set(&desc, gl); // thesis 3.6: the fills on the graphics hardware
     }
 #endif
     if (!rc)

@@ -1,7 +1,8 @@
 /*
  * The renderer of a scene of instances (issue 18 item 4): one renderer of the
  * table per distinct source, handed with its instances' models to the scene
- * renderer of render (scene_renderer.h), so render, view and eval build it alike.
+ * renderer of render (scene_renderer.h), so render, view and eval build it alike;
+ * and the default camera of a scene (instances.h), which needs no GL.
  */
 #include <math.h>
 #include <stdio.h>
@@ -11,16 +12,7 @@
 #include "amgsplat/scene_renderer.h"
 #include "util/banned.h"
 
-#ifndef ASP_HAVE_GL
-int asp_instance_scene_renderer_create(asp_gl_context *gl, const asp_instance_scene *s, const char *point_renderer,
-                                       const asp_renderer_options *options, const asp_context *ctx,
-                                       asp_renderer **out, asp_error *err)
-{
-    (void)gl, (void)s, (void)point_renderer, (void)options, (void)ctx, (void)out;
-    return asp_error_set(err, ASP_EUNSUPPORTED, "this amgsplat was built without OpenGL (ASP_WITH_GL=OFF)");
-}
-#else
-
+/* The scene camera is pure maths (camera.h), so it is here in every build, the no-GL one too. */
 static const double deg = 3.14159265358979323846 / 180.0;
 
 void asp_instance_scene_camera(const asp_instance_scene *s, int orbit, float aspect, float fov_y_default,
@@ -53,6 +45,16 @@ void asp_instance_scene_camera(const asp_instance_scene *s, int orbit, float asp
     cam->aspect = aspect > 0 ? aspect : 1.0f;
     asp_camera_clip_to_sphere(cam, zero, (float)s->frame.radius);
 }
+
+#ifndef ASP_HAVE_GL
+int asp_instance_scene_renderer_create(asp_gl_context *gl, const asp_instance_scene *s, const char *point_renderer,
+                                       const asp_renderer_options *options, const asp_context *ctx,
+                                       asp_renderer **out, asp_error *err)
+{
+    (void)gl, (void)s, (void)point_renderer, (void)options, (void)ctx, (void)out;
+    return asp_error_set(err, ASP_EUNSUPPORTED, "this amgsplat was built without OpenGL (ASP_WITH_GL=OFF)");
+}
+#else
 
 /* The row of the renderer table drawing source sc. */
 static int pick_kind(const asp_scene *sc, const char *point_renderer, const asp_renderer_kind **out, asp_error *err)

@@ -148,7 +148,7 @@ static int frame_dps_fallback(asp_scene *s, asp_error *err)
         if (!rc)
             return 0;
     }
-#ifdef ASP_HAVE_GL
+    // the level's own bounds, in every build (prim.h: no GL), so no-GL and GL builds frame alike
     float c[3], r;
     int rc = asp_prim_level_bounding_sphere(&s->dps->levels[s->dps_level], NULL, c, &r, err);
     if (rc)
@@ -157,10 +157,6 @@ static int frame_dps_fallback(asp_scene *s, asp_error *err)
         s->frame.center[k] = c[k];
     s->frame.radius = r;
     return 0;
-#else
-    return asp_error_set(err, ASP_EDEGENERATE, "cannot frame '%s': it records no frame and its source is missing",
-                         s->path);
-#endif
 }
 
 static int load_dps(asp_scene *s, const asp_scene_desc *d, asp_error *err)

@@ -2,8 +2,11 @@
  * The offscreen render target of a headless context: an sRGB colour buffer
  * (so shading happens in linear light and is encoded on store) and a 24-bit
  * depth buffer, multisampled on request with a single-sample resolve copy.
- * Kept in the context and reused while the size and sample count stay.
+ * Kept in the context and reused while the size and sample count stay; and
+ * the row flip of every read-back (the offscreen target's, the window's).
  */
+#include <string.h>
+
 #include "render/internal.h"
 #include "util/banned.h"
 
@@ -81,4 +84,15 @@ void asp__gl_restore_state(GLuint fbo)
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glBindVertexArray(0);
     glUseProgram(0);
+}
+
+void asp__image_flip_rows(asp_image *img, uint8_t *row)
+{
+    size_t stride = 4 * (size_t)img->width;
+    for (uint32_t y = 0; y < img->height / 2; y++) {
+        uint8_t *a = img->pixels + y * stride, *b = img->pixels + (img->height - 1 - y) * stride;
+        memcpy(row, a, stride);
+        memcpy(a, b, stride);
+        memcpy(b, row, stride);
+    }
 }

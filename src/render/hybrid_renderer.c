@@ -260,7 +260,8 @@ static int make_parts(hybrid_renderer *h, const asp_dps_level *level, const asp_
         asp_free(ctx, cover);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the hybrid split of %zu points", points->count);
     }
-    int rc = asp_hybrid_split(level, points, d, ctx, replaced, cover, NULL, &h->counts, err);
+    asp_hybrid_split_desc limits = {d->error_limit, d->turned_limit, d->coverage_min};
+    int rc = asp_hybrid_split(level, points, &limits, ctx, replaced, cover, NULL, &h->counts, err);
     if (!rc && h->counts.prims_kept) {
         // the whole level goes up, so kept primitives keep the crease planes of replaced neighbours
         asp_prim_renderer_desc pd = {.options = d->prim};

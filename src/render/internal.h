@@ -96,16 +96,35 @@ typedef struct asp__frame {
     uint32_t width, height;
 } asp__frame;
 
-/* The renderer interface: each kind fills the function table. */
+/*
+ * The renderer interface: each kind fills its own function table, and the public calls
+ * (renderer.c) only dispatch through it; a NULL optional entry means "not supported" and the
+ * dispatcher answers for it (noted per entry). Nothing compares tables to learn a kind: a
+ * kind's own public calls (asp_prim_renderer_options, ...) may check that a handle is theirs,
+ * against their file's static table, and nothing else.
+ *
+ * Adding a renderer kind is one new file plus one table row:
+ *  1. src/render/<kind>_renderer.c: a struct starting with asp_renderer base, a static
+ *     asp__renderer_vtable with name, draw, destroy and whichever optional entries the kind
+ *     supports, and a create function (declared in include/amgsplat/render.h) that sets
+ *     base.vt, base.gl and base.count. CMake picks the file up (it globs src/render).
+ *  2. src/render/renderer_table.c: a make_<kind> adapter (source and options to the create
+ *     call) and one row in kinds[] (asp_renderer_kind: name, noun, inputs, has_lod, create).
+ *     render, view and eval then offer it by name; asp_renderer_options (render.h) gains a desc
+ *     field if the kind has options.
+ * No other file changes: the scene renderer, frame budget, statistics and LOD controls reach
+ * the kind only through the entries below.
+ */
 typedef struct asp__renderer_vtable {
     const char *name;
     int (*draw)(asp_renderer *r, const asp__frame *frame, asp_error *err);
     void (*destroy)(asp_renderer *r);
-    /* Optional (NULL = not supported). Renderers with a level of detail of their own (beyond the
-     * point hierarchy of splat_lod.c) take the screen tolerance in pixels here, so one controller
-     * (a frame budget, asp_renderer_set_lod) drives points, primitives and hybrids alike. */
+    /* Optional (NULL = ASP_EUNSUPPORTED from asp_renderer_set_lod). Takes the screen tolerance in
+     * pixels (already checked finite and >= 0) and the depth limit, so one controller (a frame
+     * budget, asp_renderer_set_lod) drives points, primitives, hybrids and scenes alike. */
     int (*set_lod)(asp_renderer *r, float tolerance, uint32_t depth_limit, asp_error *err);
-    /* Optional: figures of the last frame for asp_renderer_stats_get (count is preset to r->count). */
+    /* Optional: figures of the last frame for asp_renderer_stats_get, which zeroes *out and presets
+     * count and points to r->count first (what a NULL entry reports). */
     void (*stats)(const asp_renderer *r, asp_renderer_stats *out);
     /* Optional: draws count instances in one frame, instance i placed by models[16 i .. 16 i + 15]
      * (renderer-local to world, column-major), sharing one accumulation/normalisation where the
@@ -113,12 +132,22 @@ typedef struct asp__renderer_vtable {
      * such a renderer once per instance with the model folded into frame->view. */
     int (*draw_instances)(asp_renderer *r, const asp__frame *frame, const float *models, size_t count,
                           asp_error *err);
+    /* Optional (NULL = ASP_EUNSUPPORTED from asp_renderer_set_budget): cut to at most splats
+     * primitives per frame instead of the tolerance (0 = off). */
+    int (*set_budget)(asp_renderer *r, size_t splats, asp_error *err);
+    /* Optional (NULL = 1): whether draw_instances suits r's current options; 0 makes a scene draw r
+     * one instance at a time, far to near (e.g. primitive methods that paint without a depth test). */
+    int (*instanced)(const asp_renderer *r);
 } asp__renderer_vtable;
+
+/* Whether a scene draws r's instances with one draw_instances call: the entry exists and instanced allows it. */
+int asp__renderer_instanced(const asp_renderer *r);
 
 /*
  * The frame of an instance placed by model (renderer-local to world, column-major, affine): view *
- * model as the view, the eye moved into the local frame (model^-1 eye). scene_renderer.c; the
- * per-instance draws of the scene renderer and of draw_instances implementations share it.
+ * model as the view, the eye moved into the local frame (model^-1 eye; asp_camera_fold_model).
+ * renderer.c; the per-instance draws of the scene renderer and of draw_instances implementations
+ * share it.
  */
 void asp__frame_fold(const asp__frame *f, const float model[16], asp__frame *out);
 

@@ -178,16 +178,13 @@ void asp__prim_debug_destroy(asp__prim_renderer *r)
     r->debug = NULL;
 }
 
-int asp_prim_renderer_set_debug_lines(asp_renderer *base, const float *lines, size_t segments, asp_error *err)
+int asp__prim_debug_set_lines(asp__prim_renderer *r, const float *lines, size_t segments, asp_error *err)
 {
-    if (!base || base->vt != &asp__prim_vtable)
-        return asp_error_set(err, ASP_EUNSUPPORTED, "the %s renderer draws no triangulation",
-                             base ? asp_renderer_name(base) : "(null)");
     if (!lines && segments)
         return asp_error_set(err, ASP_EINVAL, "no lines for %zu segments", segments);
     if (segments > (size_t)INT32_MAX / 2)
         return asp_error_set(err, ASP_EUNSUPPORTED, "cannot draw %zu segments in one call", segments);
-    asp__prim_renderer *r = (asp__prim_renderer *)base;
+    asp_renderer *base = &r->base;
     int rc = asp__gl_ensure_current(base->gl, err);
     if (!rc && !r->debug)
         rc = debug_init(r, err);

@@ -109,8 +109,6 @@ typedef struct asp__prim_renderer {
     struct asp__prim_debug *debug; /* debug drawings (prim_debug.c), made on first use */
 } asp__prim_renderer;
 
-extern const asp__renderer_vtable asp__prim_vtable;
-
 /* Draws one frame with r->opt into the currently bound draw framebuffer. */
 int asp__prim_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err);
 /* draw_instances of the vtable: count instances placed by models (16 floats each), one accumulation
@@ -153,5 +151,7 @@ void asp__prim_targets_release(asp__prim_targets *t);
 /* Thesis appendix C debug drawings (ASP_PRIM_RENDER_DEBUG_*) over the current draw framebuffer; prim_debug.c. */
 int asp__prim_debug_draw(asp__prim_renderer *r, const asp__frame *f, asp_error *err);
 void asp__prim_debug_destroy(asp__prim_renderer *r);
+/* asp_prim_renderer_set_debug_lines on a renderer known to be r (prim_renderer.c checked the kind). */
+int asp__prim_debug_set_lines(asp__prim_renderer *r, const float *lines, size_t segments, asp_error *err);
 
 #endif

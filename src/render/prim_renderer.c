@@ -143,9 +143,12 @@ static void resolve_options(const asp__prim_renderer *r, const asp_prim_render_o
     }
 }
 
+static const asp__renderer_vtable prim_vtable;
+
+/* r when it is a domain-primitive renderer (a check of this kind's own handle), else NULL. */
 static asp__prim_renderer *prim_of(asp_renderer *r)
 {
-    return r && r->vt == &asp__prim_vtable ? (asp__prim_renderer *)r : NULL;
+    return r && r->vt == &prim_vtable ? (asp__prim_renderer *)r : NULL;
 }
 
 int asp_prim_renderer_set_options(asp_renderer *r, const asp_prim_render_options *options, asp_error *err)
@@ -171,49 +174,13 @@ int asp_prim_renderer_options(const asp_renderer *r, asp_prim_render_options *ou
     return 0;
 }
 
-int asp_prim_level_bounding_sphere(const asp_dps_level *level, const double origin[3], float center[3],
-                                   float *radius, asp_error *err)
+int asp_prim_renderer_set_debug_lines(asp_renderer *r, const float *lines, size_t segments, asp_error *err)
 {
-    static const double zero[3] = {0, 0, 0};
-    if (!origin)
-        origin = zero;
-    if (level->prim_count == 0)
-        return asp_error_set(err, ASP_EDEGENERATE, "cannot bound a level without primitives");
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    // corners in double: centres are world coordinates that may be far from origin
-    for (size_t i = 0; i < level->prim_count; i++) {
-        const asp_prim *p = &level->prims[i];
-        for (int k = 0; k < 4; k++) {
-            double su = (k & 1 ? 1.0 : -1.0) * p->half_u, sv = (k & 2 ? 1.0 : -1.0) * p->half_v;
-            for (int a = 0; a < 3; a++) {
-                double x = p->centre[a] - origin[a] + su * p->axis_u[a] + sv * p->axis_v[a];
-                if (!isfinite(x))
-                    return asp_error_set(err, ASP_EFORMAT, "cannot bound primitive %zu: non-finite corner", i);
-                lo[a] = fmin(lo[a], x);
-                hi[a] = fmax(hi[a], x);
-            }
-        }
-    }
-    double c[3], r2 = 0;
-    for (int a = 0; a < 3; a++)
-        c[a] = 0.5 * (lo[a] + hi[a]);
-    for (size_t i = 0; i < level->prim_count; i++) {
-        const asp_prim *p = &level->prims[i];
-        for (int k = 0; k < 4; k++) {
-            double su = (k & 1 ? 1.0 : -1.0) * p->half_u, sv = (k & 2 ? 1.0 : -1.0) * p->half_v, d2 = 0;
-            for (int a = 0; a < 3; a++) {
-                double x = p->centre[a] - origin[a] + su * p->axis_u[a] + sv * p->axis_v[a] - c[a];
-                d2 += x * x;
-            }
-            r2 = fmax(r2, d2);
-        }
-    }
-    if (!(r2 > 0))
-        return asp_error_set(err, ASP_EDEGENERATE, "cannot bound a level whose primitives are all one point");
-    for (int a = 0; a < 3; a++)
-        center[a] = (float)c[a];
-    *radius = (float)sqrt(r2);
-    return 0;
+    asp__prim_renderer *p = prim_of(r);
+    if (!p)
+        return asp_error_set(err, ASP_EUNSUPPORTED, "the %s renderer draws no triangulation",
+                             r ? asp_renderer_name(r) : "(null)");
+    return asp__prim_debug_set_lines(p, lines, segments, err);
 }
 
 static void prim_destroy(asp_renderer *base)
@@ -260,8 +227,22 @@ static int prim_draw_instances(asp_renderer *base, const asp__frame *f, const fl
     return asp__prim_draw_instances((asp__prim_renderer *)base, f, models, count, err);
 }
 
-const asp__renderer_vtable asp__prim_vtable = {.name = "prim", .draw = prim_draw, .destroy = prim_destroy,
-                                               .draw_instances = prim_draw_instances};
+/*
+ * Instances in one draw only with the normalized method: the seeds' methods paint without a
+ * depth test and need the scene's global far-to-near order, prefix selects by primitive id,
+ * which instances share, and outlines are drawn per frame.
+ */
+static int prim_instanced(const asp_renderer *base)
+{
+    const asp__prim_renderer *r = (const asp__prim_renderer *)base;
+    return r->opt.method == ASP_PRIM_RENDER_NORMALIZED && !(r->opt.flags & ASP_PRIM_RENDER_OUTLINE);
+}
+
+static const asp__renderer_vtable prim_vtable = {.name = "prim",
+                                                 .draw = prim_draw,
+                                                 .destroy = prim_destroy,
+                                                 .draw_instances = prim_draw_instances,
+                                                 .instanced = prim_instanced};
 
 /* CPU copies used every frame by the sorted methods. */
 static int alloc_cpu(asp__prim_renderer *r, asp_error *err)
@@ -442,7 +423,7 @@ int asp_prim_renderer_create(asp_gl_context *gl, const asp_dps_level *level, con
     asp__prim_renderer *r = asp_calloc(&gl->actx, 1, sizeof *r);
     if (!r)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for a domain-primitive renderer");
-    r->base.vt = &asp__prim_vtable;
+    r->base.vt = &prim_vtable;
     r->base.gl = gl;
     r->base.count = level->prim_count;
     r->count = level->prim_count;

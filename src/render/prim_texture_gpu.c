@@ -193,9 +193,10 @@ static GLuint buffer(const void *data, size_t bytes, GLbitfield flags)
     return id;
 }
 
-int asp_prim_gpu_fill(asp_gl_context *gl, const asp_prim_fill_batch *b, float *acc, float *f, uint8_t *covered,
-                      asp_error *err)
+/* The asp_prim_fill_fn that asp_prim_gpu_fill_set installs: user is the asp_gl_context it was given. */
+static int gpu_fill(void *user, const asp_prim_fill_batch *b, float *acc, float *f, uint8_t *covered, asp_error *err)
 {
+    asp_gl_context *gl = user;
     ASP_ASSERT(gl && b && acc && f && covered);
     if (b->prim_count == 0)
         return 0;
@@ -276,16 +277,9 @@ done:
     return rc;
 }
 
-/* asp_prim_fill_fn's shape: the user pointer is the asp_gl_context asp_prim_gpu_fill_attach stored. */
-static int gpu_fill_callback(void *user, const asp_prim_fill_batch *b, float *acc, float *f, uint8_t *covered,
-                             asp_error *err)
-{
-    return asp_prim_gpu_fill((asp_gl_context *)user, b, acc, f, covered, err);
-}
-
-void asp_prim_gpu_fill_attach(asp_prim_desc *desc, asp_gl_context *gl)
+void asp_prim_gpu_fill_set(asp_prim_desc *desc, asp_gl_context *gl)
 {
     ASP_ASSERT(desc && gl);
-    desc->fill = gpu_fill_callback;
+    desc->fill = gpu_fill;
     desc->fill_user = gl;
 }

@@ -68,17 +68,6 @@ void asp__gl_attrib_buffer(asp__gl_vertex_array vao, GLuint attr, asp__gl_buffer
     glEnableVertexArrayAttrib(vao.id, attr);
 }
 
-void asp__image_flip_rows(asp_image *img, uint8_t *row)
-{
-    size_t stride = 4 * (size_t)img->width;
-    for (uint32_t y = 0; y < img->height / 2; y++) {
-        uint8_t *a = img->pixels + y * stride, *b = img->pixels + (img->height - 1 - y) * stride;
-        memcpy(row, a, stride);
-        memcpy(a, b, stride);
-        memcpy(b, row, stride);
-    }
-}
-
 static void clear_target(GLuint fbo, const uint8_t bg[4])
 {
     // stored as given (sRGB writes are off): premultiplied in linear light, encoded
@@ -230,22 +219,4 @@ int asp_render_to_image(asp_gl_context *gl, asp_renderer *r, const asp_camera *c
         unpremultiply(&img, desc->background);
     *out = img;
     return 0;
-}
-
-void asp_renderer_destroy(asp_renderer *r)
-{
-    if (!r)
-        return;
-    asp__gl_ensure_current(r->gl, NULL);
-    r->vt->destroy(r);
-}
-
-const char *asp_renderer_name(const asp_renderer *r)
-{
-    return r->vt->name;
-}
-
-size_t asp_renderer_count(const asp_renderer *r)
-{
-    return r->count;
 }

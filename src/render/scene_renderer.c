@@ -39,32 +39,7 @@ typedef struct scene_renderer {
 
 static const asp__renderer_vtable scene_vtable;
 
-static void mul4(const float a[16], const float b[16], float out[16])
-{
-    float r[16];
-    for (int c = 0; c < 4; c++)
-        for (int row = 0; row < 4; row++) {
-            float s = 0;
-            for (int k = 0; k < 4; k++)
-                s += a[4 * k + row] * b[4 * c + k];
-            r[4 * c + row] = s;
-        }
-    memcpy(out, r, sizeof r);
-}
-
-/* The eye (scene coordinates) in the local frame of affine model m: m^-1 eye, in double. */
-static void eye_to_local(const float m[16], const float eye[3], float out[3])
-{
-    double a = m[0], b = m[4], c = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6], k = m[10];
-    double det = a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g);
-    double inv[9] = {(e * k - f * h) / det, (c * h - b * k) / det, (b * f - c * e) / det,
-                     (f * g - d * k) / det, (a * k - c * g) / det, (c * d - a * f) / det,
-                     (d * h - e * g) / det, (b * g - a * h) / det, (a * e - b * d) / det};
-    double p[3] = {(double)eye[0] - m[12], (double)eye[1] - m[13], (double)eye[2] - m[14]};
-    for (int r = 0; r < 3; r++)
-        out[r] = (float)(inv[3 * r] * p[0] + inv[3 * r + 1] * p[1] + inv[3 * r + 2] * p[2]);
-}
-
+/* The largest axis scale of affine m: a sphere of radius r moved by m fits in radius r times it. */
 static float max_axis(const float m[16])
 {
     float best = 0;
@@ -73,23 +48,6 @@ static float max_axis(const float m[16])
         best = l > best ? l : best;
     }
     return best;
-}
-
-/* The six frustum planes of clip = proj * view (Gribb and Hartmann), normalised: inside where n . x + d >= 0. */
-static void frustum_planes(const asp__frame *f, float planes[6][4])
-{
-    float pv[16];
-    mul4(f->proj, f->view, pv);
-    for (int i = 0; i < 3; i++)
-        for (int s = 0; s < 2; s++) {
-            float *p = planes[2 * i + s];
-            float sign = s ? -1.0f : 1.0f;
-            for (int c = 0; c < 4; c++)
-                p[c] = pv[4 * c + 3] + sign * pv[4 * c + i];
-            float len = sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-            for (int c = 0; c < 4 && len > 0; c++)
-                p[c] /= len;
-        }
 }
 
 /* 1 when instance i of g may show: its moved sphere meets every frustum plane's inner side. */
@@ -121,14 +79,6 @@ static int far_first(const void *a, const void *b)
     return x->group != y->group ? (x->group < y->group ? -1 : 1) : (x->index < y->index ? -1 : x->index > y->index);
 }
 
-void asp__frame_fold(const asp__frame *f, const float model[16], asp__frame *out)
-{
-    asp__frame local = *f;
-    mul4(f->view, model, local.view);
-    eye_to_local(model, f->eye, local.eye);
-    *out = local;
-}
-
 static int draw_folded(asp_renderer *r, const asp__frame *f, const float model[16], asp_error *err)
 {
     asp__frame local;
@@ -137,25 +87,20 @@ static int draw_folded(asp_renderer *r, const asp__frame *f, const float model[1
 }
 
 /*
- * Whether g's renderer gets its instances in one instanced draw. Domain primitives only with the
- * normalized method: the seeds' methods paint without a depth test and need the scene's global
- * far-to-near order, and prefix selects by primitive id, which instances share.
+ * Whether g's renderer gets its instances in one instanced draw: its table says so (draw_instances,
+ * and instanced for its current options, e.g. domain primitives only with the normalized method)
+ * and the group does not ask for the reference path.
  */
 static int instanced(const group *g)
 {
-    if (!g->r->vt->draw_instances || g->one_by_one)
-        return 0;
-    asp_prim_render_options o;
-    if (asp_prim_renderer_options(g->r, &o, NULL) == 0)
-        return o.method == ASP_PRIM_RENDER_NORMALIZED && !(o.flags & ASP_PRIM_RENDER_OUTLINE);
-    return 1;
+    return !g->one_by_one && asp__renderer_instanced(g->r);
 }
 
 static int scene_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
 {
     scene_renderer *s = (scene_renderer *)base;
     float planes[6][4];
-    frustum_planes(f, planes);
+    asp_camera_frustum_planes(f->view, f->proj, planes);
     size_t nref = 0, count = 0, drawn = 0;
     for (size_t gi = 0; gi < s->group_count; gi++) {
         group *g = &s->groups[gi];

@@ -72,9 +72,6 @@ typedef struct asp__lod_renderer {
     asp__lod lod;
 } asp__lod_renderer;
 
-extern const asp__renderer_vtable asp__splat_vtable;
-extern const asp__renderer_vtable asp__square_vtable;
-
 /*
  * The hybrid renderer's access to a splat renderer r (hybrid_renderer.c):
  * select cuts the hierarchy for f (asp__lod_select); pass draws the cut into
@@ -84,8 +81,13 @@ extern const asp__renderer_vtable asp__square_vtable;
 int asp__splat_hybrid_select(asp_renderer *r, const asp__frame *f, asp_error *err);
 void asp__splat_hybrid_pass(asp_renderer *r, const asp__frame *f, int depth_only);
 
-/* r as a hierarchy renderer, or NULL for other kinds. */
-asp__lod_renderer *asp__lod_renderer_of(asp_renderer *r);
+/*
+ * The set_lod, set_budget and stats entries of every hierarchy renderer's table (splat_lod.c):
+ * r is an asp__lod_renderer; set_lod takes the tolerance asp_renderer_set_lod has checked.
+ */
+int asp__lod_set_lod(asp_renderer *r, float tolerance, uint32_t depth_limit, asp_error *err);
+int asp__lod_set_budget(asp_renderer *r, size_t splats, asp_error *err);
+void asp__lod_stats(const asp_renderer *r, asp_renderer_stats *out);
 
 /* The options that asp_splat_renderer_desc and asp_square_renderer_desc share, borrowed from the caller's desc. */
 typedef struct asp__lod_desc {

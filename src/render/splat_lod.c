@@ -2,7 +2,8 @@
  * The point hierarchy on the GPU for the splat and square renderers: all
  * splats uploaded once, the view-dependent cut of every frame (seed 001
  * section 5.1 step 1; seed 004 3.2.1-3.2.5) uploaded as splat ids that an
- * instanced draw reads, and the LOD controls and statistics of the public API.
+ * instanced draw reads, and the LOD and statistics entries of their function
+ * tables (the public calls dispatch to them, renderer.c).
  */
 #include <math.h>
 #include <stdio.h>
@@ -18,13 +19,6 @@
  * plausible there.
  */
 static const float max_cone = 1.04719755f;
-
-asp__lod_renderer *asp__lod_renderer_of(asp_renderer *r)
-{
-    if (r && (r->vt == &asp__splat_vtable || r->vt == &asp__square_vtable))
-        return (asp__lod_renderer *)r;
-    return NULL;
-}
 
 int asp__lod_check_option(const char *renderer, const char *name, float v, asp_error *err)
 {
@@ -241,48 +235,32 @@ void asp__lod_release(const asp_context *actx, asp__lod *lod)
     lod->hier = NULL;
 }
 
-int asp_renderer_set_lod(asp_renderer *r, float tolerance, uint32_t depth_limit, asp_error *err)
+/* The table entries of the hierarchy renderers (splat, square): r starts with asp__lod_renderer. */
+
+int asp__lod_set_lod(asp_renderer *r, float tolerance, uint32_t depth_limit, asp_error *err)
 {
-    asp__lod_renderer *lr = asp__lod_renderer_of(r);
-    if (!lr && !(r && r->vt->set_lod))
-        return asp_error_set(err, ASP_EUNSUPPORTED, "the %s renderer has no level of detail to set",
-                             asp_renderer_name(r));
-    if (!(tolerance >= 0) || !isfinite(tolerance))
-        return asp_error_set(err, ASP_EINVAL, "screen tolerance %g is not a finite number of pixels >= 0",
-                             (double)tolerance);
-    if (!lr)
-        return r->vt->set_lod(r, tolerance, depth_limit, err);
-    lr->lod.tolerance = tolerance;
-    lr->lod.depth_limit = depth_limit;
+    (void)err; // asp_renderer_set_lod checked the tolerance; any depth limit is valid
+    asp__lod *lod = &((asp__lod_renderer *)r)->lod;
+    lod->tolerance = tolerance;
+    lod->depth_limit = depth_limit;
     return 0;
 }
 
-int asp_renderer_set_budget(asp_renderer *r, size_t splats, asp_error *err)
+int asp__lod_set_budget(asp_renderer *r, size_t splats, asp_error *err)
 {
-    asp__lod_renderer *lr = asp__lod_renderer_of(r);
-    if (!lr)
-        return asp_error_set(err, ASP_EUNSUPPORTED, "the %s renderer has no level of detail to cut to %zu splats",
-                             asp_renderer_name(r), splats);
-    lr->lod.budget = splats;
+    (void)err;
+    ((asp__lod_renderer *)r)->lod.budget = splats;
     return 0;
 }
 
-void asp_renderer_stats_get(const asp_renderer *r, asp_renderer_stats *out)
+void asp__lod_stats(const asp_renderer *r, asp_renderer_stats *out)
 {
-    memset(out, 0, sizeof *out);
-    out->count = r->count;
-    out->points = r->count;
-    asp__lod_renderer *lr = asp__lod_renderer_of((asp_renderer *)r);
-    if (!lr) {
-        if (r->vt->stats)
-            r->vt->stats(r, out);
-        return;
-    }
-    out->count = lr->lod.count;
-    out->points = lr->lod.points;
-    out->nodes = lr->lod.nodes;
-    out->tolerance = lr->lod.tolerance;
-    out->depth_limit = lr->lod.depth_limit;
-    out->budget = lr->lod.budget;
-    out->select_seconds = lr->lod.select_seconds;
+    const asp__lod *lod = &((const asp__lod_renderer *)r)->lod;
+    out->count = lod->count;
+    out->points = lod->points;
+    out->nodes = lod->nodes;
+    out->tolerance = lod->tolerance;
+    out->depth_limit = lod->depth_limit;
+    out->budget = lod->budget;
+    out->select_seconds = lod->select_seconds;
 }

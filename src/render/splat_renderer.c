@@ -594,8 +594,13 @@ static int splat_draw_instances(asp_renderer *base, const asp__frame *f, const f
     return asp__gl_check(base->gl, "draw splat instances", err);
 }
 
-const asp__renderer_vtable asp__splat_vtable = {.name = "splat", .draw = splat_draw, .destroy = splat_destroy,
-                                                .draw_instances = splat_draw_instances};
+static const asp__renderer_vtable splat_vtable = {.name = "splat",
+                                                 .draw = splat_draw,
+                                                 .destroy = splat_destroy,
+                                                 .set_lod = asp__lod_set_lod,
+                                                 .stats = asp__lod_stats,
+                                                 .draw_instances = splat_draw_instances,
+                                                 .set_budget = asp__lod_set_budget};
 
 static void set_static_uniforms(splat_renderer *s)
 {
@@ -742,7 +747,7 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     if (rc)
         return rc;
     asp__lod_renderer *lr;
-    rc = asp__lod_renderer_create(gl, sizeof(splat_renderer), &asp__splat_vtable, cloud, hier, ASP__LOD_DESC(desc, ctx),
+    rc = asp__lod_renderer_create(gl, sizeof(splat_renderer), &splat_vtable, cloud, hier, ASP__LOD_DESC(desc, ctx),
                                   &lr, err);
     if (rc)
         return rc;
@@ -804,7 +809,7 @@ int asp_splat_renderer_create_hier(asp_gl_context *gl, const asp_hier *hier, con
  */
 int asp__splat_hybrid_select(asp_renderer *r, const asp__frame *f, asp_error *err)
 {
-    ASP_ASSERT(r->vt == &asp__splat_vtable);
+    ASP_ASSERT(r->vt == &splat_vtable);
     return asp__lod_select((asp__lod_renderer *)r, f, err);
 }
 

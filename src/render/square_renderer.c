@@ -90,7 +90,12 @@ static int square_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     return asp__gl_check(base->gl, "draw squares", err);
 }
 
-const asp__renderer_vtable asp__square_vtable = {.name = "square", .draw = square_draw, .destroy = square_destroy};
+static const asp__renderer_vtable square_vtable = {.name = "square",
+                                                  .draw = square_draw,
+                                                  .destroy = square_destroy,
+                                                  .set_lod = asp__lod_set_lod,
+                                                  .stats = asp__lod_stats,
+                                                  .set_budget = asp__lod_set_budget};
 
 static int check_desc(const asp_square_renderer_desc *d, asp_error *err)
 {
@@ -120,7 +125,7 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
         return asp_error_set(err, ASP_EINVAL, "square size %g pixels exceeds this GL context's limit of %g",
                              (double)desc->point_size, (double)range[1]);
     asp__lod_renderer *lr;
-    rc = asp__lod_renderer_create(gl, sizeof(square_renderer), &asp__square_vtable, cloud, hier, ASP__LOD_DESC(desc, ctx),
+    rc = asp__lod_renderer_create(gl, sizeof(square_renderer), &square_vtable, cloud, hier, ASP__LOD_DESC(desc, ctx),
                                   &lr, err);
     if (rc)
         return rc;

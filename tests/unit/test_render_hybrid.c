@@ -202,14 +202,14 @@ static void split_covers_every_point(void)
             CHECK(replaced[i] == (score[i] > 1));
         // bad thresholds are refused, and the outputs stay as they were
         memset(cover, 0xab, c->count * sizeof *cover);
-        CHECK(asp_hybrid_split(lv, c, &(asp_hybrid_desc){.error_limit = -1}, NULL, replaced, cover, NULL, NULL,
+        CHECK(asp_hybrid_split(lv, c, &(asp_hybrid_split_desc){.error_limit = -1}, NULL, replaced, cover, NULL, NULL,
                                &err) == ASP_EINVAL);
-        CHECK(asp_hybrid_split(lv, c, &(asp_hybrid_desc){.coverage_min = NAN}, NULL, replaced, cover, NULL, NULL,
+        CHECK(asp_hybrid_split(lv, c, &(asp_hybrid_split_desc){.coverage_min = NAN}, NULL, replaced, cover, NULL, NULL,
                                &err) == ASP_EINVAL);
         CHECK(cover[0] == 0xabababab);
         // a stricter error limit replaces at least as much
         asp_hybrid_counts strict = {0};
-        CHECK_OK(asp_hybrid_split(lv, c, &(asp_hybrid_desc){.error_limit = 0.05f}, NULL, replaced, cover, NULL,
+        CHECK_OK(asp_hybrid_split(lv, c, &(asp_hybrid_split_desc){.error_limit = 0.05f}, NULL, replaced, cover, NULL,
                                   &strict, &err), ep(&err));
         CHECK(strict.prims_replaced >= counts.prims_replaced && strict.points_drawn >= counts.points_drawn);
         free(replaced);

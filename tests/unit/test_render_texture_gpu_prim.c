@@ -1,7 +1,7 @@
 /*
  * GPU texture construction (thesis 3.6, issue 17; "_prim" in the name: it decomposes, so ASan builds
  * unwind it fully for the MPI suppressions, CMakeLists.txt): asp_prim_build with the
- * compute-shader fill (asp_prim_gpu_fill) makes the CPU build's atlases, texel
+ * compute-shader fill (asp_prim_gpu_fill_set) makes the CPU build's atlases, texel
  * for texel, for the affine method and every radial shape and criterion; a
  * fill's error reaches the caller; normal maps are refused.
  */
@@ -86,7 +86,7 @@ static void test_gpu_equals_cpu(void)
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         asp_prim_desc cpu = cases[k].d, gpu = cases[k].d;
-        asp_prim_gpu_fill_attach(&gpu, gl);
+        asp_prim_gpu_fill_set(&gpu, gl);
         asp_dps *a = NULL, *b = NULL;
         CHECK_OK(asp_prim_build(amg, NULL, levels, 3, &cpu, NULL, NULL, &a, &err), ep(&err));
         CHECK_OK(asp_prim_build(amg, NULL, levels, 3, &gpu, NULL, NULL, &b, &err), ep(&err));

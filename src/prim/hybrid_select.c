@@ -3,13 +3,14 @@
  * it draws instead (issue 18 item 3; the hybrid of points and primitives the
  * journal (section 6) and the thesis (2.6.3, future work) propose, with the
  * points drawn as the splats of seed 001). No GL: a pure function of the
- * level, its source points and the thresholds of asp_hybrid_desc.
+ * level, its source points and the thresholds of asp_hybrid_split_desc, so it
+ * lives below render (prim.h) and the no-GL build has it too.
  */
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
 
-#include "amgsplat/render.h"
+#include "amgsplat/prim.h"
 #include "util/banned.h"
 
 /*
@@ -67,13 +68,13 @@ static float membership(const asp_dps_level *lv, const asp_prim *p, const frame_
     return a;
 }
 
-int asp_hybrid_split(const asp_dps_level *level, const asp_cloud *points, const asp_hybrid_desc *desc,
+int asp_hybrid_split(const asp_dps_level *level, const asp_cloud *points, const asp_hybrid_split_desc *desc,
                      const asp_context *ctx, uint8_t *restrict prim_replaced, uint32_t *restrict point_cover,
                      float *restrict prim_score, asp_hybrid_counts *counts, asp_error *err)
 {
     ASP_ASSERT(level && points && prim_replaced && point_cover);
-    static const asp_hybrid_desc zero_desc;
-    const asp_hybrid_desc *d = desc ? desc : &zero_desc;
+    static const asp_hybrid_split_desc zero_desc;
+    const asp_hybrid_split_desc *d = desc ? desc : &zero_desc;
     float error_limit = d->error_limit > 0 ? d->error_limit : ASP_HYBRID_ERROR_LIMIT;
     float turned_limit = d->turned_limit > 0 ? d->turned_limit : ASP_HYBRID_TURNED_LIMIT;
     float coverage_min = d->coverage_min > 0 ? d->coverage_min : ASP_HYBRID_COVERAGE_MIN;
@@ -104,14 +105,14 @@ int asp_hybrid_split(const asp_dps_level *level, const asp_cloud *points, const 
         asp_free(ctx, sums);
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the hybrid split of %zu primitives", np);
     }
-    // mean point spacing: the points' radii, or the disc renderer's default
+    // mean point spacing: the points' radii, or the disc renderer's default (asp_render_default_radius)
     double spacing = 0;
     if (points->radii) {
         for (size_t j = 0; j < n; j++)
             spacing += points->radii[j];
         spacing /= (double)n;
     } else {
-        spacing = asp_render_default_radius(points) * 0.5;
+        spacing = asp_cloud_default_radius(points) * 0.5;
     }
     for (size_t i = 0; i < np; i++) {
         const asp_prim *p = &level->prims[i];

@@ -1,11 +1,12 @@
 /*
- * Orbit camera math (render/camera.c): view frame conventions, projection of
- * known points to known pixels, and asp_camera_fit keeping a bounding sphere
- * inside the frustum while touching its nearer sides.
+ * Orbit camera math (src/geom/camera.c, camera.h; no GL, so the no-GL build
+ * runs it too): view frame conventions, projection of known points to known
+ * pixels, and asp_camera_fit keeping a bounding sphere inside the frustum
+ * while touching its nearer sides.
  */
 #include <math.h>
 
-#include "amgsplat/render.h"
+#include "amgsplat/camera.h"
 #include "harness.h"
 
 static const double deg = 3.14159265358979323846 / 180.0;
@@ -245,5 +246,80 @@ static void test_up_axis(void)
     }
 }
 
+/* An instance placed by model seen through view: view * model on local points, and the eye moved into the local frame. */
+static void test_fold_model(void)
+{
+    asp_camera cam;
+    asp_camera_init(&cam);
+    cam.azimuth = 40;
+    cam.elevation = 25;
+    cam.distance = 7;
+    float view[16], eye[3];
+    asp_camera_view_matrix(&cam, view);
+    asp_camera_eye(&cam, eye);
+    // model: scale 2, turn 90 degrees about +y, move by (3, -1, 5)
+    const float model[16] = {0, 0, -2, 0, 0, 2, 0, 0, 2, 0, 0, 0, 3, -1, 5, 1};
+    float folded[16], local_eye[3];
+    asp_camera_fold_model(view, eye, model, folded, local_eye);
+    const float p[3] = {0.5f, -1.0f, 2.0f};
+    double world[4], a[4], b[4];
+    mul_point(model, p, world);
+    const float w[3] = {(float)world[0], (float)world[1], (float)world[2]};
+    mul_point(view, w, a);
+    mul_point(folded, p, b);
+    for (int k = 0; k < 4; k++)
+        CHECK_NEAR(b[k], a[k], 1e-5);
+    // the local eye maps back onto the world eye
+    double back[4];
+    mul_point(model, local_eye, back);
+    for (int k = 0; k < 3; k++)
+        CHECK_NEAR(back[k], eye[k], 1e-5);
+    // in place, as the scene renderer calls it
+    asp_camera_fold_model(view, eye, model, view, eye);
+    for (int k = 0; k < 16; k++)
+        CHECK_NEAR(view[k], folded[k], 0);
+    for (int k = 0; k < 3; k++)
+        CHECK_NEAR(eye[k], local_eye[k], 0);
+}
+
+/* The frustum planes keep what projects inside the clip cube and cut what does not, each plane its side. */
+static void test_frustum_planes(void)
+{
+    asp_camera cam;
+    asp_camera_init(&cam);
+    cam.azimuth = -20;
+    cam.elevation = 10;
+    cam.aspect = 2.0f;
+    float view[16], proj[16], planes[6][4];
+    asp_camera_view_matrix(&cam, view);
+    asp_camera_projection_matrix(&cam, proj);
+    asp_camera_frustum_planes(view, proj, planes);
+    for (int i = 0; i < 6; i++)
+        CHECK_NEAR(sqrt(planes[i][0] * planes[i][0] + planes[i][1] * planes[i][1] + planes[i][2] * planes[i][2]), 1.0,
+                   1e-5);
+    // the target is inside every plane
+    for (int i = 0; i < 6; i++)
+        CHECK(planes[i][0] * cam.target[0] + planes[i][1] * cam.target[1] + planes[i][2] * cam.target[2] +
+                  planes[i][3] > 0);
+    // a point just past the left, right, bottom, top, near and far side is outside exactly that plane
+    double t = tan(0.5 * cam.fov_y * deg), d = cam.distance;
+    const double ndc[6][3] = {{-1.1, 0, 0}, {1.1, 0, 0}, {0, -1.1, 0}, {0, 1.1, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (int i = 0; i < 6; i++) {
+        // eye coordinates of the probe: at depth d, scaled past the side; near and far along the axis
+        double z = i == 4 ? 0.5 * cam.z_near : i == 5 ? 1.1 * cam.z_far : d;
+        double e[3] = {ndc[i][0] * t * cam.aspect * z, ndc[i][1] * t * z, -z};
+        // back to world: the view matrix is rigid, so world = R^T (e - translation)
+        float x[3];
+        for (int k = 0; k < 3; k++)
+            x[k] = (float)(view[4 * k] * (e[0] - view[12]) + view[4 * k + 1] * (e[1] - view[13]) +
+                           view[4 * k + 2] * (e[2] - view[14]));
+        for (int j = 0; j < 6; j++) {
+            double s = planes[j][0] * x[0] + planes[j][1] * x[1] + planes[j][2] * x[2] + planes[j][3];
+            CHECK_MSG(j == i ? s < 0 : s > 0, "probe %d, plane %d: %g", i, j, s);
+        }
+    }
+}
+
 TEST_MAIN(TEST_CASE(test_defaults), TEST_CASE(test_view_frame), TEST_CASE(test_project_known_points),
-          TEST_CASE(test_fit_sphere_in_frustum), TEST_CASE(test_clip_inside_sphere), TEST_CASE(test_up_axis))
+          TEST_CASE(test_fit_sphere_in_frustum), TEST_CASE(test_clip_inside_sphere), TEST_CASE(test_up_axis),
+          TEST_CASE(test_fold_model), TEST_CASE(test_frustum_planes))

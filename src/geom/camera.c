@@ -1,13 +1,14 @@
 /*
  * Orbit camera: azimuth/elevation around a target and an up axis (y, z or x), perspective
- * projection, and fitting a bounding sphere to the view. Pure math, no GL, so
- * it is unit-tested without a context. Matrices follow OpenGL conventions
- * (column-major, eye looks down -z, NDC z in -1..1).
+ * projection, fitting a bounding sphere (or a recorded frame) to the view, and the
+ * per-instance view maths of scenes. Pure math, no GL, so render, eval and the no-GL
+ * build share it and it is unit-tested without a context (camera.h says why it is in
+ * geom). Matrices follow OpenGL conventions (column-major, eye looks down -z, NDC z in -1..1).
  */
 #include <math.h>
 #include <string.h>
 
-#include "render/internal.h"
+#include "amgsplat/camera.h"
 #include "util/banned.h"
 
 static const double deg = 3.14159265358979323846 / 180.0;
@@ -144,4 +145,66 @@ int asp_camera_project(const asp_camera *cam, const float p[3], uint32_t width, 
     out[1] = (float)((0.5 - y * 0.5) * height); // image rows run top to bottom, NDC y bottom to top
     out[2] = (float)(z * 0.5 + 0.5);
     return 1;
+}
+
+void asp_camera_frame(asp_camera *cam, const asp_frame *frame, const double origin[3], float aspect,
+                      float distance_radii)
+{
+    float c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = (float)(frame->center[k] - (origin ? origin[k] : 0.0));
+    float r = (float)frame->radius;
+    asp_camera_fit(cam, c, r, aspect);
+    if (distance_radii > 0) {
+        cam->distance = distance_radii * r;
+        asp_camera_clip_to_sphere(cam, c, r);
+    }
+}
+
+/* out = a * b, column-major; out may alias a or b. */
+static void mul4(const float a[16], const float b[16], float out[16])
+{
+    float r[16];
+    for (int c = 0; c < 4; c++)
+        for (int row = 0; row < 4; row++) {
+            float s = 0;
+            for (int k = 0; k < 4; k++)
+                s += a[4 * k + row] * b[4 * c + k];
+            r[4 * c + row] = s;
+        }
+    memcpy(out, r, sizeof r);
+}
+
+void asp_camera_fold_model(const float view[16], const float eye[3], const float model[16], float view_out[16],
+                           float eye_out[3])
+{
+    const float *m = model;
+    // the eye in the local frame: m^-1 eye in double, so far instances keep their precision
+    double a = m[0], b = m[4], c = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6], k = m[10];
+    double det = a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g);
+    double inv[9] = {(e * k - f * h) / det, (c * h - b * k) / det, (b * f - c * e) / det,
+                     (f * g - d * k) / det, (a * k - c * g) / det, (c * d - a * f) / det,
+                     (d * h - e * g) / det, (b * g - a * h) / det, (a * e - b * d) / det};
+    double p[3] = {(double)eye[0] - m[12], (double)eye[1] - m[13], (double)eye[2] - m[14]};
+    float local[3];
+    for (int r = 0; r < 3; r++)
+        local[r] = (float)(inv[3 * r] * p[0] + inv[3 * r + 1] * p[1] + inv[3 * r + 2] * p[2]);
+    mul4(view, model, view_out);
+    memcpy(eye_out, local, sizeof local);
+}
+
+void asp_camera_frustum_planes(const float view[16], const float proj[16], float planes[6][4])
+{
+    float pv[16];
+    mul4(proj, view, pv);
+    for (int i = 0; i < 3; i++)
+        for (int s = 0; s < 2; s++) {
+            float *p = planes[2 * i + s];
+            float sign = s ? -1.0f : 1.0f;
+            for (int c = 0; c < 4; c++)
+                p[c] = pv[4 * c + 3] + sign * pv[4 * c + i];
+            float len = sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+            for (int c = 0; c < 4 && len > 0; c++)
+                p[c] /= len;
+        }
 }
