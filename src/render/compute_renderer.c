@@ -433,6 +433,64 @@ static void dispatch_pass(compute_renderer *c, int pass, int append)
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
+/*
+ * Clears the storage framebuffer and runs the point passes. The first pass of each pair appends
+ * the splats whose footprint is too big for one invocation to the big list, which holds big_cap
+ * of them; the count it returns is every big splat seen, so a frame that overflowed the list is
+ * known and redrawn by the caller with a larger one (no splat is ever dropped).
+ */
+static GLuint draw_passes(compute_renderer *c)
+{
+    GLuint p = c->program.id;
+    static const GLuint far_bits = 0xFFFFFFFFu, zero = 0;
+    // a previous draw's resolve may still be queued (llvmpipe bins draws, runs dispatches at once):
+    // it must read these buffers before they are cleared (scenes draw the renderer once per instance)
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    glClearNamedBufferData(c->depth.id, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &far_bits);
+    if (c->use64)
+        glClearNamedBufferData(c->fb64.id, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &far_bits);
+    else
+        glClearNamedBufferData(c->color.id, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    glClearNamedBufferSubData(c->big.id, GL_R32UI, 0, 16, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, c->boxes.id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, c->depth.id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, c->color.id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, c->big.id);
+    if (c->use64)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, c->fb64.id);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(p);
+    if (c->opaque && c->use64) {
+        dispatch_pass(c, PASS_DEPTH_COLOR64, 1);
+    } else if (c->opaque) {
+        dispatch_pass(c, PASS_DEPTH, 1);
+        dispatch_pass(c, PASS_COLOR, 0);
+    } else {
+        dispatch_pass(c, PASS_BLEND_DEPTH, 1);
+        dispatch_pass(c, PASS_BLEND_SUM, 0);
+    }
+
+    GLuint big_count = 0;
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(c->big.id, 0, sizeof big_count, &big_count);
+    return big_count;
+}
+
+/* Replaces the big list by one of cap entries (48 bytes each: the record and its batch's scale). */
+static int grow_big_list(compute_renderer *c, uint32_t cap, asp_error *err)
+{
+    asp__gl_clear_errors(c->base.gl);
+    glDeleteBuffers(1, &c->big.id);
+    c->big.id = 0;
+    glCreateBuffers(1, &c->big.id);
+    glNamedBufferStorage(c->big.id, (GLsizeiptr)(16 + (size_t)cap * 48), NULL, GL_DYNAMIC_STORAGE_BIT);
+    c->big_cap = cap;
+    glProgramUniform1ui(c->program.id, c->u[U_BIG_CAP], cap);
+    char what[96];
+    snprintf(what, sizeof what, "grow the compute renderer's list of large splats to %u", cap);
+    return asp__gl_check(c->base.gl, what, err);
+}
+
 static int compute_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
 {
     compute_renderer *c = (compute_renderer *)base;
@@ -462,32 +520,13 @@ static int compute_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     // a perspective projection has -1 in row 3 of column 2; an orthographic one 0
     glProgramUniform1i(p, u[U_PERSP], f->proj[11] != 0.0f);
 
-    static const GLuint far_bits = 0xFFFFFFFFu, zero = 0;
-    // a previous draw's resolve may still be queued (llvmpipe bins draws, runs dispatches at once):
-    // it must read these buffers before they are cleared (scenes draw the renderer once per instance)
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    glClearNamedBufferData(c->depth.id, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &far_bits);
-    if (c->use64)
-        glClearNamedBufferData(c->fb64.id, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &far_bits);
-    else
-        glClearNamedBufferData(c->color.id, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-    glClearNamedBufferSubData(c->big.id, GL_R32UI, 0, 16, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, c->boxes.id);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, c->depth.id);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, c->color.id);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, c->big.id);
-    if (c->use64)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, c->fb64.id);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUseProgram(p);
-    if (c->opaque && c->use64) {
-        dispatch_pass(c, PASS_DEPTH_COLOR64, 1);
-    } else if (c->opaque) {
-        dispatch_pass(c, PASS_DEPTH, 1);
-        dispatch_pass(c, PASS_COLOR, 0);
-    } else {
-        dispatch_pass(c, PASS_BLEND_DEPTH, 1);
-        dispatch_pass(c, PASS_BLEND_SUM, 0);
+    // a frame with more large splats than the list holds is drawn again with a list that holds them
+    for (;;) {
+        GLuint big = draw_passes(c);
+        if (big <= c->big_cap)
+            break;
+        if ((rc = grow_big_list(c, big, err)) != 0)
+            return rc;
     }
 
     // the resolve: one full-screen triangle into the caller's framebuffer, depth-tested as any draw
