@@ -100,7 +100,7 @@ typedef struct asp_fit_stats {
 } asp_fit_stats;
 
 /**
- * Fits the colour texels of lv (its atlas is rewritten; geometry, alpha and the
+ * Fits the colour texels of lv (its atlas is rewritten, BC3 blocks dropped; geometry, alpha and the
  * normal atlas are unchanged) to reference images refs[0 .. nviews-1] (RGBA8
  * sRGB, each of views[i]'s size; pixels with alpha 0 are background and not
  * fitted) seen from views (origin as for asp_fit_render_cpu): minimises
@@ -117,7 +117,7 @@ int asp_fit_color(asp_dps_level *lv, const double origin[3], const asp_fit_view 
                   const asp_fit_desc *desc, const asp_context *ctx, asp_fit_stats *stats, asp_error *err);
 
 /**
- * Fits the alpha texels of lv to the silhouettes of refs (alpha > 0 = the
+ * Fits the alpha texels of lv (BC3 blocks dropped) to the silhouettes of refs (alpha > 0 = the
  * reference covers the pixel) seen from views, in desc->alpha_rounds rounds
  * of votes (src/fit/alpha_fit.c says how): texels near the silhouette move by
  * at most desc->alpha_step per round, so the alpha-tested outline grows where

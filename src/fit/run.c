@@ -178,10 +178,8 @@ int asp_fit_run(asp_gl_context *gl, asp_dps *dps, size_t level, const asp_fit_re
     if (!rc && (desc.texels || desc.bytes))
         rc = asp_fit_budget(lv, desc.texels, desc.bytes, dps->desc.padding ? dps->desc.padding : 2,
                             !desc.uncompressed, ctx, err);
-    if (!rc && lv->atlas_bc3) { /* refitting a compressed level: its texels change, the blocks go stale */
-        asp_free(ctx, lv->atlas_bc3), asp_free(ctx, lv->normal_bc3);
-        lv->atlas_bc3 = lv->normal_bc3 = NULL;
-    }
+    if (!rc) // refitting a compressed level: its texels change, the blocks go stale
+        asp__fit_drop_blocks(lv, ctx);
     if (!rc && desc.alpha_rounds >= 0)
         rc = asp_fit_alpha(lv, origin, views, refs, nv, &desc, ctx, &sil_before, &sil_after, err);
     if (!rc)

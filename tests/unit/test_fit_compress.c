@@ -110,6 +110,30 @@ static void test_round_trip(void)
     asp_dps_destroy(d);
 }
 
+/* Fitting a compressed level rewrites its texels: the stale blocks are dropped, the level is RGBA8 again. */
+static void test_refit_drops_blocks(void)
+{
+    asp_dps_level lv;
+    if (octahedron_level(&lv)) {
+        CHECK(0);
+        return;
+    }
+    asp_error err = {0};
+    CHECK_OK(asp_dps_level_compress(&lv, NULL, &err), &err);
+    asp_fit_view view;
+    look(40, 30, 64, &view);
+    asp_image ref = {0};
+    CHECK_OK(asp_fit_render_cpu(&lv, (double[3]){0, 0, 0}, &view, NULL, &ref, &err), &err);
+    size_t before = 0, after = 0;
+    CHECK(lv.atlas_bc3 != NULL);
+    CHECK_OK(asp_fit_alpha(&lv, (double[3]){0, 0, 0}, &view, &ref, 1, &(asp_fit_desc){.alpha_rounds = 1}, NULL,
+                           &before, &after, &err), &err);
+    CHECK(lv.atlas_bc3 == NULL && lv.normal_bc3 == NULL);
+    CHECK(asp_dps_level_gpu_bytes(&lv, NULL) > 4 * (size_t)lv.atlas.width * lv.atlas.height);
+    asp_image_release(&ref);
+    asp_dps_level_release(&lv, NULL);
+}
+
 #ifdef ASP_HAVE_GL
 /* The compressed level drawn by the prim renderer against the uncompressed one (normalized method). */
 static void test_render_matches(void)
@@ -187,6 +211,7 @@ int main(void)
 {
     static const asp_test_case cases[] = {
         TEST_CASE(test_round_trip),
+        TEST_CASE(test_refit_drops_blocks),
 #ifdef ASP_HAVE_GL
         TEST_CASE(test_render_matches),
 #endif
