@@ -7,6 +7,8 @@
 # Timings never decide pass or fail (STYLE.md 11).
 #
 #   bench/bench_fit.sh BUILD_DIR [MODELS="stanford-bunny cow"] [NORMALS=0] [THREADS=2] [OUT=mktemp]
+# Environment: PRIMS (default "400 100"), FIT_ARGS (more fit options, e.g. "--bytes 30000" for the
+# equal-bytes rows of issue 27; the fit stores BC3 atlases unless --uncompressed).
 set -euo pipefail
 build=${1:?build directory}; models=${2:-stanford-bunny cow}; normals=${3:-0}; threads=${4:-2}
 out=${5:-$(mktemp -d)}
@@ -20,10 +22,10 @@ for m in $models; do
   mesh=$data/$m.obj
   "$bin" sample "$mesh" -o "$out/$m.ply" --points 100000 --quiet
   "$bin" decompose "$out/$m.ply" -o "$out/$m.amg" --quiet
-  for p in 400 100; do
+  for p in ${PRIMS:-400 100}; do
     "$bin" build "$out/$m.amg" -o "$out/$m-$p.dps" --primitives "$p" "${nflag[@]}" --quiet >/dev/null
     t0=$(date +%s.%N)
-    "$bin" fit "$out/$m-$p.dps" -o "$out/$m-$p-fit.dps" --reference "$mesh" --threads "$threads" --quiet
+    "$bin" fit "$out/$m-$p.dps" -o "$out/$m-$p-fit.dps" --reference "$mesh" --threads "$threads" --quiet ${FIT_ARGS:-}
     t1=$(date +%s.%N)
     echo "fit $m <= $p primitives: $(echo "$t1 - $t0" | bc) s wall on $threads threads"
     "$build/bench_fit" "$mesh" "$out/$m-$p.dps" "$out/$m-$p-fit.dps" 16 "$out/png"

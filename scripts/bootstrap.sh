@@ -12,6 +12,7 @@ packages=(
   libglfw3-dev                     # viewer windows
   libassimp-dev                    # mesh formats
   libmeshoptimizer-dev             # simplified meshes (amgsplat simplify; 0.18 in Debian 12)
+  libsquish-dev                    # BC1/BC3 (S3TC) compression of the fitted atlases (issue 27)
   libstb-dev                       # PNG/JPEG read and write
   zlib1g-dev                       # CRC-32 of the .amg and .dps files
   libflann-dev                     # k-NN baseline for bench/bench_knn.c

@@ -79,6 +79,8 @@ typedef struct asp_fit_desc {
     size_t bytes;            /* asp_fit_run: GPU-byte budget (asp_dps_level_gpu_bytes); 0 = keep */
     int alpha_rounds;        /* asp_fit_run: silhouette rounds of asp_fit_alpha before the colour (0 = 8; < 0 = none) */
     double alpha_step;       /* largest alpha change of a texel per round (0 = 0.08) */
+    int uncompressed;        /* asp_fit_run: 1 = keep the atlases RGBA8; 0 = store them as BC3 blocks after
+                                fitting (asp_dps_level_compress; 1 byte a texel, and the budget counts so) */
     asp_fit_draw draw;
     asp_fit_log_fn log;      /* NULL = silent */
     void *log_user;
@@ -98,7 +100,7 @@ typedef struct asp_fit_stats {
 } asp_fit_stats;
 
 /**
- * Fits the colour texels of lv (its atlas is rewritten; geometry, alpha and the
+ * Fits the colour texels of lv (its atlas is rewritten, BC3 blocks dropped; geometry, alpha and the
  * normal atlas are unchanged) to reference images refs[0 .. nviews-1] (RGBA8
  * sRGB, each of views[i]'s size; pixels with alpha 0 are background and not
  * fitted) seen from views (origin as for asp_fit_render_cpu): minimises
@@ -115,7 +117,7 @@ int asp_fit_color(asp_dps_level *lv, const double origin[3], const asp_fit_view 
                   const asp_fit_desc *desc, const asp_context *ctx, asp_fit_stats *stats, asp_error *err);
 
 /**
- * Fits the alpha texels of lv to the silhouettes of refs (alpha > 0 = the
+ * Fits the alpha texels of lv (BC3 blocks dropped) to the silhouettes of refs (alpha > 0 = the
  * reference covers the pixel) seen from views, in desc->alpha_rounds rounds
  * of votes (src/fit/alpha_fit.c says how): texels near the silhouette move by
  * at most desc->alpha_step per round, so the alpha-tested outline grows where
@@ -134,12 +136,14 @@ int asp_fit_alpha(asp_dps_level *lv, const double origin[3], const asp_fit_view 
  * The texel budget: scales every texture of lv by one factor (aspect kept, at
  * least 4x4, never up), the largest for which the level holds at most texels
  * texels and at most bytes GPU bytes (asp_dps_level_gpu_bytes; either 0 = no
- * limit), then resamples them (asp_dps_level_resize, pad texels of padding).
+ * limit; bc3 = 1: the bytes the level will have once compressed, as asp_fit_run
+ * does after fitting, so 1 byte a texel, the atlas height rounded up to 4),
+ * then resamples them (asp_dps_level_resize, pad texels of padding).
  * Fit afterwards: the budget decides the resolution, the fit the texels.
  * Returns 0, ASP_EINVAL (no budget, or one below 4x4 texels a primitive),
  * ASP_EUNSUPPORTED, ASP_ENOMEM.
  */
-int asp_fit_budget(asp_dps_level *lv, uint64_t texels, size_t bytes, uint32_t pad, const asp_context *ctx,
+int asp_fit_budget(asp_dps_level *lv, uint64_t texels, size_t bytes, uint32_t pad, int bc3, const asp_context *ctx,
                    asp_error *err);
 
 /** The source a fit matches: a mesh (its own render) or a point set (its blended splats). */

@@ -180,6 +180,14 @@ typedef struct asp_dps_level {
     uint32_t *link_first;     /* prim_count + 1 entries */
     uint32_t *link_parent;    /* link_total; increasing within a primitive's range */
     float *link_weight;       /* link_total, in (0, 1] */
+    /*
+     * The atlases as BC3 (DXT5) blocks, stored so in the .dps and uploaded so (issue 27;
+     * asp_dps_level_compress): 16 bytes per 4x4 block, 1 byte per texel. NULL (normal_bc3 also when there
+     * is no normal atlas) for an RGBA8 level. When set, atlas and normal_atlas hold the decoded texels,
+     * what the GPU samples, so every CPU path (fit rasteriser, export) sees the same picture. Allocated
+     * through the level's context; any change of the atlas texels must drop them (asp_free, NULL).
+     */
+    uint8_t *atlas_bc3, *normal_bc3;
 } asp_dps_level;
 
 /** A set of levels; create with asp_prim_build or asp_dps_load, free with asp_dps_destroy. */
@@ -423,6 +431,7 @@ typedef struct asp_dps_summary {
     uint32_t atlas_width, atlas_height;
     size_t neighbour_pairs;   /* neighbour_total / 2 */
     int normal_map;
+    int compressed;           /* 1: the atlases are BC3 blocks (asp_dps_level_compress) */
 } asp_dps_summary;
 
 /**
@@ -434,9 +443,11 @@ size_t asp_dps_summarize(const asp_dps *dps, asp_dps_summary *rows, size_t capac
 /**
  * GPU bytes of a level drawn as textured quads, counted as asp_mesh_gpu_bytes
  * counts a mesh (mesh.h) so the two compare: per primitive 4 vertices x (12
- * position + 12 normal + 8 uv) and 6 indices x 4; the colour atlas width *
- * height * 4 * 4 / 3 (RGBA8 with its mipmap chain), and the normal atlas the
- * same way when the level has one. The renderer's own buffers (storage
+ * position + 12 normal + 8 uv) and 6 indices x 4; the colour atlas as the
+ * renderer allocates it (one level, no mipmaps): width * height * 4 bytes
+ * (RGBA8), or width * height (BC3 blocks, asp_dps_level_compress), and the
+ * normal atlas the same way when the level has one (issue 27: what is really
+ * in GPU memory). The renderer's own buffers (storage
  * buffers of primitives and neighbours) are not counted: they replace the
  * vertex buffers, not add to them. out may be NULL; returns the total. Pure.
  */
@@ -474,6 +485,16 @@ int asp_dps_domain_set_pick(const asp_dps *dps, size_t from, int strict, size_t 
  */
 int asp_dps_level_pick(const asp_dps_level *src, size_t prim, const asp_context *ctx, asp_dps_level *out,
                        asp_error *err);
+
+/**
+ * Compresses lv's atlas (and normal atlas) to BC3 blocks through libsquish (atlas_bc3, normal_bc3) and
+ * replaces the texels by the decoded blocks, what the GPU then samples. The atlas height is first
+ * padded to a multiple of 4 (rows of zero texels; the width is a power of two >= 64). A level that is
+ * already compressed is left as it is. GPU bytes (asp_dps_level_gpu_bytes) become 1 per texel and
+ * atlas. Returns 0, ASP_EINVAL (no atlas), ASP_ENOMEM; lv is unchanged on failure. Thread-safe on
+ * distinct levels.
+ */
+int asp_dps_level_compress(asp_dps_level *lv, const asp_context *ctx, asp_error *err);
 
 /**
  * Resamples every primitive's texture of lv to tex_w[i] x tex_h[i] texels (each 1..16384; box filter

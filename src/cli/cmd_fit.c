@@ -7,7 +7,7 @@ static const char usage[] =
     "usage: amgsplat fit IN.dps -o OUT.dps [--reference SOURCE] [--texture IMG] [--level L]\n"
     "                    [--views V] [--holdout H] [--size PX] [--iterations N] [--seed S]\n"
     "                    [--lambda X] [--smooth X] [--texels N | --bytes B] [--alpha-rounds N]\n"
-    "                    [--alpha-step X] [--json]\n"
+    "                    [--alpha-step X] [--uncompressed] [--json]\n"
     "\n"
     "Fits the colour texels of every level (or --level L) so that the level drawn by the\n"
     "default (normalized) method matches reference images of SOURCE from V views spread\n"
@@ -16,8 +16,9 @@ static const char usage[] =
     "the file the .dps was built from. H further views, not used in fitting, report the\n"
     "gain (mean squared error of linear RGB, and SSIM of the default render). Geometry and\n"
     "alpha inside the surface are not changed; alpha near the silhouette is fitted first.\n"
-    "--texels/--bytes scale every texture down to a budget before fitting. Progress and the\n"
-    "loss go to stderr.";
+    "--texels/--bytes scale every texture down to a budget before fitting. The fitted atlases\n"
+    "are stored as BC3 (DXT5) blocks, 1 byte a texel on the GPU, unless --uncompressed.\n"
+    "Progress and the loss go to stderr.";
 
 #include <stdio.h>
 #include <string.h>
@@ -58,6 +59,7 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
     double lambda = 0.0, smooth = 0.0, alpha_step = 0.0;
     int alpha_rounds = 8;
     size_t texels = 0, bytes = 0;
+    int uncompressed = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "FILE", "output .dps"},
         {"reference", 'r', CLI_STRING, &reference, "SOURCE", "mesh or point set to match (default: the source)"},
@@ -74,6 +76,7 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
         {"bytes", 0, CLI_SIZE, &bytes, "B", "GPU-byte budget per level (as info and eval count them)"},
         {"alpha-rounds", 0, CLI_INT, &alpha_rounds, "N", "silhouette rounds on alpha (default 8; 0: colour only)"},
         {"alpha-step", 0, CLI_DOUBLE, &alpha_step, "X", "largest alpha change per round (default 0.08)"},
+        {"uncompressed", 0, CLI_FLAG, &uncompressed, NULL, "keep RGBA8 atlases (default: BC3 blocks)"},
         {0},
     };
     int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -127,7 +130,7 @@ int cmd_fit(int argc, char **argv, struct cli_env *env)
     asp_fit_reference ref = {.mesh = mesh, .cloud = amg ? asp_amg_cloud(amg) : cloud};
     asp_fit_desc desc = {.views = views, .holdout = holdout, .size = (uint32_t)size,
                          .iterations = (uint32_t)iterations, .seed = seed, .lambda = lambda, .smooth = smooth,
-                         .texels = texels, .bytes = bytes,
+                         .texels = texels, .bytes = bytes, .uncompressed = uncompressed,
                          .alpha_rounds = alpha_rounds ? alpha_rounds : -1, .alpha_step = alpha_step,
                          .log = log_stderr, .log_user = env};
     for (size_t l = first; l < last && !rc; l++) {

@@ -259,6 +259,8 @@ static int info_dps(const char *path, struct cli_env *env)
                                                        2));
             cJSON_AddNumberToObject(l, "neighbour_pairs", (double)rows[i].neighbour_pairs);
             cJSON_AddBoolToObject(l, "normal_map", rows[i].normal_map);
+            cJSON_AddStringToObject(l, "atlas_format", rows[i].compressed ? "bc3" : "rgba8");
+            cJSON_AddNumberToObject(l, "gpu_bytes", (double)asp_dps_level_gpu_bytes(&dps->levels[i], NULL));
             cJSON_AddBoolToObject(l, "strict", dps->levels[i].strict != 0);
             cJSON_AddNumberToObject(l, "links", (double)dps->levels[i].link_total);
             cJSON_AddItemToArray(levels, l);
@@ -281,11 +283,17 @@ static int info_dps(const char *path, struct cli_env *env)
                d->merge ? ", merged" : "", d->no_model_colors ? ", grey points" : "", d->brightness, d->enlarge);
         printf("links       %s\n", asp_dps_has_links(dps) ? "yes: levels can be mixed by view (render --renderer cut)"
                                     : dps->level_count > 1 ? "none (rebuild for a cut across levels)" : "one level");
-        printf("level  name   primitives    texels        error  normalised   cb (s)  dpc (s)  atlas\n");
-        for (size_t i = 0; i < nl; i++)
-            printf("%5u  %-5s %11zu %9llu  %11.6g  %10.3f  %7.3f  %7.3f  %ux%u\n", rows[i].level, rows[i].name,
+        // GPU bytes: what the renderer allocates (asp_dps_level_gpu_bytes; BC3 atlases at 1 byte a texel)
+        printf("level  name   primitives    texels        error  normalised   cb (s)  dpc (s)  atlas          "
+               "GPU bytes\n");
+        for (size_t i = 0; i < nl; i++) {
+            char atlas[40];
+            snprintf(atlas, sizeof atlas, "%ux%u %s", rows[i].atlas_width, rows[i].atlas_height,
+                     rows[i].compressed ? "BC3" : "RGBA8");
+            printf("%5u  %-5s %11zu %9llu  %11.6g  %10.3f  %7.3f  %7.3f  %-15s %9zu\n", rows[i].level, rows[i].name,
                    rows[i].primitives, (unsigned long long)rows[i].texels, rows[i].error, rows[i].error_norm,
-                   rows[i].t_basis, rows[i].t_construct, rows[i].atlas_width, rows[i].atlas_height);
+                   rows[i].t_basis, rows[i].t_construct, atlas, asp_dps_level_gpu_bytes(&dps->levels[i], NULL));
+        }
     }
     asp_dps_destroy(dps);
     return rc;

@@ -136,6 +136,7 @@ int asp_fit_alpha(asp_dps_level *lv, const double origin[3], const asp_fit_view 
         if (!refs[v].pixels || refs[v].width != views[v].width || refs[v].height != views[v].height)
             return asp_error_set(err, ASP_EINVAL, "training reference %zu is %ux%u, expected %ux%u", v,
                                  refs[v].width, refs[v].height, views[v].width, views[v].height);
+    asp__fit_drop_blocks(lv, ctx);
     asp_fit_draw draw;
     double window;
     asp__fit_draw_resolve(lv, &desc.draw, &draw, &window);

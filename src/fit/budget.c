@@ -28,7 +28,7 @@ static void sizes(const asp_dps_level *lv, double s, uint32_t *w, uint32_t *h, u
 }
 
 /* GPU bytes lv would have at scale s: resized on a copy of what resizing touches. */
-static int trial_bytes(const asp_dps_level *lv, double s, uint32_t pad, uint32_t *w, uint32_t *h,
+static int trial_bytes(const asp_dps_level *lv, double s, uint32_t pad, int bc3, uint32_t *w, uint32_t *h,
                        const asp_context *ctx, size_t *bytes, asp_error *err)
 {
     uint64_t t;
@@ -37,6 +37,7 @@ static int trial_bytes(const asp_dps_level *lv, double s, uint32_t pad, uint32_t
     copy.prims = asp_alloc(ctx, lv->prim_count * sizeof *copy.prims);
     memset(&copy.atlas, 0, sizeof copy.atlas);
     memset(&copy.normal_atlas, 0, sizeof copy.normal_atlas);
+    copy.atlas_bc3 = copy.normal_bc3 = NULL; /* lv's blocks: resizing the copy must not free them */
     int rc = copy.prims ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory for a budget trial");
     if (!rc)
         memcpy(copy.prims, lv->prims, lv->prim_count * sizeof *copy.prims);
@@ -51,15 +52,22 @@ static int trial_bytes(const asp_dps_level *lv, double s, uint32_t pad, uint32_t
                    4 * (size_t)lv->normal_atlas.width * lv->normal_atlas.height);
         rc = asp_dps_level_resize(&copy, w, h, pad, ctx, err);
     }
-    if (!rc)
-        *bytes = asp_dps_level_gpu_bytes(&copy, NULL);
+    if (!rc) {
+        asp_mesh_bytes b;
+        asp_dps_level_gpu_bytes(&copy, &b);
+        if (bc3) { /* what asp_dps_level_compress will leave: 1 byte a texel, the height a multiple of 4 */
+            size_t side = (size_t)copy.atlas.width * ((copy.atlas.height + 3) & ~3u);
+            b.texture = side * (copy.normal_atlas.width ? 2 : 1);
+        }
+        *bytes = b.vertex + b.index + b.texture;
+    }
     asp_free(ctx, copy.prims);
     asp_image_release(&copy.atlas);
     asp_image_release(&copy.normal_atlas);
     return rc;
 }
 
-int asp_fit_budget(asp_dps_level *lv, uint64_t texels, size_t bytes, uint32_t pad, const asp_context *ctx,
+int asp_fit_budget(asp_dps_level *lv, uint64_t texels, size_t bytes, uint32_t pad, int bc3, const asp_context *ctx,
                    asp_error *err)
 {
     if (!lv || !lv->prim_count || (!texels && !bytes))
@@ -83,7 +91,7 @@ int asp_fit_budget(asp_dps_level *lv, uint64_t texels, size_t bytes, uint32_t pa
         sizes(lv, mid, w, h, &t);
         int ok = !texels || t <= texels;
         if (ok && bytes) {
-            rc = trial_bytes(lv, mid, pad, w, h, ctx, &b, err);
+            rc = trial_bytes(lv, mid, pad, bc3, w, h, ctx, &b, err);
             ok = b <= bytes;
         }
         if (ok)
@@ -96,7 +104,7 @@ int asp_fit_budget(asp_dps_level *lv, uint64_t texels, size_t bytes, uint32_t pa
         sizes(lv, lo, w, h, &t);
         size_t b = 0;
         if (bytes)
-            rc = trial_bytes(lv, lo, pad, w, h, ctx, &b, err);
+            rc = trial_bytes(lv, lo, pad, bc3, w, h, ctx, &b, err);
         if (!rc && ((texels && t > texels) || (bytes && b > bytes)))
             rc = asp_error_set(err, ASP_EINVAL,
                                "a budget of %zu bytes is below what %zu primitives of 4x4 texels take (%zu)", bytes,

@@ -337,6 +337,7 @@ int asp_fit_color(asp_dps_level *lv, const double origin[3], const asp_fit_view 
         rc = check_refs(holdout, href, nholdout, "held-out", err);
     if (rc)
         return rc;
+    asp__fit_drop_blocks(lv, ctx);
     size_t nall = nviews + nholdout;
     asp__fit_rows *rows = asp_calloc(ctx, nall, sizeof *rows);
     float *c0 = asp__fit_atlas_linear(&lv->atlas, ctx);

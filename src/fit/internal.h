@@ -57,4 +57,11 @@ float *asp__fit_atlas_linear(const asp_image *atlas, const asp_context *ctx);
 /* Mean squared error of linear RGB over the pixels covered by rows and by ref (alpha > 0); *count pixels. */
 double asp__fit_rows_loss(const asp__fit_rows *rows, const float *lin, const asp_image *ref, size_t *count);
 
+/* A fit rewrites lv's texels: BC3 blocks of the old ones (asp_dps_level_compress) would go stale. */
+static inline void asp__fit_drop_blocks(asp_dps_level *lv, const asp_context *ctx)
+{
+    asp_free(ctx, lv->atlas_bc3), asp_free(ctx, lv->normal_bc3);
+    lv->atlas_bc3 = lv->normal_bc3 = NULL;
+}
+
 #endif

@@ -176,11 +176,16 @@ int asp_fit_run(asp_gl_context *gl, asp_dps *dps, size_t level, const asp_fit_re
     asp_fit_stats st = {0};
     size_t sil_before = 0, sil_after = 0;
     if (!rc && (desc.texels || desc.bytes))
-        rc = asp_fit_budget(lv, desc.texels, desc.bytes, dps->desc.padding ? dps->desc.padding : 2, ctx, err);
+        rc = asp_fit_budget(lv, desc.texels, desc.bytes, dps->desc.padding ? dps->desc.padding : 2,
+                            !desc.uncompressed, ctx, err);
+    if (!rc) // refitting a compressed level: its texels change, the blocks go stale
+        asp__fit_drop_blocks(lv, ctx);
     if (!rc && desc.alpha_rounds >= 0)
         rc = asp_fit_alpha(lv, origin, views, refs, nv, &desc, ctx, &sil_before, &sil_after, err);
     if (!rc)
         rc = asp_fit_color(lv, origin, views, refs, nv, views + nv, refs + nv, nh, &desc, ctx, &st, err);
+    if (!rc && !desc.uncompressed) // after the solve: held-out SSIM is then of the BC3 texels the GPU samples
+        rc = asp_dps_level_compress(lv, ctx, err);
     if (!rc)
         rc = level_ssim(gl, lv, origin, cams + nv, refs + nv, nh, size, ctx, &ssim_after, err);
     if (!rc) {

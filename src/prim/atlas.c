@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "prim/bc3.h"
 #include "prim/internal.h"
 #include "util/banned.h"
 
@@ -101,4 +102,65 @@ void asp__atlas_pad(asp_image *img, const asp_prim *prims, size_t n, uint32_t pa
             }
         }
     }
+}
+
+/* img padded to a multiple of 4 rows (zero texels), encoded to BC3 and decoded back into img. */
+static int compress_image(asp_image *img, uint8_t **blocks, const asp_context *ctx, asp_error *err)
+{
+    const uint32_t W = img->width, H = (img->height + 3) & ~3u;
+    asp_image padded = {0, 0, NULL};
+    int rc = asp_image_init(&padded, W, H, err);
+    if (rc)
+        return rc;
+    memset(padded.pixels, 0, 4 * (size_t)W * H);
+    memcpy(padded.pixels, img->pixels, 4 * (size_t)W * img->height);
+    *blocks = asp_alloc(ctx, (size_t)ASP__BC3_BYTES(W, H));
+    if (!*blocks) {
+        asp_image_release(&padded);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory for the BC3 blocks of a %ux%u atlas", W, H);
+    }
+    asp__bc3_encode(padded.pixels, (int)W, (int)H, *blocks);
+    asp__bc3_decode(*blocks, (int)W, (int)H, padded.pixels);
+    asp_image_release(img);
+    *img = padded;
+    return 0;
+}
+
+int asp_dps_level_compress(asp_dps_level *lv, const asp_context *ctx, asp_error *err)
+{
+    if (lv->atlas_bc3)
+        return 0;
+    if (!lv->atlas.pixels || !lv->atlas.width || !lv->atlas.height || lv->atlas.width % 4)
+        return asp_error_set(err, ASP_EINVAL, "cannot compress level %u: %ux%u atlas, expected a width that is a "
+                             "multiple of 4", lv->level, lv->atlas.width, lv->atlas.height);
+    /* work on copies so that lv is unchanged on failure */
+    asp_image a = {0, 0, NULL}, n = {0, 0, NULL};
+    uint8_t *ab = NULL, *nb = NULL;
+    int rc = asp_image_init(&a, lv->atlas.width, lv->atlas.height, err);
+    if (!rc && lv->normal_atlas.width)
+        rc = asp_image_init(&n, lv->normal_atlas.width, lv->normal_atlas.height, err);
+    if (!rc) {
+        memcpy(a.pixels, lv->atlas.pixels, 4 * (size_t)a.width * a.height);
+        if (n.width)
+            memcpy(n.pixels, lv->normal_atlas.pixels, 4 * (size_t)n.width * n.height);
+        rc = compress_image(&a, &ab, ctx, err);
+    }
+    if (!rc && n.width)
+        rc = compress_image(&n, &nb, ctx, err);
+    if (rc) {
+        asp_image_release(&a);
+        asp_image_release(&n);
+        asp_free(ctx, ab);
+        asp_free(ctx, nb);
+        return rc;
+    }
+    asp_image_release(&lv->atlas);
+    lv->atlas = a;
+    lv->atlas_bc3 = ab;
+    if (n.width) {
+        asp_image_release(&lv->normal_atlas);
+        lv->normal_atlas = n;
+        lv->normal_bc3 = nb;
+    }
+    return 0;
 }

@@ -319,6 +319,8 @@ static void release_level(const asp_context *ctx, asp_dps_level *lv)
     asp_free(ctx, lv->neighbours);
     asp_image_release(&lv->atlas);
     asp_image_release(&lv->normal_atlas);
+    asp_free(ctx, lv->atlas_bc3);
+    asp_free(ctx, lv->normal_bc3);
     asp__level_links_release(ctx, lv);
     memset(lv, 0, sizeof *lv);
 }

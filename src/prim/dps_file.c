@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "prim/bc3.h"
 #include "prim/internal.h"
 #include "util/atomic_file.h"
 #include "util/byte_io.h"
@@ -30,9 +31,16 @@ enum { DPS_VERSION = 3, DPS_HEADER = 96, DPS_HEADER_V1 = 64, DPS_PARAMS = 128, D
 
 /* ---- writing: explicit little-endian bytes, so the format does not depend on the host ---- */
 
+/* Bytes of one stored atlas: RGBA8 texels, or BC3 blocks when the level is compressed. */
+static uint64_t atlas_bytes(const asp_dps_level *lv)
+{
+    return lv->atlas_bc3 ? ASP__BC3_BYTES(lv->atlas.width, lv->atlas.height)
+                         : 4 * (uint64_t)lv->atlas.width * lv->atlas.height;
+}
+
 static uint64_t level_bytes(const asp_dps_level *lv)
 {
-    uint64_t atlas = 4 * (uint64_t)lv->atlas.width * lv->atlas.height;
+    uint64_t atlas = atlas_bytes(lv);
     uint64_t links = lv->link_first ? 4 * ((uint64_t)lv->prim_count + 1) + 8 * (uint64_t)lv->link_total : 0;
     return DPS_LEVEL + DPS_PRIM * (uint64_t)lv->prim_count + 4 * (uint64_t)lv->neighbour_total + links + atlas +
            (lv->normal_atlas.width ? atlas : 0);
@@ -125,7 +133,8 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
         asp__put_u64(&w, lv->neighbour_total);
         asp__put_u32(&w, lv->atlas.width);
         asp__put_u32(&w, lv->atlas.height);
-        asp__put_u32(&w, lv->normal_atlas.width ? 1u : 0u);
+        /* bit 0: a normal atlas follows; bit 1: the atlases are BC3 blocks (issue 27) */
+        asp__put_u32(&w, (lv->normal_atlas.width ? 1u : 0u) | (lv->atlas_bc3 ? 2u : 0u));
         asp__put_u32(&w, lv->skipped);
         asp__put_u32(&w, lv->degenerate);
         asp__put_u32(&w, lv->capped);
@@ -151,9 +160,15 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
                 asp__put_f32(&w, lv->link_weight[k]);
             }
         }
-        asp__crc_put(&w, lv->atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
-        if (lv->normal_atlas.width)
-            asp__crc_put(&w, lv->normal_atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
+        if (lv->atlas_bc3) {
+            asp__crc_put(&w, lv->atlas_bc3, (size_t)atlas_bytes(lv));
+            if (lv->normal_atlas.width)
+                asp__crc_put(&w, lv->normal_bc3, (size_t)atlas_bytes(lv));
+        } else {
+            asp__crc_put(&w, lv->atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
+            if (lv->normal_atlas.width)
+                asp__crc_put(&w, lv->normal_atlas.pixels, 4 * (size_t)lv->atlas.width * lv->atlas.height);
+        }
     }
     return asp__byte_commit(&w, &f, path, dps_reads_back, (void *)dps, err);
 }
@@ -254,7 +269,8 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, uint32_t version,
     lv->level = asp__get_u32(r);
     lv->basis_count = asp__get_u32(r);
     uint64_t np = asp__get_u64(r), nn = asp__get_u64(r);
-    uint32_t aw = asp__get_u32(r), ah = asp__get_u32(r), has_n = asp__get_u32(r);
+    uint32_t aw = asp__get_u32(r), ah = asp__get_u32(r), aflags = asp__get_u32(r);
+    const uint32_t has_n = aflags & 1u, bc3 = (aflags >> 1) & 1u;
     lv->skipped = asp__get_u32(r), lv->degenerate = asp__get_u32(r);
     lv->capped = asp__get_u32(r), lv->merges = asp__get_u32(r);
     uint32_t strict = asp__get_u32(r); /* spare (0) before version 3 */
@@ -296,12 +312,13 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, uint32_t version,
                  "left after the primitives)", li, (unsigned long long)nn, after_prims / 4, after_prims);
         return asp__byte_bad(r, msg);
     }
-    if (aw == 0 || ah == 0 || aw > DPS_SIDE || ah > DPS_SIDE || has_n > 1) {
-        snprintf(msg, sizeof msg, "level %zu: %ux%u atlas with normal flag %u, expected sides 1..%d and a flag 0 or 1",
-                 li, aw, ah, has_n, DPS_SIDE);
+    if (aw == 0 || ah == 0 || aw > DPS_SIDE || ah > DPS_SIDE || aflags > 3 || (bc3 && (aw % 4 || ah % 4))) {
+        snprintf(msg, sizeof msg, "level %zu: %ux%u atlas with flags %u, expected sides 1..%d (multiples of 4 when "
+                 "BC3) and flags 0..3 (1 normal atlas, 2 BC3 blocks)", li, aw, ah, aflags, DPS_SIDE);
         return asp__byte_bad(r, msg);
     }
-    const size_t after_lists = after_prims - (size_t)nn * 4, atlas = 4 * (size_t)aw * ah;
+    const size_t after_lists = after_prims - (size_t)nn * 4,
+                 atlas = bc3 ? (size_t)ASP__BC3_BYTES(aw, ah) : 4 * (size_t)aw * ah;
     if (has_links && (after_lists < 4 * ((size_t)np + 1) || nlinks > (after_lists - 4 * ((size_t)np + 1)) / 8)) {
         snprintf(msg, sizeof msg, "level %zu: %llu links of %llu primitives, expected them to fit the %zu bytes left "
                  "after the neighbours", li, (unsigned long long)nlinks, (unsigned long long)np, after_lists);
@@ -371,6 +388,22 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, uint32_t version,
         rc = asp_image_init(&lv->normal_atlas, aw, ah, r->err);
     if (rc)
         return rc;
+    if (bc3) { /* keep the blocks (what is uploaded) and decode them once for the CPU paths */
+        lv->atlas_bc3 = asp_alloc(ctx, atlas);
+        lv->normal_bc3 = has_n ? asp_alloc(ctx, atlas) : NULL;
+        if (!lv->atlas_bc3 || (has_n && !lv->normal_bc3))
+            return asp_error_set(r->err, ASP_ENOMEM, "cannot read '%s': out of memory for a %ux%u BC3 atlas",
+                                 r->path, aw, ah);
+        memcpy(lv->atlas_bc3, r->buf + r->at, atlas);
+        asp__bc3_decode(lv->atlas_bc3, (int)aw, (int)ah, lv->atlas.pixels);
+        r->at += atlas;
+        if (has_n) {
+            memcpy(lv->normal_bc3, r->buf + r->at, atlas);
+            asp__bc3_decode(lv->normal_bc3, (int)aw, (int)ah, lv->normal_atlas.pixels);
+            r->at += atlas;
+        }
+        return 0;
+    }
     memcpy(lv->atlas.pixels, r->buf + r->at, atlas);
     r->at += atlas;
     if (has_n) {
@@ -602,9 +635,10 @@ int asp_dps_source_find(const asp_dps *dps, const char *dps_path, char *out, siz
     return first.code ? first.code : ASP_EIO;
 }
 
-static size_t mipmapped_rgba8(const asp_image *img)
+/* One level, no mipmaps: the renderer allocates the atlases so (glTextureStorage2D with 1 level). */
+static size_t atlas_gpu_bytes(const asp_dps_level *lv, const asp_image *img)
 {
-    return (size_t)img->width * img->height * 4 * 4 / 3;
+    return lv->atlas_bc3 ? (size_t)ASP__BC3_BYTES(img->width, img->height) : (size_t)img->width * img->height * 4;
 }
 
 size_t asp_dps_level_gpu_bytes(const asp_dps_level *level, asp_mesh_bytes *out)
@@ -612,7 +646,8 @@ size_t asp_dps_level_gpu_bytes(const asp_dps_level *level, asp_mesh_bytes *out)
     asp_mesh_bytes b;
     b.vertex = level->prim_count * 4 * (12 + 12 + 8);
     b.index = level->prim_count * 6 * 4;
-    b.texture = mipmapped_rgba8(&level->atlas) + (level->normal_atlas.width ? mipmapped_rgba8(&level->normal_atlas) : 0);
+    b.texture = atlas_gpu_bytes(level, &level->atlas) +
+                (level->normal_atlas.width ? atlas_gpu_bytes(level, &level->normal_atlas) : 0);
     b.total = b.vertex + b.index + b.texture;
     if (out)
         *out = b;
@@ -645,6 +680,7 @@ size_t asp_dps_summarize(const asp_dps *dps, asp_dps_summary *rows, size_t capac
         s->atlas_width = lv->atlas.width, s->atlas_height = lv->atlas.height;
         s->neighbour_pairs = lv->neighbour_total / 2;
         s->normal_map = lv->normal_atlas.width > 0;
+        s->compressed = lv->atlas_bc3 != NULL;
     }
     return dps->level_count;
 }

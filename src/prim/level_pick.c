@@ -33,6 +33,7 @@ int asp_dps_level_pick(const asp_dps_level *src, size_t prim, const asp_context 
     lv.neighbours = NULL;
     lv.atlas = (asp_image){0, 0, NULL};
     lv.normal_atlas = (asp_image){0, 0, NULL};
+    lv.atlas_bc3 = lv.normal_bc3 = NULL; /* the picked texels are the decoded ones, stored as RGBA8 */
     lv.texels = (uint64_t)p->tex_w * p->tex_h;
     lv.prims = asp_alloc(ctx, sizeof *lv.prims);
     int rc = lv.prims ? 0 : asp_error_set(err, ASP_ENOMEM, "out of memory");

@@ -116,6 +116,9 @@ int asp_dps_level_resize(asp_dps_level *lv, const uint32_t *tex_w, const uint32_
         memset(&normals, 0, sizeof normals);
     }
     lv->texels = texels;
+    asp_free(ctx, lv->atlas_bc3); /* resampled texels are RGBA8 until compressed again */
+    asp_free(ctx, lv->normal_bc3);
+    lv->atlas_bc3 = lv->normal_bc3 = NULL;
 done:
     asp_image_release(&atlas);
     asp_image_release(&normals);

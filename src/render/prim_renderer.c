@@ -303,14 +303,23 @@ static double fill_prims(asp__prim_renderer *r, const asp_dps_level *lv, const d
     return sum_radius / (double)lv->prim_count;
 }
 
-static GLuint upload_atlas(const asp_image *img, GLenum format)
+/* bc3: the atlas's BC3 blocks (issue 27), uploaded as they are where the GL has S3TC (llvmpipe has);
+ * elsewhere img, their decoded texels, as RGBA8: the same picture at 4 bytes a texel. */
+static GLuint upload_atlas(const asp_image *img, const uint8_t *bc3, GLenum format, GLenum bc3_format)
 {
     GLuint tex = 0;
     glCreateTextures(GL_TEXTURE_2D, 1, &tex);
-    glTextureStorage2D(tex, 1, format, (GLsizei)img->width, (GLsizei)img->height);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage2D(tex, 0, 0, 0, (GLsizei)img->width, (GLsizei)img->height, GL_RGBA, GL_UNSIGNED_BYTE,
-                        img->pixels);
+    if (bc3 && epoxy_has_gl_extension("GL_EXT_texture_compression_s3tc") &&
+        (bc3_format != GL_COMPRESSED_SRGB_ALPHA_S3TC_DXT5_EXT || epoxy_has_gl_extension("GL_EXT_texture_sRGB"))) {
+        glTextureStorage2D(tex, 1, bc3_format, (GLsizei)img->width, (GLsizei)img->height);
+        glCompressedTextureSubImage2D(tex, 0, 0, 0, (GLsizei)img->width, (GLsizei)img->height, bc3_format,
+                                      (GLsizei)((size_t)img->width * img->height), bc3);
+    } else {
+        glTextureStorage2D(tex, 1, format, (GLsizei)img->width, (GLsizei)img->height);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTextureSubImage2D(tex, 0, 0, 0, (GLsizei)img->width, (GLsizei)img->height, GL_RGBA, GL_UNSIGNED_BYTE,
+                            img->pixels);
+    }
     glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -392,9 +401,10 @@ static int upload(asp__prim_renderer *r, const asp_dps_level *lv, const double o
     glCreateVertexArrays(1, &r->identity_vao.id);
     bind_ids(r->identity_vao.id, r->identity_buffer.id);
     glCreateVertexArrays(1, &r->empty_vao.id);
-    r->atlas = upload_atlas(&lv->atlas, GL_SRGB8_ALPHA8);
+    r->atlas = upload_atlas(&lv->atlas, lv->atlas_bc3, GL_SRGB8_ALPHA8, GL_COMPRESSED_SRGB_ALPHA_S3TC_DXT5_EXT);
     if (r->has_normal_map)
-        r->normal_atlas = upload_atlas(&lv->normal_atlas, GL_RGBA8);
+        r->normal_atlas =
+            upload_atlas(&lv->normal_atlas, lv->normal_bc3, GL_RGBA8, GL_COMPRESSED_RGBA_S3TC_DXT5_EXT);
     char what[96];
     snprintf(what, sizeof what, "upload %zu primitives and a %ux%u atlas", n, lv->atlas.width, lv->atlas.height);
     return asp__gl_check(gl, what, err);

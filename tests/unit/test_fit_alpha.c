@@ -100,9 +100,9 @@ static void test_budget(void)
     CHECK_MSG(differ == 0, "%zu texture rows differ after a resize to the same sizes", differ);
     free(same.prims);
     asp_image_release(&same.atlas);
-    CHECK(asp_fit_budget(&lv, 100, 0, 2, NULL, &err) == ASP_EINVAL); // below 4x4 for each of 8
+    CHECK(asp_fit_budget(&lv, 100, 0, 2, 0, NULL, &err) == ASP_EINVAL); // below 4x4 for each of 8
     CHECK(lv.texels == full);
-    CHECK_OK(asp_fit_budget(&lv, 2000, 0, 2, NULL, &err), &err);
+    CHECK_OK(asp_fit_budget(&lv, 2000, 0, 2, 0, NULL, &err), &err);
     fprintf(stderr, "texels %llu -> %llu, atlas %ux%u\n", (unsigned long long)full, (unsigned long long)lv.texels,
             lv.atlas.width, lv.atlas.height);
     CHECK(lv.texels <= 2000 && lv.texels >= 1000);
@@ -127,9 +127,9 @@ static void test_budget(void)
     // 2000 texels for 8 faces seen at 64 px: the faces' alpha blurs across the creases (0.754 measured)
     CHECK(s > 0.7);
     size_t gb = 0;
-    CHECK(asp_fit_budget(&lv, 0, 1000, 2, NULL, &err) == ASP_EINVAL); // 1000 bytes hold no 8 primitives
+    CHECK(asp_fit_budget(&lv, 0, 1000, 2, 0, NULL, &err) == ASP_EINVAL); // 1000 bytes hold no 8 primitives
     gb = asp_dps_level_gpu_bytes(&lv, NULL);
-    CHECK_OK(asp_fit_budget(&lv, 0, gb / 2, 2, NULL, &err), &err);
+    CHECK_OK(asp_fit_budget(&lv, 0, gb / 2, 2, 0, NULL, &err), &err);
     CHECK(asp_dps_level_gpu_bytes(&lv, NULL) <= gb / 2);
     asp_dps_level_release(&lv, NULL);
 }
