@@ -126,9 +126,13 @@ int asp_mesh_compute_normals(asp_mesh *mesh, asp_error *err);
 /** Total triangle area in world units squared (summed in double). */
 double asp_mesh_area(const asp_mesh *mesh);
 
+/* The largest |position| asp_mesh_validate accepts (relative to origin): squares stay finite in float. */
+#define ASP_MESH_MAX_COORD 1e18
+
 /**
- * Checks a mesh before sampling: triangle indices in range, finite positions,
- * uvs and normals, material ids in range, non-zero area. name is used in the
+ * Checks a mesh before sampling: triangle indices in range, finite positions
+ * within +-ASP_MESH_MAX_COORD, uvs and normals, a finite origin, material ids
+ * in range, non-zero area. name is used in the
  * messages ("mesh 'x.obj' has zero surface area"). Returns 0, ASP_EFORMAT or
  * ASP_EDEGENERATE.
  */

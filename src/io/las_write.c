@@ -15,6 +15,7 @@
 #include "amgsplat/io.h"
 #include "io/las_internal.h"
 #include "util/atomic_file.h"
+#include "io/cloud_check.h"
 #include "util/banned.h"
 
 enum { CHUNK = 1 << 14, MAX_EXTRA = 256 };
@@ -433,6 +434,9 @@ static int write_vlr(FILE *fp, const asp_las_vlr *v, int extended)
 int asp_las_write(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err)
 {
     ASP_ASSERT(cloud && path);
+    int check = asp__cloud_output_check(cloud, path, err);
+    if (check)
+        return check;
     writer *w = asp_calloc(&cloud->ctx, 1, sizeof *w);
     if (!w)
         return asp_error_set(err, ASP_ENOMEM, "cannot write '%s': out of memory", path);
@@ -526,7 +530,9 @@ int asp_las_write(const asp_cloud *cloud, const char *path, const asp_save_desc 
         for (size_t i = 0; !bad && m && i < m->vlr_count; i++)
             if ((m->vlrs[i].extended || m->vlrs[i].size > 65535) && w->minor >= 4)
                 bad = write_vlr(f.fp, &m->vlrs[i], 1);
-        rc = bad ? write_failed(w, &f) : asp__atomic_commit(&f, err);
+        // read back as asp_cloud_load reads it (issue #31: every output kind)
+        rc = bad ? write_failed(w, &f)
+                 : asp__atomic_commit_checked(&f, asp__cloud_reads_back, &(asp__cloud_readback){cloud, "las"}, err);
     }
     asp_free(&cloud->ctx, bits);
     asp_free(&cloud->ctx, buf);

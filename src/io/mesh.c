@@ -188,6 +188,12 @@ int asp_mesh_validate(const asp_mesh *mesh, const char *name, asp_error *err)
             if (!isfinite(mesh->positions[3 * v + c]))
                 return asp_error_set(err, ASP_EFORMAT, "mesh '%s': vertex %zu: coordinate %c is not finite", name,
                                      v, axis[c]);
+            // issue #31: a 1e38 triangle sampled into radii of infinity; samplers and renderers square
+            // coordinate differences in float, which stay finite within +-1e18 of the origin
+            if (fabsf(mesh->positions[3 * v + c]) > ASP_MESH_MAX_COORD)
+                return asp_error_set(err, ASP_EFORMAT, "mesh '%s': vertex %zu: coordinate %c is %g, beyond the "
+                                     "+-%g that float arithmetic on it allows (around the centre %g)", name, v,
+                                     axis[c], (double)mesh->positions[3 * v + c], ASP_MESH_MAX_COORD, mesh->origin[c]);
             if (!isfinite(mesh->normals[3 * v + c]))
                 return asp_error_set(err, ASP_EFORMAT, "mesh '%s': vertex %zu: normal %c is not finite", name, v,
                                      axis[c]);
@@ -196,6 +202,9 @@ int asp_mesh_validate(const asp_mesh *mesh, const char *name, asp_error *err)
             return asp_error_set(err, ASP_EFORMAT, "mesh '%s': vertex %zu: texture coordinate is not finite", name,
                                  v);
     }
+    for (int c = 0; c < 3; c++)
+        if (!isfinite(mesh->origin[c]))
+            return asp_error_set(err, ASP_EFORMAT, "mesh '%s': its origin's %c is not finite", name, axis[c]);
     double area = asp_mesh_area(mesh);
     if (!(area > 0.0) || !isfinite(area))
         return asp_error_set(err, ASP_EDEGENERATE, "mesh '%s' has zero surface area", name);

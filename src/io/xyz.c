@@ -14,6 +14,7 @@
 #include "io/buffered_source.h"
 #include "io/ply_internal.h"
 #include "util/atomic_file.h"
+#include "io/cloud_check.h"
 #include "util/banned.h"
 
 enum { LINE_MAX_BYTES = 1 << 16, MAX_COLS = 9 };
@@ -283,7 +284,9 @@ int asp_xyz_write(const asp_cloud *c, const char *path, const asp_save_desc *des
     const asp_property *intensity = c->normals ? NULL : asp_cloud_find_property(c, "intensity");
     int world = c->origin[0] != 0.0 || c->origin[1] != 0.0 || c->origin[2] != 0.0;
     asp__atomic_file f;
-    int rc = asp__atomic_open(&f, path, err);
+    int rc = asp__cloud_output_check(c, path, err);
+    if (rc == 0)
+        rc = asp__atomic_open(&f, path, err);
     if (rc)
         return rc;
     if (wants_count_line(path))
@@ -314,5 +317,6 @@ int asp_xyz_write(const asp_cloud *c, const char *path, const asp_save_desc *des
         if (fwrite(line, 1, len, f.fp) != len)
             break;
     }
-    return asp__atomic_commit(&f, err);
+    // read back as asp_cloud_load reads it (issue #31: every output kind)
+    return asp__atomic_commit_checked(&f, asp__cloud_reads_back, &(asp__cloud_readback){c, "xyz"}, err);
 }
