@@ -294,8 +294,43 @@ static int check_obj(const char *b, size_t size, const char *name, asp_error *er
         while (p < e && *p != ' ' && *p != '\t' && *p != '\r')
             p++;
     }
-    if (words >= 3)
+    if (words >= 3) {
+        // issue #31: the last statement, cut or not, must be well formed: numbers after 'v', indices after 'f'
+        for (const char *p = s + 1; p < e;) {
+            while (p < e && (*p == ' ' || *p == '\t' || *p == '\r'))
+                p++;
+            const char *w = p;
+            while (p < e && *p != ' ' && *p != '\t' && *p != '\r')
+                p++;
+            if (w == p)
+                break;
+            char tok[64];
+            size_t n = (size_t)(p - w);
+            snprintf(tok, sizeof tok, "%.*s", (int)(n < sizeof tok ? n : sizeof tok - 1), w);
+            int ok = n < sizeof tok;
+            if (ok && vert) {
+                char *end;
+                strtod(tok, &end);
+                ok = *end == '\0';
+            } else if (ok) { // v, v/t, v//n, v/t/n, each index an optionally negative integer
+                int digits = 0;
+                for (const char *q = tok; ok && *q; q++) {
+                    if (*q >= '0' && *q <= '9')
+                        digits++;
+                    else if (*q == '/' || (*q == '-' && (q == tok || q[-1] == '/')))
+                        ok = *q == '-' || q > tok;
+                    else
+                        ok = 0;
+                }
+                ok = ok && digits > 0 && tok[n - 1] != '-';
+            }
+            if (!ok)
+                return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu, the last, ends without a newline "
+                                     "and its %s '%s' is malformed: the file is cut off", name, line,
+                                     vert ? "value" : "index", tok);
+        }
         return 0;
+    }
     return asp_error_set(err, ASP_EFORMAT,
                          "cannot read '%s': line %zu: the file ends inside a %s line ('%.*s'): it is cut off", name,
                          line, face ? "face" : "vertex", (int)(e - s < 40 ? e - s : 40), s);
@@ -381,6 +416,16 @@ int asp__mesh_precheck(const char *path, const char *format, const asp_context *
     if (rc)
         return rc;
     rc = asp__mesh_precheck_memory(buf, size, path, format, err);
+    int text = strcmp(format, "obj") == 0 || strcmp(format, "off") == 0 || (strcmp(format, "stl") == 0 && size >= 5 &&
+                                                                            memcmp(buf, "solid", 5) == 0);
+    if (rc == 0 && text && size > 0 && buf[size - 1] != '\n') {
+        // issue #31: a cut file and one without its final newline look alike; the last line passed the checks
+        size_t line = 1;
+        for (size_t i = 0; i < size; i++)
+            line += buf[i] == '\n';
+        asp_warn(ctx, "'%s': line %zu, the last, has no newline at its end: if the file was cut off there, its "
+                 "values are incomplete", path, line);
+    }
     if (rc == 0 && strcmp(format, "obj") == 0)
         rc = check_mtllibs(path, (const char *)buf, size, err);
     asp_free(ctx, buf);

@@ -125,6 +125,11 @@ static int parse_lines(text_reader *t)
         }
         if (n == 0)
             continue; /* only separators */
+        // issue #31: a file cut inside its last line and one that merely lacks the final newline look
+        // alike; a malformed row fails above and below, a well-formed one is read with a warning
+        if (t->src.unterminated)
+            asp_warn(t->ctx, "'%s': line %zu, the last, has no newline at its end: if the file was cut off there, "
+                     "its values are incomplete", t->name, lineno);
         if (first && n == 1 && v[0] >= 0 && v[0] == floor(v[0])) {
             first = 0; /* a point count, as .pts files start with */
             t->declared = v[0];
