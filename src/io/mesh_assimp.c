@@ -22,6 +22,7 @@
 #include "amgsplat/mesh.h"
 #include "io/mesh_precheck.h"
 #include "io/ply_internal.h"
+#include "util/atomic_file.h"
 #include "util/child_process.h"
 #include "util/regular_file.h"
 #include "util/banned.h"
@@ -323,6 +324,7 @@ static int load_override(const char *override, const char *material, asp_materia
     int rc = asp_image_load(&mat->texture, override, &e);
     if (rc)
         return asp_error_set(err, rc, "%s (texture for material '%s')", e.msg, material);
+    asp__atomic_protect(override, "a texture");
     copy_str(mat->texture_path, sizeof mat->texture_path, override);
     return 0;
 }
@@ -390,6 +392,9 @@ static int finish_materials(const char *path, const asp_mesh_load_desc *desc, as
                 int rc = asp_image_load(&mat->texture, file, &e);
                 if (rc)
                     return asp_error_set(err, rc, "%s (texture of material '%s')", e.msg, mat->name);
+                char role[40];
+                snprintf(role, sizeof role, "the texture of material '%.12s'", mat->name);
+                asp__atomic_protect(file, role);
                 copy_str(mat->texture_path, sizeof mat->texture_path, file);
                 continue;
             }
@@ -878,6 +883,7 @@ int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_co
         unlink(tmp_path);
     if (rc)
         return rc;
+    asp__atomic_protect(path, "the model");
     rc = finish(job.mesh, path, &d, job.refs, job.file_normals, err);
     asp_free(&job.ctx, job.refs);
     if (rc) {
