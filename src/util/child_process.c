@@ -77,6 +77,19 @@ static size_t address_space_now(void)
     return ok && page > 0 ? (size_t)pages * (size_t)page : 0;
 }
 
+int asp__address_space_headroom(size_t need, const char *what, asp_error *err)
+{
+    struct rlimit r;
+    if (UNDER_ASAN || getrlimit(RLIMIT_AS, &r) != 0 || r.rlim_cur == RLIM_INFINITY)
+        return 0;
+    size_t now = address_space_now(), limit = (size_t)r.rlim_cur;
+    size_t left = now < limit ? limit - now : 0;
+    if (now == 0 || left >= need)
+        return 0;
+    return asp_error_set(err, ASP_ENOMEM, "out of memory: %s needs about %zu MB of address space, the limit (ulimit -v "
+                         "%zu MB) leaves %zu MB", what, need >> 20, limit >> 20, left >> 20);
+}
+
 static void cap(int resource, rlim_t value)
 {
     struct rlimit r;

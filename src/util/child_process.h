@@ -18,6 +18,24 @@ int asp__fd_write_all(int fd, const void *buf, size_t len);
 /* Reads exactly len bytes from fd; 0, or -1 at an early end of the stream or a read error. */
 int asp__fd_read_all(int fd, void *buf, size_t len);
 
+/*
+ * 0 when the process may grow by need bytes under its address-space limit
+ * (ulimit -v, RLIMIT_AS; always 0 without one). Otherwise ASP_ENOMEM "out
+ * of memory: <what> needs about N MB of address space, the limit (ulimit -v)
+ * leaves M MB". For third-party code that does not survive its allocations
+ * failing (issue #31: Mesa's shader compiler died of SIGSEGV or an uncaught
+ * std::bad_alloc under ulimit -v), checked before calling it.
+ */
+int asp__address_space_headroom(size_t need, const char *what, asp_error *err);
+
+/*
+ * What the GL driver's code generation (llvmpipe's LLVM) may need, measured under ulimit -v on a
+ * 2M-point render: shader compilation crashed with 230 MB left and passed with 327 MB; drawing
+ * passed with 295 MB.
+ */
+#define ASP_GL_SHADER_HEADROOM ((size_t)320 << 20)
+#define ASP_GL_DRAW_HEADROOM ((size_t)160 << 20)
+
 /* What runs in the child: writes its result to fd; its return value is ignored. */
 typedef void (*asp__child_work)(void *user, int fd);
 

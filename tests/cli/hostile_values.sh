@@ -125,3 +125,16 @@ cmp -s T.png good.png || fail "T.png was overwritten"
 # ---- an empty LAS (UBSan: memcpy from NULL) ----
 : >empty.las
 refused 1 "empty.las" "$A" info empty.las
+
+# ---- memory limits: render of 2M points under ulimit -v ends in a clean out-of-memory message ----
+# (400 MB: the case; 700 and 900 MB ended in SIGSEGV and std::bad_alloc inside Mesa's compiler)
+"$A" synth sphere --points 2M -o big.ply -q
+for v in 400000 700000 900000; do
+  st=0
+  (ulimit -v $v; exec "$A" render big.ply -o big.png --size 64x64 -q) >out 2>err || st=$?
+  if ((v == 400000)); then
+    ((st == 1)) || fail "render under ulimit -v $v exited $st: $(cat err)"
+  fi
+  ((st == 0 || st == 1)) || fail "render under ulimit -v $v exited $st: $(cat err)"
+  ((st == 0)) || grep -F "out of memory" err >/dev/null || fail "render under ulimit -v $v: $(cat err)"
+done
