@@ -155,6 +155,11 @@ int asp__child_run(const asp__child_desc *desc, asp__child_work work, asp__child
         return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': the reader (%s) crashed with signal %d (%s)",
                              desc->path, desc->reader, sig, strsignal(sig));
     }
-    return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': the reader (%s) ended (exit status %d) without a result",
-                         desc->path, desc->reader, WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+    // a sanitizer's handler turns the child's SIGSEGV into exit status 1 after its report
+    int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    if (code != 0)
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': the reader (%s) crashed (exit status %d)", desc->path,
+                             desc->reader, code);
+    return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': the reader (%s) ended without a result", desc->path,
+                         desc->reader);
 }

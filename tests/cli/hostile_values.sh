@@ -30,8 +30,9 @@ refused() { # refused STATUS TEXT cmd...: exit 1 or 2 as given, TEXT on stderr
 }
 
 "$A" synth octahedron --points 400 -o oct.ply -q
-"$A" decompose oct.ply -o oct.amg -q
-"$A" build oct.amg -o oct.dps --primitives 8 -q >/dev/null
+# the inputs' makers start MPI (hypre), whose leaks the sanitizer build checks only in their own tests
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" "$A" decompose oct.ply -o oct.amg -q
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" "$A" build oct.amg -o oct.dps --primitives 8 -q >/dev/null
 "$B/seed_hier" oct.ply oct.hier
 
 # ---- NaN origins behind a valid checksum ----
@@ -128,8 +129,14 @@ refused 1 "empty.las" "$A" info empty.las
 
 # ---- memory limits: render of 2M points under ulimit -v ends in a clean out-of-memory message ----
 # (400 MB: the issue's case; 700 and 900 MB ended in SIGSEGV and std::bad_alloc inside Mesa's compiler)
-"$A" synth sphere --points 2M -o big.ply -q
-for v in 400000 700000 900000; do
+# (AddressSanitizer reserves terabytes of shadow memory: no ulimit -v there, so not in that build)
+limits="400000 700000 900000"
+if ldd "$A" | grep -F libasan >/dev/null; then
+  echo "ulimit -v cases not run: AddressSanitizer build" >&2
+  limits=""
+fi
+[[ -z $limits ]] || "$A" synth sphere --points 2M -o big.ply -q
+for v in $limits; do
   st=0
   (ulimit -v $v; exec "$A" render big.ply -o big.png --size 64x64 -q) >out 2>err || st=$?
   if ((v == 400000)); then
