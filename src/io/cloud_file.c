@@ -150,6 +150,11 @@ int asp_cloud_save(const asp_cloud *cloud, const char *path, const asp_save_desc
     asp_file_type t;
     if (asp_file_type_of_name(path, &t, NULL) || t.kind != ASP_FILE_POINTS)
         return unknown("write", path, err);
+    // the format writers write what they are given and their read-back names what is wrong; the
+    // commands' save refuses non-finite values first, with a message that is not an internal error
+    int rc = asp__cloud_output_check(cloud, path, err);
+    if (rc)
+        return rc;
     if (strcmp(t.format, "laz") == 0)
         return asp_error_set(err, ASP_EUNSUPPORTED,
                              "cannot write '%s': compressed LAS (LASzip) needs a compressor this build does not have; "

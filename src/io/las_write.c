@@ -434,9 +434,6 @@ static int write_vlr(FILE *fp, const asp_las_vlr *v, int extended)
 int asp_las_write(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err)
 {
     ASP_ASSERT(cloud && path);
-    int check = asp__cloud_output_check(cloud, path, err);
-    if (check)
-        return check;
     writer *w = asp_calloc(&cloud->ctx, 1, sizeof *w);
     if (!w)
         return asp_error_set(err, ASP_ENOMEM, "cannot write '%s': out of memory", path);

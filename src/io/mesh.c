@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "amgsplat/mesh.h"
+#include "util/atomic_file.h"
 #include "util/banned.h"
 
 static void release_arrays(asp_mesh *m)
@@ -21,8 +22,13 @@ static void release_arrays(asp_mesh *m)
     asp_free(ctx, m->colors);
     asp_free(ctx, m->triangles);
     asp_free(ctx, m->material_ids);
-    for (size_t i = 0; m->materials && i < m->material_count; i++)
+    for (size_t i = 0; m->materials && i < m->material_count; i++) {
+        const asp_material *mat = &m->materials[i];
+        // a texture read from a file stops being protected from outputs (mesh_assimp.c, issue #31)
+        if (mat->texture.pixels && mat->texture_path[0] && mat->texture_path[0] != '*')
+            asp__atomic_unprotect(mat->texture_path);
         asp_image_release(&m->materials[i].texture);
+    }
     asp_free(ctx, m->materials);
 }
 

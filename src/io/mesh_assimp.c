@@ -883,7 +883,6 @@ int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_co
         unlink(tmp_path);
     if (rc)
         return rc;
-    asp__atomic_protect(path, "the model");
     rc = finish(job.mesh, path, &d, job.refs, job.file_normals, err);
     asp_free(&job.ctx, job.refs);
     if (rc) {

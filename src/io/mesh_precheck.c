@@ -13,7 +13,6 @@
 #include <sys/stat.h>
 
 #include "io/mesh_precheck.h"
-#include "util/atomic_file.h"
 #include "util/byte_io.h"
 #include "util/regular_file.h"
 #include "util/banned.h"
@@ -368,10 +367,7 @@ static int check_side_file(const char *obj, const char *name, size_t len, asp_er
     struct stat st;
     if (stat(full, &st) != 0)
         return 0; // a missing .mtl is assimp's to report (it carries on without materials)
-    if (!S_ISREG(st.st_mode))
-        return asp__regular_file_check(full, err);
-    asp__atomic_protect(full, "a material library"); // issue #31: no output replaces a file a reader opened
-    return 0;
+    return S_ISREG(st.st_mode) ? 0 : asp__regular_file_check(full, err);
 }
 
 /*

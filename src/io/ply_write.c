@@ -389,12 +389,9 @@ int asp_ply_write(const asp_cloud *cloud, const char *path, const asp_save_desc 
     asp_ply_encoding enc = desc ? desc->encoding : ASP_PLY_DEFAULT;
     if (enc != ASP_PLY_DEFAULT && enc != ASP_PLY_ASCII && enc != ASP_PLY_BINARY_LE && enc != ASP_PLY_BINARY_BE)
         return asp_error_set(err, ASP_EINVAL, "cannot write '%s': unknown PLY encoding %d", path, (int)enc);
-    int rc = asp__cloud_output_check(cloud, path, err);
-    if (rc)
-        return rc;
     w.ascii = enc == ASP_PLY_ASCII;
     w.swap = !w.ascii && ((enc == ASP_PLY_BINARY_BE) != asp__host_big_endian());
-    rc = write_all(&w);
+    int rc = write_all(&w);
     asp_free(&cloud->ctx, w.cols);
     asp_free(&cloud->ctx, w.buf);
     asp_free(&cloud->ctx, w.tmp);

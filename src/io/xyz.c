@@ -289,9 +289,7 @@ int asp_xyz_write(const asp_cloud *c, const char *path, const asp_save_desc *des
     const asp_property *intensity = c->normals ? NULL : asp_cloud_find_property(c, "intensity");
     int world = c->origin[0] != 0.0 || c->origin[1] != 0.0 || c->origin[2] != 0.0;
     asp__atomic_file f;
-    int rc = asp__cloud_output_check(c, path, err);
-    if (rc == 0)
-        rc = asp__atomic_open(&f, path, err);
+    int rc = asp__atomic_open(&f, path, err);
     if (rc)
         return rc;
     if (wants_count_line(path))

@@ -166,13 +166,15 @@ static void remove_stale(const char *path)
 /*
  * Files read as dependencies (issue #31: `render m.obj -o T.png` overwrote
  * the mesh's own texture T.png; the CLI's output-is-input check sees only
- * the files named on the command line). A fixed table, filled once per read,
- * under a lock: loads may run on several threads.
+ * the files named on the command line). A fixed table of counted entries,
+ * one count per object that holds what was read (a mesh's texture, until
+ * asp_mesh_destroy), under a lock: loads may run on several threads.
  */
 enum { PROTECTED_MAX = 256 };
 static struct {
     dev_t dev;
     ino_t ino;
+    unsigned refs;
     char role[40];
 } protected_files[PROTECTED_MAX];
 static size_t protected_count;
@@ -191,9 +193,28 @@ void asp__atomic_protect(const char *path, const char *role)
     if (i == protected_count && i < PROTECTED_MAX) {
         protected_files[i].dev = st.st_dev;
         protected_files[i].ino = st.st_ino;
+        protected_files[i].refs = 0;
         snprintf(protected_files[i].role, sizeof protected_files[i].role, "%s", role);
         protected_count++;
     }
+    if (i < protected_count)
+        protected_files[i].refs++;
+    atomic_flag_clear_explicit(&protected_lock, memory_order_release);
+}
+
+void asp__atomic_unprotect(const char *path)
+{
+    struct stat st;
+    if (!path || stat(path, &st) != 0)
+        return;
+    while (atomic_flag_test_and_set_explicit(&protected_lock, memory_order_acquire))
+        ;
+    for (size_t i = 0; i < protected_count; i++)
+        if (protected_files[i].dev == st.st_dev && protected_files[i].ino == st.st_ino) {
+            if (--protected_files[i].refs == 0)
+                protected_files[i] = protected_files[--protected_count];
+            break;
+        }
     atomic_flag_clear_explicit(&protected_lock, memory_order_release);
 }
 
