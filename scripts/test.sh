@@ -130,6 +130,8 @@ fuzz_smoke() {
       fuzz_hier) seed "$corpus" "$seeds"/*.hier ;;
       fuzz_image) seed "$corpus" "$seeds"/*.png tests/data/bad/image ;;
       fuzz_mesh) seed "$corpus" "$seeds"/*.ply tests/data/bad/mesh ;;
+      fuzz_gltf) seed "$corpus" tests/data/bad/assimp/*.gltf tests/data/bad/assimp/*.glb ;;
+      fuzz_collada) seed "$corpus" tests/data/bad/assimp/*.dae ;;
       fuzz_las) seed "$corpus" "$seeds"/*.las ;;
       fuzz_stats_log) seed "$corpus" tests/data/experiment ;;
       fuzz_scene_file) : ;; # JSON only: its committed corpus below

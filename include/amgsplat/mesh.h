@@ -112,6 +112,14 @@ typedef struct asp_mesh_load_desc {
  * ASP_EUNSUPPORTED (more than 2^32-1 vertices), ASP_ENOMEM. On failure *out is
  * unchanged. Thread safety: not safe to call from two threads at once, because
  * assimp's C API keeps its last error message in a process-wide string.
+ * Containment (issue #31): OFF, STL, OBJ, PLY, glTF/GLB, Collada and 3DS are
+ * pre-checked (counts, lengths and indices against the bytes); then assimp
+ * runs in a forked child process with its address space capped at 512 MB plus
+ * 64 bytes per byte of the file and its CPU time at 60 s plus 10 s per MB, so
+ * a crash inside it is ASP_EFORMAT "cannot read 'x.dae': the reader (assimp)
+ * crashed with signal 11 (...)" and a blow-up ASP_ENOMEM "... out of memory:
+ * the reader (assimp) reached its limit of N MB". Texture files are read in
+ * the calling process and recorded so that no output replaces them.
  */
 int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_context *ctx, asp_mesh **out,
                   asp_error *err);
@@ -126,9 +134,13 @@ int asp_mesh_compute_normals(asp_mesh *mesh, asp_error *err);
 /** Total triangle area in world units squared (summed in double). */
 double asp_mesh_area(const asp_mesh *mesh);
 
+/* The largest |position| asp_mesh_validate accepts (relative to origin): squares stay finite in float. */
+#define ASP_MESH_MAX_COORD 1e18
+
 /**
- * Checks a mesh before sampling: triangle indices in range, finite positions,
- * uvs and normals, material ids in range, non-zero area. name is used in the
+ * Checks a mesh before sampling: triangle indices in range, finite positions
+ * within +-ASP_MESH_MAX_COORD, uvs and normals, a finite origin, material ids
+ * in range, non-zero area. name is used in the
  * messages ("mesh 'x.obj' has zero surface area"). Returns 0, ASP_EFORMAT or
  * ASP_EDEGENERATE.
  */

@@ -316,6 +316,11 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
                  a->frame.center[0], a->frame.center[1], a->frame.center[2], a->frame.radius);
         return asp__byte_bad(r, msg);
     }
+    if (!(isfinite(origin[0]) && isfinite(origin[1]) && isfinite(origin[2]))) { // issue #31: a NaN origin
+        r->at = 40;
+        snprintf(msg, sizeof msg, "origin (%g, %g, %g), expected finite values", origin[0], origin[1], origin[2]);
+        return asp__byte_bad(r, msg);
+    }
     /* sizes come from a checksummed file, but a crafted one must still not make us allocate wildly */
     if (n < 1 || n > payload / 28 || n > (uint64_t)INT32_MAX) {
         r->at = 16;

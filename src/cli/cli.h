@@ -28,6 +28,8 @@ struct cli_env {
     int threads;         /* --threads N (0 = all) */
     const void *preset_values[32]; /* option values set by --preset and not given explicitly */
     size_t preset_count;
+    const void *given_values[32]; /* option values given on the command line (cli_given) */
+    size_t given_count;
     struct cli_progress_state progress;
 };
 
@@ -62,6 +64,13 @@ int cli_parse(int argc, char **argv, const struct cli_option *opts, const char *
  * points) instead of refusing it as it refuses the same option given by hand.
  */
 int cli_from_preset(const struct cli_env *env, const void *value);
+
+/*
+ * 1 when the option whose value field is `value` was given on the command line, so a command can
+ * refuse a given value that its default sentinel shares (--las-scale 0, --points 0) instead of
+ * falling back to the default (issue #31).
+ */
+int cli_given(const struct cli_env *env, const void *value);
 
 /* Prints "amgsplat CMD: error: MSG" and returns exit status 1. */
 int cli_fail(const struct cli_env *env, const asp_error *err);

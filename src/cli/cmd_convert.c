@@ -106,13 +106,15 @@ int cmd_convert(int argc, char **argv, struct cli_env *env)
     if ((ascii || big_endian) && out_fmt && strcmp(out_fmt, "ply") != 0)
         return cli_usage_error(env, "--%s applies to .ply output only, not '%s'", ascii ? "ascii" : "big-endian", out);
     int las_out = out_fmt && strcmp(out_fmt, "las") == 0;
-    if ((las_format != -1 || las_scale != 0) && !las_out)
+    // given values are checked even where they equal the "not given" defaults -1 and 0 (issue #31)
+    int given_format = cli_given(env, &las_format), given_scale = cli_given(env, &las_scale);
+    if ((given_format || given_scale) && !las_out)
         return cli_usage_error(env, "--%s applies to .las output only, not '%s'",
-                               las_format != -1 ? "las-format" : "las-scale", out);
-    if (las_format != -1 && (las_format < 0 || las_format > 8 || las_format == 4 || las_format == 5))
+                               given_format ? "las-format" : "las-scale", out);
+    if (given_format && (las_format < 0 || las_format > 8 || las_format == 4 || las_format == 5))
         return cli_usage_error(env, "--las-format %d: expected 0, 1, 2, 3, 6, 7 or 8 (waveform formats are not written)",
                                las_format);
-    if (las_scale < 0 || !(las_scale <= 1e6))
+    if ((given_scale && !(las_scale > 0)) || las_scale < 0 || !(las_scale <= 1e6))
         return cli_usage_error(env, "--las-scale %g: expected a positive step up to 1e6", las_scale);
 
     asp_error err = {0};

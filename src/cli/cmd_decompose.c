@@ -366,7 +366,7 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
         {"crease-cut", 0, CLI_DOUBLE, &crease, "X",
          "cut coarse couplings whose interface classifier is below X times the flatter side's (default 0.25, <0: off)"},
         {"weak-cut", 0, CLI_DOUBLE, &weak, "X", "cut coarse couplings below X times the median (default 0: off)"},
-        {"drop", 0, CLI_DOUBLE, &drop, "X", "drop basis values below X, renormalised (default 1e-4)"},
+        {"drop", 0, CLI_DOUBLE, &drop, "X", "drop basis values below X, renormalised (default 1e-4; 0 drops nothing)"},
         {"stats", 0, CLI_FLAG, &stats, NULL, "print per-level statistics"},
         {"mesh-stiffness", 0, CLI_FLAG, &mesh_stiffness, NULL, "MESH input: the stiffness matrix on the mesh's own triangles (journal eq. 4)"},
         {"critical-k", 0, CLI_FLAG, &critical, NULL, "print the points' critical neighbourhood sizes (thesis 2.3), to choose --k"},
@@ -390,6 +390,10 @@ int cmd_decompose(int argc, char **argv, struct cli_env *env)
     int color_mode = 0;
     if (check_counts(env, k, k_max, fan_k, max_levels, max_coarse))
         return 2;
+    if (cli_given(env, &drop) && !(drop >= 0 && drop < 1)) // issue #31: -1 was taken as "keep all"
+        return cli_usage_error(env, "--drop expects a value in [0, 1) (0 drops nothing), got %g", drop);
+    if (cli_given(env, &drop) && drop == 0)
+        drop = -1; // the library's "keep every entry" (amg.h drop_tol), not its 0 = default
     if (check_output_name(env, input, output, colors_out))
         return 2;
     k = k == UNSET ? 0 : k, k_max = k_max == UNSET ? 0 : k_max, fan_k = fan_k == UNSET ? 0 : fan_k;

@@ -125,7 +125,7 @@ static int check_options(struct cli_env *env, const struct export_opts *o, asp_g
         else
             return cli_usage_error(env, "--alpha-mode expects blend or mask, got '%s'", o->alpha_mode);
     }
-    if (o->alpha_cutoff != 0 && !(o->alpha_cutoff > 0 && o->alpha_cutoff < 1))
+    if ((o->alpha_cutoff != 0 || cli_given(env, &o->alpha_cutoff)) && !(o->alpha_cutoff > 0 && o->alpha_cutoff < 1))
         return cli_usage_error(env, "--alpha-cutoff expects a value in (0, 1), got %g", o->alpha_cutoff);
     if (o->alpha_cutoff != 0 && d->alpha_mode != ASP_GLTF_ALPHA_MASK)
         return cli_usage_error(env, "--alpha-cutoff needs --alpha-mode mask");

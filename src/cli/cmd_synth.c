@@ -40,6 +40,8 @@ int cmd_synth(int argc, char **argv, struct cli_env *env)
     asp_synth_shape shape;
     if (asp_synth_shape_parse(argv[0], &shape, &err))
         return cli_usage_error(env, "%s", err.msg);
+    if (cli_given(env, &points) && points == 0) // 0 would mean "the shape's default" (issue #31)
+        return cli_usage_error(env, "--points expects at least 1, got 0");
     if (grid < 2 || grid > 65535)
         return cli_usage_error(env, "--grid must be 2 to 65535, got %zu", grid);
     if (squares < 1 || squares > grid)

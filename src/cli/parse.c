@@ -56,6 +56,38 @@ static void print_help(const struct cli_option *opts, const char *usage)
     printf("  %-26s %s\n", "-h, --help", "show this help");
 }
 
+/*
+ * Plain decimal notation: [+-]digits[.digits][e[+-]digits], then one of suffixes. strtod also
+ * reads hex ("0x10" = 16), "inf", "nan" and hex floats; an option value meaning any of those is a
+ * typo more often than not (issue #31), so they are refused before it.
+ */
+static int plain_decimal(const char *v, const char *suffixes)
+{
+    const char *p = v;
+    if (*p == '+' || *p == '-')
+        p++;
+    int digits = 0;
+    while (*p >= '0' && *p <= '9')
+        p++, digits++;
+    if (*p == '.')
+        for (p++; *p >= '0' && *p <= '9'; p++)
+            digits++;
+    if (!digits)
+        return 0;
+    if (*p == 'e' || *p == 'E') {
+        p++;
+        if (*p == '+' || *p == '-')
+            p++;
+        if (!(*p >= '0' && *p <= '9'))
+            return 0;
+        while (*p >= '0' && *p <= '9')
+            p++;
+    }
+    if (*p && strchr(suffixes, *p))
+        p++;
+    return *p == '\0';
+}
+
 static int set_value(struct cli_env *env, const struct cli_option *o, const char *v)
 {
     char *end = NULL;
@@ -72,7 +104,7 @@ static int set_value(struct cli_env *env, const struct cli_option *o, const char
         return 0;
     }
     case CLI_SIZE: {
-        if (*v == '-')
+        if (*v == '-' || !plain_decimal(v, "kKmM"))
             return cli_usage_error(env, "--%s expects a non-negative integer, got '%s'", o->name, v);
         /* accept 2e6 / 200k / 1M for point counts */
         double d = strtod(v, &end);
@@ -85,7 +117,7 @@ static int set_value(struct cli_env *env, const struct cli_option *o, const char
     }
     case CLI_DOUBLE: {
         double d = strtod(v, &end);
-        if (errno || end == v || *end || !isfinite(d))
+        if (errno || end == v || *end || !isfinite(d) || !plain_decimal(v, ""))
             return cli_usage_error(env, "--%s expects a finite number, got '%s'", o->name, v);
         *(double *)o->value = d;
         return 0;
@@ -102,6 +134,14 @@ static void forget_preset(struct cli_env *env, const void *value)
     for (size_t k = 0; k < env->preset_count; k++)
         if (env->preset_values[k] == value)
             env->preset_values[k--] = env->preset_values[--env->preset_count];
+}
+
+int cli_given(const struct cli_env *env, const void *value)
+{
+    for (size_t k = 0; k < env->given_count; k++)
+        if (env->given_values[k] == value)
+            return 1;
+    return 0;
 }
 
 int cli_from_preset(const struct cli_env *env, const void *value)
@@ -251,6 +291,8 @@ int cli_parse(int argc, char **argv, const struct cli_option *opts, const char *
         if (set_value(env, o, v))
             return -1;
         forget_preset(env, o->value);
+        if (!cli_given(env, o->value) && env->given_count < sizeof env->given_values / sizeof env->given_values[0])
+            env->given_values[env->given_count++] = o->value;
     }
     *npos = n;
     if (applied[0])

@@ -3,6 +3,7 @@
  * and the two layouts of the spec: GLB (4.4: 12-byte header, a JSON chunk padded with spaces,
  * a BIN chunk padded with zeros, all 4-byte aligned) or a .gltf with a .bin and PNG files.
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -512,15 +513,106 @@ static int write_separate(asp__gltf *g, const char *path, const char *json, asp_
     return rc;
 }
 
+/* The first non-finite number under item (cJSON prints it as null), its place in *where; 0 when all are finite. */
+static int json_nonfinite(const cJSON *item, char *where, size_t cap)
+{
+    if (cJSON_IsNumber(item) && !isfinite(item->valuedouble)) {
+        snprintf(where, cap, "%s", item->string ? item->string : "a value");
+        return 1;
+    }
+    const cJSON *c;
+    int i = 0;
+    cJSON_ArrayForEach(c, item) {
+        if (json_nonfinite(c, where, cap)) {
+            char inner[192];
+            snprintf(inner, sizeof inner, "%s", where);
+            if (item->string)
+                snprintf(where, cap, "%s[%d].%s", item->string, i, inner);
+            return 1;
+        }
+        i++;
+    }
+    return 0;
+}
+
+/* Which mesh's attribute reads accessor a, for the message; "" when none. */
+static void accessor_user(const cJSON *root, int a, char *out, size_t cap)
+{
+    const cJSON *m, *p, *at;
+    int mi = 0;
+    out[0] = '\0';
+    cJSON_ArrayForEach(m, cJSON_GetObjectItemCaseSensitive(root, "meshes")) {
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(m, "name");
+        cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(m, "primitives")) {
+            cJSON_ArrayForEach(at, cJSON_GetObjectItemCaseSensitive(p, "attributes")) {
+                if (cJSON_IsNumber(at) && at->valueint == a) {
+                    if (cJSON_IsString(name))
+                        snprintf(out, cap, " (%s of mesh '%s')", at->string, name->valuestring);
+                    else
+                        snprintf(out, cap, " (%s of mesh %d)", at->string, mi);
+                    return;
+                }
+            }
+        }
+        mi++;
+    }
+}
+
+/*
+ * Issue #31: no glTF with a non-finite number (an exported .hier with a NaN
+ * origin wrote "translation": [null, ...]; a .dps, non-finite vertices). The
+ * JSON and every float accessor's bytes are checked before a file is
+ * written; the element index is the input primitive's or point's within the
+ * mesh it names.
+ */
+static int check_finite(const asp__gltf *g, const char *path, asp_error *err)
+{
+    char where[256];
+    if (json_nonfinite(g->root, where, sizeof where))
+        return asp_error_set(err, ASP_EFORMAT, "cannot write '%s': %s is not finite (from the input); nothing written",
+                             path, where);
+    const cJSON *a;
+    int ai = 0;
+    cJSON_ArrayForEach(a, cJSON_GetObjectItemCaseSensitive(g->root, "accessors")) {
+        const cJSON *ct = cJSON_GetObjectItemCaseSensitive(a, "componentType");
+        const cJSON *vi = cJSON_GetObjectItemCaseSensitive(a, "bufferView");
+        const cJSON *v = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(g->root, "bufferViews"),
+                                            cJSON_IsNumber(vi) ? vi->valueint : -1);
+        const cJSON *off = cJSON_GetObjectItemCaseSensitive(v, "byteOffset");
+        const cJSON *len = cJSON_GetObjectItemCaseSensitive(v, "byteLength");
+        const cJSON *type = cJSON_GetObjectItemCaseSensitive(a, "type");
+        if (cJSON_IsNumber(ct) && ct->valueint == 5126 && cJSON_IsNumber(len) && cJSON_IsString(type)) {
+            size_t o = cJSON_IsNumber(off) ? (size_t)off->valuedouble : 0, n = (size_t)len->valuedouble / 4;
+            size_t ncomp = (size_t)type_components(type->valuestring);
+            for (size_t k = 0; o + 4 * n <= g->bin_size && k < n; k++) {
+                float f;
+                memcpy(&f, g->bin + o + 4 * k, 4);
+                if (!isfinite(f)) {
+                    char user[160];
+                    accessor_user(g->root, ai, user, sizeof user);
+                    return asp_error_set(err, ASP_EFORMAT, "cannot write '%s': accessor %d%s: element %zu is not "
+                                         "finite (from the input's element %zu there); nothing written", path, ai,
+                                         user, k / ncomp, k / ncomp);
+                }
+            }
+        }
+        ai++;
+    }
+    return 0;
+}
+
 int asp__gltf_write(asp__gltf *g, const char *path, asp_gltf_stats *st, asp_error *err)
 {
     if (g->failed || finish_json(g))
         return asp_error_set(err, ASP_ENOMEM, "out of memory while building the glTF document for '%s'", path);
+    int rc = check_finite(g, path, err);
+    if (rc)
+        return rc;
     st->images = (size_t)cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(g->root, "images"));
     char *json = g->glb ? cJSON_PrintUnformatted(g->root) : cJSON_Print(g->root);
     if (!json)
         return asp_error_set(err, ASP_ENOMEM, "out of memory printing the glTF JSON of '%s'", path);
-    int rc = g->glb ? write_glb(path, json, g->bin, g->bin_size, st, err) : write_separate(g, path, json, st, err);
+    rc = g->glb ? write_glb(path, json, g->bin, g->bin_size, st, err) : write_separate(g, path, json, st, err);
     cJSON_free(json);
     return rc;
 }

@@ -337,6 +337,12 @@ static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
                  (UINT32_MAX - 1) / 3, ASP_HIER_MAX_LEAF);
         return asp__byte_bad(r, msg);
     }
+    if (!(isfinite(origin[0]) && isfinite(origin[1]) && isfinite(origin[2]))) { // issue #31: a NaN origin
+        r->at = 48;
+        snprintf(msg, sizeof msg, "header: origin (%g, %g, %g), expected finite values", origin[0], origin[1],
+                 origin[2]);
+        return asp__byte_bad(r, msg);
+    }
     if (payload != payload_size(nodes, points)) {
         r->at = 80;
         snprintf(msg, sizeof msg, "header: payload %llu bytes, expected %llu", (unsigned long long)payload,

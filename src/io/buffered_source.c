@@ -163,6 +163,7 @@ int asp__src_line(asp__src *s, size_t max_len, const char **line, size_t *len)
                 return -1;
             size_t eol = !nl ? 0 : (*nl == '\r' && n + 1 < avail && nl[1] == '\n') ? 2 : 1;
             s->pos += n + eol;
+            s->unterminated = !nl;
             if (n > 0 && p[n - 1] == '\r')
                 n--;
             *line = (const char *)p;

@@ -22,6 +22,7 @@ typedef struct asp__src {
     int io_errno;         /* errno of a failed read, else 0 */
     int nomem;            /* a window could not grow */
     int cr_lines;         /* asp__src_line also ends a line at a lone CR (old Mac text; set by the text readers) */
+    int unterminated;     /* the line asp__src_line returned last ended at the end of the input, without '\n' */
     const asp_context *ctx;
     const char *name;     /* for messages */
 } asp__src;

@@ -6,9 +6,11 @@
  * onwards) starts from a usable point set; degenerate but valid sets (all
  * points equal) load fine.
  */
+#include <math.h>
 #include <string.h>
 
 #include "amgsplat/io.h"
+#include "io/cloud_check.h"
 #include "io/las_internal.h"
 #include "util/banned.h"
 
@@ -98,11 +100,61 @@ int asp_cloud_load(const char *path, const asp_context *ctx, asp_cloud **out, as
     return 0;
 }
 
+/*
+ * What every point writer checks first (issue #31): the values it would
+ * write are finite (asp_cloud_validate: coordinates, normals, radii, uvs,
+ * and the world coordinates origin + position), so no command writes a file
+ * that asp_cloud_load refuses; the message names the point, which is the
+ * input's point of the same index for convert and estimate, and the sample
+ * that made it for sample.
+ */
+int asp__cloud_output_check(const asp_cloud *c, const char *path, asp_error *err)
+{
+    asp_error e = {0};
+    int rc = asp_cloud_validate(c, &e);
+    if (rc)
+        return asp_error_set(err, rc, "cannot write '%s': %s; nothing written", path, e.msg);
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(c->origin[k]))
+            return asp_error_set(err, ASP_EFORMAT, "cannot write '%s': the origin's %c is not finite; nothing written",
+                                 path, "xyz"[k]);
+    for (size_t i = 0; i < c->count; i++)
+        for (int k = 0; k < 3; k++)
+            if (!isfinite(c->origin[k] + (double)c->positions[3 * i + k]))
+                return asp_error_set(err, ASP_EFORMAT, "cannot write '%s': point %zu: world coordinate %c (origin %g "
+                                     "plus %g) is not finite; nothing written", path, i, "xyz"[k], c->origin[k],
+                                     (double)c->positions[3 * i + k]);
+    return 0;
+}
+
+/* The read-back of every point writer (asp__atomic_check): the written file loads as asp_cloud_load loads it. */
+int asp__cloud_reads_back(const char *tmp, void *user, asp_error *err)
+{
+    const asp__cloud_readback *rb = user;
+    const asp_cloud *c = rb->cloud;
+    asp_cloud *back = NULL;
+    asp_error e = {0};
+    int rc = strcmp(rb->format, "ply") == 0   ? asp_ply_read(tmp, &c->ctx, &back, err)
+             : strcmp(rb->format, "las") == 0 ? asp_las_read(tmp, &c->ctx, &back, err)
+                                              : asp_xyz_read(tmp, &c->ctx, &back, err);
+    if (rc == 0 && (rc = asp_cloud_validate(back, &e)))
+        asp_error_set(err, rc, "%s", e.msg);
+    if (rc == 0 && back->count != c->count)
+        rc = asp_error_set(err, ASP_EFORMAT, "%zu points read back of %zu written", back->count, c->count);
+    asp_cloud_destroy(back);
+    return rc;
+}
+
 int asp_cloud_save(const asp_cloud *cloud, const char *path, const asp_save_desc *desc, asp_error *err)
 {
     asp_file_type t;
     if (asp_file_type_of_name(path, &t, NULL) || t.kind != ASP_FILE_POINTS)
         return unknown("write", path, err);
+    // the format writers write what they are given and their read-back names what is wrong; the
+    // commands' save refuses non-finite values first, with a message that is not an internal error
+    int rc = asp__cloud_output_check(cloud, path, err);
+    if (rc)
+        return rc;
     if (strcmp(t.format, "laz") == 0)
         return asp_error_set(err, ASP_EUNSUPPORTED,
                              "cannot write '%s': compressed LAS (LASzip) needs a compressor this build does not have; "

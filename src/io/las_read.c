@@ -500,7 +500,8 @@ static int read_header(reader *r)
     int rc = fetch(r, 0, r->size < LAS_HEADER_14 ? r->size : LAS_HEADER_14, &head);
     if (rc)
         return rc;
-    memcpy(h, head, r->size < LAS_HEADER_14 ? r->size : LAS_HEADER_14);
+    if (r->size) // an empty file fetches nothing: memcpy from NULL, even of 0 bytes, is undefined (UBSan, issue #31)
+        memcpy(h, head, r->size < LAS_HEADER_14 ? r->size : LAS_HEADER_14);
     asp_las_meta *m = r->meta;
     if (r->size < 4 || memcmp(h, "LASF", 4) != 0)
         return bad(r, "not a LAS file (the first 4 bytes are not 'LASF')");

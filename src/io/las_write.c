@@ -15,6 +15,7 @@
 #include "amgsplat/io.h"
 #include "io/las_internal.h"
 #include "util/atomic_file.h"
+#include "io/cloud_check.h"
 #include "util/banned.h"
 
 enum { CHUNK = 1 << 14, MAX_EXTRA = 256 };
@@ -526,7 +527,9 @@ int asp_las_write(const asp_cloud *cloud, const char *path, const asp_save_desc 
         for (size_t i = 0; !bad && m && i < m->vlr_count; i++)
             if ((m->vlrs[i].extended || m->vlrs[i].size > 65535) && w->minor >= 4)
                 bad = write_vlr(f.fp, &m->vlrs[i], 1);
-        rc = bad ? write_failed(w, &f) : asp__atomic_commit(&f, err);
+        // read back as asp_cloud_load reads it (issue #31: every output kind)
+        rc = bad ? write_failed(w, &f)
+                 : asp__atomic_commit_checked(&f, asp__cloud_reads_back, &(asp__cloud_readback){cloud, "las"}, err);
     }
     asp_free(&cloud->ctx, bits);
     asp_free(&cloud->ctx, buf);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "amgsplat/mesh.h"
+#include "util/atomic_file.h"
 #include "util/banned.h"
 
 static void release_arrays(asp_mesh *m)
@@ -21,8 +22,13 @@ static void release_arrays(asp_mesh *m)
     asp_free(ctx, m->colors);
     asp_free(ctx, m->triangles);
     asp_free(ctx, m->material_ids);
-    for (size_t i = 0; m->materials && i < m->material_count; i++)
+    for (size_t i = 0; m->materials && i < m->material_count; i++) {
+        const asp_material *mat = &m->materials[i];
+        // a texture read from a file stops being protected from outputs (mesh_assimp.c, issue #31)
+        if (mat->texture.pixels && mat->texture_path[0] && mat->texture_path[0] != '*')
+            asp__atomic_unprotect(mat->texture_path);
         asp_image_release(&m->materials[i].texture);
+    }
     asp_free(ctx, m->materials);
 }
 
@@ -188,6 +194,12 @@ int asp_mesh_validate(const asp_mesh *mesh, const char *name, asp_error *err)
             if (!isfinite(mesh->positions[3 * v + c]))
                 return asp_error_set(err, ASP_EFORMAT, "mesh '%s': vertex %zu: coordinate %c is not finite", name,
                                      v, axis[c]);
+            // issue #31: a 1e38 triangle sampled into radii of infinity; samplers and renderers square
+            // coordinate differences in float, which stay finite within +-1e18 of the origin
+            if (fabsf(mesh->positions[3 * v + c]) > ASP_MESH_MAX_COORD)
+                return asp_error_set(err, ASP_EFORMAT, "mesh '%s': vertex %zu: coordinate %c is %g, beyond the "
+                                     "+-%g that float arithmetic on it allows (around the centre %g)", name, v,
+                                     axis[c], (double)mesh->positions[3 * v + c], ASP_MESH_MAX_COORD, mesh->origin[c]);
             if (!isfinite(mesh->normals[3 * v + c]))
                 return asp_error_set(err, ASP_EFORMAT, "mesh '%s': vertex %zu: normal %c is not finite", name, v,
                                      axis[c]);
@@ -196,6 +208,9 @@ int asp_mesh_validate(const asp_mesh *mesh, const char *name, asp_error *err)
             return asp_error_set(err, ASP_EFORMAT, "mesh '%s': vertex %zu: texture coordinate is not finite", name,
                                  v);
     }
+    for (int c = 0; c < 3; c++)
+        if (!isfinite(mesh->origin[c]))
+            return asp_error_set(err, ASP_EFORMAT, "mesh '%s': its origin's %c is not finite", name, axis[c]);
     double area = asp_mesh_area(mesh);
     if (!(area > 0.0) || !isfinite(area))
         return asp_error_set(err, ASP_EDEGENERATE, "mesh '%s' has zero surface area", name);

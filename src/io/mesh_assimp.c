@@ -22,6 +22,8 @@
 #include "amgsplat/mesh.h"
 #include "io/mesh_precheck.h"
 #include "io/ply_internal.h"
+#include "util/atomic_file.h"
+#include "util/child_process.h"
 #include "util/regular_file.h"
 #include "util/banned.h"
 
@@ -322,12 +324,24 @@ static int load_override(const char *override, const char *material, asp_materia
     int rc = asp_image_load(&mat->texture, override, &e);
     if (rc)
         return asp_error_set(err, rc, "%s (texture for material '%s')", e.msg, material);
+    asp__atomic_protect(override, "a texture");
     copy_str(mat->texture_path, sizeof mat->texture_path, override);
     return 0;
 }
 
-static int load_materials(const struct aiScene *scene, const char *path, const asp_mesh_load_desc *desc,
-                          asp_mesh *m, asp_error *err)
+/* A material's texture reference that the reader process leaves to the parent: a file to look for. */
+typedef struct texture_ref {
+    char ref[1024];
+} texture_ref;
+
+/*
+ * The reader process's part of the materials: names, colours and embedded
+ * textures (their bytes came from the model file itself); a reference to a
+ * texture file goes to refs[i] for the parent (finish_materials), which opens
+ * and decodes image files with the reader contained no longer involved.
+ */
+static int read_materials(const struct aiScene *scene, const char *path, asp_mesh *m, texture_ref *refs,
+                          asp_error *err)
 {
     for (size_t i = 0; i < m->material_count; i++) {
         asp_material *mat = &m->materials[i];
@@ -347,23 +361,40 @@ static int load_materials(const struct aiScene *scene, const char *path, const a
         enum aiTextureType type = aiTextureType_DIFFUSE;
         if (aiGetMaterialTextureCount(am, type) == 0)
             type = aiTextureType_BASE_COLOR;
-        int rc = 0;
         if (aiGetMaterialTextureCount(am, type) > 0 &&
             aiGetMaterialTexture(am, type, 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS &&
             s.length > 0) {
-            rc = load_embedded(scene, s.data, path, mat->name, &mat->texture, err);
+            int rc = load_embedded(scene, s.data, path, mat->name, &mat->texture, err);
             if (rc == 0) {
                 copy_str(mat->texture_path, sizeof mat->texture_path, s.data);
                 continue;
             }
             if (rc != ASP_EIO)
                 return rc;
+            copy_str(refs[i].ref, sizeof refs[i].ref, s.data);
+        }
+    }
+    return 0;
+}
+
+/* The parent's part: texture files named by the materials, the override, the missing ones (mesh.h). */
+static int finish_materials(const char *path, const asp_mesh_load_desc *desc, asp_mesh *m, const texture_ref *refs,
+                            asp_error *err)
+{
+    for (size_t i = 0; i < m->material_count; i++) {
+        asp_material *mat = &m->materials[i];
+        if (mat->texture.pixels)
+            continue; // embedded
+        if (refs[i].ref[0]) {
             char file[1024];
-            if (resolve_texture(path, s.data, file, sizeof file)) {
+            if (resolve_texture(path, refs[i].ref, file, sizeof file)) {
                 asp_error e = {0};
-                rc = asp_image_load(&mat->texture, file, &e);
+                int rc = asp_image_load(&mat->texture, file, &e);
                 if (rc)
                     return asp_error_set(err, rc, "%s (texture of material '%s')", e.msg, mat->name);
+                char role[40];
+                snprintf(role, sizeof role, "the texture of material '%.12s'", mat->name);
+                asp__atomic_protect(file, role);
                 copy_str(mat->texture_path, sizeof mat->texture_path, file);
                 continue;
             }
@@ -379,7 +410,7 @@ static int load_materials(const struct aiScene *scene, const char *path, const a
                                      file, mat->name, path);
         }
         if (desc->texture_override) {
-            rc = load_override(desc->texture_override, mat->name, mat, err);
+            int rc = load_override(desc->texture_override, mat->name, mat, err);
             if (rc)
                 return rc;
         }
@@ -400,8 +431,13 @@ static void fill_material_colors(asp_mesh *m)
     }
 }
 
+/*
+ * The reader process's mesh: the scene's triangles merged with the node
+ * transforms applied, materials (read_materials) and the file's normals when
+ * every mesh has them (*file_normals = 1; else the parent computes them).
+ */
 static int build(const struct aiScene *scene, const char *path, const asp_mesh_load_desc *desc, const mat4 *start,
-                 const asp_context *ctx, asp_mesh **out, asp_error *err)
+                 const asp_context *ctx, asp_mesh **out, texture_ref **refs_out, int *file_normals, asp_error *err)
 {
     if (!scene->mRootNode)
         return asp_error_set(err, ASP_EDEGENERATE, "'%s' has no triangles", path);
@@ -438,15 +474,19 @@ static int build(const struct aiScene *scene, const char *path, const asp_mesh_l
     w.mesh = m;
     w.world = asp_alloc(ctx, 3 * m->vertex_count * sizeof(double) + 1);
     w.file_normals = use_file_normals ? m->normals : NULL;
-    if (!w.world) {
+    texture_ref *refs = asp_calloc(ctx, m->material_count, sizeof *refs);
+    if (!w.world || !refs) {
+        asp_free(ctx, w.world);
+        asp_free(ctx, refs);
         asp_mesh_destroy(m);
         return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", path);
     }
     rc = walk_node(&w, scene->mRootNode, start, 0);
     if (rc == 0)
-        rc = load_materials(scene, path, desc, m, err);
+        rc = read_materials(scene, path, m, refs, err);
     if (rc) {
         asp_free(ctx, w.world);
+        asp_free(ctx, refs);
         asp_mesh_destroy(m);
         return rc;
     }
@@ -463,6 +503,24 @@ static int build(const struct aiScene *scene, const char *path, const asp_mesh_l
     asp_free(ctx, w.world);
     if (m->colors)
         fill_material_colors(m);
+    *out = m;
+    *refs_out = refs;
+    *file_normals = use_file_normals;
+    return 0;
+}
+
+/*
+ * The parent's end of the load: texture files, normals (the file's,
+ * normalised, when every one is usable; else area-weighted) and the checks
+ * of asp_mesh_validate, which also guard against a reader process that sent
+ * indices or values out of range.
+ */
+static int finish(asp_mesh *m, const char *path, const asp_mesh_load_desc *desc, const texture_ref *refs,
+                  int use_file_normals, asp_error *err)
+{
+    int rc = finish_materials(path, desc, m, refs, err);
+    if (rc)
+        return rc;
     int need_normals = !use_file_normals;
     for (size_t v = 0; use_file_normals && v < m->vertex_count; v++) {
         float *n = m->normals + 3 * v;
@@ -478,12 +536,7 @@ static int build(const struct aiScene *scene, const char *path, const asp_mesh_l
         rc = asp_mesh_compute_normals(m, err);
     if (rc == 0)
         rc = asp_mesh_validate(m, path, err);
-    if (rc) {
-        asp_mesh_destroy(m);
-        return rc;
-    }
-    *out = m;
-    return 0;
+    return rc;
 }
 
 /*
@@ -620,6 +673,173 @@ static int ply_precheck(const char *path, const asp_context *ctx, char *tmp_path
     return rc;
 }
 
+/*
+ * The reader process (issue #31): assimp runs in a forked child
+ * (util/child_process.h), which sends the merged mesh back through a pipe as
+ * a head, the arrays and the materials; a crash inside assimp (Collada with a
+ * count of -1: SIGSEGV) or a blow-up (the child's address space is capped)
+ * becomes an error naming the file. The pre-checks stop what the bytes show
+ * before any process starts. Cost on normal files: BENCHMARKS.md (issue #31).
+ */
+enum { MESH_WIRE_MAGIC = 0x41535057 };
+
+typedef struct wire_head {
+    uint32_t magic;
+    int32_t rc;
+    char msg[256];
+    uint64_t nv, nt, nmat;
+    uint32_t attrs, uv_sets;
+    int32_t file_normals;
+    double origin[3];
+} wire_head;
+
+typedef struct wire_material {
+    char name[64];
+    float diffuse[4];
+    int32_t has_color;
+    char texture_path[512];
+    texture_ref ref;
+    uint32_t width, height; /* embedded texture decoded in the reader, 0 x 0 when none */
+} wire_material;
+
+typedef struct mesh_job {
+    const char *path, *import_path;
+    asp_mesh_load_desc desc;
+    mat4 start;
+    asp_context ctx;
+    size_t budget;
+    /* parent: the result */
+    asp_mesh *mesh;
+    texture_ref *refs;
+    int file_normals;
+} mesh_job;
+
+static void send_error(int fd, int rc, const asp_error *e)
+{
+    wire_head h = {.magic = MESH_WIRE_MAGIC, .rc = rc};
+    copy_str(h.msg, sizeof h.msg, e->msg);
+    asp__fd_write_all(fd, &h, sizeof h);
+}
+
+static void reader_child(void *user, int fd)
+{
+    mesh_job *j = user;
+    asp_error e = {0};
+    j->ctx.threads = 1; // no OpenMP team in a forked child: the parent's pool threads do not exist here
+    const struct aiScene *scene = aiImportFile(j->import_path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                                                   aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+    if (!scene) {
+        const char *why = aiGetErrorString();
+        int rc = ASP_EFORMAT;
+        if (why && strstr(why, "bad_alloc"))
+            rc = asp_error_set(&e, ASP_ENOMEM, "cannot read '%s': out of memory: the reader (assimp) reached its limit "
+                               "of %zu MB", j->path, j->budget >> 20);
+        else
+            asp_error_set(&e, rc, "cannot read '%s': %s", j->path, why && *why ? why : "unknown format");
+        send_error(fd, rc, &e);
+        return;
+    }
+    asp_mesh *m = NULL;
+    texture_ref *refs = NULL;
+    int file_normals = 0;
+    int rc = build(scene, j->path, &j->desc, &j->start, &j->ctx, &m, &refs, &file_normals, &e);
+    if (rc) {
+        send_error(fd, rc, &e);
+        return;
+    }
+    wire_head h = {.magic = MESH_WIRE_MAGIC, .nv = m->vertex_count, .nt = m->triangle_count, .nmat = m->material_count,
+                   .attrs = (m->uvs ? ASP_MESH_UVS : 0) | (m->colors ? ASP_MESH_COLORS : 0), .uv_sets = m->uv_set_count,
+                   .file_normals = file_normals};
+    memcpy(h.origin, m->origin, sizeof h.origin);
+    size_t nv = m->vertex_count, nt = m->triangle_count;
+    if (asp__fd_write_all(fd, &h, sizeof h) || asp__fd_write_all(fd, m->positions, 12 * nv) ||
+        (file_normals && asp__fd_write_all(fd, m->normals, 12 * nv)) ||
+        (m->uvs && asp__fd_write_all(fd, m->uvs, 8 * nv)) || (m->colors && asp__fd_write_all(fd, m->colors, 4 * nv)) ||
+        asp__fd_write_all(fd, m->triangles, 12 * nt) || asp__fd_write_all(fd, m->material_ids, 4 * nt))
+        return;
+    for (size_t i = 0; i < m->material_count; i++) {
+        const asp_material *mat = &m->materials[i];
+        wire_material w = {.has_color = mat->has_color, .ref = refs[i]};
+        memcpy(w.name, mat->name, sizeof w.name);
+        memcpy(w.diffuse, mat->diffuse, sizeof w.diffuse);
+        memcpy(w.texture_path, mat->texture_path, sizeof w.texture_path);
+        if (mat->texture.pixels)
+            w.width = mat->texture.width, w.height = mat->texture.height;
+        if (asp__fd_write_all(fd, &w, sizeof w) ||
+            (mat->texture.pixels && asp__fd_write_all(fd, mat->texture.pixels, (size_t)w.width * w.height * 4)))
+            return;
+    }
+}
+
+/* Reads the reader's mesh; every count is bounded before it sizes an allocation (the child may be damaged). */
+static int reader_receive(void *user, int fd, asp_error *err)
+{
+    mesh_job *j = user;
+    wire_head h;
+    if (asp__fd_read_all(fd, &h, sizeof h) || h.magic != MESH_WIRE_MAGIC)
+        return ASP_ECHILD_STREAM;
+    if (h.rc) {
+        h.msg[sizeof h.msg - 1] = '\0';
+        return asp_error_set(err, h.rc < 0 ? h.rc : ASP_EFORMAT, "%s", h.msg);
+    }
+    if (h.nmat == 0 || h.nmat > (uint64_t)1 << 20 || (h.attrs & ~(unsigned)(ASP_MESH_UVS | ASP_MESH_COLORS)))
+        return ASP_ECHILD_STREAM;
+    asp_mesh *m = NULL;
+    int rc = asp_mesh_create(h.nv, h.nt, h.attrs, &j->ctx, &m, err);
+    if (rc)
+        return rc == ASP_EINVAL ? ASP_ECHILD_STREAM : rc;
+    texture_ref *refs = asp_calloc(&j->ctx, h.nmat, sizeof *refs);
+    asp_material *mats = asp_calloc(&j->ctx, h.nmat, sizeof *mats);
+    if (!refs || !mats) {
+        asp_free(&j->ctx, refs);
+        asp_free(&j->ctx, mats);
+        asp_mesh_destroy(m);
+        return asp_error_set(err, ASP_ENOMEM, "out of memory reading '%s'", j->path);
+    }
+    asp_free(&j->ctx, m->materials);
+    m->materials = mats;
+    m->material_count = h.nmat;
+    m->uv_set_count = h.uv_sets;
+    memcpy(m->origin, h.origin, sizeof h.origin);
+    size_t nv = m->vertex_count, nt = m->triangle_count;
+    rc = ASP_ECHILD_STREAM;
+    if (asp__fd_read_all(fd, m->positions, 12 * nv) || (h.file_normals && asp__fd_read_all(fd, m->normals, 12 * nv)) ||
+        (m->uvs && asp__fd_read_all(fd, m->uvs, 8 * nv)) || (m->colors && asp__fd_read_all(fd, m->colors, 4 * nv)) ||
+        asp__fd_read_all(fd, m->triangles, 12 * nt) || asp__fd_read_all(fd, m->material_ids, 4 * nt))
+        goto fail;
+    for (size_t i = 0; i < m->material_count; i++) {
+        asp_material *mat = &m->materials[i];
+        wire_material w;
+        if (asp__fd_read_all(fd, &w, sizeof w))
+            goto fail;
+        w.name[sizeof w.name - 1] = w.texture_path[sizeof w.texture_path - 1] = w.ref.ref[sizeof w.ref.ref - 1] = '\0';
+        memcpy(mat->name, w.name, sizeof mat->name);
+        memcpy(mat->diffuse, w.diffuse, sizeof mat->diffuse);
+        mat->has_color = w.has_color != 0;
+        memcpy(mat->texture_path, w.texture_path, sizeof mat->texture_path);
+        refs[i] = w.ref;
+        if (w.width || w.height) {
+            if ((uint64_t)w.width * w.height > (uint64_t)16384 * 16384)
+                goto fail;
+            int irc = asp_image_init(&mat->texture, w.width, w.height, err);
+            if (irc) {
+                rc = irc;
+                goto fail;
+            }
+            if (asp__fd_read_all(fd, mat->texture.pixels, (size_t)w.width * w.height * 4))
+                goto fail;
+        }
+    }
+    j->mesh = m;
+    j->refs = refs;
+    j->file_normals = h.file_normals != 0;
+    return 0;
+fail:
+    asp_free(&j->ctx, refs);
+    asp_mesh_destroy(m);
+    return rc;
+}
+
 int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_context *ctx, asp_mesh **out,
                   asp_error *err)
 {
@@ -627,6 +847,8 @@ int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_co
     FILE *fp = asp__regular_file_open(path, err);
     if (!fp)
         return ASP_EIO;
+    struct stat st;
+    size_t file_size = fstat(fileno(fp), &st) == 0 ? (size_t)st.st_size : 0;
     fclose(fp);
     /* unknown extensions go on to assimp, which reads more formats than the recogniser names */
     asp_file_type type = {.kind = ASP_FILE_MESH};
@@ -636,32 +858,39 @@ int asp_mesh_load(const char *path, const asp_mesh_load_desc *desc, const asp_co
         return asp_error_set(err, rc, "%s", e.msg);
     if (rc == 0 && type.kind != ASP_FILE_MESH)
         return refuse_non_mesh(path, &type, err);
-    /*
-     * JoinIdenticalVertices welds the per-corner vertices OBJ/STL importers
-     * emit; SortByPType puts points and lines into meshes of their own so the
-     * walk can skip them.
-     */
-    unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
-                     aiProcess_ValidateDataStructure;
     char tmp_path[4096] = "";
     if (rc == 0 && strcmp(type.format, "ply") == 0 && (rc = ply_precheck(path, ctx, tmp_path, sizeof tmp_path, err)))
         return rc;
     if (rc == 0 && (rc = asp__mesh_precheck(path, type.format, ctx, err)))
         return rc;
-    const struct aiScene *scene = aiImportFile(tmp_path[0] ? tmp_path : path, flags);
+    /*
+     * JoinIdenticalVertices (reader_child) welds the per-corner vertices
+     * OBJ/STL importers emit; SortByPType puts points and lines into meshes of
+     * their own so the walk can skip them. The reader may use 512 MB plus 64
+     * bytes per byte of the file (a 'info' of the 2.4 MB bunny OBJ peaks at
+     * 49 MB resident, process included) and 60 s plus 10 s per MB of CPU.
+     */
+    char rule[96];
+    mesh_job job = {.path = path, .import_path = tmp_path[0] ? tmp_path : path, .desc = d,
+                    .start = start_transform(type.format, d.up, rule, sizeof rule)};
+    if (ctx)
+        job.ctx = *ctx;
+    job.budget = ((size_t)512 << 20) + (file_size < ((size_t)1 << 40) ? 64 * file_size : ((size_t)1 << 46));
+    asp__child_desc cd = {.path = path, .reader = "assimp", .memory_budget = job.budget,
+                          .cpu_seconds = 60 + (unsigned)(file_size < ((size_t)1 << 36) ? 10 * (file_size >> 20) : 655360)};
+    rc = asp__child_run(&cd, reader_child, reader_receive, &job, err);
     if (tmp_path[0])
         unlink(tmp_path);
-    if (!scene) {
-        const char *why = aiGetErrorString();
-        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': %s", path, why && *why ? why : "unknown format");
+    if (rc)
+        return rc;
+    rc = finish(job.mesh, path, &d, job.refs, job.file_normals, err);
+    asp_free(&job.ctx, job.refs);
+    if (rc) {
+        asp_mesh_destroy(job.mesh);
+        return rc;
     }
-    char rule[96];
-    mat4 start = start_transform(type.format, d.up, rule, sizeof rule);
-    rc = build(scene, path, &d, &start, ctx, out, err);
-    aiReleaseImport(scene);
-    if (rc == 0) {
-        (*out)->up = d.up;
-        snprintf((*out)->up_rule, sizeof (*out)->up_rule, "%s", rule);
-    }
-    return rc;
+    *out = job.mesh;
+    (*out)->up = d.up;
+    snprintf((*out)->up_rule, sizeof (*out)->up_rule, "%s", rule);
+    return 0;
 }

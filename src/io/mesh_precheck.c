@@ -294,8 +294,43 @@ static int check_obj(const char *b, size_t size, const char *name, asp_error *er
         while (p < e && *p != ' ' && *p != '\t' && *p != '\r')
             p++;
     }
-    if (words >= 3)
+    if (words >= 3) {
+        // issue #31: the last statement, cut or not, must be well formed: numbers after 'v', indices after 'f'
+        for (const char *p = s + 1; p < e;) {
+            while (p < e && (*p == ' ' || *p == '\t' || *p == '\r'))
+                p++;
+            const char *w = p;
+            while (p < e && *p != ' ' && *p != '\t' && *p != '\r')
+                p++;
+            if (w == p)
+                break;
+            char tok[64];
+            size_t n = (size_t)(p - w);
+            snprintf(tok, sizeof tok, "%.*s", (int)(n < sizeof tok ? n : sizeof tok - 1), w);
+            int ok = n < sizeof tok;
+            if (ok && vert) {
+                char *end;
+                strtod(tok, &end);
+                ok = *end == '\0';
+            } else if (ok) { // v, v/t, v//n, v/t/n, each index an optionally negative integer
+                int digits = 0;
+                for (const char *q = tok; ok && *q; q++) {
+                    if (*q >= '0' && *q <= '9')
+                        digits++;
+                    else if (*q == '/' || (*q == '-' && (q == tok || q[-1] == '/')))
+                        ok = *q == '-' || q > tok;
+                    else
+                        ok = 0;
+                }
+                ok = ok && digits > 0 && tok[n - 1] != '-';
+            }
+            if (!ok)
+                return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': line %zu, the last, ends without a newline "
+                                     "and its %s '%s' is malformed: the file is cut off", name, line,
+                                     vert ? "value" : "index", tok);
+        }
         return 0;
+    }
     return asp_error_set(err, ASP_EFORMAT,
                          "cannot read '%s': line %zu: the file ends inside a %s line ('%.*s'): it is cut off", name,
                          line, face ? "face" : "vertex", (int)(e - s < 40 ? e - s : 40), s);
@@ -309,6 +344,12 @@ int asp__mesh_precheck_memory(const void *data, size_t size, const char *name, c
         return check_stl(data, size, name, err);
     if (strcmp(format, "obj") == 0)
         return check_obj(data, size, name, err);
+    if (strcmp(format, "gltf") == 0 || strcmp(format, "glb") == 0)
+        return asp__gltf_precheck_memory(data, size, name, err);
+    if (strcmp(format, "dae") == 0)
+        return asp__dae_precheck_memory(data, size, name, err);
+    if (strcmp(format, "3ds") == 0)
+        return asp__3ds_precheck_memory(data, size, name, err);
     return 0;
 }
 
@@ -363,7 +404,11 @@ static int check_mtllibs(const char *path, const char *b, size_t size, asp_error
 
 int asp__mesh_precheck(const char *path, const char *format, const asp_context *ctx, asp_error *err)
 {
-    if (strcmp(format, "off") != 0 && strcmp(format, "stl") != 0 && strcmp(format, "obj") != 0)
+    static const char *const checked[] = {"off", "stl", "obj", "gltf", "glb", "dae", "3ds"};
+    int known = 0;
+    for (size_t i = 0; i < sizeof checked / sizeof checked[0]; i++)
+        known |= strcmp(format, checked[i]) == 0;
+    if (!known)
         return 0;
     uint8_t *buf = NULL;
     size_t size = 0;
@@ -371,8 +416,127 @@ int asp__mesh_precheck(const char *path, const char *format, const asp_context *
     if (rc)
         return rc;
     rc = asp__mesh_precheck_memory(buf, size, path, format, err);
+    int text = strcmp(format, "obj") == 0 || strcmp(format, "off") == 0 || (strcmp(format, "stl") == 0 && size >= 5 &&
+                                                                            memcmp(buf, "solid", 5) == 0);
+    if (rc == 0 && text && size > 0 && buf[size - 1] != '\n') {
+        // issue #31: a cut file and one without its final newline look alike; the last line passed the checks
+        size_t line = 1;
+        for (size_t i = 0; i < size; i++)
+            line += buf[i] == '\n';
+        asp_warn(ctx, "'%s': line %zu, the last, has no newline at its end: if the file was cut off there, its "
+                 "values are incomplete", path, line);
+    }
     if (rc == 0 && strcmp(format, "obj") == 0)
         rc = check_mtllibs(path, (const char *)buf, size, err);
     asp_free(ctx, buf);
     return rc;
+}
+
+/*
+ * 3DS: chunks of a 16-bit id and a 32-bit length that counts its 6-byte
+ * header (the "3D Studio File Format" of the 3ds Max SDK, as assimp's
+ * 3DSLoader reads it). The container chunks' children must fit inside them;
+ * the vertex (0x4110), face (0x4120), mapping (0x4140) lists hold the bytes
+ * their counts claim and faces use existing vertices. Random field values in
+ * a 3DS made assimp's reader return vertices of 1e38 (issue #31): the values
+ * themselves are checked after the read.
+ */
+enum { C3DS_MAX_DEPTH = 32 };
+
+static uint32_t le32_3ds(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+typedef struct c3ds {
+    const uint8_t *b;
+    const char *name;
+    long vertices; /* of the current trimesh, -1 before its vertex list */
+    asp_error *err;
+} c3ds;
+
+static uint16_t le16(const uint8_t *p)
+{
+    return (uint16_t)(p[0] | p[1] << 8);
+}
+
+static int is_container(uint16_t id)
+{
+    // main, editor, object (after its name), trimesh, material, its texture maps, keyframer and its nodes
+    switch (id) {
+    case 0x4D4D: case 0x3D3D: case 0x4000: case 0x4100: case 0xAFFF: case 0xA200: case 0xA204: case 0xA210:
+    case 0xA220: case 0xA230: case 0xB000: case 0xB002: case 0x4120:
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+static int walk_3ds(c3ds *c, size_t at, size_t end, int depth)
+{
+    if (depth > C3DS_MAX_DEPTH)
+        return asp_error_set(c->err, ASP_EFORMAT, "cannot read '%s': byte %zu: 3DS chunks nested deeper than %d",
+                             c->name, at, C3DS_MAX_DEPTH);
+    while (at < end) {
+        if (end - at < 6)
+            return asp_error_set(c->err, ASP_EFORMAT, "cannot read '%s': byte %zu: 3DS chunk header cut off (%zu bytes "
+                                 "left in its parent)", c->name, at, end - at);
+        uint16_t id = le16(c->b + at);
+        uint32_t len = le32_3ds(c->b + at + 2);
+        if (len < 6 || len > end - at)
+            return asp_error_set(c->err, ASP_EFORMAT, "cannot read '%s': byte %zu: 3DS chunk 0x%04X declares %u bytes, "
+                                 "but its parent has %zu left", c->name, at, id, len, end - at);
+        size_t body = at + 6, stop = at + len;
+        const uint8_t *p = c->b + body;
+        size_t n = stop - body;
+        if (id == 0x4000) { // object: a NUL-terminated name, then chunks
+            const uint8_t *nul = memchr(p, 0, n);
+            if (!nul)
+                return asp_error_set(c->err, ASP_EFORMAT, "cannot read '%s': byte %zu: 3DS object name not "
+                                     "terminated", c->name, body);
+            body += (size_t)(nul - p) + 1;
+        }
+        if (id == 0x4100)
+            c->vertices = -1;
+        if (id == 0x4110 || id == 0x4120 || id == 0x4140) {
+            size_t per = id == 0x4110 ? 12 : 8;
+            if (n < 2 || (size_t)le16(p) * per > n - 2)
+                return asp_error_set(c->err, ASP_EFORMAT, "cannot read '%s': byte %zu: 3DS %s list of %u entries does "
+                                     "not fit its chunk of %zu bytes", c->name, body,
+                                     id == 0x4110 ? "vertex" : id == 0x4120 ? "face" : "mapping", n < 2 ? 0 : le16(p), n);
+            unsigned count = le16(p);
+            if (id == 0x4110)
+                c->vertices = (long)count;
+            if (id == 0x4120)
+                for (unsigned f = 0; f < count; f++)
+                    for (int k = 0; k < 3; k++) {
+                        unsigned v = le16(p + 2 + 8 * f + 2 * k);
+                        if (c->vertices >= 0 && (long)v >= c->vertices)
+                            return asp_error_set(c->err, ASP_EFORMAT, "cannot read '%s': byte %zu: 3DS face %u uses "
+                                                 "vertex %u of %ld", c->name, body + 2 + 8 * f, f, v, c->vertices);
+                    }
+            if (id == 0x4120)
+                body += 2 + (size_t)count * 8; // its sub-chunks (materials, smoothing) follow the faces
+        }
+        if (is_container(id)) {
+            int rc = walk_3ds(c, body, stop, depth + 1);
+            if (rc)
+                return rc;
+        }
+        at = stop;
+    }
+    return 0;
+}
+
+int asp__3ds_precheck_memory(const void *data, size_t size, const char *name, asp_error *err)
+{
+    const uint8_t *b = data;
+    if (size < 6 || le16(b) != 0x4D4D)
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': not a 3DS file (no main chunk 0x4D4D)", name);
+    c3ds c = {b, name, -1, err};
+    uint32_t len = le32_3ds(b + 2);
+    if (len > size || len < 6)
+        return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': its 3DS main chunk declares %u bytes, but the file "
+                             "has %zu", name, len, size);
+    return walk_3ds(&c, 0, len, 0);
 }

@@ -10,13 +10,25 @@
 #include "amgsplat/core.h"
 
 /*
- * Checks path as format ("off", "stl", "obj"; any other format passes).
+ * Checks path as format ("off", "stl", "obj", "gltf", "glb", "dae", "3ds"; any other format passes).
  * 0 when nothing is wrong; ASP_EFORMAT with "cannot read '<path>': ..." when
  * the file contradicts itself; ASP_EIO or ASP_ENOMEM when it cannot be read.
  */
 int asp__mesh_precheck(const char *path, const char *format, const asp_context *ctx, asp_error *err);
 
-/* The same over bytes in memory (the fuzz target's entry); name is used in messages. */
+/*
+ * The same over bytes in memory (the fuzz targets' entry); name is used in messages and, for glTF,
+ * to find the files its buffers name beside it.
+ */
 int asp__mesh_precheck_memory(const void *data, size_t size, const char *name, const char *format, asp_error *err);
+
+/* glTF 2.0 JSON or GLB (gltf_precheck.c): header, chunk, buffer, bufferView, accessor and node ranges. */
+int asp__gltf_precheck_memory(const void *data, size_t size, const char *name, asp_error *err);
+
+/* Collada (dae_precheck.c): array counts against their text, accessors and primitive indices in range. */
+int asp__dae_precheck_memory(const void *data, size_t size, const char *name, asp_error *err);
+
+/* 3DS (mesh_precheck.c): chunk lengths nested inside their parents, vertex and face lists inside their chunks. */
+int asp__3ds_precheck_memory(const void *data, size_t size, const char *name, asp_error *err);
 
 #endif

@@ -11,6 +11,7 @@
 #include "amgsplat/io.h"
 #include "io/ply_internal.h"
 #include "util/atomic_file.h"
+#include "io/cloud_check.h"
 #include "util/banned.h"
 
 enum { S_POS, S_NORMAL, S_COLOR, S_RADIUS, S_UV, S_LABEL, S_EXTRA };
@@ -342,16 +343,10 @@ static int write_faces(writer *w, int index_uint)
  * No command writes a PLY that asp_ply_read refuses (issue #13): the file is
  * read back whole before it replaces the target. The reader's checks are
  * per value (finite coordinates, list counts, face indices), so a header
- * check would miss what can actually be wrong.
+ * check would miss what can actually be wrong; the read-back also validates
+ * radii, normals and uvs as asp_cloud_load does (issue #31: infinite radii
+ * passed asp_ply_read alone).
  */
-static int ply_reads_back(const char *tmp, void *user, asp_error *err)
-{
-    const asp_cloud *c = user;
-    asp_cloud *back = NULL;
-    int rc = asp_ply_read(tmp, &c->ctx, &back, err);
-    asp_cloud_destroy(back);
-    return rc;
-}
 
 static int write_all(writer *w)
 {
@@ -379,7 +374,7 @@ static int write_all(writer *w)
     if (rc == 0)
         rc = write_faces(w, index_uint);
     if (rc == 0)
-        return asp__atomic_commit_checked(&w->file, ply_reads_back, (void *)c, w->err);
+        return asp__atomic_commit_checked(&w->file, asp__cloud_reads_back, &(asp__cloud_readback){c, "ply"}, w->err);
     asp__atomic_abort(&w->file);
     return rc;
 }

@@ -14,6 +14,7 @@
 #include "io/buffered_source.h"
 #include "io/ply_internal.h"
 #include "util/atomic_file.h"
+#include "io/cloud_check.h"
 #include "util/banned.h"
 
 enum { LINE_MAX_BYTES = 1 << 16, MAX_COLS = 9 };
@@ -124,6 +125,11 @@ static int parse_lines(text_reader *t)
         }
         if (n == 0)
             continue; /* only separators */
+        // issue #31: a file cut inside its last line and one that merely lacks the final newline look
+        // alike; a malformed row fails above and below, a well-formed one is read with a warning
+        if (t->src.unterminated)
+            asp_warn(t->ctx, "'%s': line %zu, the last, has no newline at its end: if the file was cut off there, "
+                     "its values are incomplete", t->name, lineno);
         if (first && n == 1 && v[0] >= 0 && v[0] == floor(v[0])) {
             first = 0; /* a point count, as .pts files start with */
             t->declared = v[0];
@@ -314,5 +320,6 @@ int asp_xyz_write(const asp_cloud *c, const char *path, const asp_save_desc *des
         if (fwrite(line, 1, len, f.fp) != len)
             break;
     }
-    return asp__atomic_commit(&f, err);
+    // read back as asp_cloud_load reads it (issue #31: every output kind)
+    return asp__atomic_commit_checked(&f, asp__cloud_reads_back, &(asp__cloud_readback){c, "xyz"}, err);
 }

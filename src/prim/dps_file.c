@@ -291,6 +291,12 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, uint32_t version,
         return asp__byte_bad(r, msg);
     }
     lv->strict = strict;
+    // issue #31: a NaN in a level's errors or timings (checksum fixed up) reached export's glTF
+    if (!(isfinite(lv->error) && isfinite(lv->error_norm) && isfinite(lv->t_basis) && isfinite(lv->t_construct))) {
+        snprintf(msg, sizeof msg, "level %zu: error %g, relative error %g, times %g and %g s, expected finite values", li,
+                 lv->error, lv->error_norm, lv->t_basis, lv->t_construct);
+        return asp__byte_bad(r, msg);
+    }
     /* levels are stored finest first without duplicates (asp_prim_build) */
     /* thresholded then strict levels of one AMG level may sit side by side (build --domains both) */
     const uint32_t lo = li ? dps->levels[li - 1].level + !(lv->strict && !dps->levels[li - 1].strict) : 0;

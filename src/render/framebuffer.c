@@ -25,12 +25,25 @@ void asp__gl_target_release(asp__gl_target *t)
     t->width = t->height = t->samples = 0;
 }
 
-static int check_complete(GLuint fbo, const char *which, asp_error *err)
+/*
+ * Issue #31: 16384x16384, inside GL_MAX_RENDERBUFFER_SIZE, ended in "status
+ * 0x8cd6" (an attachment the driver could not allocate): the message says
+ * the size, the memory it needs and the context's side limit.
+ */
+static int check_complete(const asp_gl_context *gl, GLuint fbo, const char *which, uint32_t w, uint32_t h,
+                          uint32_t samples, asp_error *err)
 {
     GLenum status = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER);
     if (status == GL_FRAMEBUFFER_COMPLETE)
         return 0;
-    return asp_error_set(err, ASP_EGL, "cannot create the %s framebuffer: status 0x%04x", which, (unsigned)status);
+    double mb = (double)w * h * 8.0 * (samples > 1 ? samples : 1) / (1 << 20); // RGBA8 colour + 24/8 depth
+    return asp_error_set(err, status == GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT ? ASP_ENOMEM : ASP_EGL,
+                         "cannot create the %s framebuffer of %ux%u with %u sample%s (%.0f MB; the GL context allows "
+                         "up to %d pixels a side): status 0x%04x%s", which, w, h, samples > 1 ? samples : 1,
+                         samples > 1 ? "s" : "", mb, gl->max_size, (unsigned)status,
+                         status == GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT
+                             ? " (incomplete attachment: out of memory for it; try a smaller --size or --samples)"
+                             : "");
 }
 
 int asp__gl_target_ensure(asp_gl_context *gl, uint32_t width, uint32_t height, uint32_t samples, asp_error *err)
@@ -51,7 +64,7 @@ int asp__gl_target_ensure(asp_gl_context *gl, uint32_t width, uint32_t height, u
     glNamedFramebufferRenderbuffer(t->fbo.id, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t->depth.id);
     int rc = asp__gl_check(gl, "create the offscreen framebuffer", err);
     if (!rc)
-        rc = check_complete(t->fbo.id, "offscreen", err);
+        rc = check_complete(gl, t->fbo.id, "offscreen", width, height, samples, err);
     if (!rc && s > 0) {
         glCreateRenderbuffers(1, &t->resolve_color.id);
         glNamedRenderbufferStorage(t->resolve_color.id, GL_SRGB8_ALPHA8, (GLsizei)width, (GLsizei)height);
@@ -60,7 +73,7 @@ int asp__gl_target_ensure(asp_gl_context *gl, uint32_t width, uint32_t height, u
                                        t->resolve_color.id);
         rc = asp__gl_check(gl, "create the resolve framebuffer", err);
         if (!rc)
-            rc = check_complete(t->resolve_fbo.id, "resolve", err);
+            rc = check_complete(gl, t->resolve_fbo.id, "resolve", width, height, 1, err);
     }
     if (rc) {
         asp__gl_target_release(t);

@@ -75,7 +75,9 @@ int asp__gl_check(asp_gl_context *gl, const char *what, asp_error *err)
     if (code == GL_NO_ERROR && n == 0)
         return 0;
     int rc;
-    if (n > 0)
+    if (code == GL_OUT_OF_MEMORY) // issue #31: the same clean out-of-memory error as elsewhere
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory: cannot %s (GL_OUT_OF_MEMORY from %s)", what, gl->renderer);
+    else if (n > 0)
         rc = asp_error_set(err, ASP_EGL, "cannot %s: %s: %s%s", what,
                            code != GL_NO_ERROR ? asp__gl_error_name(code) : "GL error", gl->debug_msg,
                            n > 1 ? " (and more errors)" : "");

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "render/internal.h"
+#include "util/child_process.h"
 #include "util/banned.h"
 
 /* First line of a compiler log: the rest usually repeats the same cause. */
@@ -46,6 +47,11 @@ int asp__gl_program_create(asp_gl_context *gl, const char *name, const char *vs,
                            asp__gl_program *out, asp_error *err)
 {
     asp__gl_clear_errors(gl);
+    // issue #31: Mesa's compiler crashes when its allocations fail (ulimit -v); the room is checked first
+    char room[224];
+    snprintf(room, sizeof room, "compiling the '%.40s' shaders (%s)", name, gl->renderer);
+    if (asp__address_space_headroom(ASP_GL_SHADER_HEADROOM, room, err))
+        return ASP_ENOMEM;
     GLuint v = compile(GL_VERTEX_SHADER, vs, name, err);
     if (!v)
         return ASP_EGL;

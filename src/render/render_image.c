@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "render/internal.h"
+#include "util/child_process.h"
 #include "util/banned.h"
 
 enum { DEFAULT_SIZE = 512, MAX_SIDE = 16384 };
@@ -144,7 +145,11 @@ static int prepare(asp_gl_context *gl, const asp_renderer *r, const asp_camera *
     if (*samples > (uint32_t)gl->max_samples)
         *samples = (uint32_t)gl->max_samples;
     make_frame(cam, desc, w, h, frame);
-    int rc = asp__gl_ensure_current(gl, err);
+    // issue #31: llvmpipe compiles its draw code now, and crashes when that allocation fails (ulimit -v)
+    int rc = asp__address_space_headroom(ASP_GL_DRAW_HEADROOM, "drawing (the GL driver's code generation)", err);
+    if (rc)
+        return rc;
+    rc = asp__gl_ensure_current(gl, err);
     if (rc)
         return rc;
     asp__gl_clear_errors(gl);

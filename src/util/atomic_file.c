@@ -163,6 +163,74 @@ static void remove_stale(const char *path)
     closedir(d);
 }
 
+/*
+ * Files read as dependencies (issue #31: `render m.obj -o T.png` overwrote
+ * the mesh's own texture T.png; the CLI's output-is-input check sees only
+ * the files named on the command line). A fixed table of counted entries,
+ * one count per object that holds what was read (a mesh's texture, until
+ * asp_mesh_destroy), under a lock: loads may run on several threads.
+ */
+enum { PROTECTED_MAX = 256 };
+static struct {
+    dev_t dev;
+    ino_t ino;
+    unsigned refs;
+    char role[40];
+} protected_files[PROTECTED_MAX];
+static size_t protected_count;
+static atomic_flag protected_lock = ATOMIC_FLAG_INIT;
+
+void asp__atomic_protect(const char *path, const char *role)
+{
+    struct stat st;
+    if (!path || stat(path, &st) != 0)
+        return;
+    while (atomic_flag_test_and_set_explicit(&protected_lock, memory_order_acquire))
+        ;
+    size_t i = 0;
+    while (i < protected_count && !(protected_files[i].dev == st.st_dev && protected_files[i].ino == st.st_ino))
+        i++;
+    if (i == protected_count && i < PROTECTED_MAX) {
+        protected_files[i].dev = st.st_dev;
+        protected_files[i].ino = st.st_ino;
+        protected_files[i].refs = 0;
+        snprintf(protected_files[i].role, sizeof protected_files[i].role, "%s", role);
+        protected_count++;
+    }
+    if (i < protected_count)
+        protected_files[i].refs++;
+    atomic_flag_clear_explicit(&protected_lock, memory_order_release);
+}
+
+void asp__atomic_unprotect(const char *path)
+{
+    struct stat st;
+    if (!path || stat(path, &st) != 0)
+        return;
+    while (atomic_flag_test_and_set_explicit(&protected_lock, memory_order_acquire))
+        ;
+    for (size_t i = 0; i < protected_count; i++)
+        if (protected_files[i].dev == st.st_dev && protected_files[i].ino == st.st_ino) {
+            if (--protected_files[i].refs == 0)
+                protected_files[i] = protected_files[--protected_count];
+            break;
+        }
+    atomic_flag_clear_explicit(&protected_lock, memory_order_release);
+}
+
+/* The role of path when it was read as a dependency, else NULL. */
+static const char *protected_role(const struct stat *st)
+{
+    const char *role = NULL;
+    while (atomic_flag_test_and_set_explicit(&protected_lock, memory_order_acquire))
+        ;
+    for (size_t i = 0; i < protected_count && !role; i++)
+        if (protected_files[i].dev == st->st_dev && protected_files[i].ino == st->st_ino)
+            role = protected_files[i].role;
+    atomic_flag_clear_explicit(&protected_lock, memory_order_release);
+    return role;
+}
+
 int asp__atomic_open(asp__atomic_file *f, const char *path, asp_error *err)
 {
     memset(f, 0, sizeof *f);
@@ -175,6 +243,10 @@ int asp__atomic_open(asp__atomic_file *f, const char *path, asp_error *err)
     struct stat st;
     if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
         return asp_error_set(err, ASP_EIO, "cannot write '%s': is a directory", path);
+    const char *role = stat(path, &st) == 0 ? protected_role(&st) : NULL;
+    if (role)
+        return asp_error_set(err, ASP_EINVAL, "cannot write '%s': it was read as %s; write to another file", path,
+                             role);
     snprintf(f->path, sizeof f->path, "%s", path);
     snprintf(f->tmp, sizeof f->tmp, "%s.tmp.%ld", path, (long)getpid());
     install_handlers();

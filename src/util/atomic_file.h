@@ -42,6 +42,18 @@ typedef int (*asp__atomic_check)(const char *tmp, void *user, asp_error *err);
  * and err says "internal error: the written 'PATH' does not read back: ...".
  */
 int asp__atomic_commit_checked(asp__atomic_file *f, asp__atomic_check check, void *user, asp_error *err);
+/**
+ * Records path (when it exists) as read by this process in role ("the
+ * texture of material 'skin' of 'm.obj'"): asp__atomic_open then refuses to
+ * write over it, with "cannot write '<path>': it was read as <role>; write to
+ * another file". For the files a reader opens that the command line does not
+ * name (textures): the object holding what was read calls
+ * asp__atomic_unprotect when it goes (asp_mesh_destroy), so a later save in
+ * the same process may write there again. Counted, up to 256 files; thread safe.
+ */
+void asp__atomic_protect(const char *path, const char *role);
+void asp__atomic_unprotect(const char *path);
+
 /** Closes and removes the temporary file (after a failure). Safe to call twice. */
 void asp__atomic_abort(asp__atomic_file *f);
 

@@ -95,7 +95,8 @@ static uint64_t png_row_bytes(uint32_t w, unsigned depth, unsigned colour)
     return channels ? ((uint64_t)w * channels * depth + 7) / 8 + 1 : 0;
 }
 
-int asp__png_precheck(FILE *fp, unsigned max_side, char *out, size_t cap)
+/* strict (asp__png_verify): the data must also inflate whole to what the image needs. */
+static int png_check(FILE *fp, unsigned max_side, int strict, char *out, size_t cap)
 {
     unsigned char h[33];
     rewind(fp);
@@ -154,9 +155,31 @@ int asp__png_precheck(FILE *fp, unsigned max_side, char *out, size_t cap)
         }
         if (rc)
             break;
+        if (strict && zrc != Z_OK && zrc != Z_STREAM_END) {
+            snprintf(out, cap, "PNG of %ux%u: damaged image data (zlib: %s)", w, hh, z.msg ? z.msg : "error");
+            rc = 1;
+            break;
+        }
     }
     inflateEnd(&z);
+    // non-interlaced images need exactly row * height bytes; Adam7's passes need at least the pixels' own
+    if (strict && !rc && (zrc != Z_STREAM_END || produced < (h[28] ? row * hh - hh : row * hh))) {
+        snprintf(out, cap, "PNG of %ux%u: its image data %s %llu of the %llu bytes the image needs", w, hh,
+                 produced ? "inflates to" : "is missing:", (unsigned long long)produced,
+                 (unsigned long long)(row * hh));
+        rc = 1;
+    }
 done:
     rewind(fp);
     return rc;
+}
+
+int asp__png_precheck(FILE *fp, unsigned max_side, char *out, size_t cap)
+{
+    return png_check(fp, max_side, 0, out, cap);
+}
+
+int asp__png_verify(FILE *fp, unsigned max_side, char *out, size_t cap)
+{
+    return png_check(fp, max_side, 1, out, cap);
 }

@@ -29,4 +29,12 @@ void asp__image_problem(FILE *fp, const char *stb_reason, unsigned max_side, cha
  */
 int asp__png_precheck(FILE *fp, unsigned max_side, char *out, size_t cap);
 
+/*
+ * asp__png_precheck, and the image data must inflate without error to the
+ * bytes the header's size needs (issue #31: info reported a PNG cut inside
+ * its data, or without IDAT, as whole). For 'amgsplat info', which decodes
+ * nothing.
+ */
+int asp__png_verify(FILE *fp, unsigned max_side, char *out, size_t cap);
+
 #endif
