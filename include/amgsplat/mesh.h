@@ -97,6 +97,28 @@ typedef struct asp_mesh_load_desc {
     asp_up_axis up;
 } asp_mesh_load_desc;
 
+/** What a glTF 2.0 / GLB file holds, read from its JSON alone (asp_gltf_summary_load). */
+typedef struct asp_gltf_summary {
+    size_t primitives; /* mesh primitives over every mesh */
+    size_t points;     /* POSITION elements of primitives drawn as points (mode 0) */
+    size_t vertices;   /* POSITION elements of every other primitive */
+    int glb;           /* 1: binary container */
+    int decodable;     /* 0: it requires an extension the mesh reader cannot decode (asp_mesh_load refuses it) */
+    char required[256]; /* extensionsRequired, comma-separated (cut at 255 bytes) */
+} asp_gltf_summary;
+
+/**
+ * Describes the glTF 2.0 or GLB file at path from its JSON, after the same
+ * structural checks asp_mesh_load makes before its reader (header and chunk
+ * lengths, buffers, views, accessors, meshes, nodes), without decoding any
+ * vertex data; so it also describes files whose required extensions the mesh
+ * reader lacks, such as the compact GLB amgsplat export writes
+ * (EXT_meshopt_compression). Returns 0 and fills *out, or ASP_EIO,
+ * ASP_EFORMAT (the message names the file and element), ASP_ENOMEM; *out is
+ * unchanged on failure.
+ */
+int asp_gltf_summary_load(const char *path, const asp_context *ctx, asp_gltf_summary *out, asp_error *err);
+
 /**
  * Loads a triangle mesh (OBJ+MTL, PLY with faces, OFF, STL, glTF/GLB, 3DS and
  * whatever else the installed assimp reads). Polygons are triangulated, the

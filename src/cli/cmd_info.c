@@ -534,11 +534,54 @@ static int info_points(const char *path, struct cli_env *env)
 }
 
 /* A mesh, loaded as 'sample' would but tolerating missing textures, so they can be named. */
+/*
+ * A glTF whose vertex data the mesh reader cannot decode (export's compact GLB: issue #32), or one of
+ * points only: what its JSON says, checked as asp_mesh_load checks it, so every file amgsplat writes
+ * is one info describes.
+ */
+static int info_gltf_summary(const char *path, const asp_file_type *type, const asp_gltf_summary *gs,
+                             struct cli_env *env)
+{
+    const asp_gltf_summary s = *gs;
+    asp_error err = {0};
+    cli_progress_end(env);
+    if (env->json) {
+        cJSON *o = cJSON_CreateObject();
+        if (!o || !cJSON_AddStringToObject(o, "file", path) || !cJSON_AddStringToObject(o, "format", type->format) ||
+            !cJSON_AddStringToObject(o, "kind", "gltf") || !cJSON_AddNumberToObject(o, "primitives", (double)s.primitives) ||
+            !cJSON_AddNumberToObject(o, "points", (double)s.points) ||
+            !cJSON_AddNumberToObject(o, "vertices", (double)s.vertices) ||
+            !cJSON_AddStringToObject(o, "extensions_required", s.required) ||
+            !cJSON_AddBoolToObject(o, "mesh_reader_decodes", s.decodable)) {
+            cJSON_Delete(o);
+            asp_error_set(&err, ASP_ENOMEM, "out of memory describing '%s'", path);
+            return cli_fail(env, &err);
+        }
+        return cli_json_print(env, o);
+    }
+    printf("%s: %s, glTF 2.0, %zu primitives: %zu points, %zu other vertices\n", path, type->format, s.primitives,
+           s.points, s.vertices);
+    if (!s.decodable)
+        printf("  requires %s: described from its JSON; the mesh reader (assimp) cannot decode it, so sample, "
+               "render and decompose refuse it (export --plain writes plain glTF)\n", s.required);
+    else
+        printf("  points only, no triangles: described from its JSON (a point GLB is a viewer's file, not a mesh "
+               "to sample)%s%s\n", s.required[0] ? "; requires " : "", s.required);
+    return 0;
+}
+
 static int info_mesh(const char *path, const asp_file_type *type, struct cli_env *env)
 {
     asp_mesh *m = NULL;
     asp_error err = {0};
     if (asp_mesh_load(path, &(asp_mesh_load_desc){.allow_missing_textures = 1}, &env->ctx, &m, &err)) {
+        asp_gltf_summary gs;
+        asp_error e2 = {0};
+        // a glTF of points only (export's point GLB) or one the mesh reader cannot decode: described from its JSON
+        if ((strcmp(type->format, "glb") == 0 || strcmp(type->format, "gltf") == 0) &&
+            asp_gltf_summary_load(path, &env->ctx, &gs, &e2) == 0 &&
+            (!gs.decodable || (gs.points > 0 && gs.vertices == 0)))
+            return info_gltf_summary(path, type, &gs, env);
         if (strcmp(type->format, "ply") != 0)
             return cli_fail(env, &err);
         /* our PLY reader takes more than assimp's (double coordinates, odd types): show the vertices at least */

@@ -17,7 +17,9 @@
 
 #include <cjson/cJSON.h>
 
+#include "amgsplat/mesh.h"
 #include "io/mesh_precheck.h"
+#include "util/byte_io.h"
 #include "util/banned.h"
 
 #define GLB_JSON 0x4E4F534Au
@@ -30,7 +32,25 @@ typedef struct gltf_check {
     size_t bin_size;
     int glb;
     asp_error *err;
+    asp_gltf_summary *summary; /* non-NULL: describe the file (asp_gltf_summary_load) instead of refusing what
+                                  assimp cannot decode */
 } gltf_check;
+
+/*
+ * Required extensions that change how the bytes read and that assimp 5.2 (Debian 12) does not decode
+ * (only the one amgsplat itself writes is listed; others are left to assimp, which names them):
+ * a file that requires one is refused before assimp with a message that says so, rather than read
+ * as garbage or failing inside it. amgsplat's own compact GLB (export's default, issue #32) is one.
+ */
+static const char *const undecodable[] = {"EXT_meshopt_compression"};
+
+/* 1 when buffer b is a fallback buffer of EXT_meshopt_compression (it may have no data: the spec's 4.2). */
+static int meshopt_fallback(const cJSON *b)
+{
+    const cJSON *ext = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(b, "extensions"),
+                                                        "EXT_meshopt_compression");
+    return cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(ext, "fallback"));
+}
 
 static uint32_t le32(const uint8_t *p)
 {
@@ -136,6 +156,8 @@ static int check_buffers(gltf_check *c, long long *lens, int n)
             return rc;
         const cJSON *uri = cJSON_GetObjectItemCaseSensitive(b, "uri");
         long long have;
+        if (!uri && meshopt_fallback(b))
+            continue; // no bytes of its own: the compressed views decode into it
         if (!uri) {
             if (!c->glb || i != 0)
                 return asp_error_set(c->err, ASP_EFORMAT, "cannot read '%s': %s has no 'uri' (only a GLB's first "
@@ -423,6 +445,57 @@ static int check_nodes(gltf_check *c)
     return 0;
 }
 
+/*
+ * The file's required extensions: refused when assimp cannot decode one (undecodable[]), unless
+ * c->summary asks for a description, which is then filled from the JSON (counts are the POSITION
+ * accessors' element counts, already checked against their buffers).
+ */
+static int required_extensions(gltf_check *c, const long long *counts)
+{
+    const cJSON *req = cJSON_GetObjectItemCaseSensitive(c->root, "extensionsRequired"), *e;
+    const char *blocker = NULL;
+    cJSON_ArrayForEach(e, req) {
+        if (!cJSON_IsString(e))
+            return asp_error_set(c->err, ASP_EFORMAT, "cannot read '%s': extensionsRequired holds a non-string",
+                                 c->name);
+        for (size_t k = 0; k < sizeof undecodable / sizeof undecodable[0] && !blocker; k++)
+            if (strcmp(e->valuestring, undecodable[k]) == 0)
+                blocker = undecodable[k];
+        if (c->summary) {
+            size_t len = strlen(c->summary->required);
+            snprintf(c->summary->required + len, sizeof c->summary->required - len, "%s%s", len ? "," : "",
+                     e->valuestring);
+        }
+    }
+    if (c->summary) {
+        asp_gltf_summary *s = c->summary;
+        s->glb = c->glb;
+        s->decodable = blocker == NULL;
+        int nacc = array_size(c->root, "accessors");
+        const cJSON *m, *p;
+        cJSON_ArrayForEach(m, cJSON_GetObjectItemCaseSensitive(c->root, "meshes")) {
+            cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(m, "primitives")) {
+                const cJSON *pos = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(p, "attributes"),
+                                                                    "POSITION");
+                const cJSON *mode = cJSON_GetObjectItemCaseSensitive(p, "mode");
+                long long n = cJSON_IsNumber(pos) && pos->valuedouble >= 0 && pos->valuedouble < nacc
+                                  ? counts[(int)pos->valuedouble] : 0;
+                s->primitives++;
+                if (cJSON_IsNumber(mode) && mode->valueint == 0)
+                    s->points += (size_t)n;
+                else
+                    s->vertices += (size_t)n;
+            }
+        }
+        return 0;
+    }
+    if (blocker)
+        return asp_error_set(c->err, ASP_EUNSUPPORTED, "cannot read '%s' as a mesh: it requires %s, which the mesh "
+                             "reader (assimp) cannot decode (a compact amgsplat export: write it with "
+                             "'amgsplat export --plain' for tools that need plain glTF)", c->name, blocker);
+    return 0;
+}
+
 static int check_json(gltf_check *c, const char *json, size_t len)
 {
     cJSON *root = cJSON_ParseWithLength(json, len);
@@ -450,15 +523,17 @@ static int check_json(gltf_check *c, const char *json, size_t len)
         rc = check_meshes(c, lens + nbuf + nview, nacc);
     if (!rc)
         rc = check_nodes(c);
+    if (!rc)
+        rc = required_extensions(c, lens + nbuf + nview);
     free(lens);
     cJSON_Delete(root);
     return rc;
 }
 
-int asp__gltf_precheck_memory(const void *data, size_t size, const char *name, asp_error *err)
+static int gltf_precheck(const void *data, size_t size, const char *name, asp_gltf_summary *summary, asp_error *err)
 {
     const uint8_t *b = data;
-    gltf_check c = {.name = name, .err = err};
+    gltf_check c = {.name = name, .err = err, .summary = summary};
     if (size < 4 || memcmp(b, "glTF", 4) != 0)
         return check_json(&c, data, size);
     c.glb = 1;
@@ -498,4 +573,26 @@ int asp__gltf_precheck_memory(const void *data, size_t size, const char *name, a
     if (!json)
         return asp_error_set(err, ASP_EFORMAT, "cannot read '%s': GLB without a JSON chunk", name);
     return check_json(&c, (const char *)json, json_len);
+}
+
+int asp_gltf_summary_load(const char *path, const asp_context *ctx, asp_gltf_summary *out, asp_error *err)
+{
+    ASP_ASSERT(path && out);
+    uint8_t *buf = NULL;
+    size_t size = 0;
+    int rc = asp__byte_slurp(path, ctx, &buf, &size, err);
+    if (rc)
+        return rc;
+    asp_gltf_summary s;
+    memset(&s, 0, sizeof s);
+    rc = gltf_precheck(buf, size, path, &s, err);
+    asp_free(ctx, buf);
+    if (!rc)
+        *out = s;
+    return rc;
+}
+
+int asp__gltf_precheck_memory(const void *data, size_t size, const char *name, asp_error *err)
+{
+    return gltf_precheck(data, size, name, NULL, err);
 }

@@ -91,6 +91,19 @@ fi
 
 # errors: usage (2) and input (1), and no output file left behind
 "$AMGSPLAT" synth octahedron -o "$T/o.ply" -q
+# every GLB export writes is one info describes (issue #31/#32): the compact one from its JSON (assimp cannot
+# decode EXT_meshopt_compression), the plain point one too; a mesh reader refuses the compact one by name
+n_pts=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['points'])" <("$AMGSPLAT" info "$T/utm.ply" --json))
+for g in utmc plain; do
+  "$AMGSPLAT" info "$T/$g.glb" --json >"$T/$g.info.json" || fail "info refuses export's own $g.glb"
+  python3 -c "
+import json, sys
+o = json.load(open(sys.argv[1]))
+assert o['kind'] == 'gltf' and o['points'] == int(sys.argv[2]) and o['vertices'] == 0, o
+assert o['mesh_reader_decodes'] == (sys.argv[3] == 'plain'), o
+" "$T/$g.info.json" "$n_pts" "$g" || fail "info on $g.glb: $(cat "$T/$g.info.json")"
+done
+expect_fail 1 "requires EXT_meshopt_compression" "$AMGSPLAT" sample "$T/utmc.glb" -o "$T/x.ply"
 expect_fail 2 "must end in .glb or .gltf" "$AMGSPLAT" export "$T/o.ply" -o "$T/x.obj"
 expect_fail 2 "missing -o" "$AMGSPLAT" export "$T/o.ply"
 expect_fail 2 "are for .dps inputs" "$AMGSPLAT" export "$T/o.ply" -o "$T/x.glb" --alpha-mode mask
