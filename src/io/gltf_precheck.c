@@ -62,6 +62,7 @@ static int get_int(gltf_check *c, const cJSON *obj, const char *key, long long l
                    const char *what, long long *out)
 {
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    *out = 0; // set on every path, so callers' values are defined whatever the compiler proves
     if (!v) {
         if (def < 0)
             return asp_error_set(c->err, ASP_EFORMAT, "cannot read '%s': %s has no '%s'", c->name, what, key);
