@@ -251,6 +251,14 @@ void asp_dps_level_release(asp_dps_level *lv, const asp_context *ctx);
  */
 int asp_prim_level_for_budget(const asp_amg *amg, size_t max_prims, size_t *level, asp_error *err);
 
+/**
+ * Picks the level whose basis function count is nearest prims (build
+ * --primitives N, issue 29: 300 gives the level with 372 rather than the one
+ * with 161); of two equally near, the finer. Returns 0, or ASP_EINVAL for
+ * prims == 0.
+ */
+int asp_prim_level_nearest(const asp_amg *amg, size_t prims, size_t *level, asp_error *err);
+
 /** Frees a dps and everything it owns; NULL is accepted. */
 void asp_dps_destroy(asp_dps *dps);
 

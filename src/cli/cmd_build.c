@@ -23,7 +23,8 @@ static const char usage[] =
     "its points) with a texture: colour = the points' colours, alpha = the domain's basis\n"
     "function. A .ply input is decomposed first (as 'amgsplat decompose'). Levels: L is the\n"
     "coarsest, L-3 three levels finer, an index, a list 'L-5,L-3' or a range 'L-6..L'.\n"
-    "--primitives N picks the finest level with at most N domains. Prints per level the\n"
+    "--primitives N picks the level whose domain count is nearest N and names it on stderr;\n"
+    "--merge then joins domains, so the count drops below that level's. Prints per level the\n"
     "thesis Table 5.2 columns: primitives, texels, error, normalised error, basis time (cb)\n"
     "and construction time (dpc).";
 
@@ -92,12 +93,33 @@ static void print_table(const asp_dps *dps, const asp_dps_summary *rows)
     }
 }
 
+/* What --primitives N chose (issue 29: the choice is reported, not silent); requested 0: not given. */
+struct pick {
+    size_t requested, level, domains;
+    char name[24];
+};
+
+static void amg_level_name(const asp_amg *amg, size_t level, char name[24])
+{
+    size_t top = asp_amg_level_count(amg) - 1; // same names as asp_dps_level_name: L the coarsest
+    if (level == top)
+        snprintf(name, 24, "L");
+    else
+        snprintf(name, 24, "L-%zu", top - level);
+}
+
 static int print_json(const struct cli_env *env, const char *input, const char *output, const asp_dps *dps,
-                      const asp_dps_summary *rows, double t_decompose, double t_total, int gpu)
+                      const asp_dps_summary *rows, double t_decompose, double t_total, int gpu, const struct pick *pick)
 {
     cJSON *o = cJSON_CreateObject(), *levels = cJSON_CreateArray();
     cJSON_AddStringToObject(o, "input", input);
     cJSON_AddStringToObject(o, "output", output);
+    if (pick->requested) {
+        cJSON *p = cJSON_AddObjectToObject(o, "primitives_pick");
+        cJSON_AddNumberToObject(p, "requested", (double)pick->requested);
+        cJSON_AddStringToObject(p, "level", pick->name);
+        cJSON_AddNumberToObject(p, "domains", (double)pick->domains);
+    }
     cJSON_AddNumberToObject(o, "points", (double)dps->source_points);
     cJSON_AddItemToObject(o, "mean_radius", cli_json_number("%.9g", dps->mean_radius));
     cJSON_AddStringToObject(o, "method", asp_prim_method_name(dps->desc.method));
@@ -166,7 +188,7 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         {"output", 'o', CLI_STRING, &output, "FILE", "output primitives (.dps)"},
         {"preset", 0, CLI_STRING, &preset, "SEED", "the seed's options: thesis, journal (docs/seeds.md)"},
         {"level", 'l', CLI_STRING, &level_text, "L", "level(s): L, L-5, 3, 'L-5,L-3' or 'L-6..L' (default L-3)"},
-        {"primitives", 'p', CLI_SIZE, &budget, "N", "the finest level with at most N domains"},
+        {"primitives", 'p', CLI_SIZE, &budget, "N", "the level with the domain count nearest N"},
         {"texel-size", 0, CLI_DOUBLE, &texel, "X", "texel edge in mean point radii (default 1)"},
         {"max-texture", 0, CLI_SIZE, &max_texture, "N", "cap on a texture's side in texels (default 512)"},
         {"method", 'm', CLI_STRING, &method, "M", "affine (default: Delaunay + barycentric) or radial"},
@@ -271,8 +293,22 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         t_dec = asp_time_now() - t0;
     }
     size_t levels[64], nlevels = 0;
-    if (!rc && budget != SIZE_MAX)
-        rc = asp_prim_level_for_budget(amg, budget, &levels[nlevels++], &err);
+    struct pick pick = {0};
+    if (!rc && budget != SIZE_MAX && (rc = asp_prim_level_nearest(amg, budget, &levels[nlevels++], &err)) == 0) {
+        size_t l = levels[0], nl = asp_amg_level_count(amg);
+        pick = (struct pick){.requested = budget, .level = l, .domains = asp_amg_level_size(amg, l)};
+        amg_level_name(amg, l, pick.name);
+        // the neighbour on the other side of N, so the user sees what the other choice would have been
+        size_t other = pick.domains > budget ? (l + 1 < nl ? l + 1 : l) : (l > 0 ? l - 1 : l);
+        char oname[24];
+        amg_level_name(amg, other, oname);
+        if (other != l)
+            cli_info(env, "build: --primitives %zu: level %s with %zu domains is the nearest (%s: %zu)", budget,
+                     pick.name, pick.domains, oname, asp_amg_level_size(amg, other));
+        else
+            cli_info(env, "build: --primitives %zu: level %s with %zu domains is the nearest", budget, pick.name,
+                     pick.domains);
+    }
     else if (!rc)
         rc = parse_levels(amg, level_text ? level_text : "L-3", levels, &nlevels, 64, &err);
     asp_dps *dps = NULL;
@@ -313,9 +349,12 @@ int cmd_build(int argc, char **argv, struct cli_env *env)
         if (rows[i].capped)
             cli_info(env, "warning: level %s: %u of %zu textures reached --max-texture %u; their texels are larger",
                      rows[i].name, rows[i].capped, rows[i].primitives, dps->desc.max_texture);
+    if (pick.requested && merge && rows[0].primitives != pick.domains)
+        cli_info(env, "build: --merge joined the %zu domains of %s into %zu primitives; --primitives %zu picks the "
+                 "level before merging", pick.domains, pick.name, rows[0].primitives, pick.requested);
     int status = 0;
     if (env->json) {
-        status = print_json(env, argv[0], output, dps, rows, t_dec, t_total, gpu);
+        status = print_json(env, argv[0], output, dps, rows, t_dec, t_total, gpu, &pick);
     } else {
         if (!env->quiet)
             printf("%s: %llu points, %zu level(s), mean radius %.4g, %s textures, texel size %g%s, %.2f s\n", output,

@@ -4,7 +4,8 @@
  * asp_cloud_load / asp_cloud_save.
  */
 static const char usage[] =
-    "usage: amgsplat convert [--ascii | --big-endian] [--las-format N] [--las-scale S] IN OUT\n"
+    "usage: amgsplat convert [--ascii | --big-endian] [--las-format N] [--las-scale S] IN -o OUT\n"
+    "       amgsplat convert [options] IN OUT\n"
     "\n"
     "Converts a point file; formats follow the extensions (.ply, .xyz, .pts, .txt, .las).\n"
     "PLY output is binary little endian unless --ascii or --big-endian is given.\n"
@@ -83,7 +84,9 @@ int cmd_convert(int argc, char **argv, struct cli_env *env)
 {
     int ascii = 0, big_endian = 0, npos = 0, las_format = -1;
     double las_scale = 0;
+    const char *output = NULL;
     const struct cli_option opts[] = {
+        {"output", 'o', CLI_STRING, &output, "OUT", "output point file (.ply, .las, .xyz, .pts, .txt); or OUT as the second argument"},
         {"ascii", 0, CLI_FLAG, &ascii, NULL, "write PLY as ascii text"},
         {"big-endian", 0, CLI_FLAG, &big_endian, NULL, "write PLY as binary big endian"},
         {"las-format", 0, CLI_INT, &las_format, "N", "LAS point data record format: 0-3 or 6-8"},
@@ -93,10 +96,14 @@ int cmd_convert(int argc, char **argv, struct cli_env *env)
     int rc = cli_parse(argc, argv, opts, usage, env, &npos);
     if (rc)
         return rc > 0 ? 0 : 2;
-    if (npos != 2)
+    // -o OUT as in every other command (issue 29); IN OUT as before
+    if (output && npos != 1)
+        return cli_usage_error(env, "with -o %s expected one input file, got %d argument%s; see 'amgsplat convert -h'",
+                               output, npos, npos == 1 ? "" : "s");
+    if (!output && npos != 2)
         return cli_usage_error(env, "expected an input and an output file, got %d argument%s; see 'amgsplat convert -h'",
                                npos, npos == 1 ? "" : "s");
-    const char *in = argv[0], *out = argv[1];
+    const char *in = argv[0], *out = output ? output : argv[1];
     if (ascii && big_endian)
         return cli_usage_error(env, "--ascii and --big-endian exclude each other");
     if (cli_check_output(env, out, NULL, 0, (const char *const[]){in}, 1))

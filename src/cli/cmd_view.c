@@ -12,8 +12,8 @@
 #include "util/banned.h"
 
 static const char usage[] =
-    "usage: amgsplat view FILE [--size WxH] [--view AZ,EL[,DIST]] [--renderer NAME] [--tau PX]\n"
-    "                     [--color MODE] [--level L] [--method NAME] [--alpha-ref X] [--unlit]\n"
+    "usage: amgsplat view FILE [--size WxH] [--view AZ,EL[,DIST]] [--renderer NAME] [--tolerance PX]\n"
+    "                     [--color-by MODE] [--level L] [--method NAME] [--alpha-ref X] [--unlit]\n"
     "                     [--background R,G,B] [--texture IMG] [--hybrid] [--verbose]\n"
     "                     [--preset thesis|journal|pajarola|schwarz]\n"
     "                     [--frame-ms T] [--overlay | --no-overlay]\n"

@@ -13,26 +13,44 @@ struct cli_command {
     const char *name;
     int (*fn)(int argc, char **argv, struct cli_env *env);
     const char *summary;
+    const char *reads; /* what its input may be, listed by the overview (issue 29) */
 };
 
 static const struct cli_command commands[] = {
-    {"info", cmd_info, "print counts, attributes, bounds and radii of a point or primitive file"},
-    {"convert", cmd_convert, "convert between point formats (PLY ascii/binary, XYZ)"},
-    {"sample", cmd_sample, "sample a mesh (OBJ, PLY, OFF, STL, glTF, 3DS) to points"},
-    {"synth", cmd_synth, "make a synthetic test model (octahedron, cube, sphere, torus, checker-plane)"},
-    {"estimate", cmd_estimate, "estimate normals and radii of a raw scan"},
-    {"render", cmd_render, "render points to PNG headlessly (EGL)"},
-    {"imgdiff", cmd_imgdiff, "compare two images: PSNR, SSIM, silhouette IoU"},
-    {"decompose", cmd_decompose, "multiscale AMG decomposition of a point set into domains"},
-    {"simplify", cmd_simplify, "simplify a mesh to N triangles (meshoptimizer), keeping UVs and textures"},
-    {"build", cmd_build, "domain primitives (textured polygons) of AMG levels into a .dps file"},
-    {"fit", cmd_fit, "fit the textures of .dps levels to images of their source (mesh or points)"},
-    {"export", cmd_export, "glTF 2.0 (.glb/.gltf) of domain primitives, point sets and hierarchies"},
-    {"view", cmd_view, "open a window on points or an .amg decomposition (interactive viewer)"},
-    {"eval", cmd_eval, "measure every representation against the reference: PSNR, SSIM, IoU, frame time"},
-    {"bench-paper", cmd_bench_paper, "print the seeds' tables (journal Tables 1-2, thesis Tables 5.1-5.4)"},
-    {"scene", cmd_scene, "scene files of instances: 'scene field' writes N models receding to the horizon"},
-    {"experiment", cmd_experiment, "the perceptual experiment of seed 004: run (people or observer), analyze, ttest"},
+    {"info", cmd_info, "print counts, attributes, bounds and radii of a point or primitive file",
+     "points (PLY, LAS, XYZ/PTS/TXT), meshes, .amg, .dps, .hier, images (PNG), scenes (.json), glTF exports"},
+    {"convert", cmd_convert, "convert between point formats (PLY ascii/binary, LAS, XYZ/PTS/TXT)",
+     "points: PLY, LAS, XYZ/PTS/TXT (writes the same)"},
+    {"sample", cmd_sample, "sample a mesh (OBJ, PLY, OFF, STL, glTF, 3DS) to points",
+     "meshes: OBJ+MTL, PLY with faces, OFF, STL, glTF/GLB, 3DS (assimp)"},
+    {"synth", cmd_synth, "make a synthetic test model (octahedron, cube, sphere, torus, checker-plane)",
+     "nothing (a shape name)"},
+    {"estimate", cmd_estimate, "estimate normals and radii of a raw scan",
+     "points: PLY, LAS, XYZ/PTS/TXT"},
+    {"render", cmd_render, "render points, .amg, .dps, meshes or scenes to PNG headlessly (EGL)",
+     "points (PLY, LAS, XYZ/PTS/TXT), .amg, .dps, .hier, meshes, scenes (.json)"},
+    {"imgdiff", cmd_imgdiff, "compare two images: PSNR, SSIM, silhouette IoU",
+     "two images (PNG)"},
+    {"decompose", cmd_decompose, "multiscale AMG decomposition of a point set into domains",
+     "points (PLY, LAS, XYZ/PTS/TXT), meshes (--mesh-stiffness), .amg (--stats)"},
+    {"simplify", cmd_simplify, "simplify a mesh to N triangles (meshoptimizer), keeping UVs and textures",
+     "meshes: OBJ+MTL, PLY with faces, OFF, STL, glTF/GLB, 3DS"},
+    {"build", cmd_build, "domain primitives (textured polygons) of AMG levels into a .dps file",
+     "points (PLY, LAS, XYZ/PTS/TXT) or .amg"},
+    {"fit", cmd_fit, "fit the textures of .dps levels to images of their source (mesh or points)",
+     ".dps, with a mesh, points or images as the reference"},
+    {"export", cmd_export, "glTF 2.0 (.glb/.gltf) of domain primitives, point sets and hierarchies",
+     ".dps, points (PLY, LAS, XYZ/PTS/TXT), .hier"},
+    {"view", cmd_view, "open a window on points, .amg, .dps, meshes or scenes (interactive viewer)",
+     "points (PLY, LAS, XYZ/PTS/TXT), .amg, .dps, .hier, meshes, scenes (.json)"},
+    {"eval", cmd_eval, "measure every representation against the reference: PSNR, SSIM, IoU, frame time",
+     "points (PLY, LAS, XYZ/PTS/TXT), meshes, synthetic shape names"},
+    {"bench-paper", cmd_bench_paper, "print the seeds' tables (journal Tables 1-2, thesis Tables 5.1-5.4)",
+     "points, meshes or synthetic shape names, as eval"},
+    {"scene", cmd_scene, "scene files of instances: 'scene field' writes N models receding to the horizon",
+     "points, .amg, .hier, .dps and meshes as instances (writes SCENE.json)"},
+    {"experiment", cmd_experiment, "the perceptual experiment of seed 004: run (people or observer), analyze, ttest",
+     "run: scenes it makes itself; analyze: its logs; ttest: summary figures"},
 };
 enum { N_COMMANDS = sizeof commands / sizeof commands[0] };
 
@@ -45,6 +63,10 @@ static void print_overview(FILE *fp)
             ASP_VERSION_STRING);
     for (size_t i = 0; i < N_COMMANDS; i++)
         fprintf(fp, "  %-10s %s\n", commands[i].name, commands[i].summary);
+    // a section of its own: tests/cli/help.sh reads command names from the lines under "commands:"
+    fprintf(fp, "\nwhat each command reads:\n");
+    for (size_t i = 0; i < N_COMMANDS; i++)
+        fprintf(fp, "  %-10s %s\n", commands[i].name, commands[i].reads);
     fprintf(fp, "\nEvery command takes -h, --quiet, --json and --threads N.\n");
 }
 

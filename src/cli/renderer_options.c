@@ -23,10 +23,10 @@ void cli_renderer_rows(struct cli_renderer_opts *o, unsigned which, struct cli_o
     } table[] = {
         {CLI_RO_RENDERER, {"renderer", 0, CLI_STRING, &o->renderer, "NAME", "how points are drawn: disc (default), splat, square, compute (compute shaders); meshes: mesh (default); .dps: prim (default), cut (levels mixed by view); in the viewer, h lists them"}},
         {CLI_RO_TOLERANCE, {"tolerance", 0, CLI_DOUBLE, &o->tolerance, "PX", "splat, square, cut: screen tolerance tau in pixels (render: default 1; view: 0; 0 = every point, finest level)"}},
-        {CLI_RO_TOLERANCE, {"tau", 0, CLI_DOUBLE, &o->tau, "PX", "the same as --tolerance"}},
+        {CLI_RO_TOLERANCE, {"tau", 0, CLI_DOUBLE, &o->tau, "PX", "deprecated spelling of --tolerance"}},
         {CLI_RO_BUDGET, {"budget", 0, CLI_SIZE, &o->budget, "N", "splat, square: cut the hierarchy to N splats per view instead of a tolerance"}},
         {CLI_RO_COLOR_BY, {"color-by", 0, CLI_STRING, &o->color_by, "MODE", ".amg input: classifier, domains, strict or input (render: default input; view: classifier); .dps input (render): domain"}},
-        {CLI_RO_COLOR_BY, {"color", 0, CLI_STRING, &o->color, "MODE", "the same as --color-by"}},
+        {CLI_RO_COLOR_BY, {"color", 0, CLI_STRING, &o->color, "MODE", "deprecated spelling of --color-by"}},
         {CLI_RO_LEVEL, {"level", 0, CLI_STRING, &o->level, "L", ".amg: level of the domain colours: L, L-2 or an index; .dps: level drawn (default the finest in the file)"}},
         {CLI_RO_METHOD, {"method", 0, CLI_STRING, &o->method, "NAME", ".dps: how primitives blend (default normalized; see docs/render-methods.md)"}},
         {CLI_RO_ALPHA_REF, {"alpha-ref", 0, CLI_DOUBLE, &o->alpha_ref, "X", ".dps: alpha test of the locks and the front layer, 0..1 (default 0.1)"}},
@@ -56,6 +56,8 @@ static int pick_spelling(const struct cli_env *env, int a_given, int b_given, co
     if (a_given && b_given)
         return cli_usage_error(env, "%s and %s are the same option; give one", a, b);
     *name = b_given ? b : a;
+    if (b_given) // one vocabulary across commands (issue 29): the old spelling still works, and says so
+        cli_info(env, "amgsplat %s: %s is deprecated; use %s", env->cmd, b, a);
     return 0;
 }
 

@@ -531,6 +531,22 @@ int asp_prim_level_for_budget(const asp_amg *amg, size_t max_prims, size_t *leve
     return 0;
 }
 
+int asp_prim_level_nearest(const asp_amg *amg, size_t prims, size_t *level, asp_error *err)
+{
+    if (!amg || !level || prims == 0)
+        return asp_error_set(err, ASP_EINVAL, "primitive count must be at least 1");
+    size_t nl = asp_amg_level_count(amg), best = 0, best_d = SIZE_MAX;
+    for (size_t l = 0; l < nl; l++) { // finest first: a tie keeps the finer level (more detail for the same distance)
+        size_t n = asp_amg_level_size(amg, l), d = n > prims ? n - prims : prims - n;
+        if (d < best_d) {
+            best = l;
+            best_d = d;
+        }
+    }
+    *level = best;
+    return 0;
+}
+
 /* Estimates radii when there are none (16th neighbour) and takes their mean. */
 static int prepare_src(build_src *src, const asp_context *ctx, float **own, asp_error *err)
 {

@@ -261,6 +261,25 @@ static void test_options_rejected(void)
     CHECK_OK(asp_prim_level_for_budget(amg, 1, &budget, &err), &err);
     CHECK(budget == asp_amg_level_count(amg) - 1);
     CHECK(asp_prim_level_for_budget(amg, 0, &budget, &err) == ASP_EINVAL);
+    /* nearest: just above a coarser level's count gives that level, just below a finer one's gives the finer */
+    size_t pairs = 0;
+    for (size_t k = 0; k + 1 < asp_amg_level_count(amg); k++) {
+        size_t fine = asp_amg_level_size(amg, k), coarse = asp_amg_level_size(amg, k + 1);
+        if (fine < coarse + 4)
+            continue;
+        size_t got = SIZE_MAX;
+        CHECK_OK(asp_prim_level_nearest(amg, coarse + 1, &got, &err), &err);
+        CHECK(got == k + 1);
+        CHECK_OK(asp_prim_level_nearest(amg, fine - 1, &got, &err), &err);
+        CHECK(got == k);
+        CHECK_OK(asp_prim_level_nearest(amg, (fine + coarse + 1) / 2 + 1, &got, &err), &err);
+        CHECK(got == k); // nearer the finer count though below it: the budget pick would give k + 1
+        pairs++;
+    }
+    CHECK(pairs > 0); // the model has levels far enough apart to tell the picks apart
+    CHECK_OK(asp_prim_level_nearest(amg, SIZE_MAX / 2, &budget, &err), &err);
+    CHECK(budget == 0);
+    CHECK(asp_prim_level_nearest(amg, 0, &budget, &err) == ASP_EINVAL);
 }
 
 static void teardown(void)
