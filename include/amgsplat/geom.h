@@ -382,6 +382,25 @@ typedef struct asp_mesh_simplify_stats {
 int asp_mesh_simplify(const asp_mesh *mesh, const asp_mesh_simplify_desc *desc, const asp_context *ctx,
                       asp_mesh **out, asp_mesh_simplify_stats *stats, asp_error *err);
 
+/* ---- colour by a per-point scalar (issue 29: a surveyor sees the scan's own fields) ---- */
+
+/** The colour of class code cls in the ASPRS palette asp_cloud_color_by uses for "classification" (RGB). */
+void asp_scalar_color_class(unsigned cls, uint8_t rgb[3]);
+/** The colour at t in [0, 1] (clamped; NaN gives t = 0) of the viridis ramp (RGB). */
+void asp_scalar_color_ramp(double t, uint8_t rgb[3]);
+
+/**
+ * Overwrites cloud's colours (adding them when absent; alpha 255) from a per-point
+ * scalar named by what:
+ *   "elevation"      the world coordinate along up (ASP_UP_Z: z, -z: -z, ...), viridis from min to max;
+ *   "classification" the property of that name, ASPRS palette (asp_scalar_color_class);
+ *   "intensity"      the property of that name, grey between its 1st and 99th percentile;
+ *   "prop:NAME" or any other NAME: the property NAME, viridis from its min to its max.
+ * A constant field takes the ramp's start. Returns 0; ASP_EINVAL for an unknown name,
+ * the message listing the cloud's properties; ASP_ENOMEM.
+ */
+int asp_cloud_color_by(asp_cloud *cloud, const char *what, asp_up_axis up, asp_error *err);
+
 #ifdef __cplusplus
 }
 #endif
