@@ -136,6 +136,7 @@ struct cli_renderer_opts {
     const char *color_by_name;       /* "--color-by" or "--color" */
     int has_color;                   /* a colour mode was given: color_mode holds it */
     asp_scene_amg_color color_mode;  /* classifier, domains (or "domain"), strict, input */
+    const char *color_field;         /* a point file's scalar: elevation, classification, prop:NAME (asp_cloud_color_by) */
     asp_prim_render_method method_kind; /* when method */
     float alpha_ref_lib;             /* asp_prim_render_options.alpha_ref (-1: exactly 0) when alpha_ref */
     double crease;                   /* degrees in (0, 180); -1 = off; 0 = not given */

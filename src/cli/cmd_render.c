@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "amgsplat/geom.h"
 #include "amgsplat/instances.h"
 #include "amgsplat/scene_renderer.h"
 #include "cli/cli.h"
@@ -273,6 +274,9 @@ static int parse_splat_options(struct cli_env *env, struct render_opts *o)
             return cli_usage_error(env, "--lighting expects gouraud, pixel or flat, got '%s'", o->lighting);
         o->light_mode = (asp_splat_lighting)found;
     }
+    if (o->r.color_field && (o->dps_input || o->amg_input))
+        return cli_usage_error(env, "%s expects classifier, domains, strict or input (.amg), or domain (.dps), got '%s'",
+                               o->r.color_by_name, o->r.color_field);
     if (o->dps_input) {
         if (o->r.has_color && o->r.color_mode != ASP_SCENE_AMG_DOMAINS)
             return cli_usage_error(env, "%s on a .dps input expects domain, got '%s'", o->r.color_by_name,
@@ -708,6 +712,9 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     if (o.r.hybrid && !o.dps_input)
         return cli_usage_error(env, "--hybrid needs a .dps input (amgsplat build makes one)");
     o.mesh_input = type.kind == ASP_FILE_MESH;
+    if (o.r.color_field && (o.mesh_input || type.kind == ASP_FILE_HIER))
+        return cli_usage_error(env, "%s %s colours a point file's points (PLY, XYZ, LAS), not a %s", o.r.color_by_name,
+                               o.r.color_field, o.mesh_input ? "mesh" : ".hier");
     if ((o.flat || o.r.texture) && !o.mesh_input)
         return cli_usage_error(env, "--flat and --texture need a mesh input (OBJ, PLY with faces, OFF, STL, glTF, 3DS)");
     asp_error err = {0, ""};
@@ -752,6 +759,14 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     int rc = load_scene(argv[0], &o, env, &s, &err);
     if (!rc)
         warn_missing_textures(&s);
+    // --color-by a scalar field: the library colours the points (elevation along the shown up axis)
+    if (!rc && o.r.color_field && s.cloud && (rc = asp_cloud_color_by(s.cloud, o.r.color_field, o.up_axis, &err))) {
+        if (rc == ASP_EINVAL) {
+            asp_scene_release(&s);
+            return cli_usage_error(env, "%s expects classifier, domains, strict or input (.amg), domain (.dps), or for a "
+                                        "point file elevation or a property: %s", o.r.color_by_name, err.msg);
+        }
+    }
     if (!rc && o.r.hybrid)
         rc = asp_scene_load_source_from(&s, o.hybrid_points, &err);
     if (!rc && s.dps && (rc = pick_domain_set(&o, &s, &ropts, &err)) != 0) {

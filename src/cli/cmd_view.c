@@ -79,6 +79,9 @@ static int parse_into(struct cli_env *env, const char *path, struct view_opts *o
         return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
     if (cli_renderer_check(env, &o->r, VIEW_OPTIONS))
         return 2;
+    if (o->r.color_field) // colouring by a point file's scalar is render's (asp_cloud_color_by); the viewer's c key cycles these
+        return cli_usage_error(env, "%s expects classifier, domains, strict or input, got '%s' (render --color-by colours "
+                                    "a point file by elevation or a property)", o->r.color_by_name, o->r.color_field);
     d->tolerance = isnan(o->r.tolerance) ? 0.0f : (float)o->r.tolerance;
     if (o->r.has_color) // the viewer's modes in the order its c key cycles them (asp_viewer_desc.amg_color)
         d->amg_color = o->r.color_mode == ASP_SCENE_AMG_INPUT ? 3u : (unsigned)o->r.color_mode - 1u;

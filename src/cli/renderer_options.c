@@ -25,7 +25,7 @@ void cli_renderer_rows(struct cli_renderer_opts *o, unsigned which, struct cli_o
         {CLI_RO_TOLERANCE, {"tolerance", 0, CLI_DOUBLE, &o->tolerance, "PX", "splat, square, cut: screen tolerance tau in pixels (render: default 1; view: 0; 0 = every point, finest level)"}},
         {CLI_RO_TOLERANCE, {"tau", 0, CLI_DOUBLE, &o->tau, "PX", "deprecated spelling of --tolerance"}},
         {CLI_RO_BUDGET, {"budget", 0, CLI_SIZE, &o->budget, "N", "splat, square: cut the hierarchy to N splats per view instead of a tolerance"}},
-        {CLI_RO_COLOR_BY, {"color-by", 0, CLI_STRING, &o->color_by, "MODE", ".amg input: classifier, domains, strict or input (render: default input; view: classifier); .dps input (render): domain"}},
+        {CLI_RO_COLOR_BY, {"color-by", 0, CLI_STRING, &o->color_by, "MODE", ".amg input: classifier, domains, strict or input (render: default input; view: classifier); .dps input (render): domain; point file: elevation, classification, intensity, return_number or any property (prop:NAME)"}},
         {CLI_RO_COLOR_BY, {"color", 0, CLI_STRING, &o->color, "MODE", "deprecated spelling of --color-by"}},
         {CLI_RO_LEVEL, {"level", 0, CLI_STRING, &o->level, "L", ".amg: level of the domain colours: L, L-2 or an index; .dps: level drawn (default the finest in the file)"}},
         {CLI_RO_METHOD, {"method", 0, CLI_STRING, &o->method, "NAME", ".dps: how primitives blend (default normalized; see docs/render-methods.md)"}},
@@ -82,8 +82,9 @@ static int check_color(const struct cli_env *env, struct cli_renderer_opts *o)
             o->has_color = 1;
             return 0;
         }
-    return cli_usage_error(env, "%s expects classifier, domains, strict or input (.amg), or domain (.dps), got '%s'",
-                           o->color_by_name, v);
+    // any other name is a point file's scalar field, checked against the file once it is read
+    o->color_field = v;
+    return 0;
 }
 
 int cli_renderer_check(const struct cli_env *env, struct cli_renderer_opts *o, unsigned which)
