@@ -763,8 +763,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     if (!rc && o.r.color_field && s.cloud && (rc = asp_cloud_color_by(s.cloud, o.r.color_field, o.up_axis, &err))) {
         if (rc == ASP_EINVAL) {
             asp_scene_release(&s);
-            return cli_usage_error(env, "%s expects classifier, domains, strict or input (.amg), domain (.dps), or for a "
-                                        "point file elevation or a property: %s", o.r.color_by_name, err.msg);
+            return cli_usage_error(env, "%s expects classifier, domains, strict or input (.amg), domain (.dps), or a "
+                                        "point field: %s", o.r.color_by_name, err.msg);
         }
     }
     if (!rc && o.r.hybrid)

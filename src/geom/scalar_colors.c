@@ -101,9 +101,8 @@ static int unknown(const asp_cloud *c, const char *what, asp_error *err)
         n = w < 0 ? n : n + (size_t)w;
     }
     return asp_error_set(err, ASP_EINVAL,
-                         "cannot colour by '%s': no such property (expected elevation, or one of the file's "
-                         "properties: %s)",
-                         what, c->property_count ? list : "none");
+                         "no such property '%s' (elevation or the file's: %s)", what,
+                         c->property_count ? list : "none");
 }
 
 int asp_cloud_color_by(asp_cloud *cloud, const char *what, asp_up_axis up, asp_error *err)
