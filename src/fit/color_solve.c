@@ -24,7 +24,7 @@
 enum { BLOCK = 4096 };
 
 /* The linear system over all atlas texels, 3 channels each. */
-typedef struct system {
+typedef struct color_system {
     size_t rows, texels;
     size_t *rfirst;      /* rows + 1 */
     uint32_t *rtex;
@@ -37,9 +37,9 @@ typedef struct system {
     double lambda, smooth;
     uint32_t width;      /* atlas width */
     int threads;
-} system;
+} color_system;
 
-static double dot(const system *s, const double *a, const double *b, double *partial)
+static double dot(const color_system *s, const double *a, const double *b, double *partial)
 {
     size_t n = 3 * s->texels, nb = (n + BLOCK - 1) / BLOCK;
 #pragma omp parallel for schedule(static) num_threads(s->threads)
@@ -57,7 +57,7 @@ static double dot(const system *s, const double *a, const double *b, double *par
 }
 
 /* z = R x (3 channels per row). */
-static void apply_r(const system *s, const double *x, double *z)
+static void apply_r(const color_system *s, const double *x, double *z)
 {
 #pragma omp parallel for schedule(static) num_threads(s->threads)
     for (size_t r = 0; r < s->rows; r++) {
@@ -72,7 +72,7 @@ static void apply_r(const system *s, const double *x, double *z)
 }
 
 /* y = (R^T R + lambda I + smooth L) x, with z = R x as scratch. */
-static void apply_a(const system *s, const double *x, double *z, double *y)
+static void apply_a(const color_system *s, const double *x, double *z, double *y)
 {
     apply_r(s, x, z);
     uint32_t w = s->width;
@@ -98,7 +98,7 @@ static void apply_a(const system *s, const double *x, double *z, double *y)
     }
 }
 
-static size_t smooth_degree(const system *s, size_t t)
+static size_t smooth_degree(const color_system *s, size_t t)
 {
     uint32_t o = s->owner[t], w = s->width;
     if (!o)
@@ -111,7 +111,7 @@ static size_t smooth_degree(const system *s, size_t t)
     return d;
 }
 
-static void system_release(system *s, const asp_context *ctx)
+static void system_release(color_system *s, const asp_context *ctx)
 {
     void *p[] = {s->rfirst, s->rtex, s->rcoef, s->b, s->tfirst, s->trow, s->tcoef, s->owner};
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++)
@@ -120,7 +120,7 @@ static void system_release(system *s, const asp_context *ctx)
 }
 
 /* Rows of every covered pixel the reference sees, with b = y - R c0; then the transpose. */
-static int system_build(system *s, const asp_dps_level *lv, const asp__fit_rows *vr, const asp_image *refs,
+static int system_build(color_system *s, const asp_dps_level *lv, const asp__fit_rows *vr, const asp_image *refs,
                         size_t nviews, const float *c0, const asp_context *ctx, asp_error *err)
 {
     size_t rows = 0, total = 0;
@@ -200,7 +200,7 @@ static void log_line(const asp_fit_desc *d, const char *fmt, double a, double b)
 }
 
 /* Data loss of the correction d: mean over rows and channels of |R d - b|^2. */
-static double data_loss(const system *s, const double *d, double *z)
+static double data_loss(const color_system *s, const double *d, double *z)
 {
     apply_r(s, d, z);
     double sum = 0;
@@ -212,7 +212,7 @@ static double data_loss(const system *s, const double *d, double *z)
 }
 
 /* Preconditioned CG from d = 0; returns the iterations run or a negative ASP_E* code. */
-static int solve(const system *s, const asp_fit_desc *desc, uint32_t iterations, const asp_context *ctx, double *d,
+static int solve(const color_system *s, const asp_fit_desc *desc, uint32_t iterations, const asp_context *ctx, double *d,
                  asp_error *err)
 {
     size_t n = 3 * s->texels, nb = (n + BLOCK - 1) / BLOCK;
@@ -342,7 +342,7 @@ int asp_fit_color(asp_dps_level *lv, const double origin[3], const asp_fit_view 
     asp__fit_rows *rows = asp_calloc(ctx, nall, sizeof *rows);
     float *c0 = asp__fit_atlas_linear(&lv->atlas, ctx);
     double *d = asp_calloc(ctx, 3 * (size_t)lv->atlas.width * lv->atlas.height + 1, sizeof *d);
-    system s = {0};
+    color_system s = {0};
     s.threads = asp_context_threads(ctx);
     if (!rows || !c0 || !d) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for a fit of %zu views", nall);
