@@ -4,7 +4,7 @@
  * asp_mesh_load of them as a .dae file, where assimp runs in a child process
  * (a count of -1 crashed it with SIGSEGV before the pre-check). Any input
  * gives a clean error naming the file or a mesh whose triangles index its
- * vertices. Seeds: tests/data/bad/assimp/*.dae (make_cases.py):
+ * vertices. Seeds: the .dae files of tests/data/bad/assimp/ (make_cases.py):
  *   ./fuzz_collada -max_total_time=600 -rss_limit_mb=2048 -max_len=65536 corpus-dae
  */
 #include <stdint.h>
