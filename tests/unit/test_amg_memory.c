@@ -61,6 +61,7 @@ static void test_free_returns(void)
     CHECK_MSG(after - before < 32 * 1024, "%ld KiB still resident after free", after - before);
 #else
     fprintf(stderr, "not glibc on Linux, or under AddressSanitizer: nothing to check\n");
+    asp_test_skips++; // reported as skipped, not passed
 #endif
 }
 

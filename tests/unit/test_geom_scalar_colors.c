@@ -42,6 +42,7 @@ static void test_cloud(void)
     asp_property *cls = NULL, *in = NULL;
     CHECK(asp_cloud_add_property(c, "classification", ASP_SCALAR_UINT8, &cls, &err) == 0);
     CHECK(asp_cloud_add_property(c, "intensity", ASP_SCALAR_UINT16, &in, &err) == 0);
+    cls = &c->properties[0]; // adding a property may move the array: the first pointer is stale
     const uint8_t classes[4] = {2, 6, 9, 2};
     const uint16_t intensity[4] = {100, 200, 300, 60000};
     for (int i = 0; i < 4; i++) {
