@@ -139,6 +139,9 @@ int asp_cloud_add_property(asp_cloud *cloud, const char *name, asp_scalar_type t
 /** The property called name, or NULL. */
 asp_property *asp_cloud_find_property(const asp_cloud *cloud, const char *name);
 
+/** Value i (< the cloud's count) of property p as a double, whatever its scalar type; NaN for an unknown type. */
+double asp_property_value(const asp_property *p, size_t i);
+
 /** Appends a comment (PLY "comment" line, without the keyword). */
 int asp_cloud_add_comment(asp_cloud *cloud, const char *text, asp_error *err);
 /** Appends an obj_info line (without the keyword). */

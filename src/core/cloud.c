@@ -308,3 +308,18 @@ int asp_cloud_clone(const asp_cloud *src, asp_cloud **out, asp_error *err)
     *out = c;
     return 0;
 }
+
+double asp_property_value(const asp_property *p, size_t i)
+{
+    switch (p->type) {
+    case ASP_SCALAR_INT8: return ((const int8_t *)p->data)[i];
+    case ASP_SCALAR_UINT8: return ((const uint8_t *)p->data)[i];
+    case ASP_SCALAR_INT16: return ((const int16_t *)p->data)[i];
+    case ASP_SCALAR_UINT16: return ((const uint16_t *)p->data)[i];
+    case ASP_SCALAR_INT32: return ((const int32_t *)p->data)[i];
+    case ASP_SCALAR_UINT32: return ((const uint32_t *)p->data)[i];
+    case ASP_SCALAR_FLOAT32: return ((const float *)p->data)[i];
+    case ASP_SCALAR_FLOAT64: return ((const double *)p->data)[i];
+    default: return NAN;
+    }
+}

@@ -71,21 +71,6 @@ void asp_scalar_color_ramp(double t, uint8_t rgb[3])
         rgb[k] = (uint8_t)lround(stops[i][k] + f * (stops[i + 1][k] - stops[i][k]));
 }
 
-static double value_at(const asp_property *p, size_t i)
-{
-    switch (p->type) {
-    case ASP_SCALAR_INT8: return ((const int8_t *)p->data)[i];
-    case ASP_SCALAR_UINT8: return ((const uint8_t *)p->data)[i];
-    case ASP_SCALAR_INT16: return ((const int16_t *)p->data)[i];
-    case ASP_SCALAR_UINT16: return ((const uint16_t *)p->data)[i];
-    case ASP_SCALAR_INT32: return ((const int32_t *)p->data)[i];
-    case ASP_SCALAR_UINT32: return ((const uint32_t *)p->data)[i];
-    case ASP_SCALAR_FLOAT32: return ((const float *)p->data)[i];
-    case ASP_SCALAR_FLOAT64: return ((const double *)p->data)[i];
-    default: return NAN;
-    }
-}
-
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -123,7 +108,7 @@ int asp_cloud_color_by(asp_cloud *cloud, const char *what, asp_up_axis up, asp_e
     for (size_t i = 0; i < n; i++)
         v[i] = elevation ? (up >= ASP_UP_NEG_Y ? -1.0 : 1.0) *
                                ((double)cloud->positions[3 * i + axis[up % 6]] + cloud->origin[axis[up % 6]])
-                         : value_at(p, i);
+                         : asp_property_value(p, i);
     int rc = cloud->colors ? 0 : asp_cloud_add_attrs(cloud, ASP_ATTR_COLORS, err);
     if (rc) {
         asp_free(&cloud->ctx, v);

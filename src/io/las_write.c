@@ -59,21 +59,6 @@ static int invalid(writer *w, const char *fmt, ...)
     return asp_error_set(w->err, ASP_EINVAL, "cannot write '%s': %s", w->path, what);
 }
 
-static double prop_value(const asp_property *p, size_t i)
-{
-    switch (p->type) {
-    case ASP_SCALAR_INT8: return ((const int8_t *)p->data)[i];
-    case ASP_SCALAR_UINT8: return ((const uint8_t *)p->data)[i];
-    case ASP_SCALAR_INT16: return ((const int16_t *)p->data)[i];
-    case ASP_SCALAR_UINT16: return ((const uint16_t *)p->data)[i];
-    case ASP_SCALAR_INT32: return ((const int32_t *)p->data)[i];
-    case ASP_SCALAR_UINT32: return ((const uint32_t *)p->data)[i];
-    case ASP_SCALAR_FLOAT32: return ((const float *)p->data)[i];
-    case ASP_SCALAR_FLOAT64: return ((const double *)p->data)[i];
-    default: return 0;
-    }
-}
-
 static unsigned choose_format(const asp_cloud *c, const asp_save_desc *desc)
 {
     if (desc && desc->las_format)
@@ -135,10 +120,10 @@ static int plan(writer *w)
         int shift = 0, same = 1;
         for (size_t i = 0; i < c->count && !shift; i++)
             for (int k = 0; k < 3; k++)
-                shift |= prop_value(rgb[k], i) > 255;
+                shift |= asp_property_value(rgb[k], i) > 255;
         for (size_t i = 0; i < c->count && same; i++)
             for (int k = 0; k < 3; k++) {
-                double v = prop_value(rgb[k], i);
+                double v = asp_property_value(rgb[k], i);
                 same &= v >= 0 && v <= 65535 && (uint8_t)((unsigned)v >> (shift ? 8 : 0)) == c->colors[4 * i + k];
             }
         w->rgb_from16 = same;
@@ -188,13 +173,13 @@ static int field_bits(writer *w, size_t fi, size_t i, uint64_t *out)
     const asp_property *p = w->src[fi];
     double v = 0;
     if (p)
-        v = prop_value(p, i);
+        v = asp_property_value(p, i);
     else if (!strcmp(f->name, "return_number") || !strcmp(f->name, "number_of_returns"))
         v = 1; // a single return: what a point without pulse information is
     else if (w->angle_other && !strcmp(f->name, "scan_angle"))
-        v = prop_value(w->angle_other, i) / 0.006;
+        v = asp_property_value(w->angle_other, i) / 0.006;
     else if (w->angle_other && !strcmp(f->name, "scan_angle_rank"))
-        v = prop_value(w->angle_other, i) * 0.006;
+        v = asp_property_value(w->angle_other, i) * 0.006;
     if (!strcmp(f->name, "red16") || !strcmp(f->name, "green16") || !strcmp(f->name, "blue16")) {
         int k = f->name[0] == 'r' ? 0 : f->name[0] == 'g' ? 1 : 2;
         v = w->rgb_from16 && p ? v : w->c->colors ? 257.0 * w->c->colors[4 * i + (size_t)k] : 0;
@@ -259,7 +244,7 @@ static void encode(writer *w, size_t i, const int32_t X[3], uint8_t *rec, uint64
     }
     for (size_t x = 0; x < w->nextras; x++) {
         const extra *e = &w->extras[x];
-        double v = e->prop ? prop_value(e->prop, i) : e->f ? e->f[i * e->stride + e->k] : e->u[i];
+        double v = e->prop ? asp_property_value(e->prop, i) : e->f ? e->f[i * e->stride + e->k] : e->u[i];
         uint64_t u;
         if (e->kind == 'f' && e->bytes == 4) {
             float f = (float)v;
