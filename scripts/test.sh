@@ -2,18 +2,18 @@
 # The README's test command and CI's (.ci/run calls it): installs dependencies, then builds and
 # tests every configuration with -Werror (ASP_WERROR is off for users; docs/build.md):
 #   a. RelWithDebInfo (gcc)          build/          all targets, ctest
-#   b. Release -O3 (gcc)             build-release/  all targets, ctest
+#   b. Release -O3 (gcc)             build-release/  all targets, ctest but the e2e label
 #   c. Release with clang, libFuzzer + ASan/UBSan    build-fuzz/  all targets and tools/fuzz_*.c
 #   d. reduced: no GL, no hypre      build-nogl/ build-nohypre/  library + its tests, ctest
 #   e. fuzz smoke: every fuzz target of c, FUZZ_SECONDS each, seeded from files made by a
-#   f. ASan + UBSan (gcc, Debug)     build-asan/     ctest
+#   f. ASan + UBSan (gcc, Debug)     build-asan/     ctest but the e2e label
 # Stops at the first failure. Prints each stage's time and test counts; docs/build.md lists
 # measured times. Build directories are reused, so a second run only rebuilds what changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/bootstrap.sh
 jobs=$(nproc)
-fuzz_seconds=${FUZZ_SECONDS:-12}
+fuzz_seconds=${FUZZ_SECONDS:-10}
 werror=(-DASP_WERROR=ON)
 summary=()
 t_all=$SECONDS
@@ -36,12 +36,13 @@ configure() {
   cmake -S . -B "$dir" "${werror[@]}" "$@" >/dev/null
 }
 
-# run_ctest DIR: ctest in DIR; appends "passed/failed/skipped" to the summary
+# run_ctest DIR [CTEST ARGS...]: ctest in DIR; appends "passed/failed/skipped" to the summary
 run_ctest() {
   local dir=$1 log
+  shift
   log=$(mktemp)
   local st=0
-  (cd "$dir" && ctest --output-on-failure -j "$jobs") 2>&1 | tee "$log" || st=$?
+  (cd "$dir" && ctest --output-on-failure -j "$jobs" "$@") 2>&1 | tee "$log" || st=$?
   local total skipped failed
   total=$(grep -Eo 'out of [0-9]+' "$log" | tail -1 | grep -Eo '[0-9]+' || echo 0)
   skipped=$(grep -c '\*\*\*Skipped\|Not Run' "$log" || true)
@@ -50,7 +51,7 @@ run_ctest() {
   n_passed=$((n_passed + total - skipped - ${failed/\?/0}))
   n_failed=$((n_failed + ${failed/\?/1}))
   n_skipped=$((n_skipped + skipped))
-  summary+=("  $dir: $total tests, $((total - skipped - ${failed/\?/0})) passed, $failed failed, $skipped skipped")
+  summary+=("  $dir${*:+ ($*)}: $total tests, $((total - skipped - ${failed/\?/0})) passed, $failed failed, $skipped skipped")
   return "$st"
 }
 
@@ -64,7 +65,8 @@ build_a() {
 build_b() {
   configure build-release -DCMAKE_BUILD_TYPE=Release
   cmake --build build-release -j "$jobs"
-  run_ctest build-release
+  # the end-to-end tests (label e2e: browser, Xvfb, whole experiment) ran in stage a
+  run_ctest build-release -LE e2e
 }
 
 # One clang compile of everything (library, CLI, tests, benchmarks, fuzzers); its tests are not
@@ -174,7 +176,7 @@ build_f() {
   ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:intercept_tls_get_addr=0" \
     UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
     LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0" \
-    run_ctest build-asan
+    run_ctest build-asan -LE e2e
 }
 
 report() {

@@ -1,3 +1,4 @@
+# ctest-label: e2e
 # amgsplat view / render --frame-ms (issue 18 item 5): the frame budget holds the frame time of a
 # scripted fly-through under Xvfb by moving tau, the figures show over the frame (i toggles them),
 # renderers without a level of detail say so, and render's simulated budget settles.

@@ -1,3 +1,4 @@
+# ctest-label: e2e
 # amgsplat experiment run (issue 15): the machine observer runs the four tests of seed 004 2.3 for two
 # subjects; the logs follow docs/experiment-log.md, the same seed gives the same logs apart from
 # frame_ms and timestamps, a blank frame leaves the observer where it started, and a subject's logs

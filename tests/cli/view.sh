@@ -1,3 +1,4 @@
+# ctest-label: e2e
 # amgsplat view: scripted frames in a real window (Xvfb + Mesa llvmpipe through GLX), screenshots
 # checked against headless 'amgsplat render' of the same view, keys, .amg colouring, errors.
 

@@ -1,3 +1,4 @@
+# ctest-label: e2e
 # The web viewer (web/, issue 16): the bunny's primitives and points exported to GLB, screenshot in headless
 # Chromium (web/test/screenshot.mjs) and compared with `amgsplat render` of the same view, size,
 # background and lighting: SSIM >= 0.9 (the issue's Done-when line). The viewer's "normalized" is the
