@@ -63,7 +63,9 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     "uniform int u_unlit;\n"                                                                           \
     "uniform ivec2 u_size;\n"                                                                          \
     "uniform int u_persp;\n"                                                                           \
-    "uniform int u_pass;\n"                                                                            \
+    /* the pass is a constant of its program: llvmpipe runs both sides of a branch under a lane    */ \
+    /* mask, so a uniform pass would pay for the per-pixel work of every pass in each           */ \
+    "const int u_pass = PASS;\n"                                                                      \
     "uniform int u_big;\n"                                                                             \
     "uniform int u_append;\n"                                                                          \
     "uniform uint u_batch0;\n"                                                                         \
@@ -74,7 +76,7 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
     "uniform float u_epsilon;\n"                                                                       \
     "uniform int u_eps_uniform;\n"                                                                     \
     "uniform float u_ka, u_kb, u_kn, u_kscale, u_ksigma;\n"                                            \
-    "uniform int u_kgauss;\n"                                                                          \
+    "const int u_kgauss = KGAUSS;\n" /* the kernel too: exp and pow would both run */              \
     "uniform int u_has_colors;\n"                                                                      \
     "uniform vec4 u_default_color;\n"                                                                  \
     "vec3 oct_decode(vec2 e) {\n"                                                                      \
@@ -251,7 +253,8 @@ enum { PASS_DEPTH, PASS_COLOR, PASS_BLEND_DEPTH, PASS_BLEND_SUM, PASS_DEPTH_COLO
 /* The 32-bit program: no 64-bit buffer, pass 4 never runs. */
 #define FB64_DECL ""
 #define FB64_PASS ""
-static const char *compute32_src = "#version 450 core\n" COMPUTE_GLSL;
+static const char *compute32_head = "#version 450 core\n";
+static const char *compute32_body = COMPUTE_GLSL;
 #undef FB64_DECL
 #undef FB64_PASS
 
@@ -260,9 +263,10 @@ static const char *compute32_src = "#version 450 core\n" COMPUTE_GLSL;
 #define FB64_PASS                                                                  \
     "    else if (u_pass == 4)\n"                                                  \
     "        atomicMin(fb64[i], packUint2x32(uvec2(s.pk, zb)));\n"
-static const char *compute64_src = "#version 450 core\n"
-                                   "#extension GL_ARB_gpu_shader_int64 : require\n"
-                                   "#extension GL_NV_shader_atomic_int64 : require\n" COMPUTE_GLSL;
+static const char *compute64_head = "#version 450 core\n"
+                                    "#extension GL_ARB_gpu_shader_int64 : require\n"
+                                    "#extension GL_NV_shader_atomic_int64 : require\n";
+static const char *compute64_body = COMPUTE_GLSL;
 #undef FB64_DECL
 #undef FB64_PASS
 
@@ -317,20 +321,23 @@ static const char *resolve64_src =
     "#define FETCH_OPAQUE if (u_mode == 1) { uvec2 v = unpackUint2x32(fb64[i]); z = v.y; c = v.x; } "
     "else { z = depth[i]; c = color[i]; }\n" RESOLVE_GLSL;
 
-enum { U_EYE, U_VIEW_DIR, U_MVP, U_LIGHT, U_UNLIT, U_SIZE, U_PERSP, U_PASS, U_BIG, U_APPEND, U_BATCH0,
+enum { U_EYE, U_VIEW_DIR, U_MVP, U_LIGHT, U_UNLIT, U_SIZE, U_PERSP, U_BIG, U_APPEND, U_BATCH0,
        U_POINTS, U_BIG_CAP, U_SUPPORT, U_RADIUS_SCALE, U_EPSILON, U_EPS_UNIFORM, U_KA, U_KB, U_KN, U_KSCALE,
-       U_KSIGMA, U_KGAUSS, U_HAS_COLORS, U_DEFAULT_COLOR, U_LUT, U_COUNT };
+       U_KSIGMA, U_HAS_COLORS, U_DEFAULT_COLOR, U_LUT, U_COUNT };
 static const char *uniform_names[U_COUNT] = {
-    "u_eye", "u_view_dir", "u_mvp", "u_light", "u_unlit", "u_size", "u_persp", "u_pass",
+    "u_eye", "u_view_dir", "u_mvp", "u_light", "u_unlit", "u_size", "u_persp",
     "u_big", "u_append", "u_batch0", "u_points", "u_big_cap", "u_support", "u_radius_scale", "u_epsilon",
-    "u_eps_uniform", "u_ka", "u_kb", "u_kn", "u_kscale", "u_ksigma", "u_kgauss", "u_has_colors",
+    "u_eps_uniform", "u_ka", "u_kb", "u_kn", "u_kscale", "u_ksigma", "u_has_colors",
     "u_default_color", "u_lut"};
 
 typedef struct compute_renderer {
     asp_renderer base; // first, so an asp_renderer * is a compute_renderer *
-    asp__gl_program program;  /* the 64-bit program where it is used, else the 32-bit one */
+    /* one program a pass of the mode, the pass compiled in: the 64-bit one-pass program where it is
+       used, else the 32-bit depth pass and its colour (opaque) or sum (blended) pass */
+    asp__gl_program program[2];
+    int programs;
     asp__gl_program resolve;
-    GLint u[U_COUNT];
+    GLint u[2][U_COUNT];
     GLint r_mode, r_size;
     asp__gl_vertex_array vao;
     asp__gl_buffer splats, boxes, depth, color, big, fb64;
@@ -338,6 +345,11 @@ typedef struct compute_renderer {
     uint32_t fb_width, fb_height, big_cap;
     int opaque, use64;
 } compute_renderer;
+
+/* Sets uniform `which` of every pass program: fn is a glProgramUniform* function, then its values. */
+#define SET_UNIFORM(c, fn, which, ...)                                                              \
+    for (int k_ = 0; k_ < (c)->programs; k_++)                                                      \
+    fn((c)->program[k_].id, (c)->u[k_][which], __VA_ARGS__)
 
 static void del_buffer(asp__gl_buffer *b)
 {
@@ -354,7 +366,8 @@ static void compute_destroy(asp_renderer *base)
         del_buffer(bufs[i]);
     if (c->vao.id)
         glDeleteVertexArrays(1, &c->vao.id);
-    asp__gl_program_destroy(&c->program);
+    for (int k = 0; k < 2; k++)
+        asp__gl_program_destroy(&c->program[k]);
     asp__gl_program_destroy(&c->resolve);
     asp_context actx = base->gl->actx;
     asp_free(&actx, c);
@@ -413,12 +426,15 @@ static void mat4_mul(const float *a, const float *b, float *out)
         }
 }
 
-/* One pass over every splat: the batches in chunks whose splats fit one storage binding, then the big list. */
-static void dispatch_pass(compute_renderer *c, int pass, int append)
+/*
+ * One pass (program k) over every splat: the batches in chunks whose splats fit one storage
+ * binding, then the big list.
+ */
+static void dispatch_pass(compute_renderer *c, int k, int append)
 {
-    GLuint p = c->program.id;
-    const GLint *u = c->u;
-    glProgramUniform1i(p, u[U_PASS], pass);
+    GLuint p = c->program[k].id;
+    const GLint *u = c->u[k];
+    glUseProgram(p);
     glProgramUniform1i(p, u[U_APPEND], append);
     glProgramUniform1i(p, u[U_BIG], 0);
     for (size_t b0 = 0; b0 < c->batches; b0 += c->chunk_batches) {
@@ -445,7 +461,6 @@ static void dispatch_pass(compute_renderer *c, int pass, int append)
  */
 static GLuint draw_passes(compute_renderer *c, int read_count)
 {
-    GLuint p = c->program.id;
     static const GLuint far_bits = 0xFFFFFFFFu, zero = 0;
     // a previous draw's resolve may still be queued (llvmpipe bins draws, runs dispatches at once):
     // it must read these buffers before they are cleared (scenes draw the renderer once per instance)
@@ -463,16 +478,9 @@ static GLuint draw_passes(compute_renderer *c, int read_count)
     if (c->use64)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, c->fb64.id);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUseProgram(p);
-    if (c->opaque && c->use64) {
-        dispatch_pass(c, PASS_DEPTH_COLOR64, 1);
-    } else if (c->opaque) {
-        dispatch_pass(c, PASS_DEPTH, 1);
-        dispatch_pass(c, PASS_COLOR, 0);
-    } else {
-        dispatch_pass(c, PASS_BLEND_DEPTH, 1);
-        dispatch_pass(c, PASS_BLEND_SUM, 0);
-    }
+    // the depth pass (or the one 64-bit pass) appends the large splats; the second reads the list
+    for (int k = 0; k < c->programs; k++)
+        dispatch_pass(c, k, k == 0);
 
     GLuint big_count = 0;
     if (read_count) {
@@ -491,7 +499,7 @@ static int grow_big_list(compute_renderer *c, uint32_t cap, asp_error *err)
     glCreateBuffers(1, &c->big.id);
     glNamedBufferStorage(c->big.id, (GLsizeiptr)(16 + (size_t)cap * 48), NULL, GL_DYNAMIC_STORAGE_BIT);
     c->big_cap = cap;
-    glProgramUniform1ui(c->program.id, c->u[U_BIG_CAP], cap);
+    SET_UNIFORM(c, glProgramUniform1ui, U_BIG_CAP, cap);
     char what[96];
     snprintf(what, sizeof what, "grow the compute renderer's list of large splats to %u", cap);
     return asp__gl_check(c->base.gl, what, err);
@@ -503,8 +511,6 @@ static int compute_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     int rc = ensure_framebuffer(c, f->width, f->height, err);
     if (rc)
         return rc;
-    GLuint p = c->program.id;
-    const GLint *u = c->u;
     float mvp[16];
     mat4_mul(f->proj, f->view, mvp);
     // the light and the view direction into the splats' frame: the transposed rotation of the view
@@ -517,14 +523,14 @@ static int compute_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     }
     normalize3(light);
     normalize3(dir);
-    glProgramUniform3fv(p, u[U_EYE], 1, f->eye);
-    glProgramUniform3fv(p, u[U_VIEW_DIR], 1, dir);
-    glProgramUniformMatrix4fv(p, u[U_MVP], 1, GL_FALSE, mvp);
-    glProgramUniform3fv(p, u[U_LIGHT], 1, light);
-    glProgramUniform1i(p, u[U_UNLIT], (f->flags & ASP_RENDER_UNLIT) ? 1 : 0);
-    glProgramUniform2i(p, u[U_SIZE], (GLint)f->width, (GLint)f->height);
+    SET_UNIFORM(c, glProgramUniform3fv, U_EYE, 1, f->eye);
+    SET_UNIFORM(c, glProgramUniform3fv, U_VIEW_DIR, 1, dir);
+    SET_UNIFORM(c, glProgramUniformMatrix4fv, U_MVP, 1, GL_FALSE, mvp);
+    SET_UNIFORM(c, glProgramUniform3fv, U_LIGHT, 1, light);
+    SET_UNIFORM(c, glProgramUniform1i, U_UNLIT, (f->flags & ASP_RENDER_UNLIT) ? 1 : 0);
+    SET_UNIFORM(c, glProgramUniform2i, U_SIZE, (GLint)f->width, (GLint)f->height);
     // a perspective projection has -1 in row 3 of column 2; an orthographic one 0
-    glProgramUniform1i(p, u[U_PERSP], f->proj[11] != 0.0f);
+    SET_UNIFORM(c, glProgramUniform1i, U_PERSP, f->proj[11] != 0.0f);
 
     /*
      * A two-pass frame with more large splats than the list holds is drawn again with a list that
@@ -771,11 +777,18 @@ static int build_records(asp_context *a, const asp_cloud *cloud, const asp_hier 
     return 0;
 }
 
-static int compile_compute(asp_gl_context *gl, const char *name, const char *src, asp__gl_program *out,
-                           asp_error *err)
+/*
+ * The compute program of one pass: head (version, extensions), the constants (the pass, and
+ * whether the kernel is psi_G), body.
+ */
+static int compile_compute(asp_gl_context *gl, const char *name, const char *head, const char *body, int pass,
+                           int gauss, asp__gl_program *out, asp_error *err)
 {
+    char define[64];
+    snprintf(define, sizeof define, "#define PASS %d\n#define KGAUSS %d\n", pass, gauss != 0);
+    const char *src[3] = {head, define, body};
     GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
-    glShaderSource(sh, 1, &src, NULL);
+    glShaderSource(sh, 3, src, NULL);
     glCompileShader(sh);
     GLint ok = 0;
     glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
@@ -783,7 +796,8 @@ static int compile_compute(asp_gl_context *gl, const char *name, const char *src
     if (!ok) {
         glGetShaderInfoLog(sh, sizeof log, NULL, log);
         glDeleteShader(sh);
-        return asp_error_set(err, ASP_EGL, "cannot compile the %s compute shader: %.300s", name, log);
+        return asp_error_set(err, ASP_EGL, "cannot compile the %s compute shader of pass %d: %.300s", name, pass,
+                             log);
     }
     GLuint p = glCreateProgram();
     glAttachShader(p, sh);
@@ -793,7 +807,8 @@ static int compile_compute(asp_gl_context *gl, const char *name, const char *src
     if (!ok) {
         glGetProgramInfoLog(p, sizeof log, NULL, log);
         glDeleteProgram(p);
-        return asp_error_set(err, ASP_EGL, "cannot link the %s compute program: %.300s", name, log);
+        return asp_error_set(err, ASP_EGL, "cannot link the %s compute program of pass %d: %.300s", name, pass,
+                             log);
     }
     out->id = p;
     (void)gl;
@@ -803,36 +818,33 @@ static int compile_compute(asp_gl_context *gl, const char *name, const char *src
 /* Kernel constants as asp_splat_renderer_desc defines them (splat_renderer.c kernel_params_of). */
 static void set_static_uniforms(compute_renderer *c, const asp_splat_renderer_desc *d, int has_colors)
 {
-    GLuint p = c->program.id;
-    const GLint *u = c->u;
     float ka = d->kernel_a > 0 ? d->kernel_a : 6.0f, kb = d->kernel_b > 0 ? d->kernel_b : 1.5f;
     float kn = d->kernel_n > 0 ? d->kernel_n : 3.0f, sigma = d->kernel_sigma > 0 ? d->kernel_sigma : 0.5f;
     int rim_at_b = (d->flags & ASP_SPLAT_KERNEL_RIM_AT_B) != 0;
     // opaque splats are the whole ellipse, as disc and opaque splat draw them
     float support = c->opaque || rim_at_b ? 1.0f : fminf(kb, 1.0f), kscale = rim_at_b ? kb : 1.0f;
     float eps = d->epsilon > 0 ? d->epsilon : d->epsilon < 0 ? 0.0f : 1.0f;
-    glProgramUniform1f(p, u[U_SUPPORT], support);
-    glProgramUniform1f(p, u[U_RADIUS_SCALE], d->radius_scale > 0 ? d->radius_scale : 1.0f);
-    glProgramUniform1f(p, u[U_EPSILON], eps);
-    glProgramUniform1i(p, u[U_EPS_UNIFORM], (d->flags & ASP_SPLAT_EPSILON_UNIFORM) != 0);
-    glProgramUniform1f(p, u[U_KA], ka);
-    glProgramUniform1f(p, u[U_KB], kb);
-    glProgramUniform1f(p, u[U_KN], kn);
-    glProgramUniform1f(p, u[U_KSCALE], kscale);
-    glProgramUniform1f(p, u[U_KSIGMA], sigma);
-    glProgramUniform1i(p, u[U_KGAUSS], d->kernel == ASP_SPLAT_KERNEL_PSI_G);
-    glProgramUniform1i(p, u[U_HAS_COLORS], has_colors);
+    SET_UNIFORM(c, glProgramUniform1f, U_SUPPORT, support);
+    SET_UNIFORM(c, glProgramUniform1f, U_RADIUS_SCALE, d->radius_scale > 0 ? d->radius_scale : 1.0f);
+    SET_UNIFORM(c, glProgramUniform1f, U_EPSILON, eps);
+    SET_UNIFORM(c, glProgramUniform1i, U_EPS_UNIFORM, (d->flags & ASP_SPLAT_EPSILON_UNIFORM) != 0);
+    SET_UNIFORM(c, glProgramUniform1f, U_KA, ka);
+    SET_UNIFORM(c, glProgramUniform1f, U_KB, kb);
+    SET_UNIFORM(c, glProgramUniform1f, U_KN, kn);
+    SET_UNIFORM(c, glProgramUniform1f, U_KSCALE, kscale);
+    SET_UNIFORM(c, glProgramUniform1f, U_KSIGMA, sigma);
+    SET_UNIFORM(c, glProgramUniform1i, U_HAS_COLORS, has_colors);
     const uint8_t *dc = d->default_color;
     int given = dc[0] || dc[1] || dc[2] || dc[3];
     float col[4];
     for (int k = 0; k < 4; k++)
         col[k] = given ? dc[k] / 255.0f : (k < 3 ? 200.0f / 255.0f : 1.0f);
-    glProgramUniform4fv(p, u[U_DEFAULT_COLOR], 1, col);
-    glProgramUniform1ui(p, u[U_BIG_CAP], c->big_cap);
+    SET_UNIFORM(c, glProgramUniform4fv, U_DEFAULT_COLOR, 1, col);
+    SET_UNIFORM(c, glProgramUniform1ui, U_BIG_CAP, c->big_cap);
     float lut[256];
     for (int k = 0; k < 256; k++)
         lut[k] = asp__srgb_to_linear((uint8_t)k);
-    glProgramUniform1fv(p, u[U_LUT], 256, lut);
+    SET_UNIFORM(c, glProgramUniform1fv, U_LUT, 256, lut);
 }
 
 static int upload(compute_renderer *c, const uint32_t *w, const float *boxes, size_t n, asp_error *err)
@@ -928,15 +940,18 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     c->base.gl = gl;
     c->base.count = n;
     c->opaque = desc->mode == ASP_SPLAT_OPAQUE;
+    int gauss = desc->kernel == ASP_SPLAT_KERNEL_PSI_G;
     c->use64 = c->opaque && has_gl_extension("GL_NV_shader_atomic_int64") &&
                has_gl_extension("GL_ARB_gpu_shader_int64");
     if (c->use64) {
         // a driver that lists the extensions but fails the shaders still draws, by the 32-bit path
         asp_error e64;
-        if (compile_compute(gl, "64-bit", compute64_src, &c->program, &e64) ||
+        c->programs = 1;
+        if (compile_compute(gl, "64-bit", compute64_head, compute64_body, PASS_DEPTH_COLOR64, gauss, &c->program[0],
+                            &e64) ||
             asp__gl_program_create(gl, "compute resolve (64-bit)", resolve_vertex_src, resolve64_src, &c->resolve,
                                    &e64)) {
-            asp__gl_program_destroy(&c->program);
+            asp__gl_program_destroy(&c->program[0]);
             asp__gl_program_destroy(&c->resolve);
             asp__gl_clear_errors(gl);
             c->use64 = 0;
@@ -944,7 +959,11 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     }
     rc = 0;
     if (!c->use64) {
-        rc = compile_compute(gl, "32-bit", compute32_src, &c->program, err);
+        c->programs = 2;
+        int first = c->opaque ? PASS_DEPTH : PASS_BLEND_DEPTH, second = c->opaque ? PASS_COLOR : PASS_BLEND_SUM;
+        rc = compile_compute(gl, "32-bit", compute32_head, compute32_body, first, gauss, &c->program[0], err);
+        if (!rc)
+            rc = compile_compute(gl, "32-bit", compute32_head, compute32_body, second, gauss, &c->program[1], err);
         if (!rc)
             rc = asp__gl_program_create(gl, "compute resolve", resolve_vertex_src, resolve32_src, &c->resolve, err);
     }
@@ -957,7 +976,8 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
         return rc;
     }
     for (int i = 0; i < U_COUNT; i++)
-        c->u[i] = glGetUniformLocation(c->program.id, uniform_names[i]);
+        for (int k = 0; k < c->programs; k++)
+            c->u[k][i] = glGetUniformLocation(c->program[k].id, uniform_names[i]);
     c->r_mode = glGetUniformLocation(c->resolve.id, "u_mode");
     c->r_size = glGetUniformLocation(c->resolve.id, "u_size");
     glCreateVertexArrays(1, &c->vao.id);
