@@ -156,6 +156,8 @@ struct viewer {
     double frame_top;         /* when the current frame began (after any idle wait) */
     asp_camera fly_start;     /* the first view: the fly-through's path starts there */
     asp__viewer_frame_log flog;
+    int edl_on;               /* eye-dome lighting for the disc and square renderers (desc->edl, the E key) */
+    int help_on;              /* the h key: the keys drawn over the frame */
 };
 
 static void vlog(const viewer *v, const char *fmt, ...)
@@ -327,6 +329,8 @@ static int make_renderer(viewer *v, size_t k, asp_renderer **out, asp_error *err
     o.splat.tolerance = v->tolerance;
     o.square.tolerance = v->tolerance;
     o.splat.flags = o.square.flags = v->desc->lod_flags;
+    if (v->edl_on) // the renderers without the pass ignore it
+        o.disc.edl = o.square.edl = (asp_edl_desc){.strength = v->desc->edl_strength > 0 ? v->desc->edl_strength : 1.0f};
     o.prim = v->prim;
     // thesis appendix C "one picked domain only": a copy of the level holding that primitive alone
     asp_dps_level one;
@@ -632,6 +636,26 @@ static void scene_action(viewer *v, enum asp__viewer_action a)
     vlog(v, "%s", v->status);
 }
 
+/* The disc and square renderers draw eye-dome lighting (asp_edl_desc); the others ignore it. */
+static int edl_applies(const viewer *v, size_t k)
+{
+    return !v->is_scene && (strcmp(K(k)->name, "disc") == 0 || strcmp(K(k)->name, "square") == 0);
+}
+
+/* E: eye-dome lighting on or off; the renderer is made again with it when it draws it. */
+static void toggle_edl(viewer *v)
+{
+    v->edl_on = !v->edl_on;
+    asp_error e = {0, ""};
+    if (edl_applies(v, v->kind) && switch_renderer(v, v->kind, &e)) {
+        vlog(v, "cannot switch eye-dome lighting: %s", e.msg);
+        v->edl_on = !v->edl_on;
+        return;
+    }
+    vlog(v, "eye-dome lighting %s%s", v->edl_on ? "on" : "off",
+         edl_applies(v, v->kind) ? "" : " (the disc and square renderers draw it)");
+}
+
 static void apply(viewer *v, const action *a)
 {
     const double step_px = 10.0 / ASP__VIEWER_ORBIT_DEG_PER_PX; // 10 degrees per key press
@@ -664,7 +688,12 @@ static void apply(viewer *v, const action *a)
     case ASP__VIEWER_POINTS: toggle_points(v); break;
     case ASP__VIEWER_SCREENSHOT: v->screenshot_wanted = 1; break;
     case ASP__VIEWER_OVERLAY: v->overlay_on = !v->overlay_on; break;
-    case ASP__VIEWER_HELP: print_help(v); break;
+    case ASP__VIEWER_HELP:
+        v->help_on = !v->help_on;
+        if (v->help_on)
+            print_help(v);
+        break;
+    case ASP__VIEWER_EDL: toggle_edl(v); break;
     case ASP__VIEWER_PRINT_VIEW: print_view(v); break;
     case ASP__VIEWER_ORBIT_LEFT: asp__viewer_orbit(&v->cam, -step_px, 0); break;
     case ASP__VIEWER_ORBIT_RIGHT: asp__viewer_orbit(&v->cam, step_px, 0); break;
@@ -756,38 +785,104 @@ static void budget_after_frame(viewer *v, double frame_ms, size_t count)
         v->dirty = 1;
 }
 
-static int draw_overlay(viewer *v, asp_error *err)
+/*
+ * The figures over the frame (the i key): what is shown (file, renderer, method or level, colours),
+ * then how fast (frame and draw time, budget, tau, counts). Frame times are of the previous frame,
+ * which the overlay of this one cannot know; the first frame has none yet and its drawing includes
+ * the driver's one-time work (shader compilation, buffer uploads), so it says so.
+ */
+static void overlay_text(viewer *v, char *text, size_t cap)
+{
+    asp_renderer_stats rs;
+    asp_renderer_stats_get(v->r, &rs);
+    const char *base = strrchr(v->path, '/');
+    base = base ? base + 1 : v->path;
+    size_t n = 0;
+#define ADD(...)                                                                                                   \
+    do {                                                                                                           \
+        int w_ = snprintf(text + n, cap - n, __VA_ARGS__);                                                         \
+        n = w_ < 0 ? n : n + (size_t)w_ < cap ? n + (size_t)w_ : cap - 1;                                          \
+    } while (0)
+    ADD("%s", base);
+    if (v->kind == v->kind_prim)
+        ADD("\nrenderer prim: %s, alpha-ref %.2f%s%s", asp_prim_render_method_name(v->prim.method),
+            alpha_ref_of(&v->prim), v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? ", outline" : "",
+            v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? ", domain colours" : "");
+    else
+        ADD("\nrenderer %s%s%s", K(v->kind)->name, v->unlit ? ", unlit" : "",
+            v->edl_on && edl_applies(v, v->kind) ? ", eye-dome lighting" : "");
+    if (v->status[0])
+        ADD("\n%s", v->status);
+    if (v->desc->color_field)
+        ADD("\ncolour by %s", v->desc->color_field);
+    if (v->frames <= 1)
+        ADD("\nframe -- ms  first draw %.1f ms (with GL warm-up)", v->last_ms);
+    else
+        ADD("\nframe %.1f ms  draw %.1f ms", v->frame_last_ms, v->last_ms);
+    if (v->budget_on)
+        ADD("\nbudget %g ms%s", v->desc->frame_ms,
+            !v->budget_ok           ? " (no level of detail here)"
+            : v->budget.saturated   ? " (coarsest: cannot hold it)"
+            : v->budget.bound       ? " (coarser is not faster here)"
+            : v->budget.finest      ? " (full detail fits)"
+                                    : "");
+    if (K(v->kind)->has_lod || v->budget_ok) {
+        char depth[32] = "none";
+        if (v->depth_limit)
+            snprintf(depth, sizeof depth, "%u", v->depth_limit);
+        ADD("\ntau %.2f px  depth limit %s", (double)v->tolerance, depth);
+    }
+    ADD("\n%zu / %zu %s", rs.count, rs.points ? rs.points : rs.count, K(v->kind)->noun);
+#undef ADD
+}
+
+/* The key list for the h key, as print_help logs it. */
+static void help_text(char *text, size_t cap)
+{
+    size_t n = 0;
+    int w = snprintf(text, cap, "keys (h hides them)\nmouse: left drag orbit, wheel or right drag zoom,\n"
+                                "       middle drag or shift + left drag pan");
+    n = w < 0 ? 0 : (size_t)w;
+    for (const asp__viewer_key *k = asp__viewer_keys; k->key && n + 1 < cap; k++) {
+        if (!k->help)
+            continue;
+        const char *name = k->action == ASP__VIEWER_PICK_RENDERER ? asp_viewer_renderer_name((size_t)k->arg) : NULL;
+        if (k->action == ASP__VIEWER_PICK_RENDERER && !name)
+            continue;
+        w = name ? snprintf(text + n, cap - n, "\n%c  renderer %s", k->key, name)
+                 : snprintf(text + n, cap - n, "\n%c  %s", k->key, k->help);
+        n = w < 0 ? n : n + (size_t)w < cap ? n + (size_t)w : cap - 1;
+    }
+}
+
+static int draw_overlay(viewer *v, uint32_t width, uint32_t height, asp_error *err)
 {
     if (!v->overlay) {
         int rc = asp_text_overlay_create(v->gl, &v->overlay, err);
         if (rc)
             return rc;
     }
-    asp_renderer_stats rs;
-    asp_renderer_stats_get(v->r, &rs);
-    char text[512], line[160];
-    snprintf(text, sizeof text, "frame %.1f ms  draw %.1f ms", v->frame_last_ms, v->last_ms);
-    if (v->budget_on) {
-        snprintf(line, sizeof line, "\nbudget %g ms%s", v->desc->frame_ms,
-                 !v->budget_ok                    ? " (no level of detail here)"
-                 : v->budget.saturated            ? " (coarsest: cannot hold it)"
-                 : v->budget.bound                ? " (coarser is not faster here)"
-                 : v->budget.finest               ? " (full detail fits)"
-                                                  : "");
-        strncat(text, line, sizeof text - strlen(text) - 1);
+    float top = 8;
+    if (v->overlay_on) {
+        overlay_text(v, v->stats.overlay, sizeof v->stats.overlay);
+        asp_text_overlay_desc od = {.x = 8, .y = top, .scale = 2};
+        int rc = asp_text_overlay_draw(v->overlay, v->stats.overlay, &od, err);
+        if (rc)
+            return rc;
+        float w, h;
+        asp_text_overlay_measure(v->stats.overlay, 2, &w, &h);
+        top += h + 8;
     }
-    if (K(v->kind)->has_lod || v->budget_ok) {
-        char depth[32] = "none";
-        if (v->depth_limit)
-            snprintf(depth, sizeof depth, "%u", v->depth_limit);
-        snprintf(line, sizeof line, "\ntau %.2f px  depth limit %s", (double)v->tolerance, depth);
-        strncat(text, line, sizeof text - strlen(text) - 1);
-    }
-    snprintf(line, sizeof line, "\n%zu / %zu %s (%s)", rs.count, rs.points ? rs.points : rs.count, K(v->kind)->noun,
-             K(v->kind)->name);
-    strncat(text, line, sizeof text - strlen(text) - 1);
-    asp_text_overlay_desc od = {.x = 8, .y = 8, .scale = 2};
-    return asp_text_overlay_draw(v->overlay, text, &od, err);
+    if (!v->help_on)
+        return 0;
+    char help[4096];
+    help_text(help, sizeof help);
+    // twice the font where it fits the window, else the font's own size (small windows)
+    float w, h;
+    asp_text_overlay_measure(help, 2, &w, &h);
+    float scale = w + 16 <= (float)width && top + h + 8 <= (float)height ? 2.0f : 1.0f;
+    asp_text_overlay_desc hd = {.x = 8, .y = top, .scale = scale};
+    return asp_text_overlay_draw(v->overlay, help, &hd, err);
 }
 
 /* ---- the loop ---- */
@@ -876,11 +971,11 @@ static int draw(viewer *v, int last, asp_error *err)
     rec.draw_ms = 1000.0 * (now - t0);
     rec.count = asp_renderer_count(v->r);
     account_frame(v, rec.draw_ms, now);
-    if (v->overlay_on) {
+    if (v->overlay_on || v->help_on) {
         asp_error e = {0, ""};
-        if (draw_overlay(v, &e)) {
-            vlog(v, "cannot draw the figures over the frame: %s", e.msg);
-            v->overlay_on = 0;
+        if (draw_overlay(v, w, h, &e)) {
+            vlog(v, "cannot draw text over the frame: %s", e.msg);
+            v->overlay_on = v->help_on = 0;
         }
     }
     if (v->screenshot_wanted) {
@@ -1017,6 +1112,23 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
              : v.scene.hier ? find_renderer("splat")
              : v.scene.mesh ? find_renderer("mesh")
                             : first_accepted(&v);
+    // a frame budget steers tau, so without --renderer it picks the first renderer with a level of detail
+    if (!desc->renderer && desc->frame_ms > 0 && !K(v.kind)->has_lod) {
+        size_t k = 0;
+        while (k < asp_renderer_kind_count() && !(K(k)->has_lod && kind_accepts(&v, k)))
+            k++;
+        if (k < asp_renderer_kind_count()) {
+            vlog(&v, "frame budget %g ms: drawing with the %s renderer, whose tau it steers (the %s renderer has "
+                     "no level of detail)", desc->frame_ms, K(k)->name, K(v.kind)->name);
+            v.kind = k;
+        }
+    }
+    // points without normals cannot be lit: eye-dome lighting shades them (Boucheny 2009), as in CloudCompare
+    int no_normals = !v.is_scene && v.scene.cloud && !v.scene.cloud->normals && !v.scene.dps;
+    v.edl_on = desc->edl > 0 || (desc->edl == 0 && no_normals && !v.unlit);
+    if (no_normals && (K(v.kind)->inputs & ASP_RENDER_INPUT_POINTS))
+        vlog(&v, "hint: '%s' has no normals: drawn %s; 'amgsplat estimate %s -o WITH_NORMALS.ply' estimates them "
+                 "for lit discs", path, v.edl_on ? "with eye-dome lighting" : "flat", path);
     // the scene loader records missing textures; the viewer says so through its log (issue 14)
     for (size_t i = 0; v.scene.mesh && i < v.scene.mesh->material_count; i++)
         if (v.scene.mesh->materials[i].texture_missing)
@@ -1040,6 +1152,7 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
         update_title(&v, asp_time_now(), 1);
     if (!rc) {
         v.stats.budget_applied = v.budget_on && v.budget_ok;
+        v.stats.edl = v.edl_on && edl_applies(&v, v.kind);
         snprintf(v.stats.renderer, sizeof v.stats.renderer, "%s", K(v.kind)->name);
         v.stats.mean_frame_ms = v.frames ? v.total_ms / (double)v.frames : 0;
         asp__viewer_frame_log_summary(&v.flog, &v.ctx, &v.stats);
