@@ -855,6 +855,16 @@ static void help_text(char *text, size_t cap)
     }
 }
 
+/* Twice the font where text fits the room left, else 1.5 times or the font's own size (small windows). */
+static float fit_scale(const char *text, float room_w, float room_h)
+{
+    float w, h, scale = 2.0f;
+    asp_text_overlay_measure(text, 2.0f, &w, &h);
+    while (scale > 1.0f && (w * scale / 2 > room_w || h * scale / 2 > room_h))
+        scale -= 0.5f;
+    return scale;
+}
+
 static int draw_overlay(viewer *v, uint32_t width, uint32_t height, asp_error *err)
 {
     if (!v->overlay) {
@@ -865,23 +875,47 @@ static int draw_overlay(viewer *v, uint32_t width, uint32_t height, asp_error *e
     float top = 8;
     if (v->overlay_on) {
         overlay_text(v, v->stats.overlay, sizeof v->stats.overlay);
-        asp_text_overlay_desc od = {.x = 8, .y = top, .scale = 2};
+        float scale = fit_scale(v->stats.overlay, (float)width - 16, (float)height - 16);
+        asp_text_overlay_desc od = {.x = 8, .y = top, .scale = scale};
         int rc = asp_text_overlay_draw(v->overlay, v->stats.overlay, &od, err);
         if (rc)
             return rc;
         float w, h;
-        asp_text_overlay_measure(v->stats.overlay, 2, &w, &h);
+        asp_text_overlay_measure(v->stats.overlay, scale, &w, &h);
         top += h + 8;
     }
     if (!v->help_on)
         return 0;
     char help[4096];
     help_text(help, sizeof help);
-    // twice the font where it fits the window, else the font's own size (small windows)
-    float w, h;
-    asp_text_overlay_measure(help, 2, &w, &h);
-    float scale = w + 16 <= (float)width && top + h + 8 <= (float)height ? 2.0f : 1.0f;
-    asp_text_overlay_desc hd = {.x = 8, .y = top, .scale = scale};
+    float room_w = (float)width - 16, room_h = (float)height - top - 8;
+    float one = fit_scale(help, room_w, room_h);
+    // too tall for the window at the font's size or more: the lines' second half in a second column
+    size_t lines = 1;
+    for (const char *c = help; *c; c++)
+        lines += *c == '\n';
+    char *mid = help; // the first character of line (lines + 1) / 2
+    for (size_t seen = 0; *mid && seen < (lines + 1) / 2; mid++)
+        seen += *mid == '\n';
+    float full_w, full_h;
+    asp_text_overlay_measure(help, one, &full_w, &full_h);
+    if (*mid) {
+        mid[-1] = '\0';
+        float w1, h1, w2, h2, two = 2.0f;
+        asp_text_overlay_measure(help, 2.0f, &w1, &h1);
+        asp_text_overlay_measure(mid, 2.0f, &w2, &h2);
+        while (two > 1.0f && ((w1 + w2 + 8) * two / 2 > room_w || (h1 > h2 ? h1 : h2) * two / 2 > room_h))
+            two -= 0.5f;
+        // two columns when they allow a larger font, or when one column runs off the bottom anyway
+        if (two > one || full_h > room_h) {
+            asp_text_overlay_desc a = {.x = 8, .y = top, .scale = two}, b = a;
+            b.x = 8 + w1 * two / 2 + 8;
+            int rc = asp_text_overlay_draw(v->overlay, help, &a, err);
+            return rc ? rc : asp_text_overlay_draw(v->overlay, mid, &b, err);
+        }
+        mid[-1] = '\n';
+    }
+    asp_text_overlay_desc hd = {.x = 8, .y = top, .scale = one};
     return asp_text_overlay_draw(v->overlay, help, &hd, err);
 }
 
@@ -1127,8 +1161,9 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
     int no_normals = !v.is_scene && v.scene.cloud && !v.scene.cloud->normals && !v.scene.dps;
     v.edl_on = desc->edl > 0 || (desc->edl == 0 && no_normals && !v.unlit);
     if (no_normals && (K(v.kind)->inputs & ASP_RENDER_INPUT_POINTS))
-        vlog(&v, "hint: '%s' has no normals: drawn %s; 'amgsplat estimate %s -o WITH_NORMALS.ply' estimates them "
-                 "for lit discs", path, v.edl_on ? "with eye-dome lighting" : "flat", path);
+        vlog(&v, "hint: '%s' has no normals%s; 'amgsplat estimate %s -o WITH_NORMALS.ply' estimates them for lit "
+                 "discs", path, v.edl_on && edl_applies(&v, v.kind) ? ": drawn with eye-dome lighting (E toggles it)" : "",
+             path);
     // the scene loader records missing textures; the viewer says so through its log (issue 14)
     for (size_t i = 0; v.scene.mesh && i < v.scene.mesh->material_count; i++)
         if (v.scene.mesh->materials[i].texture_missing)
