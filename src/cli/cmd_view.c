@@ -235,8 +235,13 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         return 2;
     asp_error err = {0, ""};
     asp_viewer_stats stats;
-    if (asp_viewer_run(argv[0], &desc, &env->ctx, &stats, &err))
+    if (asp_viewer_run(argv[0], &desc, &env->ctx, &stats, &err)) {
+        // a field the file does not have is a bad option value, as in render (the viewer's message names the file)
+        if (desc.color_field && err.code == ASP_EINVAL && strncmp(err.msg, "cannot colour '", 15) == 0)
+            return cli_usage_error(env, "%s expects classifier, domains, strict or input (.amg), or a point field: %s",
+                                   o.r.color_by_name, err.msg);
         return cli_fail(env, &err);
+    }
     if (env->json)
         return print_json(env, argv[0], &desc, &stats);
     cli_info(env, "drew %zu frames of '%s' (%s, %zu %s, %.2f ms per frame)\n", stats.frames, argv[0], stats.renderer,

@@ -260,7 +260,7 @@ check "$T/cls.png" "sum(1 for x in range(w) for y in range(h) if px(x, y)[:3] ==
 check "$T/cls.png" "all(px(x, y)[:3] in ((255, 255, 255), (150, 100, 50), (230, 80, 40)) for x in range(w) for y in range(h))"
 [[ "$(field "$T/cls.json" edl)" == False ]] || fail "--unlit left eye-dome lighting on: $(cat "$T/cls.json")"
 view "$T/scan.ply" --frames 1 --up z --color-by elevation --size 64x48 -q || fail "view --color-by elevation"
-expect_fail 1 "no such property 'colour'" view "$T/scan.ply" --frames 1 --color-by colour
+expect_fail 2 "no such property 'colour' (elevation or the file's: classification, intensity)" view "$T/scan.ply" --frames 1 --color-by colour
 expect_fail 2 "--color-by expects classifier" "$AMGSPLAT" view "$T/oct.amg" --color-by elevation
 
 # Eye-dome lighting: on by default for points without normals; it shades the flat grey discs (the
@@ -287,6 +287,22 @@ view "$T/scan.ply" --frames 3 --up z --size 64x48 --keys 21 -q 2>"$T/edl_q.err"
 view "$T/sphere.ply" --frames 1 --size 64x48 2>"$T/sph.err"
 ! grep -q "hint:" "$T/sph.err" || fail "hint on a cloud with normals: $(cat "$T/sph.err")"
 expect_fail 2 "--no-edl excludes" "$AMGSPLAT" view "$T/scan.ply" --edl --no-edl
+# render draws the same shading (default on without normals) and says the same hint once
+"$AMGSPLAT" render "$T/scan.ply" --up z --size 160x120 --view 30,35 -o "$T/r_edl.png" 2>"$T/r_edl.err"
+"$AMGSPLAT" render "$T/scan.ply" --up z --size 160x120 --view 30,35 -o "$T/r_noedl.png" --no-edl -q 2>"$T/r_q.err"
+[[ "$(grep -c "hint: '$T/scan.ply' has no normals: drawn with eye-dome lighting; 'amgsplat estimate" "$T/r_edl.err")" == 1 &&
+   ! -s "$T/r_q.err" ]] || fail "render hint: $(cat "$T/r_edl.err" "$T/r_q.err")"
+ssim=$(metric "$T/r_edl.png" "$T/r_noedl.png" ssim)
+awk -v s="$ssim" 'BEGIN { exit !(s < 0.8) }' || fail "render: eye-dome lighting changed too little (SSIM $ssim)"
+at_least "$(metric "$T/r_edl.png" "$T/edl.png" ssim)" 0.9 "render vs view with eye-dome lighting"
+"$AMGSPLAT" render "$T/sphere.ply" --size 160x120 --view 0,0 -o "$T/r_sph.png" --samples 0 2>"$T/r_sph.err"
+! grep -q "hint:" "$T/r_sph.err" && [[ "$(metric "$T/r_sph.png" "$T/ref0.png" psnr)" == inf ]] ||
+  fail "points with normals: a hint or eye-dome lighting: $(cat "$T/r_sph.err")"
+"$AMGSPLAT" render "$T/sphere.ply" --size 160x120 --view 0,0 -o "$T/r_sph_edl.png" --samples 0 --edl -q
+ssim=$(metric "$T/r_sph_edl.png" "$T/ref0.png" ssim)
+awk -v s="$ssim" 'BEGIN { exit !(s < 0.99) }' || fail "render --edl on points with normals changed nothing (SSIM $ssim)"
+expect_fail 2 "--edl and --edl-strength need --renderer disc or square" "$AMGSPLAT" render "$T/scan.ply" -o "$T/x.png" --edl --renderer splat
+expect_fail 2 "--edl-strength expects a number in (0, 100]" "$AMGSPLAT" render "$T/scan.ply" -o "$T/x.png" --edl-strength 0
 
 # The figures (i) name the file, renderer, level or method; the first frame has no frame time yet.
 view "$T/sphere.ply" --frames 1 --overlay --size 320x240 --screenshot "$T/ov1.png" --json -q >"$T/ov1.json"
