@@ -89,6 +89,9 @@ int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err)
         return asp_error_set(err, ASP_EINVAL, "a screenshot file needs a number of frames (scripted mode)");
     if (desc->screenshot && !asp_file_name_is(desc->screenshot, "png"))
         return asp_error_set(err, ASP_EINVAL, "screenshot '%s' must end in .png", desc->screenshot);
+    if (!(desc->edl_strength >= 0 && desc->edl_strength <= 100))
+        return asp_error_set(err, ASP_EINVAL, "eye-dome lighting strength %g is outside 0..100",
+                             (double)desc->edl_strength);
     if (!(desc->frame_ms >= 0 && desc->frame_ms <= 1e6))
         return asp_error_set(err, ASP_EINVAL, "frame budget %g ms is outside 0..1e6", desc->frame_ms);
     if (desc->fly && desc->frames == 0)
@@ -329,7 +332,7 @@ static int make_renderer(viewer *v, size_t k, asp_renderer **out, asp_error *err
     o.splat.tolerance = v->tolerance;
     o.square.tolerance = v->tolerance;
     o.splat.flags = o.square.flags = v->desc->lod_flags;
-    if (v->edl_on) // the renderers without the pass ignore it
+    if (v->edl_on && !v->is_scene) // the renderers without the pass ignore it
         o.disc.edl = o.square.edl = (asp_edl_desc){.strength = v->desc->edl_strength > 0 ? v->desc->edl_strength : 1.0f};
     o.prim = v->prim;
     // thesis appendix C "one picked domain only": a copy of the level holding that primitive alone
@@ -785,6 +788,24 @@ static void budget_after_frame(viewer *v, double frame_ms, size_t count)
         v->dirty = 1;
 }
 
+/* Appends to text (cap bytes, *n used): what fits, always terminated. */
+static void append(char *text, size_t cap, size_t *n, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+static void append(char *text, size_t cap, size_t *n, const char *fmt, ...)
+{
+    if (*n + 1 >= cap)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    int w = vsnprintf(text + *n, cap - *n, fmt, ap);
+    va_end(ap);
+    *n = w < 0 ? *n : *n + (size_t)w < cap ? *n + (size_t)w : cap - 1;
+}
+
 /*
  * The figures over the frame (the i key): what is shown (file, renderer, method or level, colours),
  * then how fast (frame and draw time, budget, tau, counts). Frame times are of the previous frame,
@@ -798,29 +819,24 @@ static void overlay_text(viewer *v, char *text, size_t cap)
     const char *base = strrchr(v->path, '/');
     base = base ? base + 1 : v->path;
     size_t n = 0;
-#define ADD(...)                                                                                                   \
-    do {                                                                                                           \
-        int w_ = snprintf(text + n, cap - n, __VA_ARGS__);                                                         \
-        n = w_ < 0 ? n : n + (size_t)w_ < cap ? n + (size_t)w_ : cap - 1;                                          \
-    } while (0)
-    ADD("%s", base);
+    append(text, cap, &n, "%s", base);
     if (v->kind == v->kind_prim)
-        ADD("\nrenderer prim: %s, alpha-ref %.2f%s%s", asp_prim_render_method_name(v->prim.method),
+        append(text, cap, &n, "\nrenderer prim: %s, alpha-ref %.2f%s%s", asp_prim_render_method_name(v->prim.method),
             alpha_ref_of(&v->prim), v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? ", outline" : "",
             v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? ", domain colours" : "");
     else
-        ADD("\nrenderer %s%s%s", K(v->kind)->name, v->unlit ? ", unlit" : "",
+        append(text, cap, &n, "\nrenderer %s%s%s", K(v->kind)->name, v->unlit ? ", unlit" : "",
             v->edl_on && edl_applies(v, v->kind) ? ", eye-dome lighting" : "");
     if (v->status[0])
-        ADD("\n%s", v->status);
+        append(text, cap, &n, "\n%s", v->status);
     if (v->desc->color_field)
-        ADD("\ncolour by %s", v->desc->color_field);
+        append(text, cap, &n, "\ncolour by %s", v->desc->color_field);
     if (v->frames <= 1)
-        ADD("\nframe -- ms  first draw %.1f ms (with GL warm-up)", v->last_ms);
+        append(text, cap, &n, "\nframe -- ms  first draw %.1f ms (with GL warm-up)", v->last_ms);
     else
-        ADD("\nframe %.1f ms  draw %.1f ms", v->frame_last_ms, v->last_ms);
+        append(text, cap, &n, "\nframe %.1f ms  draw %.1f ms", v->frame_last_ms, v->last_ms);
     if (v->budget_on)
-        ADD("\nbudget %g ms%s", v->desc->frame_ms,
+        append(text, cap, &n, "\nbudget %g ms%s", v->desc->frame_ms,
             !v->budget_ok           ? " (no level of detail here)"
             : v->budget.saturated   ? " (coarsest: cannot hold it)"
             : v->budget.bound       ? " (coarser is not faster here)"
@@ -830,28 +846,28 @@ static void overlay_text(viewer *v, char *text, size_t cap)
         char depth[32] = "none";
         if (v->depth_limit)
             snprintf(depth, sizeof depth, "%u", v->depth_limit);
-        ADD("\ntau %.2f px  depth limit %s", (double)v->tolerance, depth);
+        append(text, cap, &n, "\ntau %.2f px  depth limit %s", (double)v->tolerance, depth);
     }
-    ADD("\n%zu / %zu %s", rs.count, rs.points ? rs.points : rs.count, K(v->kind)->noun);
-#undef ADD
+    append(text, cap, &n, "\n%zu / %zu %s", rs.count, rs.points ? rs.points : rs.count, K(v->kind)->noun);
 }
 
 /* The key list for the h key, as print_help logs it. */
 static void help_text(char *text, size_t cap)
 {
     size_t n = 0;
-    int w = snprintf(text, cap, "keys (h hides them)\nmouse: left drag orbit, wheel or right drag zoom,\n"
-                                "       middle drag or shift + left drag pan");
-    n = w < 0 ? 0 : (size_t)w;
-    for (const asp__viewer_key *k = asp__viewer_keys; k->key && n + 1 < cap; k++) {
+    text[0] = '\0';
+    append(text, cap, &n, "keys (h hides them)\nmouse: left drag orbit, wheel or right drag zoom,\n"
+                          "       middle drag or shift + left drag pan");
+    for (const asp__viewer_key *k = asp__viewer_keys; k->key; k++) {
         if (!k->help)
             continue;
         const char *name = k->action == ASP__VIEWER_PICK_RENDERER ? asp_viewer_renderer_name((size_t)k->arg) : NULL;
         if (k->action == ASP__VIEWER_PICK_RENDERER && !name)
             continue;
-        w = name ? snprintf(text + n, cap - n, "\n%c  renderer %s", k->key, name)
-                 : snprintf(text + n, cap - n, "\n%c  %s", k->key, k->help);
-        n = w < 0 ? n : n + (size_t)w < cap ? n + (size_t)w : cap - 1;
+        if (name)
+            append(text, cap, &n, "\n%c  renderer %s", k->key, name);
+        else
+            append(text, cap, &n, "\n%c  %s", k->key, k->help);
     }
 }
 
