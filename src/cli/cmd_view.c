@@ -28,11 +28,11 @@ static const char usage[] =
     "drag or shift + left drag pans; press h in the window for the keys (docs/cli/view.md).\n"
     "With --frames N the viewer draws N frames, pressing KEYS one per frame, saves the last\n"
     "frame to OUT.png and exits (needs a display: run under xvfb-run without one). --frame-ms T\n"
-    "sets the screen tolerance every frame so a frame takes T ms (splat, square; without --renderer\n"
-    "it draws with splat); --fly N draws\n"
-    "N frames on a fixed path around the model. --color-by colours a point file by a field of\n"
-    "its own (elevation, classification, intensity, return_number, any property) as render does;\n"
-    "points without normals are shaded by eye-dome lighting unless --no-edl or --unlit.";
+    "sets the screen tolerance every frame so a frame takes T ms (splat, square; without\n"
+    "--renderer it draws with splat); --fly N draws N frames on a fixed path around the model.\n"
+    "--color-by colours a point file by a field of its own (elevation, classification,\n"
+    "intensity, return_number, any property) as render does; points without normals are\n"
+    "shaded by eye-dome lighting unless --no-edl or --unlit.";
 
 /* The renderer options view takes (renderer_options.c). */
 #define VIEW_OPTIONS                                                                                     \

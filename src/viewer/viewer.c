@@ -431,20 +431,26 @@ static void next_renderer(viewer *v)
 
 /* ---- actions ---- */
 
+/* "k  what it does" for key k of the table, the renderer keys with their renderer's name; 0 = not listed. */
+static int key_line(const asp__viewer_key *k, char *line, size_t cap)
+{
+    const char *name = k->action == ASP__VIEWER_PICK_RENDERER ? asp_viewer_renderer_name((size_t)k->arg) : NULL;
+    if (!k->help || (k->action == ASP__VIEWER_PICK_RENDERER && !name))
+        return 0;
+    if (name)
+        snprintf(line, cap, "%c  renderer %s", k->key, name);
+    else
+        snprintf(line, cap, "%c  %s", k->key, k->help);
+    return 1;
+}
+
 static void print_help(const viewer *v)
 {
     vlog(v, "mouse: left drag orbit, wheel or right drag zoom, middle drag or shift + left drag pan");
-    for (const asp__viewer_key *k = asp__viewer_keys; k->key; k++) {
-        if (!k->help)
-            continue;
-        if (k->action == ASP__VIEWER_PICK_RENDERER) {
-            const char *name = asp_viewer_renderer_name((size_t)k->arg);
-            if (name)
-                vlog(v, "  %c  renderer %s", k->key, name);
-            continue;
-        }
-        vlog(v, "  %c  %s", k->key, k->help);
-    }
+    char line[160];
+    for (const asp__viewer_key *k = asp__viewer_keys; k->key; k++)
+        if (key_line(k, line, sizeof line))
+            vlog(v, "  %s", line);
 }
 
 static void print_view(const viewer *v)
@@ -822,11 +828,11 @@ static void overlay_text(viewer *v, char *text, size_t cap)
     append(text, cap, &n, "%s", base);
     if (v->kind == v->kind_prim)
         append(text, cap, &n, "\nrenderer prim: %s, alpha-ref %.2f%s%s", asp_prim_render_method_name(v->prim.method),
-            alpha_ref_of(&v->prim), v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? ", outline" : "",
-            v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? ", domain colours" : "");
+               alpha_ref_of(&v->prim), v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? ", outline" : "",
+               v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? ", domain colours" : "");
     else
         append(text, cap, &n, "\nrenderer %s%s%s", K(v->kind)->name, v->unlit ? ", unlit" : "",
-            v->edl_on && edl_applies(v, v->kind) ? ", eye-dome lighting" : "");
+               v->edl_on && edl_applies(v, v->kind) ? ", eye-dome lighting" : "");
     if (v->status[0])
         append(text, cap, &n, "\n%s", v->status);
     if (v->desc->color_field)
@@ -837,11 +843,11 @@ static void overlay_text(viewer *v, char *text, size_t cap)
         append(text, cap, &n, "\nframe %.1f ms  draw %.1f ms", v->frame_last_ms, v->last_ms);
     if (v->budget_on)
         append(text, cap, &n, "\nbudget %g ms%s", v->desc->frame_ms,
-            !v->budget_ok           ? " (no level of detail here)"
-            : v->budget.saturated   ? " (coarsest: cannot hold it)"
-            : v->budget.bound       ? " (coarser is not faster here)"
-            : v->budget.finest      ? " (full detail fits)"
-                                    : "");
+               !v->budget_ok         ? " (no level of detail here)"
+               : v->budget.saturated ? " (coarsest: cannot hold it)"
+               : v->budget.bound     ? " (coarser is not faster here)"
+               : v->budget.finest    ? " (full detail fits)"
+                                     : "");
     if (K(v->kind)->has_lod || v->budget_ok) {
         char depth[32] = "none";
         if (v->depth_limit)
@@ -851,24 +857,17 @@ static void overlay_text(viewer *v, char *text, size_t cap)
     append(text, cap, &n, "\n%zu / %zu %s", rs.count, rs.points ? rs.points : rs.count, K(v->kind)->noun);
 }
 
-/* The key list for the h key, as print_help logs it. */
+/* The key list for the h key, the lines print_help logs. */
 static void help_text(char *text, size_t cap)
 {
     size_t n = 0;
     text[0] = '\0';
     append(text, cap, &n, "keys (h hides them)\nmouse: left drag orbit, wheel or right drag zoom,\n"
                           "       middle drag or shift + left drag pan");
-    for (const asp__viewer_key *k = asp__viewer_keys; k->key; k++) {
-        if (!k->help)
-            continue;
-        const char *name = k->action == ASP__VIEWER_PICK_RENDERER ? asp_viewer_renderer_name((size_t)k->arg) : NULL;
-        if (k->action == ASP__VIEWER_PICK_RENDERER && !name)
-            continue;
-        if (name)
-            append(text, cap, &n, "\n%c  renderer %s", k->key, name);
-        else
-            append(text, cap, &n, "\n%c  %s", k->key, k->help);
-    }
+    char line[160];
+    for (const asp__viewer_key *k = asp__viewer_keys; k->key; k++)
+        if (key_line(k, line, sizeof line))
+            append(text, cap, &n, "\n%s", line);
 }
 
 /* Twice the font where text fits the room left, else 1.5 times or the font's own size (small windows). */
