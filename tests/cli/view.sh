@@ -264,7 +264,8 @@ expect_fail 2 "no such property 'colour' (elevation or the file's: classificatio
 expect_fail 2 "--color-by expects classifier" "$AMGSPLAT" view "$T/oct.amg" --color-by elevation
 
 # Eye-dome lighting: on by default for points without normals; it shades the flat grey discs (the
-# building's edges and the ground behind it go dark) without moving the silhouette; E turns it off.
+# building's edges and the ground behind it go dark; SSIM 0.78 on llvmpipe) without moving the
+# silhouette; E turns it off.
 view "$T/scan.ply" --frames 2 --up z --size 160x120 --view 30,35 --screenshot "$T/edl.png" --json \
   >"$T/edl.json" 2>"$T/edl.err"
 view "$T/scan.ply" --frames 2 --up z --size 160x120 --view 30,35 --no-edl --screenshot "$T/noedl.png" -q
@@ -274,7 +275,7 @@ view "$T/scan.ply" --frames 2 --up z --size 160x120 --view 30,35 --keys E --scre
   fail "edl flags: $(cat "$T/edl.json" "$T/edl_e.json")"
 [[ "$(metric "$T/edl.png" "$T/noedl.png" iou)" == "1.000000" ]] || fail "eye-dome lighting moved the silhouette"
 ssim=$(metric "$T/edl.png" "$T/noedl.png" ssim)
-awk -v s="$ssim" 'BEGIN { exit !(s < 0.8) }' || fail "eye-dome lighting changed too little (SSIM $ssim)"
+awk -v s="$ssim" 'BEGIN { exit !(s < 0.9) }' || fail "eye-dome lighting changed too little (SSIM $ssim)"
 [[ "$(metric "$T/edl_e.png" "$T/noedl.png" psnr)" == inf ]] || fail "E differs from --no-edl"
 # without it the discs face the eye and are all one grey; with it a quarter of the model is darker
 check "$T/noedl.png" "sum(1 for x in range(w) for y in range(h) if px(x, y)[0] < 150) == 0"
@@ -293,7 +294,7 @@ expect_fail 2 "--no-edl excludes" "$AMGSPLAT" view "$T/scan.ply" --edl --no-edl
 [[ "$(grep -c "hint: '$T/scan.ply' has no normals: drawn with eye-dome lighting; 'amgsplat estimate" "$T/r_edl.err")" == 1 &&
    ! -s "$T/r_q.err" ]] || fail "render hint: $(cat "$T/r_edl.err" "$T/r_q.err")"
 ssim=$(metric "$T/r_edl.png" "$T/r_noedl.png" ssim)
-awk -v s="$ssim" 'BEGIN { exit !(s < 0.8) }' || fail "render: eye-dome lighting changed too little (SSIM $ssim)"
+awk -v s="$ssim" 'BEGIN { exit !(s < 0.9) }' || fail "render: eye-dome lighting changed too little (SSIM $ssim)"
 at_least "$(metric "$T/r_edl.png" "$T/edl.png" ssim)" 0.9 "render vs view with eye-dome lighting"
 "$AMGSPLAT" render "$T/sphere.ply" --size 160x120 --view 0,0 -o "$T/r_sph.png" --samples 0 2>"$T/r_sph.err"
 ! grep -q "hint:" "$T/r_sph.err" && [[ "$(metric "$T/r_sph.png" "$T/ref0.png" psnr)" == inf ]] ||
