@@ -143,12 +143,27 @@ int asp_gl_context_read_window(asp_gl_context *gl, asp_image *out, asp_error *er
  */
 typedef struct asp_renderer asp_renderer;
 
+/**
+ * Eye-dome lighting (Boucheny 2009; src/render/edl.c), a screen-space pass of
+ * the disc and square renderers for points without normals: each pixel is
+ * darkened by exp(-300 strength m), m the mean over 8 neighbours radius
+ * pixels away of how much nearer they are in log2 depth, so silhouettes and
+ * depth steps get dark rims and surfaces turning away shade. Drawn through a
+ * single-sample target of the frame's size (so multisampling does not apply
+ * to the points while it is on). The zero value is off.
+ */
+typedef struct asp_edl_desc {
+    float strength;            /* 0 = off; 1 = the usual (CloudCompare's and Potree's default look) */
+    float radius;              /* neighbour distance in pixels, 0..16; 0 = 1.4 */
+} asp_edl_desc;
+
 /** Options of the disc renderer; the zero value means defaults. */
 typedef struct asp_disc_renderer_desc {
     float radius_scale;        /* multiplies every disc radius; 0 = 1 */
     uint8_t default_color[4];  /* sRGB colour of points when the cloud has none; all 0 = light grey 200,200,200 */
     const float *clip_planes;  /* 8 floats per point (asp_crease_clip_planes in geom.h), NULL = none;
                                   only read during create */
+    asp_edl_desc edl;          /* eye-dome lighting; zero = off */
 } asp_disc_renderer_desc;
 
 /**
@@ -403,6 +418,7 @@ typedef struct asp_square_renderer_desc {
     unsigned flags;          /* asp_splat_renderer_flags */
     uint8_t default_color[4]; /* as asp_splat_renderer_desc */
     asp_hier_desc hier;      /* hierarchy build options for asp_square_renderer_create */
+    asp_edl_desc edl;        /* eye-dome lighting (as asp_disc_renderer_desc.edl); zero = off */
 } asp_square_renderer_desc;
 
 /**

@@ -72,6 +72,13 @@ typedef struct asp_viewer_desc {
                                 first distance and out again), the same path every run */
     const char *stats_json;  /* scripted or not: JSON file written at the end with every frame's time, tau,
                                 depth limit and count and their summary; NULL = none */
+    const char *color_field; /* point file: colour the points by this scalar as asp_cloud_color_by does
+                                (elevation along up, classification, intensity, return_number, a property);
+                                NULL = their own colours */
+    int edl;                 /* eye-dome lighting of the disc and square renderers (asp_edl_desc; the E key
+                                toggles it): 0 = on when the points have no normals and ASP_VIEWER_UNLIT is
+                                not set, > 0 = on, < 0 = off */
+    float edl_strength;      /* asp_edl_desc.strength when on; 0 = 1 */
 } asp_viewer_desc;
 
 /** What a viewer run did, for scripts (amgsplat view --json). */
@@ -91,6 +98,9 @@ typedef struct asp_viewer_stats {
     float tolerance_min, tolerance_max; /* range of tau over the frames drawn by a level-of-detail renderer */
     size_t count_min, count_max;        /* range of primitives drawn per frame */
     int budget_applied;       /* desc->frame_ms > 0 and the last renderer took it (it has a level of detail) */
+    char overlay[640];        /* the figures last drawn over the frame (the i key): file, renderer, level or
+                                 method, colours, frame time, counts; "" when they were never shown */
+    int edl;                  /* eye-dome lighting was on in the last frame */
 } asp_viewer_stats;
 
 /**

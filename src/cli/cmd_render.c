@@ -112,6 +112,8 @@ struct render_opts {
     asp_up_axis up_axis;
     double point_crease; /* point inputs: crease angle of the clip planes, degrees; 0 = no clipping */
     int point_crease_default; /* point_crease is the default (points without normals: no clipping) */
+    int edl, no_edl;     /* --edl, --no-edl: eye-dome lighting forced on or off (default: points without normals) */
+    double edl_strength; /* --edl-strength; NaN: not given (1) */
     const asp_context *ctx;
 };
 
@@ -128,6 +130,25 @@ static int load_scene(const char *path, const struct render_opts *o, const struc
             d.level = "L-3";
     }
     return asp_scene_load(path, &d, &env->ctx, s, err);
+}
+
+/*
+ * Eye-dome lighting (asp_edl_desc) for the disc and square renderers: on when asked, or by default
+ * when the points have no normals to light (CloudCompare and Potree turn it on for such scans), except
+ * with --unlit, which asks for the colours as they are. Says once that estimate gives normals.
+ */
+static void edl_options(const struct render_opts *o, const asp_scene *s, const asp_renderer_kind *kind,
+                        const struct cli_env *env, const char *path, asp_renderer_options *r)
+{
+    int points = s->cloud && !s->dps && (strcmp(kind->name, "disc") == 0 || strcmp(kind->name, "square") == 0);
+    int no_normals = points && !s->cloud->normals;
+    if (!points || o->no_edl || !(o->edl || !isnan(o->edl_strength) || (no_normals && !o->r.unlit)))
+        return;
+    asp_edl_desc e = {.strength = isnan(o->edl_strength) ? 1.0f : (float)o->edl_strength};
+    r->disc.edl = r->square.edl = e;
+    if (no_normals)
+        cli_info(env, "hint: '%s' has no normals: drawn with eye-dome lighting; 'amgsplat estimate %s -o "
+                      "WITH_NORMALS.ply' estimates them for lit discs", path, path);
 }
 
 static void renderer_options(const struct render_opts *o, asp_renderer_options *r)
@@ -368,6 +389,10 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
         o->r.tolerance = 1.0; // render's default tau, in pixels
     if (!o->output)
         return cli_usage_error(env, "missing -o OUT.png");
+    if (o->no_edl && (o->edl || !isnan(o->edl_strength)))
+        return cli_usage_error(env, "--no-edl excludes --edl and --edl-strength");
+    if (!isnan(o->edl_strength) && !(o->edl_strength > 0 && o->edl_strength <= 100))
+        return cli_usage_error(env, "--edl-strength expects a number in (0, 100], got %g", o->edl_strength);
     if (o->up && cli_parse_up(o->up, &o->up_axis) != 0)
         return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
     if (!asp_file_name_is(o->output, "png"))
@@ -636,7 +661,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .width = 512, .height = 512,
                             .az = 30.0, .el = 20.0, .epsilon = 1.0,
                             .sigma = NAN, .epsilon_uniform = NAN, .tolerance_area = NAN,
-                            .transparency = NAN, .depth_window = NAN, .only_domain = SIZE_MAX, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
+                            .transparency = NAN, .depth_window = NAN, .only_domain = SIZE_MAX, .edl_strength = NAN, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     cli_renderer_opts_init(&o.r);
     struct cli_option opts[80] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
@@ -673,6 +698,9 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y, z (scans, CAD), x, -y, -z or -x (default: z for LAS, else y)"},
         {"flat", 0, CLI_FLAG, &o.flat, NULL, "mesh: light each triangle by its face normal (default: smooth vertex normals)"},
         {"radius-scale", 0, CLI_DOUBLE, &o.radius_scale, "X", "multiply every disc, ellipse or square size by X (default 1)"},
+        {"edl", 0, CLI_FLAG, &o.edl, NULL, "disc, square: eye-dome lighting (default: on for points without normals, unless --unlit)"},
+        {"no-edl", 0, CLI_FLAG, &o.no_edl, NULL, "disc, square: no eye-dome lighting"},
+        {"edl-strength", 0, CLI_DOUBLE, &o.edl_strength, "S", "eye-dome lighting strength, 0..100 (default 1; implies --edl)"},
         {0},
     };
     cli_renderer_rows(&o.r, RENDER_OPTIONS, opts, sizeof opts / sizeof opts[0]);
@@ -734,6 +762,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "renderer '%s' draws points; sample the mesh to points first (amgsplat sample "
                                     "'%s' -o points.ply) or draw it with --renderer mesh",
                                kind->name, argv[0]);
+    if ((o.edl || !isnan(o.edl_strength)) && strcmp(kind->name, "disc") != 0 && strcmp(kind->name, "square") != 0)
+        return cli_usage_error(env, "--edl and --edl-strength need --renderer disc or square (points drawn opaque)");
     if ((o.r.depth_limit || o.r.cull_backfaces) && !kind->has_lod)
         return cli_usage_error(env, "--depth-limit and --cull-backfaces need --renderer splat or square");
     if (o.r.budget && !kind->has_lod)
@@ -777,6 +807,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         rc = asp_gl_context_create_headless(NULL, &env->ctx, &gl, &err);
     if (!rc) {
         asp_scene_render_source(&s, &src);
+        edl_options(&o, &s, kind, env, argv[0], &ropts);
         rc = kind->create(gl, &src, &ropts, &env->ctx, &r, &err);
     }
     if (!rc && (o.prim.flags & ASP_PRIM_RENDER_DEBUG_TRIANGULATION))

@@ -16,7 +16,7 @@ static const char usage[] =
     "                     [--color-by MODE] [--level L] [--method NAME] [--alpha-ref X] [--unlit]\n"
     "                     [--background R,G,B] [--texture IMG] [--hybrid] [--verbose]\n"
     "                     [--preset thesis|journal|pajarola|schwarz]\n"
-    "                     [--frame-ms T] [--overlay | --no-overlay]\n"
+    "                     [--frame-ms T] [--overlay | --no-overlay] [--edl | --no-edl] [--edl-strength S]\n"
     "       amgsplat view FILE --frames N [--screenshot OUT.png] [--keys KEYS] [options above]\n"
     "       amgsplat view FILE --fly N [--frame-ms T] [--stats-json OUT.json] [options above]\n"
     "\n"
@@ -28,8 +28,11 @@ static const char usage[] =
     "drag or shift + left drag pans; press h in the window for the keys (docs/cli/view.md).\n"
     "With --frames N the viewer draws N frames, pressing KEYS one per frame, saves the last\n"
     "frame to OUT.png and exits (needs a display: run under xvfb-run without one). --frame-ms T\n"
-    "sets the screen tolerance every frame so a frame takes T ms (splat, square); --fly N draws\n"
-    "N frames on a fixed path around the model.";
+    "sets the screen tolerance every frame so a frame takes T ms (splat, square; without\n"
+    "--renderer it draws with splat); --fly N draws N frames on a fixed path around the model.\n"
+    "--color-by colours a point file by a field of its own (elevation, classification,\n"
+    "intensity, return_number, any property) as render does; points without normals are\n"
+    "shaded by eye-dome lighting unless --no-edl or --unlit.";
 
 /* The renderer options view takes (renderer_options.c). */
 #define VIEW_OPTIONS                                                                                     \
@@ -52,6 +55,8 @@ struct view_opts {
     const char *stats_json;
     int overlay, no_overlay;
     int verbose;
+    int edl, no_edl;     /* eye-dome lighting forced on or off; default: on for points without normals */
+    double edl_strength; /* NaN: not given */
 };
 
 static void log_line(void *user, const char *line)
@@ -79,9 +84,6 @@ static int parse_into(struct cli_env *env, const char *path, struct view_opts *o
         return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
     if (cli_renderer_check(env, &o->r, VIEW_OPTIONS))
         return 2;
-    if (o->r.color_field) // colouring by a point file's scalar is render's (asp_cloud_color_by); the viewer's c key cycles these
-        return cli_usage_error(env, "%s expects classifier, domains, strict or input, got '%s' (render --color-by colours "
-                                    "a point file by elevation or a property)", o->r.color_by_name, o->r.color_field);
     d->tolerance = isnan(o->r.tolerance) ? 0.0f : (float)o->r.tolerance;
     if (o->r.has_color) // the viewer's modes in the order its c key cycles them (asp_viewer_desc.amg_color)
         d->amg_color = o->r.color_mode == ASP_SCENE_AMG_INPUT ? 3u : (unsigned)o->r.color_mode - 1u;
@@ -93,6 +95,18 @@ static int parse_into(struct cli_env *env, const char *path, struct view_opts *o
     // LAS is z-up (ASPRS LAS 1.4: Z is the elevation of a projected CRS), so a scan stands upright unless --up says otherwise
     if (!o->up && (strcmp(type.format, "las") == 0 || strcmp(type.format, "laz") == 0))
         d->up = ASP_UP_Z;
+    // a point file's own fields, coloured as render --color-by colours them (asp_cloud_color_by)
+    if (o->r.color_field && type.kind != ASP_FILE_POINTS && type.kind != ASP_FILE_UNKNOWN)
+        return cli_usage_error(env, "%s expects classifier, domains, strict or input, got '%s' (a field such as "
+                                    "elevation or classification colours a point file's points, not %s input)",
+                               o->r.color_by_name, o->r.color_field, asp_file_kind_name(type.kind));
+    d->color_field = o->r.color_field;
+    if (o->no_edl && (o->edl || !isnan(o->edl_strength)))
+        return cli_usage_error(env, "--no-edl excludes --edl and --edl-strength");
+    if (!isnan(o->edl_strength) && !(o->edl_strength > 0 && o->edl_strength <= 100))
+        return cli_usage_error(env, "--edl-strength expects a number in (0, 100], got %g", o->edl_strength);
+    d->edl = o->no_edl ? -1 : o->edl || !isnan(o->edl_strength) ? 1 : 0;
+    d->edl_strength = isnan(o->edl_strength) ? 0.0f : (float)o->edl_strength;
     int dps = type.kind == ASP_FILE_DPS || type.kind == ASP_FILE_SCENE; // a scene's .dps sources take them
     if (o->r.hybrid && type.kind == ASP_FILE_SCENE)
         return cli_usage_error(env, "--hybrid draws one .dps with its points, not a scene");
@@ -164,6 +178,8 @@ static int print_json(const struct cli_env *env, const char *path, const asp_vie
     cJSON_AddItemToObject(o, "tolerance_max", cli_json_number("%g", s->tolerance_max));
     cJSON_AddNumberToObject(o, "count_min", (double)s->count_min);
     cJSON_AddNumberToObject(o, "count_max", (double)s->count_max);
+    cJSON_AddBoolToObject(o, "edl", s->edl);
+    cJSON_AddStringToObject(o, "overlay", s->overlay);
     return cli_json_print(env, o);
 }
 
@@ -178,7 +194,7 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
 #else
 int cmd_view(int argc, char **argv, struct cli_env *env)
 {
-    struct view_opts o = {0};
+    struct view_opts o = {.edl_strength = NAN};
     cli_renderer_opts_init(&o.r);
     struct cli_option opts[48] = {
         {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
@@ -194,6 +210,9 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         {"stats-json", 0, CLI_STRING, &o.stats_json, "OUT.json", "write every frame's time, tau, depth limit and count, with median, p10, p90"},
         {"overlay", 0, CLI_FLAG, &o.overlay, NULL, "start with the figures over the frame (i toggles; on with --frame-ms)"},
         {"no-overlay", 0, CLI_FLAG, &o.no_overlay, NULL, "start without them"},
+        {"edl", 0, CLI_FLAG, &o.edl, NULL, "disc, square: eye-dome lighting (default: on for points without normals, unless --unlit; E toggles)"},
+        {"no-edl", 0, CLI_FLAG, &o.no_edl, NULL, "disc, square: no eye-dome lighting"},
+        {"edl-strength", 0, CLI_DOUBLE, &o.edl_strength, "S", "eye-dome lighting strength, 0..100 (default 1; implies --edl)"},
         {0},
     };
     cli_renderer_rows(&o.r, VIEW_OPTIONS, opts, sizeof opts / sizeof opts[0]);
@@ -216,8 +235,13 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         return 2;
     asp_error err = {0, ""};
     asp_viewer_stats stats;
-    if (asp_viewer_run(argv[0], &desc, &env->ctx, &stats, &err))
+    if (asp_viewer_run(argv[0], &desc, &env->ctx, &stats, &err)) {
+        // a field the file does not have is a bad option value, as in render (the viewer's message names the file)
+        if (desc.color_field && err.code == ASP_EINVAL && strncmp(err.msg, "cannot colour '", 15) == 0)
+            return cli_usage_error(env, "%s expects classifier, domains, strict or input (.amg), or a point field: %s",
+                                   o.r.color_by_name, err.msg);
         return cli_fail(env, &err);
+    }
     if (env->json)
         return print_json(env, argv[0], &desc, &stats);
     cli_info(env, "drew %zu frames of '%s' (%s, %zu %s, %.2f ms per frame)\n", stats.frames, argv[0], stats.renderer,

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "render/edl_internal.h"
 #include "render/internal.h"
 #include "util/banned.h"
 
@@ -131,6 +132,7 @@ typedef struct disc_renderer {
     int has[A_COUNT];
     float default_color[4];
     float default_radius, radius_scale;
+    asp__edl edl; /* eye-dome lighting around the draw when on */
 } disc_renderer;
 
 static void disc_destroy(asp_renderer *base)
@@ -142,6 +144,7 @@ static void disc_destroy(asp_renderer *base)
     if (d->vao.id)
         glDeleteVertexArrays(1, &d->vao.id);
     asp__gl_program_destroy(&d->program);
+    asp__edl_release(&d->edl);
     asp_context actx = base->gl->actx;
     asp_free(&actx, d);
 }
@@ -156,12 +159,19 @@ static int disc_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     glProgramUniform3fv(p, u[U_EYE], 1, f->eye);
     glProgramUniform3fv(p, u[U_LIGHT], 1, f->light_eye);
     glProgramUniform1i(p, u[U_UNLIT], (f->flags & ASP_RENDER_UNLIT) ? 1 : 0);
+    if (asp__edl_on(&d->edl)) {
+        int rc = asp__edl_begin(&d->edl, base->gl, f, err);
+        if (rc)
+            return rc;
+    }
     glUseProgram(p);
     glBindVertexArray(d->vao.id);
     // one triangle per point; the point's attributes advance once per instance
     glDrawArraysInstanced(GL_TRIANGLES, 0, 3, (GLsizei)base->count);
     glBindVertexArray(0);
     glUseProgram(0);
+    if (asp__edl_on(&d->edl))
+        return asp__edl_end(&d->edl, base->gl, f, err);
     return asp__gl_check(base->gl, "draw discs", err);
 }
 
@@ -215,6 +225,9 @@ static int check_input(const asp_cloud *cloud, const asp_disc_renderer_desc *des
     if (!(desc->radius_scale >= 0) || !isfinite(desc->radius_scale))
         return asp_error_set(err, ASP_EINVAL, "disc radius scale %g is not a finite non-negative number",
                              (double)desc->radius_scale);
+    int rc = asp__edl_check(&desc->edl, err);
+    if (rc)
+        return rc;
     if (desc->clip_planes)
         for (size_t i = 0; i < 8 * cloud->count; i++)
             if (!isfinite(desc->clip_planes[i]))
@@ -253,6 +266,8 @@ int asp_disc_renderer_create(asp_gl_context *gl, const asp_cloud *cloud, const a
         d->default_color[c] = color_given ? dc[c] / 255.0f : (c < 3 ? 200.0f / 255.0f : 1.0f);
 
     rc = asp__gl_program_create(gl, "disc", vertex_src, fragment_src, &d->program, err);
+    if (!rc)
+        rc = asp__edl_init(&d->edl, gl, &desc->edl, err);
     if (rc) {
         disc_destroy(&d->base);
         return rc;

@@ -7,6 +7,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "render/edl_internal.h"
 #include "render/splat_internal.h"
 #include "util/banned.h"
 
@@ -58,12 +59,14 @@ typedef struct square_renderer {
     GLint uniforms[U_COUNT];
     asp__gl_vertex_array vao; // no attributes: the vertex shader reads the storage buffers
     float point_size, radius_scale, max_size;
+    asp__edl edl; /* eye-dome lighting around the draw when on */
 } square_renderer;
 
 static void square_destroy(asp_renderer *base)
 {
     square_renderer *q = (square_renderer *)base;
     asp__gl_program_destroy(&q->program);
+    asp__edl_release(&q->edl);
     if (q->vao.id)
         glDeleteVertexArrays(1, &q->vao.id);
     asp__lod_renderer_free((asp__lod_renderer *)q);
@@ -80,6 +83,8 @@ static int square_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     asp__lod_frame_uniforms(p, u, f);
     glProgramUniform1f(p, u[U_PX_PER_UNIT], f->proj[5] * 0.5f * (float)f->height);
     glProgramUniform1i(p, u[U_UNLIT], (f->flags & ASP_RENDER_UNLIT) ? 1 : 0);
+    if (asp__edl_on(&q->edl) && (rc = asp__edl_begin(&q->edl, base->gl, f, err)) != 0)
+        return rc;
     glEnable(GL_PROGRAM_POINT_SIZE);
     glUseProgram(p);
     glBindVertexArray(q->vao.id);
@@ -87,6 +92,8 @@ static int square_draw(asp_renderer *base, const asp__frame *f, asp_error *err)
     glBindVertexArray(0);
     glUseProgram(0);
     glDisable(GL_PROGRAM_POINT_SIZE);
+    if (asp__edl_on(&q->edl))
+        return asp__edl_end(&q->edl, base->gl, f, err);
     return asp__gl_check(base->gl, "draw squares", err);
 }
 
@@ -104,6 +111,8 @@ static int check_desc(const asp_square_renderer_desc *d, asp_error *err)
         rc = asp__lod_check_option("square", "tolerance", d->tolerance, err);
     if (!rc)
         rc = asp__lod_check_option("square", "radius_scale", d->radius_scale, err);
+    if (!rc)
+        rc = asp__edl_check(&d->edl, err);
     return rc;
 }
 
@@ -135,6 +144,8 @@ static int create(asp_gl_context *gl, const asp_cloud *cloud, const asp_hier *hi
     q->max_size = range[1];
 
     rc = asp__gl_program_create(gl, "square", vertex_src, fragment_src, &q->program, err);
+    if (!rc)
+        rc = asp__edl_init(&q->edl, gl, &desc->edl, err);
     if (!rc)
         rc = asp__lod_upload(gl, &q->lod, "square", err);
     if (rc) {

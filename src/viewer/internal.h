@@ -44,7 +44,8 @@ enum asp__viewer_action {
     ASP__VIEWER_DEBUG_EIGENVECTORS,
     ASP__VIEWER_DEBUG_TEXELS,
     ASP__VIEWER_DOMAIN_SET,
-    ASP__VIEWER_PICK_DOMAIN /* thesis appendix C: one picked domain only */
+    ASP__VIEWER_PICK_DOMAIN, /* thesis appendix C: one picked domain only */
+    ASP__VIEWER_EDL          /* eye-dome lighting of the disc and square renderers (Boucheny 2009) */
 };
 
 /* One printable key of the viewer; the table ends with key 0. */

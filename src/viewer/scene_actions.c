@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "amgsplat/geom.h"
 #include "viewer/internal.h"
 #include "util/banned.h"
 
@@ -74,6 +75,19 @@ int asp__viewer_scene_load(asp_scene *s, const char *path, const asp_viewer_desc
     if (t.amg && desc->amg_color == MODE_INPUT && !asp_amg_cloud(t.amg)->colors) {
         asp_scene_release(&t);
         return asp_error_set(err, ASP_EINVAL, "cannot view '%s' in input colours: its points have no colours", path);
+    }
+    // a scan's own fields (issue 29): the same colouring as amgsplat render --color-by, along the shown up axis
+    if (desc->color_field) {
+        asp_error e = {0, ""};
+        if (!t.cloud || t.amg || t.dps || t.mesh || t.hier)
+            rc = asp_error_set(&e, ASP_EINVAL, "a point file's points (PLY, XYZ, LAS), not %s input",
+                               asp_file_kind_name(t.type.kind));
+        else
+            rc = asp_cloud_color_by(t.cloud, desc->color_field, desc->up, &e);
+        if (rc) {
+            asp_scene_release(&t);
+            return asp_error_set(err, rc, "cannot colour '%s' by '%s': %s", path, desc->color_field, e.msg);
+        }
     }
     *s = t;
     return 0;

@@ -89,6 +89,9 @@ int asp_viewer_desc_check(const asp_viewer_desc *desc, asp_error *err)
         return asp_error_set(err, ASP_EINVAL, "a screenshot file needs a number of frames (scripted mode)");
     if (desc->screenshot && !asp_file_name_is(desc->screenshot, "png"))
         return asp_error_set(err, ASP_EINVAL, "screenshot '%s' must end in .png", desc->screenshot);
+    if (!(desc->edl_strength >= 0 && desc->edl_strength <= 100))
+        return asp_error_set(err, ASP_EINVAL, "eye-dome lighting strength %g is outside 0..100",
+                             (double)desc->edl_strength);
     if (!(desc->frame_ms >= 0 && desc->frame_ms <= 1e6))
         return asp_error_set(err, ASP_EINVAL, "frame budget %g ms is outside 0..1e6", desc->frame_ms);
     if (desc->fly && desc->frames == 0)
@@ -156,6 +159,8 @@ struct viewer {
     double frame_top;         /* when the current frame began (after any idle wait) */
     asp_camera fly_start;     /* the first view: the fly-through's path starts there */
     asp__viewer_frame_log flog;
+    int edl_on;               /* eye-dome lighting for the disc and square renderers (desc->edl, the E key) */
+    int help_on;              /* the h key: the keys drawn over the frame */
 };
 
 static void vlog(const viewer *v, const char *fmt, ...)
@@ -327,6 +332,8 @@ static int make_renderer(viewer *v, size_t k, asp_renderer **out, asp_error *err
     o.splat.tolerance = v->tolerance;
     o.square.tolerance = v->tolerance;
     o.splat.flags = o.square.flags = v->desc->lod_flags;
+    if (v->edl_on && !v->is_scene) // the renderers without the pass ignore it
+        o.disc.edl = o.square.edl = (asp_edl_desc){.strength = v->desc->edl_strength > 0 ? v->desc->edl_strength : 1.0f};
     o.prim = v->prim;
     // thesis appendix C "one picked domain only": a copy of the level holding that primitive alone
     asp_dps_level one;
@@ -424,20 +431,26 @@ static void next_renderer(viewer *v)
 
 /* ---- actions ---- */
 
+/* "k  what it does" for key k of the table, the renderer keys with their renderer's name; 0 = not listed. */
+static int key_line(const asp__viewer_key *k, char *line, size_t cap)
+{
+    const char *name = k->action == ASP__VIEWER_PICK_RENDERER ? asp_viewer_renderer_name((size_t)k->arg) : NULL;
+    if (!k->help || (k->action == ASP__VIEWER_PICK_RENDERER && !name))
+        return 0;
+    if (name)
+        snprintf(line, cap, "%c  renderer %s", k->key, name);
+    else
+        snprintf(line, cap, "%c  %s", k->key, k->help);
+    return 1;
+}
+
 static void print_help(const viewer *v)
 {
     vlog(v, "mouse: left drag orbit, wheel or right drag zoom, middle drag or shift + left drag pan");
-    for (const asp__viewer_key *k = asp__viewer_keys; k->key; k++) {
-        if (!k->help)
-            continue;
-        if (k->action == ASP__VIEWER_PICK_RENDERER) {
-            const char *name = asp_viewer_renderer_name((size_t)k->arg);
-            if (name)
-                vlog(v, "  %c  renderer %s", k->key, name);
-            continue;
-        }
-        vlog(v, "  %c  %s", k->key, k->help);
-    }
+    char line[160];
+    for (const asp__viewer_key *k = asp__viewer_keys; k->key; k++)
+        if (key_line(k, line, sizeof line))
+            vlog(v, "  %s", line);
 }
 
 static void print_view(const viewer *v)
@@ -632,6 +645,26 @@ static void scene_action(viewer *v, enum asp__viewer_action a)
     vlog(v, "%s", v->status);
 }
 
+/* The disc and square renderers draw eye-dome lighting (asp_edl_desc); the others ignore it. */
+static int edl_applies(const viewer *v, size_t k)
+{
+    return !v->is_scene && (strcmp(K(k)->name, "disc") == 0 || strcmp(K(k)->name, "square") == 0);
+}
+
+/* E: eye-dome lighting on or off; the renderer is made again with it when it draws it. */
+static void toggle_edl(viewer *v)
+{
+    v->edl_on = !v->edl_on;
+    asp_error e = {0, ""};
+    if (edl_applies(v, v->kind) && switch_renderer(v, v->kind, &e)) {
+        vlog(v, "cannot switch eye-dome lighting: %s", e.msg);
+        v->edl_on = !v->edl_on;
+        return;
+    }
+    vlog(v, "eye-dome lighting %s%s", v->edl_on ? "on" : "off",
+         edl_applies(v, v->kind) ? "" : " (the disc and square renderers draw it)");
+}
+
 static void apply(viewer *v, const action *a)
 {
     const double step_px = 10.0 / ASP__VIEWER_ORBIT_DEG_PER_PX; // 10 degrees per key press
@@ -664,7 +697,12 @@ static void apply(viewer *v, const action *a)
     case ASP__VIEWER_POINTS: toggle_points(v); break;
     case ASP__VIEWER_SCREENSHOT: v->screenshot_wanted = 1; break;
     case ASP__VIEWER_OVERLAY: v->overlay_on = !v->overlay_on; break;
-    case ASP__VIEWER_HELP: print_help(v); break;
+    case ASP__VIEWER_HELP:
+        v->help_on = !v->help_on;
+        if (v->help_on)
+            print_help(v);
+        break;
+    case ASP__VIEWER_EDL: toggle_edl(v); break;
     case ASP__VIEWER_PRINT_VIEW: print_view(v); break;
     case ASP__VIEWER_ORBIT_LEFT: asp__viewer_orbit(&v->cam, -step_px, 0); break;
     case ASP__VIEWER_ORBIT_RIGHT: asp__viewer_orbit(&v->cam, step_px, 0); break;
@@ -756,38 +794,144 @@ static void budget_after_frame(viewer *v, double frame_ms, size_t count)
         v->dirty = 1;
 }
 
-static int draw_overlay(viewer *v, asp_error *err)
+/* Appends to text (cap bytes, *n used): what fits, always terminated. */
+static void append(char *text, size_t cap, size_t *n, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+static void append(char *text, size_t cap, size_t *n, const char *fmt, ...)
+{
+    if (*n + 1 >= cap)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    int w = vsnprintf(text + *n, cap - *n, fmt, ap);
+    va_end(ap);
+    *n = w < 0 ? *n : *n + (size_t)w < cap ? *n + (size_t)w : cap - 1;
+}
+
+/*
+ * The figures over the frame (the i key): what is shown (file, renderer, method or level, colours),
+ * then how fast (frame and draw time, budget, tau, counts). Frame times are of the previous frame,
+ * which the overlay of this one cannot know; the first frame has none yet and its drawing includes
+ * the driver's one-time work (shader compilation, buffer uploads), so it says so.
+ */
+static void overlay_text(viewer *v, char *text, size_t cap)
+{
+    asp_renderer_stats rs;
+    asp_renderer_stats_get(v->r, &rs);
+    const char *base = strrchr(v->path, '/');
+    base = base ? base + 1 : v->path;
+    size_t n = 0;
+    append(text, cap, &n, "%s", base);
+    if (v->kind == v->kind_prim)
+        append(text, cap, &n, "\nrenderer prim: %s, alpha-ref %.2f%s%s", asp_prim_render_method_name(v->prim.method),
+               alpha_ref_of(&v->prim), v->prim.flags & ASP_PRIM_RENDER_OUTLINE ? ", outline" : "",
+               v->prim.flags & ASP_PRIM_RENDER_COLOR_BY_DOMAIN ? ", domain colours" : "");
+    else
+        append(text, cap, &n, "\nrenderer %s%s%s", K(v->kind)->name, v->unlit ? ", unlit" : "",
+               v->edl_on && edl_applies(v, v->kind) ? ", eye-dome lighting" : "");
+    if (v->status[0])
+        append(text, cap, &n, "\n%s", v->status);
+    if (v->desc->color_field)
+        append(text, cap, &n, "\ncolour by %s", v->desc->color_field);
+    if (v->frames <= 1)
+        append(text, cap, &n, "\nframe -- ms  first draw %.1f ms (with GL warm-up)", v->last_ms);
+    else
+        append(text, cap, &n, "\nframe %.1f ms  draw %.1f ms", v->frame_last_ms, v->last_ms);
+    if (v->budget_on)
+        append(text, cap, &n, "\nbudget %g ms%s", v->desc->frame_ms,
+               !v->budget_ok         ? " (no level of detail here)"
+               : v->budget.saturated ? " (coarsest: cannot hold it)"
+               : v->budget.bound     ? " (coarser is not faster here)"
+               : v->budget.finest    ? " (full detail fits)"
+                                     : "");
+    if (K(v->kind)->has_lod || v->budget_ok) {
+        char depth[32] = "none";
+        if (v->depth_limit)
+            snprintf(depth, sizeof depth, "%u", v->depth_limit);
+        append(text, cap, &n, "\ntau %.2f px  depth limit %s", (double)v->tolerance, depth);
+    }
+    append(text, cap, &n, "\n%zu / %zu %s", rs.count, rs.points ? rs.points : rs.count, K(v->kind)->noun);
+}
+
+/* The key list for the h key, the lines print_help logs. */
+static void help_text(char *text, size_t cap)
+{
+    size_t n = 0;
+    text[0] = '\0';
+    append(text, cap, &n, "keys (h hides them)\nmouse: left drag orbit, wheel or right drag zoom,\n"
+                          "       middle drag or shift + left drag pan");
+    char line[160];
+    for (const asp__viewer_key *k = asp__viewer_keys; k->key; k++)
+        if (key_line(k, line, sizeof line))
+            append(text, cap, &n, "\n%s", line);
+}
+
+/* Twice the font where text fits the room left, else 1.5 times or the font's own size (small windows). */
+static float fit_scale(const char *text, float room_w, float room_h)
+{
+    float w, h, scale = 2.0f;
+    asp_text_overlay_measure(text, 2.0f, &w, &h);
+    while (scale > 1.0f && (w * scale / 2 > room_w || h * scale / 2 > room_h))
+        scale -= 0.5f;
+    return scale;
+}
+
+static int draw_overlay(viewer *v, uint32_t width, uint32_t height, asp_error *err)
 {
     if (!v->overlay) {
         int rc = asp_text_overlay_create(v->gl, &v->overlay, err);
         if (rc)
             return rc;
     }
-    asp_renderer_stats rs;
-    asp_renderer_stats_get(v->r, &rs);
-    char text[512], line[160];
-    snprintf(text, sizeof text, "frame %.1f ms  draw %.1f ms", v->frame_last_ms, v->last_ms);
-    if (v->budget_on) {
-        snprintf(line, sizeof line, "\nbudget %g ms%s", v->desc->frame_ms,
-                 !v->budget_ok                    ? " (no level of detail here)"
-                 : v->budget.saturated            ? " (coarsest: cannot hold it)"
-                 : v->budget.bound                ? " (coarser is not faster here)"
-                 : v->budget.finest               ? " (full detail fits)"
-                                                  : "");
-        strncat(text, line, sizeof text - strlen(text) - 1);
+    float top = 8;
+    if (v->overlay_on) {
+        overlay_text(v, v->stats.overlay, sizeof v->stats.overlay);
+        float scale = fit_scale(v->stats.overlay, (float)width - 16, (float)height - 16);
+        asp_text_overlay_desc od = {.x = 8, .y = top, .scale = scale};
+        int rc = asp_text_overlay_draw(v->overlay, v->stats.overlay, &od, err);
+        if (rc)
+            return rc;
+        float w, h;
+        asp_text_overlay_measure(v->stats.overlay, scale, &w, &h);
+        top += h + 8;
     }
-    if (K(v->kind)->has_lod || v->budget_ok) {
-        char depth[32] = "none";
-        if (v->depth_limit)
-            snprintf(depth, sizeof depth, "%u", v->depth_limit);
-        snprintf(line, sizeof line, "\ntau %.2f px  depth limit %s", (double)v->tolerance, depth);
-        strncat(text, line, sizeof text - strlen(text) - 1);
+    if (!v->help_on)
+        return 0;
+    char help[4096];
+    help_text(help, sizeof help);
+    float room_w = (float)width - 16, room_h = (float)height - top - 8;
+    float one = fit_scale(help, room_w, room_h);
+    // too tall for the window at the font's size or more: the lines' second half in a second column
+    size_t lines = 1;
+    for (const char *c = help; *c; c++)
+        lines += *c == '\n';
+    char *mid = help; // the first character of line (lines + 1) / 2
+    for (size_t seen = 0; *mid && seen < (lines + 1) / 2; mid++)
+        seen += *mid == '\n';
+    float full_w, full_h;
+    asp_text_overlay_measure(help, one, &full_w, &full_h);
+    if (*mid) {
+        mid[-1] = '\0';
+        float w1, h1, w2, h2, two = 2.0f;
+        asp_text_overlay_measure(help, 2.0f, &w1, &h1);
+        asp_text_overlay_measure(mid, 2.0f, &w2, &h2);
+        while (two > 1.0f && ((w1 + w2 + 8) * two / 2 > room_w || (h1 > h2 ? h1 : h2) * two / 2 > room_h))
+            two -= 0.5f;
+        // two columns when they allow a larger font, or when one column runs off the bottom anyway
+        if (two > one || full_h > room_h) {
+            asp_text_overlay_desc a = {.x = 8, .y = top, .scale = two}, b = a;
+            b.x = 8 + w1 * two / 2 + 8;
+            int rc = asp_text_overlay_draw(v->overlay, help, &a, err);
+            return rc ? rc : asp_text_overlay_draw(v->overlay, mid, &b, err);
+        }
+        mid[-1] = '\n';
     }
-    snprintf(line, sizeof line, "\n%zu / %zu %s (%s)", rs.count, rs.points ? rs.points : rs.count, K(v->kind)->noun,
-             K(v->kind)->name);
-    strncat(text, line, sizeof text - strlen(text) - 1);
-    asp_text_overlay_desc od = {.x = 8, .y = 8, .scale = 2};
-    return asp_text_overlay_draw(v->overlay, text, &od, err);
+    asp_text_overlay_desc hd = {.x = 8, .y = top, .scale = one};
+    return asp_text_overlay_draw(v->overlay, help, &hd, err);
 }
 
 /* ---- the loop ---- */
@@ -876,11 +1020,11 @@ static int draw(viewer *v, int last, asp_error *err)
     rec.draw_ms = 1000.0 * (now - t0);
     rec.count = asp_renderer_count(v->r);
     account_frame(v, rec.draw_ms, now);
-    if (v->overlay_on) {
+    if (v->overlay_on || v->help_on) {
         asp_error e = {0, ""};
-        if (draw_overlay(v, &e)) {
-            vlog(v, "cannot draw the figures over the frame: %s", e.msg);
-            v->overlay_on = 0;
+        if (draw_overlay(v, w, h, &e)) {
+            vlog(v, "cannot draw text over the frame: %s", e.msg);
+            v->overlay_on = v->help_on = 0;
         }
     }
     if (v->screenshot_wanted) {
@@ -1017,6 +1161,24 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
              : v.scene.hier ? find_renderer("splat")
              : v.scene.mesh ? find_renderer("mesh")
                             : first_accepted(&v);
+    // a frame budget steers tau, so without --renderer it picks the first renderer with a level of detail
+    if (!desc->renderer && desc->frame_ms > 0 && !K(v.kind)->has_lod) {
+        size_t k = 0;
+        while (k < asp_renderer_kind_count() && !(K(k)->has_lod && kind_accepts(&v, k)))
+            k++;
+        if (k < asp_renderer_kind_count()) {
+            vlog(&v, "frame budget %g ms: drawing with the %s renderer, whose tau it steers (the %s renderer has "
+                     "no level of detail)", desc->frame_ms, K(k)->name, K(v.kind)->name);
+            v.kind = k;
+        }
+    }
+    // points without normals cannot be lit: eye-dome lighting shades them (Boucheny 2009), as in CloudCompare
+    int no_normals = !v.is_scene && v.scene.cloud && !v.scene.cloud->normals && !v.scene.dps;
+    v.edl_on = desc->edl > 0 || (desc->edl == 0 && no_normals && !v.unlit);
+    if (no_normals && (K(v.kind)->inputs & ASP_RENDER_INPUT_POINTS))
+        vlog(&v, "hint: '%s' has no normals%s; 'amgsplat estimate %s -o WITH_NORMALS.ply' estimates them for lit "
+                 "discs", path, v.edl_on && edl_applies(&v, v.kind) ? ": drawn with eye-dome lighting (E toggles it)" : "",
+             path);
     // the scene loader records missing textures; the viewer says so through its log (issue 14)
     for (size_t i = 0; v.scene.mesh && i < v.scene.mesh->material_count; i++)
         if (v.scene.mesh->materials[i].texture_missing)
@@ -1040,6 +1202,7 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
         update_title(&v, asp_time_now(), 1);
     if (!rc) {
         v.stats.budget_applied = v.budget_on && v.budget_ok;
+        v.stats.edl = v.edl_on && edl_applies(&v, v.kind);
         snprintf(v.stats.renderer, sizeof v.stats.renderer, "%s", K(v.kind)->name);
         v.stats.mean_frame_ms = v.frames ? v.total_ms / (double)v.frames : 0;
         asp__viewer_frame_log_summary(&v.flog, &v.ctx, &v.stats);

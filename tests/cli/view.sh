@@ -224,6 +224,121 @@ expect_fail 2 "need a .dps input" "$AMGSPLAT" view "$T/sphere.ply" --method pref
 expect_fail 1 "renderer 'prim' cannot draw points input" view "$T/sphere.ply" --frames 1 --renderer prim
 expect_fail 1 "renderer 'disc' cannot draw dps input" view "$T/o.dps" --frames 1 --renderer disc
 
+# A scan without normals (issue 29): ground (ASPRS class 2) and a box-shaped building (class 6) on it,
+# z up, with an intensity; no normals, no colours, as a LAS export gives them.
+python3 - "$T/scan.ply" <<'PY'
+import random, sys
+random.seed(7)
+pts = []
+for i in range(6000):
+    x, y = random.uniform(-10, 10), random.uniform(-10, 10)
+    if abs(x) < 3 and abs(y) < 3:
+        continue
+    pts.append((x, y, random.gauss(0, 0.02), 2, 200))
+for i in range(4000):
+    f = random.random()
+    if f < 0.5:
+        p = (random.uniform(-3, 3), random.uniform(-3, 3), 4.0)
+    elif f < 0.75:
+        p = (random.choice((-3, 3)), random.uniform(-3, 3), random.uniform(0, 4))
+    else:
+        p = (random.uniform(-3, 3), random.choice((-3, 3)), random.uniform(0, 4))
+    pts.append(p + (6, 800))
+with open(sys.argv[1], 'w') as f:
+    f.write('ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n'
+            'property uchar classification\nproperty ushort intensity\nend_header\n' % len(pts))
+    f.writelines('%.4f %.4f %.4f %d %d\n' % p for p in pts)
+PY
+# --color-by classification: the ASPRS palette of render --color-by (ground 150,100,50, building
+# 230,80,40; src/geom/scalar_colors.c), pixel for pixel the same as render's with shading off
+view "$T/scan.ply" --frames 2 --up z --color-by classification --unlit --size 160x120 --view 30,35 \
+  --screenshot "$T/cls.png" --json -q >"$T/cls.json"
+"$AMGSPLAT" render "$T/scan.ply" --up z --color-by classification --unlit --samples 0 --size 160x120 --view 30,35 \
+  -o "$T/cls_ref.png" -q
+[[ "$(metric "$T/cls.png" "$T/cls_ref.png" psnr)" == inf ]] || fail "view --color-by classification differs from render"
+check "$T/cls.png" "sum(1 for x in range(w) for y in range(h) if px(x, y)[:3] == (150, 100, 50)) > 1500"
+check "$T/cls.png" "sum(1 for x in range(w) for y in range(h) if px(x, y)[:3] == (230, 80, 40)) > 400"
+check "$T/cls.png" "all(px(x, y)[:3] in ((255, 255, 255), (150, 100, 50), (230, 80, 40)) for x in range(w) for y in range(h))"
+[[ "$(field "$T/cls.json" edl)" == False ]] || fail "--unlit left eye-dome lighting on: $(cat "$T/cls.json")"
+view "$T/scan.ply" --frames 1 --up z --color-by elevation --size 64x48 -q || fail "view --color-by elevation"
+expect_fail 2 "no such property 'colour' (elevation or the file's: classification, intensity)" view "$T/scan.ply" --frames 1 --color-by colour
+expect_fail 2 "--color-by expects classifier" "$AMGSPLAT" view "$T/oct.amg" --color-by elevation
+
+# Eye-dome lighting: on by default for points without normals; it shades the flat grey discs (the
+# building's edges and the ground behind it go dark; SSIM 0.78 on llvmpipe) without moving the
+# silhouette; E turns it off.
+view "$T/scan.ply" --frames 2 --up z --size 160x120 --view 30,35 --screenshot "$T/edl.png" --json \
+  >"$T/edl.json" 2>"$T/edl.err"
+view "$T/scan.ply" --frames 2 --up z --size 160x120 --view 30,35 --no-edl --screenshot "$T/noedl.png" -q
+view "$T/scan.ply" --frames 2 --up z --size 160x120 --view 30,35 --keys E --screenshot "$T/edl_e.png" \
+  --json -q >"$T/edl_e.json"
+[[ "$(field "$T/edl.json" edl)" == True && "$(field "$T/edl_e.json" edl)" == False ]] ||
+  fail "edl flags: $(cat "$T/edl.json" "$T/edl_e.json")"
+[[ "$(metric "$T/edl.png" "$T/noedl.png" iou)" == "1.000000" ]] || fail "eye-dome lighting moved the silhouette"
+ssim=$(metric "$T/edl.png" "$T/noedl.png" ssim)
+awk -v s="$ssim" 'BEGIN { exit !(s < 0.9) }' || fail "eye-dome lighting changed too little (SSIM $ssim)"
+[[ "$(metric "$T/edl_e.png" "$T/noedl.png" psnr)" == inf ]] || fail "E differs from --no-edl"
+# without it the discs face the eye and are all one grey; with it a quarter of the model is darker
+check "$T/noedl.png" "sum(1 for x in range(w) for y in range(h) if px(x, y)[0] < 150) == 0"
+check "$T/edl.png" "sum(1 for x in range(w) for y in range(h) if px(x, y)[0] < 150) > 0.25 * fg * w * h"
+# the hint that estimate gives normals: once per run, and not with --quiet or on points with normals
+[[ "$(grep -c "has no normals: drawn with eye-dome lighting (E toggles it); 'amgsplat estimate" "$T/edl.err")" == 1 ]] ||
+  fail "hint: $(cat "$T/edl.err")"
+view "$T/scan.ply" --frames 3 --up z --size 64x48 --keys 21 -q 2>"$T/edl_q.err"
+[[ ! -s "$T/edl_q.err" ]] || fail "--quiet printed: $(cat "$T/edl_q.err")"
+view "$T/sphere.ply" --frames 1 --size 64x48 2>"$T/sph.err"
+! grep -q "hint:" "$T/sph.err" || fail "hint on a cloud with normals: $(cat "$T/sph.err")"
+expect_fail 2 "--no-edl excludes" "$AMGSPLAT" view "$T/scan.ply" --edl --no-edl
+# render draws the same shading (default on without normals) and says the same hint once
+"$AMGSPLAT" render "$T/scan.ply" --up z --size 160x120 --view 30,35 -o "$T/r_edl.png" 2>"$T/r_edl.err"
+"$AMGSPLAT" render "$T/scan.ply" --up z --size 160x120 --view 30,35 -o "$T/r_noedl.png" --no-edl -q 2>"$T/r_q.err"
+[[ "$(grep -c "hint: '$T/scan.ply' has no normals: drawn with eye-dome lighting; 'amgsplat estimate" "$T/r_edl.err")" == 1 &&
+   ! -s "$T/r_q.err" ]] || fail "render hint: $(cat "$T/r_edl.err" "$T/r_q.err")"
+ssim=$(metric "$T/r_edl.png" "$T/r_noedl.png" ssim)
+awk -v s="$ssim" 'BEGIN { exit !(s < 0.9) }' || fail "render: eye-dome lighting changed too little (SSIM $ssim)"
+at_least "$(metric "$T/r_edl.png" "$T/edl.png" ssim)" 0.9 "render vs view with eye-dome lighting"
+"$AMGSPLAT" render "$T/sphere.ply" --size 160x120 --view 0,0 -o "$T/r_sph.png" --samples 0 2>"$T/r_sph.err"
+! grep -q "hint:" "$T/r_sph.err" && [[ "$(metric "$T/r_sph.png" "$T/ref0.png" psnr)" == inf ]] ||
+  fail "points with normals: a hint or eye-dome lighting: $(cat "$T/r_sph.err")"
+"$AMGSPLAT" render "$T/sphere.ply" --size 160x120 --view 0,0 -o "$T/r_sph_edl.png" --samples 0 --edl -q
+ssim=$(metric "$T/r_sph_edl.png" "$T/ref0.png" ssim)
+awk -v s="$ssim" 'BEGIN { exit !(s < 0.99) }' || fail "render --edl on points with normals changed nothing (SSIM $ssim)"
+expect_fail 2 "--edl and --edl-strength need --renderer disc or square" "$AMGSPLAT" render "$T/scan.ply" -o "$T/x.png" --edl --renderer splat
+expect_fail 2 "--edl-strength expects a number in (0, 100]" "$AMGSPLAT" render "$T/scan.ply" -o "$T/x.png" --edl-strength 0
+
+# The figures (i) name the file, renderer, level or method; the first frame has no frame time yet.
+view "$T/sphere.ply" --frames 1 --overlay --size 320x240 --screenshot "$T/ov1.png" --json -q >"$T/ov1.json"
+python3 - "$T/ov1.json" <<'PY' || fail "first frame figures: $(cat "$T/ov1.json")"
+import json, re, sys
+t = json.load(open(sys.argv[1]))['overlay'].split('\n')
+assert t[0] == 'sphere.ply' and t[1] == 'renderer disc', t
+assert re.fullmatch(r'frame -- ms  first draw [0-9.]+ ms \(with GL warm-up\)', t[2]), t
+PY
+check "$T/ov1.png" "px(10, 10)[0] < 200 and px(300, 230)[:3] == (255, 255, 255)"
+view "$T/o.dps" --frames 3 --keys i --method prefix --level L --size 320x240 --screenshot "$T/ov_dps.png" --json -q \
+  >"$T/ov_dps.json"
+python3 - "$T/ov_dps.json" <<'PY' || fail "figures of a .dps: $(cat "$T/ov_dps.json")"
+import json, re, sys
+t = json.load(open(sys.argv[1]))['overlay'].split('\n')
+assert t[:3] == ['o.dps', 'renderer prim: prefix, alpha-ref 0.10', 'level 10 (L)'], t
+assert re.fullmatch(r'frame [0-9.]+ ms  draw [0-9.]+ ms', t[3]) and t[4] == '8 / 8 primitives', t
+PY
+view "$T/scan.ply" --frames 2 --keys i --up z --color-by intensity --size 320x240 --json -q >"$T/ov_scan.json"
+[[ "$(field "$T/ov_scan.json" overlay)" == "scan.ply"$'\n'"renderer disc, eye-dome lighting"$'\n'"colour by intensity"$'\n'* ]] ||
+  fail "figures of a scan: $(field "$T/ov_scan.json" overlay)"
+# h shows the keys over the frame as well as printing them; h again hides them
+view "$T/sphere.ply" --frames 2 --keys h --size 480x400 --view 0,0 --screenshot "$T/help.png" 2>"$T/help.err"
+grep -q "^  E  toggle eye-dome lighting" "$T/help.err" || fail "h did not print: $(cat "$T/help.err")"
+check "$T/help.png" "px(10, 10)[0] < 200 and px(400, 20)[0] < 200 and px(10, 300)[:3] == (255, 255, 255)"
+check "$T/shot.png" "px(10, 10)[:3] == (255, 255, 255)"
+view "$T/sphere.ply" --frames 3 --keys hh --size 160x120 --view 0,0 --screenshot "$T/help2.png" -q
+[[ "$(metric "$T/help2.png" "$T/ref0.png" psnr)" == inf ]] || fail "h h leaves text on the frame"
+# --frame-ms without --renderer draws with a renderer it steers (splat), and says so
+view "$T/sphere.ply" --frames 3 --frame-ms 50 --size 128x96 --json >"$T/fb.json" 2>"$T/fb.err"
+[[ "$(field "$T/fb.json" renderer)" == splat && "$(field "$T/fb.json" budget_applied)" == True ]] ||
+  fail "--frame-ms default renderer: $(cat "$T/fb.json")"
+grep -qF "drawing with the splat renderer, whose tau it steers" "$T/fb.err" || fail "--frame-ms: $(cat "$T/fb.err")"
+
 # Errors: a missing or bad file exits 1 naming it (before any window opens); bad options exit 2.
 expect_fail 1 "cannot open '$T/missing.ply'" view "$T/missing.ply" --frames 1
 printf 'ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n' >"$T/empty.ply"
