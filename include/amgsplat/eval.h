@@ -163,8 +163,10 @@ typedef struct asp_chart_sheet_desc {
  * Draws sheet (a grid of desc->row_count x desc->col_count equal tiles, as
  * asp_image_contact_sheet makes) into dst (initialised here) with a white
  * margin on the left holding the row labels and one on top holding the title
- * and the column labels, in PLplot's text like the charts; a label too wide
- * for its room is drawn smaller. The tiles' pixels are copied unchanged.
+ * and the column labels, in PLplot's text like the charts. A column is as
+ * wide as its widest label line (up to 4 tiles; tiles centred, white between),
+ * a label still too wide is drawn smaller. The tiles' pixels are copied
+ * unchanged.
  * Returns 0, ASP_EINVAL (no pixels, a zero count, a size not divisible into
  * the grid), ASP_EUNSUPPORTED (no PLplot memcairo driver) or ASP_ENOMEM; dst
  * is unchanged on failure. Thread safe (one drawing at a time).
@@ -297,7 +299,8 @@ typedef struct asp_eval_result {
     size_t mesh_triangles;     /* triangles of asp_eval_desc.mesh; 0 without one */
     double t_simplify;         /* seconds spent simplifying the mesh (both mesh rows, every level) */
     asp_image sheet;           /* contact sheet of view 0 at sheet_size: one row per representation,
-                                  the reference first, then the levels; width 0 when not made */
+                                  the reference first, then the levels, with row and column labels
+                                  (asp_chart_label_sheet); width 0 when not made */
     uint32_t sheet_cols, sheet_rows;
     asp_context ctx;
 } asp_eval_result;
