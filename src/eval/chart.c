@@ -193,18 +193,28 @@ static void draw_axes(const struct layout *l, const struct asp__axis *ax, const 
     // the plot area: world coordinates are the axes' (log10 on a log axis)
     plot_view(l, ax, ay);
     plwidth(1);
+    // grid lines and tick marks on pixel centres: crisp 1-pixel lines
+    double gx[ASP__AXIS_MAX_TICKS], gy[ASP__AXIS_MAX_TICKS];
+    for (int i = 0; i < ax->nticks; i++) {
+        double px = round(l->x0 + (ax->ticks[i] - ax->lo) / (ax->hi - ax->lo) * (l->x1 - l->x0));
+        gx[i] = ax->lo + (px - l->x0) / (l->x1 - l->x0) * (ax->hi - ax->lo);
+    }
+    for (int i = 0; i < ay->nticks; i++) {
+        double py = round(l->y1 - (ay->ticks[i] - ay->lo) / (ay->hi - ay->lo) * (l->y1 - l->y0));
+        gy[i] = ay->lo + (l->y1 - py) / (l->y1 - l->y0) * (ay->hi - ay->lo);
+    }
     plcol0(2);
     for (int i = 0; i < ax->nticks; i++)
-        pljoin(ax->ticks[i], ay->lo, ax->ticks[i], ay->hi);
+        pljoin(gx[i], ay->lo, gx[i], ay->hi);
     for (int i = 0; i < ay->nticks; i++)
-        pljoin(ax->lo, ay->ticks[i], ax->hi, ay->ticks[i]);
+        pljoin(ax->lo, gy[i], ax->hi, gy[i]);
     plcol0(1);
     plbox("bc", 0, 0, "bc", 0, 0);
     double tick_x = 5 * (ax->hi - ax->lo) / (l->x1 - l->x0), tick_y = 5 * (ay->hi - ay->lo) / (l->y1 - l->y0);
     for (int i = 0; i < ax->nticks; i++)
-        pljoin(ax->ticks[i], ay->lo, ax->ticks[i], ay->lo + tick_y);
+        pljoin(gx[i], ay->lo, gx[i], ay->lo + tick_y);
     for (int i = 0; i < ay->nticks; i++)
-        pljoin(ax->lo, ay->ticks[i], ax->lo + tick_x, ay->ticks[i]);
+        pljoin(ax->lo, gy[i], ax->lo + tick_x, gy[i]);
     page_view(l);
     asp__plot_font(l->text_px);
     char buf[64];
