@@ -22,6 +22,7 @@ packages=(
   python3                          # tests/cli/png_check.py and the JSON checks of tests/cli
   libcjson-dev                     # the one JSON library (reading and writing)
   libgsl-dev                       # statistics of the perceptual experiment (t distribution)
+  libplplot-dev plplot-driver-cairo fonts-dejavu-core   # charts (PLplot, drawn in memory by its cairo driver) and their font
   chromium                         # the web page's test in headless Chromium (puppeteer-core)
 )
 # Node.js and npm for the web page and its tests (three.js, gltf-validator, puppeteer-core, loaders.gl,

@@ -88,7 +88,7 @@ int asp_image_silhouettes(const asp_image *a, const asp_image *b, const asp_silh
                           asp_silhouette_info info[2], asp_error *err);
 
 /* ------------------------------------------------------------------------ */
-/* Line charts (src/eval/chart.c; no GL, thread safe)                       */
+/* Charts (src/eval/chart.c, drawn by PLplot; no GL, thread safe)          */
 /* ------------------------------------------------------------------------ */
 
 /** One line of a chart: count points (x[i], y[i]); non-finite points are skipped (the line breaks). */
@@ -120,22 +120,58 @@ typedef struct asp_chart_desc {
      * vertical error bars (y +- y_err[s][i]), e.g. standard deviations
      */
     const double *const *y_err;
+    /*
+     * NULL, or x_category_count names of categories at x = 1, 2, ...: the x
+     * axis runs from 0.5 to count + 0.5 with one tick per category, named
+     */
+    const char *const *x_categories;
+    size_t x_category_count;
 } asp_chart_desc;
 
 /**
- * Draws a line chart into dst (initialised here, opaque white background,
- * release with asp_image_release): axes with "nice" 1-2-5 ticks (decades on
- * log axes), a light grid, one coloured polyline with square markers per
- * series (series i gets palette colour i mod 12), a legend right of the plot
- * area, the title and axis labels in stb_easy_font's bitmap font. Axis
- * ranges cover every finite point (padded by 5%); a single value gets a unit
- * range around it. nseries may be 0 (axes only, range 0..1). Error bars
- * (desc->y_err) widen the y range to hold them. Deterministic.
- * Returns 0, ASP_EINVAL (size out of range, a series with count > 0 and NULL
- * x or y) or ASP_ENOMEM; dst is unchanged on failure. Thread safe.
+ * Draws a line chart with PLplot (its cairo driver, in memory) into dst
+ * (initialised here, opaque white background, release with
+ * asp_image_release): the title on top, the y label horizontal above the y
+ * axis, the x label below, at least 3 labelled ticks per axis ("nice" 1-2-5
+ * steps; decades, 1-2-5 or plain steps on log axes, whichever gives 3), a
+ * light grid, one polyline (width 2) with a marker per series (series i: the
+ * i-th colour of the Okabe-Ito palette without yellow, 7 colours, dashed from
+ * the 8th series on, and its own marker shape), and a legend right of the plot
+ * area naming every series with a name. Axis ranges cover every finite point
+ * (padded by 5%); a single value or a constant series gets a range around it.
+ * nseries may be 0, or every point NaN: the axes (range 0..1) and "no data".
+ * Error bars (desc->y_err) widen the y range to hold them. Deterministic.
+ * Returns 0, ASP_EINVAL (size out of range, over 64 series, a series with
+ * count > 0 and NULL x or y), ASP_EUNSUPPORTED (PLplot's memcairo driver,
+ * Debian plplot-driver-cairo, is missing) or ASP_ENOMEM; dst is unchanged on
+ * failure. Thread safe: PLplot's global state is behind a lock, so charts are
+ * drawn one at a time.
  */
 int asp_chart_draw(const asp_chart_series *series, size_t nseries, const asp_chart_desc *desc, asp_image *dst,
                    asp_error *err);
+
+/** Labels of a contact sheet's rows and columns (asp_chart_label_sheet). */
+typedef struct asp_chart_sheet_desc {
+    const char *title;              /* above the column labels; may be NULL */
+    size_t row_count, col_count;    /* the sheet's grid: rows x cols equal tiles */
+    const char *const *row_labels;  /* NULL, or row_count names, right-aligned left of each row */
+    const char *const *col_labels;  /* NULL, or col_count names centred above each column; '\n' breaks
+                                       a name into lines (at most 3) */
+} asp_chart_sheet_desc;
+
+/**
+ * Draws sheet (a grid of desc->row_count x desc->col_count equal tiles, as
+ * asp_image_contact_sheet makes) into dst (initialised here) with a white
+ * margin on the left holding the row labels and one on top holding the title
+ * and the column labels, in PLplot's text like the charts. A column is as
+ * wide as its widest label line (up to 4 tiles; tiles centred, white between),
+ * a label still too wide is drawn smaller. The tiles' pixels are copied
+ * unchanged.
+ * Returns 0, ASP_EINVAL (no pixels, a zero count, a size not divisible into
+ * the grid), ASP_EUNSUPPORTED (no PLplot memcairo driver) or ASP_ENOMEM; dst
+ * is unchanged on failure. Thread safe (one drawing at a time).
+ */
+int asp_chart_label_sheet(const asp_image *sheet, const asp_chart_sheet_desc *desc, asp_image *dst, asp_error *err);
 
 /* ------------------------------------------------------------------------ */
 /* Models (src/eval/model.c)                                                */
@@ -263,7 +299,8 @@ typedef struct asp_eval_result {
     size_t mesh_triangles;     /* triangles of asp_eval_desc.mesh; 0 without one */
     double t_simplify;         /* seconds spent simplifying the mesh (both mesh rows, every level) */
     asp_image sheet;           /* contact sheet of view 0 at sheet_size: one row per representation,
-                                  the reference first, then the levels; width 0 when not made */
+                                  the reference first, then the levels, with row and column labels
+                                  (asp_chart_label_sheet); width 0 when not made */
     uint32_t sheet_cols, sheet_rows;
     asp_context ctx;
 } asp_eval_result;

@@ -1,149 +1,67 @@
 /*
- * Line charts drawn on the CPU into an asp_image: the "quality against
- * primitive count" and "frame time against primitive count" figures the
- * evaluation shows (thesis Fig. 1.1 compares exactly these; journal section 5
- * Table 2). Text comes from stb_easy_font's quads, rasterised as rectangles.
- * Scatter plots with error bars and histograms draw the experiment's figures
- * (seed 004 Figs 4.1-4.5).
+ * Line charts, scatter plots with error bars and histograms drawn by PLplot
+ * into an asp_image (src/eval/plot_canvas.c): the "quality against primitive
+ * count" and "frame time against primitive count" figures of the evaluation
+ * (thesis Fig. 1.1 compares exactly these; journal section 5 Table 2) and the
+ * experiment's figures (seed 004 Figs 4.1-4.5). Every chart explains itself
+ * (issue 29): a title, both axis labels (the y label horizontal, above the
+ * axis), at least 3 labelled ticks per axis (src/eval/chart_axis.c), a legend
+ * naming each series, and colours from Okabe and Ito's palette for colour
+ * blindness ("Color Universal Design", 2002), each series with its own marker
+ * shape as well.
  */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "amgsplat/eval.h"
+#include <plplot.h>
 
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#endif
-#include <stb/stb_easy_font.h>
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
-
+#include "eval/chart_axis.h"
+#include "eval/plot_canvas.h"
 #include "util/banned.h"
 
-enum { MAX_TICKS = 32, FONT_H = 7 };
+/*
+ * Okabe-Ito without its yellow, which vanishes on white. Series 7 and on take
+ * the colours again with dashed lines; the markers differ for 10 series.
+ */
+enum { NCOLOURS = 7, NMARKERS = 10, FIRST_SERIES_COLOUR = 4, MAX_SERIES = 64 };
+static const uint8_t palette[NCOLOURS][3] = {
+    {0, 114, 178}, {213, 94, 0}, {0, 158, 115}, {204, 121, 167}, {230, 159, 0}, {86, 180, 233}, {0, 0, 0},
+};
+static const char *const markers[NMARKERS] = {"●", "■", "▲", "◆", "▼", "◀", "▶", "★", "⬟", "✚"};
 
-// 12 colours: an evaluation with a mesh draws up to 10 series, each needs its own
-static const uint8_t palette[12][3] = {
-    {31, 119, 180}, {214, 39, 40}, {44, 160, 44}, {255, 127, 14}, {148, 103, 189}, {140, 86, 75},
-    {227, 119, 194}, {23, 190, 207}, {188, 189, 34}, {0, 0, 0}, {127, 127, 127}, {255, 187, 120},
+struct layout {
+    double w, h;          /* image, pixels */
+    double x0, y0, x1, y1; /* plot area, pixels from the top left */
+    double text_px, title_px;
+    double legend_x;      /* left edge of the legend; 0 = none */
 };
 
-struct canvas {
-    asp_image *img;
-};
-
-static void put(const struct canvas *c, long x, long y, const uint8_t rgb[3])
+static void page_view(const struct layout *l)
 {
-    if (x < 0 || y < 0 || x >= (long)c->img->width || y >= (long)c->img->height)
-        return;
-    uint8_t *p = c->img->pixels + ((size_t)y * c->img->width + (size_t)x) * 4;
-    p[0] = rgb[0];
-    p[1] = rgb[1];
-    p[2] = rgb[2];
-    p[3] = 255;
+    asp__plot_page(l->w, l->h);
 }
 
-static void rect(const struct canvas *c, long x0, long y0, long x1, long y1, const uint8_t rgb[3])
+static void text_at(double x, double y, double just, const char *text)
 {
-    for (long y = y0; y < y1; y++)
-        for (long x = x0; x < x1; x++)
-            put(c, x, y, rgb);
+    asp__plot_text(x, y, just, text);
 }
 
-/* Bresenham with a 2x2 pen so lines read at a glance on small charts. */
-static void line(const struct canvas *c, long x0, long y0, long x1, long y1, int thick, const uint8_t rgb[3])
+/* Like text_at for labels this file makes (exponents as #u..#d): no escaping. */
+static void raw_text_at(double x, double y, double just, const char *s)
 {
-    long dx = labs(x1 - x0), dy = -labs(y1 - y0);
-    long sx = x0 < x1 ? 1 : -1, sy = y0 < y1 ? 1 : -1, e = dx + dy;
-    for (long guard = 0; guard < 100000; guard++) {
-        if (thick)
-            rect(c, x0, y0, x0 + 2, y0 + 2, rgb);
-        else
-            put(c, x0, y0, rgb);
-        if (x0 == x1 && y0 == y1)
-            break;
-        long e2 = 2 * e;
-        if (e2 >= dy) {
-            e += dy;
-            x0 += sx;
-        }
-        if (e2 <= dx) {
-            e += dx;
-            y0 += sy;
-        }
-    }
+    plptex(x, y, 1, 0, just, s);
 }
 
-/* stb_easy_font takes a mutable string; copy the (short) label. */
-static int text_width(const char *s)
+static void set_colour(size_t s)
 {
-    char buf[256];
-    snprintf(buf, sizeof buf, "%s", s);
-    return stb_easy_font_width(buf);
+    plcol0((PLINT)(FIRST_SERIES_COLOUR + s % NCOLOURS));
+    pllsty(s / NCOLOURS % 2 ? 2 : 1); // the second round of colours: dashed
 }
 
-static void text(const struct canvas *c, long x, long y, const char *s, const uint8_t rgb[3])
+static double tx(const struct asp__axis *a, double v)
 {
-    char buf[256];
-    snprintf(buf, sizeof buf, "%s", s);
-    // about 270 bytes per character (stb_easy_font.h); 256 characters at most
-    static const int cap = 256 * 300;
-    float verts[256 * 300 / 4];
-    int quads = stb_easy_font_print((float)x, (float)y, buf, NULL, verts, cap);
-    for (int q = 0; q < quads; q++) {
-        const float *v = verts + q * 16; // 4 vertices of 16 bytes: x y z rgba
-        long qx0 = lrintf(v[0]), qy0 = lrintf(v[1]), qx1 = lrintf(v[8]), qy1 = lrintf(v[9]);
-        rect(c, qx0, qy0, qx1, qy1, rgb);
-    }
-}
-
-/* Vertical text: letters stacked, so the y label needs no rotation. */
-static void text_vertical(const struct canvas *c, long x, long y, const char *s, const uint8_t rgb[3])
-{
-    for (size_t i = 0; s[i] && i < 64; i++) {
-        char ch[2] = {s[i], 0};
-        text(c, x, y + (long)i * (FONT_H + 2), ch, rgb);
-    }
-}
-
-struct axis {
-    double lo, hi;
-    int log;
-    int integer; /* ticks at whole numbers only */
-    double ticks[MAX_TICKS];
-    int nticks;
-};
-
-static double nice_step(double range)
-{
-    double raw = range / 5, mag = pow(10, floor(log10(raw))), f = raw / mag;
-    return (f < 1.5 ? 1 : f < 3.5 ? 2 : f < 7.5 ? 5 : 10) * mag;
-}
-
-static void axis_ticks(struct axis *a)
-{
-    a->nticks = 0;
-    if (a->log) {
-        double d0 = floor(a->lo), d1 = ceil(a->hi);
-        int per_decade = d1 - d0 <= 2 ? 3 : 1; // 1, 2, 5 on short log axes
-        static const double steps[3] = {1, 2, 5};
-        for (double d = d0; d <= d1 && a->nticks < MAX_TICKS; d++)
-            for (int k = 0; k < per_decade && a->nticks < MAX_TICKS; k++) {
-                double v = log10(steps[k]) + d;
-                if (v >= a->lo - 1e-9 && v <= a->hi + 1e-9)
-                    a->ticks[a->nticks++] = v;
-            }
-        return;
-    }
-    double step = nice_step(a->hi - a->lo);
-    if (a->integer && step < 1)
-        step = 1;
-    for (double v = ceil(a->lo / step - 1e-9) * step; v <= a->hi + 1e-9 * step && a->nticks < MAX_TICKS; v += step)
-        a->ticks[a->nticks++] = fabs(v) < 1e-12 * step ? 0 : v;
+    return a->log ? log10(v) : v;
 }
 
 static int usable(double v, int log)
@@ -151,147 +69,42 @@ static int usable(double v, int log)
     return isfinite(v) && (!log || v > 0);
 }
 
-static void axis_range(struct axis *a, const asp_chart_series *series, size_t n, const double *const *y_err,
-                       int use_x, double fixed_lo, double fixed_hi, int bars, double bar_slot)
+static void draw_series(const asp_chart_series *s, size_t k, const double *y_err, const struct asp__axis *ax,
+                        const struct asp__axis *ay, unsigned flags, double marker_px)
 {
-    double lo = INFINITY, hi = -INFINITY;
-    for (size_t s = 0; s < n; s++)
-        for (size_t i = 0; i < series[s].count; i++) {
-            double v = use_x ? series[s].x[i] : series[s].y[i];
-            double other = use_x ? series[s].y[i] : series[s].x[i];
-            if (!usable(v, a->log) || !isfinite(other))
-                continue;
-            // error bars and bars (from 0) must fit inside the y range too
-            double e = !use_x && y_err && y_err[s] && isfinite(y_err[s][i]) ? fabs(y_err[s][i]) : 0;
-            double vlo = v - e, vhi = v + e;
-            if (!use_x && bars)
-                vlo = vlo < 0 ? vlo : 0;
-            if (a->log) {
-                vlo = usable(vlo, 1) ? log10(vlo) : log10(v);
-                vhi = log10(vhi);
-            }
-            lo = vlo < lo ? vlo : lo;
-            hi = vhi > hi ? vhi : hi;
-        }
-    if (use_x && bars && lo <= hi) {
-        lo -= 0.5 * bar_slot;
-        hi += 0.5 * bar_slot;
-    }
-    if (!use_x && fixed_lo < fixed_hi && !a->log) {
-        lo = fixed_lo;
-        hi = fixed_hi;
-    } else if (!(lo <= hi)) {
-        lo = 0;
-        hi = 1;
-    } else if (hi - lo < 1e-12 * (fabs(lo) + 1)) {
-        lo -= a->log ? 0.5 : 0.5 * (fabs(lo) > 0 ? fabs(lo) : 1);
-        hi += a->log ? 0.5 : 0.5 * (fabs(hi) > 0 ? fabs(hi) : 1);
-    } else {
-        double pad = 0.05 * (hi - lo);
-        // a histogram's bars stand on the x axis: no padding below 0
-        lo = bars && !use_x && lo == 0 ? 0 : lo - pad;
-        hi += pad;
-    }
-    a->lo = lo;
-    a->hi = hi;
-    axis_ticks(a);
-}
-
-static void tick_label(char *buf, size_t cap, double v, int log)
-{
-    double x = log ? pow(10, v) : v;
-    if (fabs(x) >= 1e5 || (fabs(x) < 1e-3 && x != 0))
-        snprintf(buf, cap, "%.0e", x);
-    else
-        snprintf(buf, cap, "%.4g", x);
-}
-
-struct plot {
-    long x0, y0, x1, y1; // plot area, pixels; y0 top
-    struct axis ax, ay;
-};
-
-static long map_x(const struct plot *p, double v)
-{
-    return p->x0 + lrint((v - p->ax.lo) / (p->ax.hi - p->ax.lo) * (double)(p->x1 - p->x0));
-}
-
-static long map_y(const struct plot *p, double v)
-{
-    return p->y1 - lrint((v - p->ay.lo) / (p->ay.hi - p->ay.lo) * (double)(p->y1 - p->y0));
-}
-
-static void draw_axes(const struct canvas *c, const struct plot *p, const asp_chart_desc *d)
-{
-    static const uint8_t grid[3] = {225, 225, 225}, ink[3] = {40, 40, 40};
-    char buf[32];
-    for (int i = 0; i < p->ay.nticks; i++) {
-        long y = map_y(p, p->ay.ticks[i]);
-        line(c, p->x0, y, p->x1, y, 0, grid);
-        tick_label(buf, sizeof buf, p->ay.ticks[i], p->ay.log);
-        text(c, p->x0 - 6 - text_width(buf), y - FONT_H / 2 - 1, buf, ink);
-    }
-    for (int i = 0; i < p->ax.nticks; i++) {
-        long x = map_x(p, p->ax.ticks[i]);
-        line(c, x, p->y0, x, p->y1, 0, grid);
-        tick_label(buf, sizeof buf, p->ax.ticks[i], p->ax.log);
-        text(c, x - text_width(buf) / 2, p->y1 + 6, buf, ink);
-    }
-    line(c, p->x0, p->y1, p->x1, p->y1, 0, ink);
-    line(c, p->x0, p->y0, p->x0, p->y1, 0, ink);
-    if (d->title)
-        text(c, (p->x0 + p->x1) / 2 - text_width(d->title) / 2, 6, d->title, ink);
-    if (d->x_label)
-        text(c, (p->x0 + p->x1) / 2 - text_width(d->x_label) / 2, p->y1 + 20, d->x_label, ink);
-    if (d->y_label) {
-        long len = (long)strlen(d->y_label);
-        text_vertical(c, 4, (p->y0 + p->y1) / 2 - len * (FONT_H + 2) / 2, d->y_label, ink);
-    }
-}
-
-static double clamp_y(const struct plot *p, double y)
-{
-    return y < p->ay.lo ? p->ay.lo : y > p->ay.hi ? p->ay.hi : y;
-}
-
-/* Vertical error bar with caps; on a log axis the lower end may fall below 0 and is clamped. */
-static void draw_error_bar(const struct canvas *c, const struct plot *p, long cx, double y, double e,
-                           const uint8_t rgb[3])
-{
-    double y0 = y - e, y1 = y + e;
-    y0 = p->ay.log ? (y0 > 0 ? log10(y0) : p->ay.lo) : y0;
-    y1 = p->ay.log ? log10(y1) : y1;
-    long a = map_y(p, clamp_y(p, y0)), b = map_y(p, clamp_y(p, y1));
-    line(c, cx, a, cx, b, 0, rgb);
-    line(c, cx - 3, a, cx + 3, a, 0, rgb);
-    line(c, cx - 3, b, cx + 3, b, 0, rgb);
-}
-
-static void draw_series(const struct canvas *c, const struct plot *p, const asp_chart_series *s, const double *y_err,
-                        const uint8_t rgb[3], unsigned flags)
-{
+    set_colour(k);
+    plwidth(2);
+    PLFLT px[2], py[2];
     int have_prev = 0;
-    long px = 0, py = 0;
     for (size_t i = 0; i < s->count; i++) {
         double x = s->x[i], y = s->y[i];
-        if (!usable(x, p->ax.log) || !usable(y, p->ay.log)) {
+        if (!usable(x, ax->log) || !usable(y, ay->log)) {
             have_prev = 0;
             continue;
         }
-        x = p->ax.log ? log10(x) : x;
-        double yv = y;
-        y = p->ay.log ? log10(y) : y;
-        // clamp to the plot so a fixed y range never draws outside it
-        y = clamp_y(p, y);
-        long cx = map_x(p, x), cy = map_y(p, y);
+        px[1] = tx(ax, x);
+        py[1] = tx(ay, y);
         if (have_prev && !(flags & ASP_CHART_MARKERS))
-            line(c, px, py, cx, cy, 1, rgb);
-        rect(c, cx - 2, cy - 2, cx + 4, cy + 4, rgb);
-        if (y_err && isfinite(y_err[i]) && y_err[i] != 0)
-            draw_error_bar(c, p, cx + 1, yv, fabs(y_err[i]), rgb);
-        px = cx;
-        py = cy;
+            pljoin(px[0], py[0], px[1], py[1]);
+        px[0] = px[1];
+        py[0] = py[1];
         have_prev = 1;
+    }
+    pllsty(1);
+    plwidth(1.5);
+    for (size_t i = 0; y_err && i < s->count; i++) {
+        double x = s->x[i], y = s->y[i], e = fabs(y_err[i]);
+        if (!usable(x, ax->log) || !usable(y, ay->log) || !isfinite(e) || e == 0)
+            continue;
+        // on a log axis the lower end may fall below 0: it runs to the bottom of the plot
+        PLFLT ex = tx(ax, x), lo = ay->log ? (y - e > 0 ? log10(y - e) : ay->lo) : y - e, hi = tx(ay, y + e);
+        plerry(1, &ex, &lo, &hi);
+    }
+    asp__plot_font(marker_px);
+    for (size_t i = 0; i < s->count; i++) {
+        double x = s->x[i], y = s->y[i];
+        if (usable(x, ax->log) && usable(y, ay->log))
+            plstring(1, &(PLFLT){tx(ax, x)}, &(PLFLT){tx(ay, y)}, markers[k % NMARKERS]);
     }
 }
 
@@ -309,8 +122,7 @@ static double bar_slot_width(const asp_chart_series *series, size_t n)
 }
 
 /* Series k of nseries takes the k-th share of each slot, so bars of several series stand side by side. */
-static void draw_bars(const struct canvas *c, const struct plot *p, const asp_chart_series *s, const double *y_err,
-                      size_t k, size_t nseries, double slot, const uint8_t rgb[3])
+static void draw_bars(const asp_chart_series *s, size_t k, size_t nseries, const double *y_err, double slot)
 {
     double w = 0.9 * slot / (double)nseries;
     for (size_t i = 0; i < s->count; i++) {
@@ -318,37 +130,168 @@ static void draw_bars(const struct canvas *c, const struct plot *p, const asp_ch
         if (!isfinite(x) || !isfinite(y))
             continue;
         double left = x - 0.45 * slot + (double)k * w;
-        long x0 = map_x(p, left), x1 = map_x(p, left + w);
-        long y0 = map_y(p, clamp_y(p, 0)), y1 = map_y(p, clamp_y(p, y));
-        if (x1 <= x0)
-            x1 = x0 + 1;
-        rect(c, x0, y1 < y0 ? y1 : y0, x1, (y1 < y0 ? y0 : y1) + 1, rgb);
-        if (y_err && isfinite(y_err[i]) && y_err[i] != 0)
-            draw_error_bar(c, p, (x0 + x1) / 2, y, fabs(y_err[i]), (const uint8_t[3]){40, 40, 40});
+        PLFLT bx[4] = {left, left + w, left + w, left}, by[4] = {0, 0, y, y};
+        set_colour(k);
+        plfill(4, bx, by);
+        if (y_err && isfinite(y_err[i]) && y_err[i] != 0) {
+            plcol0(1);
+            plerry(1, &(PLFLT){left + 0.5 * w}, &(PLFLT){y - fabs(y_err[i])}, &(PLFLT){y + fabs(y_err[i])});
+        }
     }
 }
 
-static void draw_legend(const struct canvas *c, const struct plot *p, const asp_chart_series *series, size_t n)
+static void layout_chart(struct layout *l, const asp_chart_desc *d, const asp_chart_series *series, size_t n,
+                         const struct asp__axis *ay)
 {
-    static const uint8_t ink[3] = {40, 40, 40}, box[3] = {250, 250, 250};
-    int w = 0, rows = 0;
+    l->w = d->width;
+    l->h = d->height;
+    l->text_px = d->width >= 400 && d->height >= 260 ? 13 : 11;
+    l->title_px = l->text_px + 2;
+    double line = 1.35 * l->text_px, margin = 8;
+    // top: the title, then the y label above the axis; bottom: tick labels, then the x label
+    l->y0 = margin + (d->title ? 1.35 * l->title_px : 0) + line + 10;
+    l->y1 = l->h - margin - 2 * line - 4;
+    double ylab = 0;
+    char buf[64];
+    for (int i = 0; i < ay->nticks; i++) {
+        asp__axis_label(ay, ay->ticks[i], buf, sizeof buf);
+        double tw = asp__plot_text_width(buf, l->text_px);
+        ylab = tw > ylab ? tw : ylab;
+    }
+    l->x0 = margin + ylab + 10;
+    double legend = 0;
     for (size_t s = 0; s < n; s++)
         if (series[s].name && series[s].name[0]) {
-            int tw = text_width(series[s].name);
-            w = tw > w ? tw : w;
-            rows++;
+            double tw = 44 + asp__plot_text_width(series[s].name, l->text_px) + 10;
+            legend = tw > legend ? tw : legend;
         }
-    if (!rows)
+    // the legend takes at most a third of the width, right of the plot, so it never hides data
+    if (legend > l->w / 3)
+        legend = l->w / 3;
+    l->x1 = l->w - margin - (legend > 0 ? legend + 10 : 2.0 * l->text_px);
+    l->legend_x = legend > 0 ? l->x1 + 10 : 0;
+    l->x0 = round(l->x0);
+    l->x1 = round(l->x1);
+    l->y0 = round(l->y0);
+    l->y1 = round(l->y1);
+}
+
+/*
+ * The plot area, world coordinates the axes' (log10 on a log axis). Its edges lie on pixel centres
+ * (+0.5), so the 1-pixel frame is one crisp row or column rather than two grey ones.
+ */
+static void plot_view(const struct layout *l, const struct asp__axis *ax, const struct asp__axis *ay)
+{
+    plvpor((l->x0 + 0.5) / l->w, (l->x1 + 0.5) / l->w, 1 - (l->y1 + 0.5) / l->h, 1 - (l->y0 + 0.5) / l->h);
+    plwind(ax->lo, ax->hi, ay->lo, ay->hi);
+}
+
+/* Grid, frame, ticks and their labels; the axis labels and the title. */
+static void draw_axes(const struct layout *l, const struct asp__axis *ax, const struct asp__axis *ay,
+                      const asp_chart_desc *d, const char *const *categories, size_t ncat)
+{
+    // the plot area: world coordinates are the axes' (log10 on a log axis)
+    plot_view(l, ax, ay);
+    plwidth(1);
+    // grid lines and tick marks on pixel centres: crisp 1-pixel lines
+    double gx[ASP__AXIS_MAX_TICKS], gy[ASP__AXIS_MAX_TICKS];
+    for (int i = 0; i < ax->nticks; i++) {
+        double px = round(l->x0 + (ax->ticks[i] - ax->lo) / (ax->hi - ax->lo) * (l->x1 - l->x0));
+        gx[i] = ax->lo + (px - l->x0) / (l->x1 - l->x0) * (ax->hi - ax->lo);
+    }
+    for (int i = 0; i < ay->nticks; i++) {
+        double py = round(l->y1 - (ay->ticks[i] - ay->lo) / (ay->hi - ay->lo) * (l->y1 - l->y0));
+        gy[i] = ay->lo + (l->y1 - py) / (l->y1 - l->y0) * (ay->hi - ay->lo);
+    }
+    plcol0(2);
+    for (int i = 0; i < ax->nticks; i++)
+        pljoin(gx[i], ay->lo, gx[i], ay->hi);
+    for (int i = 0; i < ay->nticks; i++)
+        pljoin(ax->lo, gy[i], ax->hi, gy[i]);
+    plcol0(1);
+    plbox("bc", 0, 0, "bc", 0, 0);
+    double tick_x = 5 * (ax->hi - ax->lo) / (l->x1 - l->x0), tick_y = 5 * (ay->hi - ay->lo) / (l->y1 - l->y0);
+    for (int i = 0; i < ax->nticks; i++)
+        pljoin(gx[i], ay->lo, gx[i], ay->lo + tick_y);
+    for (int i = 0; i < ay->nticks; i++)
+        pljoin(ax->lo, gy[i], ax->lo + tick_x, gy[i]);
+    page_view(l);
+    asp__plot_font(l->text_px);
+    char buf[64];
+    double tick_row = l->y1 + 0.75 * l->text_px + 4;
+    for (int i = 0; i < ax->nticks; i++) {
+        double px = l->x0 + (ax->ticks[i] - ax->lo) / (ax->hi - ax->lo) * (l->x1 - l->x0);
+        double v = ax->ticks[i];
+        size_t c = (size_t)llround(v);
+        if (categories && fabs(v - (double)c) < 1e-9 && c >= 1 && c <= ncat) {
+            text_at(px, tick_row, 0.5, categories[c - 1]);
+            continue;
+        }
+        asp__axis_label(ax, ax->ticks[i], buf, sizeof buf);
+        raw_text_at(px, tick_row, 0.5, categories ? "" : buf);
+    }
+    for (int i = 0; i < ay->nticks; i++) {
+        double py = l->y1 - (ay->ticks[i] - ay->lo) / (ay->hi - ay->lo) * (l->y1 - l->y0);
+        asp__axis_label(ay, ay->ticks[i], buf, sizeof buf);
+        raw_text_at(l->x0 - 6, py, 1, buf);
+    }
+    double line = 1.35 * l->text_px;
+    if (d->x_label)
+        text_at(0.5 * (l->x0 + l->x1), tick_row + line, 0.5, d->x_label);
+    if (d->y_label)
+        text_at(8, l->y0 - 0.5 * line - 8, 0, d->y_label); // horizontal, above the y axis and its top label
+    if (d->title) {
+        asp__plot_font(l->title_px);
+        text_at(0.5 * l->w, 8 + 0.6 * l->title_px, 0.5, d->title);
+    }
+}
+
+static void draw_legend(const struct layout *l, const asp_chart_series *series, size_t n, unsigned flags)
+{
+    if (!l->legend_x)
         return;
-    // right of the plot area (asp_chart_draw leaves the room), so it never hides data
-    long x = p->x1 + 10, y = p->y0 + 4;
-    rect(c, x - 4, y - 3, x + w + 22, y + rows * 12 + 1, box);
+    double line = 1.5 * l->text_px, x = l->legend_x, y = l->y0 + 2;
+    size_t rows = 0;
+    for (size_t s = 0; s < n; s++)
+        rows += series[s].name && series[s].name[0];
+    // a white box with a grey rim
+    PLFLT bx[4] = {x, l->w - 8, l->w - 8, x}, by[4] = {y, y, y + (double)rows * line + 8, y + (double)rows * line + 8};
+    plcol0(3);
+    plfill(4, bx, by);
+    plcol0(2);
+    plwidth(1);
+    plline(4, bx, by);
+    pljoin(bx[3], by[3], bx[0], by[0]);
+    y += 4 + 0.5 * line;
     for (size_t s = 0; s < n; s++) {
         if (!(series[s].name && series[s].name[0]))
             continue;
-        rect(c, x, y + 2, x + 14, y + 5, palette[s % 12]);
-        text(c, x + 18, y, series[s].name, ink);
-        y += 12;
+        if (flags & ASP_CHART_BARS) {
+            PLFLT sx[4] = {x + 8, x + 34, x + 34, x + 8}, sy[4] = {y - 5, y - 5, y + 5, y + 5};
+            set_colour(s);
+            plfill(4, sx, sy);
+        } else {
+            set_colour(s);
+            plwidth(2);
+            if (!(flags & ASP_CHART_MARKERS)) // a scatter plot's series have no lines
+                pljoin(x + 6, y, x + 36, y);
+            asp__plot_font(0.9 * l->text_px);
+            plstring(1, &(PLFLT){x + 21}, &(PLFLT){y}, markers[s % NMARKERS]);
+        }
+        pllsty(1);
+        plcol0(1);
+        asp__plot_font(l->text_px);
+        char name[128];
+        // a name wider than the legend's third of the chart is cut, with an ellipsis
+        double room = l->w - 12 - (x + 44);
+        snprintf(name, sizeof name, "%s", series[s].name);
+        for (size_t len = strlen(name); len > 4 && asp__plot_text_width(name, l->text_px) > room; len--) {
+            while (len > 1 && ((unsigned char)name[len - 1] & 0xC0) == 0x80)
+                len--; // never split a UTF-8 character
+            snprintf(name + len - 1, sizeof name - (len - 1), "…");
+        }
+        text_at(x + 44, y, 0, name);
+        y += line;
     }
 }
 
@@ -362,43 +305,68 @@ int asp_chart_draw(const asp_chart_series *series, size_t nseries, const asp_cha
         d.height = 340;
     if (d.width < 160 || d.height < 160 || d.width > 4096 || d.height > 4096)
         return asp_error_set(err, ASP_EINVAL, "chart size %ux%u is outside 160..4096", d.width, d.height);
+    if (nseries > MAX_SERIES)
+        return asp_error_set(err, ASP_EINVAL, "chart of %zu series (at most %d)", nseries, MAX_SERIES);
     for (size_t s = 0; s < nseries; s++)
         if (series[s].count && (!series[s].x || !series[s].y))
             return asp_error_set(err, ASP_EINVAL, "chart series %zu ('%s') has %zu points but no x or y array", s,
                                  series[s].name ? series[s].name : "", series[s].count);
+    if (d.x_categories && d.x_category_count == 0)
+        return asp_error_set(err, ASP_EINVAL, "chart x categories given but their count is 0");
+    int bars = (d.flags & ASP_CHART_BARS) != 0;
+    struct asp__axis ax = {.log = (d.flags & ASP_CHART_LOG_X) != 0 && !bars},
+                     ay = {.log = (d.flags & ASP_CHART_LOG_Y) != 0 && !bars};
+    ax.integer = ((d.flags & ASP_CHART_X_INTEGER) != 0 || d.x_categories) && !ax.log;
+    double slot = bars ? bar_slot_width(series, nseries) : 0;
+    asp__axis_fit(&ax, series, nseries, NULL, 1, 0, 0, bars, slot);
+    asp__axis_fit(&ay, series, nseries, d.y_err, 0, d.y_min, d.y_max, bars, slot);
+    if (d.x_categories) {
+        // one tick per category, named, over the categories' range whatever the data
+        ax.lo = 0.5;
+        ax.hi = (double)d.x_category_count + 0.5;
+        ax.nticks = 0;
+        for (size_t c = 1; c <= d.x_category_count && ax.nticks < ASP__AXIS_MAX_TICKS; c++)
+            ax.ticks[ax.nticks++] = (double)c;
+    }
     asp_image img = {0};
     int rc = asp_image_init(&img, d.width, d.height, err);
     if (rc)
         return rc;
     static const uint8_t white[4] = {255, 255, 255, 255};
     asp_image_fill(&img, white);
-    struct canvas c = {&img};
-    int legend = 0;
-    for (size_t s = 0; s < nseries; s++)
-        if (series[s].name && series[s].name[0]) {
-            int tw = text_width(series[s].name) + 36;
-            legend = tw > legend ? tw : legend;
-        }
-    // the legend takes at most a third of the width
-    if (legend > (int)d.width / 3)
-        legend = (int)d.width / 3;
-    struct plot p = {.x0 = 58, .y0 = 22, .x1 = (long)d.width - 14 - legend, .y1 = (long)d.height - 34};
-    int bars = (d.flags & ASP_CHART_BARS) != 0;
-    p.ax.log = (d.flags & ASP_CHART_LOG_X) != 0 && !bars;
-    p.ay.log = (d.flags & ASP_CHART_LOG_Y) != 0 && !bars;
-    p.ax.integer = (d.flags & ASP_CHART_X_INTEGER) != 0 && !p.ax.log;
-    double slot = bars ? bar_slot_width(series, nseries) : 0;
-    axis_range(&p.ax, series, nseries, NULL, 1, 0, 0, bars, slot);
-    axis_range(&p.ay, series, nseries, d.y_err, 0, d.y_min, d.y_max, bars, slot);
-    draw_axes(&c, &p, &d);
+    struct asp__plot p;
+    rc = asp__plot_begin(&p, &img, err);
+    if (rc) {
+        asp_image_release(&img);
+        return rc;
+    }
+    for (int c = 0; c < NCOLOURS; c++)
+        plscol0(FIRST_SERIES_COLOUR + c, palette[c][0], palette[c][1], palette[c][2]);
+    struct layout l;
+    layout_chart(&l, &d, series, nseries, &ay);
+    draw_axes(&l, &ax, &ay, &d, d.x_categories, d.x_category_count);
+    // the data, clipped to the plot area
+    plot_view(&l, &ax, &ay);
     for (size_t s = 0; s < nseries; s++) {
         const double *e = d.y_err ? d.y_err[s] : NULL;
         if (bars)
-            draw_bars(&c, &p, &series[s], e, s, nseries, slot, palette[s % 12]);
+            draw_bars(&series[s], s, nseries, e, slot);
         else
-            draw_series(&c, &p, &series[s], e, palette[s % 12], d.flags);
+            draw_series(&series[s], s, e, &ax, &ay, d.flags, 0.8 * l.text_px);
     }
-    draw_legend(&c, &p, series, nseries);
+    plcol0(1);
+    pllsty(1);
+    plwidth(1);
+    plbox("bc", 0, 0, "bc", 0, 0); // the frame again, over bars that stand on it
+    page_view(&l);
+    if (ax.empty || ay.empty) {
+        // nothing to draw: say so, rather than leave an empty frame to puzzle over
+        plcol0(1);
+        asp__plot_font(l.text_px);
+        text_at(0.5 * (l.x0 + l.x1), 0.5 * (l.y0 + l.y1), 0.5, nseries ? "no finite data" : "no data");
+    }
+    draw_legend(&l, series, nseries, d.flags);
+    asp__plot_end(&p);
     *dst = img;
     return 0;
 }

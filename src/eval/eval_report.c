@@ -141,9 +141,14 @@ int asp_eval_chart(const asp_eval_result *res, uint32_t size, int which, asp_ima
         k++;
     }
     char title[96];
-    snprintf(title, sizeof title, "%s at %ux%u, mean of %zu views", which == 0 ? "SSIM" : "frame time (ms)", size,
-             size, res->views);
-    asp_chart_desc cd = {.title = title, .x_label = "primitives", .y_label = which == 0 ? "SSIM" : "ms",
+    if (which == 0)
+        snprintf(title, sizeof title, "SSIM against the reference at %ux%u px, mean of %zu views", size, size,
+                 res->views);
+    else
+        snprintf(title, sizeof title, "frame time at %ux%u px (median of view 0)", size, size);
+    asp_chart_desc cd = {.title = title,
+                         .x_label = "primitives of the level (log scale)",
+                         .y_label = which == 0 ? "SSIM (1 = identical)" : "frame time (ms, log scale)",
                          .flags = ASP_CHART_LOG_X | (which == 1 ? ASP_CHART_LOG_Y : 0)};
     int rc = asp_chart_draw(series, ns, &cd, dst, err);
     asp_free(&res->ctx, xy);

@@ -582,10 +582,47 @@ static int make_sheet(struct eval_state *s, struct sheet *sh, asp_eval_result *r
         if (i % sh->cols == 0)
             memcpy(sh->tiles[i].pixels, ref->pixels, (size_t)ref->width * ref->height * 4);
     }
-    (void)s;
     res->sheet_cols = (uint32_t)sh->cols;
     res->sheet_rows = (uint32_t)sh->rows;
-    return asp_image_contact_sheet(sh->tiles, sh->rows * sh->cols, (uint32_t)sh->cols, &res->sheet, err);
+    asp_image grid = {0};
+    int rc = asp_image_contact_sheet(sh->tiles, sh->rows * sh->cols, (uint32_t)sh->cols, &grid, err);
+    if (rc)
+        return rc;
+    // the sheet says what it shows (issue 29): each row's representation, each column's level
+    enum { LABEL = 48 };
+    char *text = asp_calloc(s->ctx, sh->rows + sh->cols, LABEL);
+    const char **labels = asp_calloc(s->ctx, sh->rows + sh->cols, sizeof *labels);
+    if (!text || !labels)
+        rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the sheet's labels");
+    for (size_t i = 0; !rc && i < sh->rows + sh->cols; i++) {
+        char *t = text + i * LABEL;
+        size_t c = i - sh->rows, lv = c - 1;
+        if (i < sh->rows)
+            snprintf(t, LABEL, "%s", s->reps[i].name);
+        else if (c == 0)
+            snprintf(t, LABEL, "reference\n%s", s->mesh ? "mesh" : "all points");
+        else if (s->dps->amg_levels - 1 - s->dps->levels[lv].level)
+            snprintf(t, LABEL, "level L-%u\n%zu primitives", s->dps->amg_levels - 1 - s->dps->levels[lv].level,
+                     s->dps->levels[lv].prim_count);
+        else
+            snprintf(t, LABEL, "level L\n%zu primitives", s->dps->levels[lv].prim_count);
+        labels[i] = t;
+    }
+    char title[96];
+    snprintf(title, sizeof title, "view 0 at %ux%u: rows are representations, columns levels", ref->width,
+             ref->height);
+    if (!rc)
+        rc = asp_chart_label_sheet(&grid,
+                                   &(asp_chart_sheet_desc){.title = title,
+                                                           .row_count = sh->rows,
+                                                           .col_count = sh->cols,
+                                                           .row_labels = labels,
+                                                           .col_labels = labels + sh->rows},
+                                   &res->sheet, err);
+    asp_free(s->ctx, text);
+    asp_free(s->ctx, labels);
+    asp_image_release(&grid);
+    return rc;
 }
 
 int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_context *ctx, asp_eval_result **out,

@@ -12,6 +12,7 @@
 
 #include "render/internal.h"
 #include "util/banned.h"
+#include "util/child_process.h"
 
 enum { MAX_DEVICES = 16 };
 
@@ -199,6 +200,10 @@ int asp_gl_context_create_headless(const asp_gl_context_desc *desc, const asp_co
     static const asp_gl_context_desc zero_desc;
     if (!desc)
         desc = &zero_desc;
+    // Mesa does not survive running out of address space while it loads (util/child_process.h)
+    int rc = asp__address_space_headroom(ASP_GL_CONTEXT_HEADROOM, "creating a GL context", err);
+    if (rc)
+        return rc;
     asp_gl_context *gl = asp_calloc(ctx, 1, sizeof *gl);
     if (!gl)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for a GL context");

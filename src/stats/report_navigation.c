@@ -254,8 +254,10 @@ static void improvement_chart(struct report *r, const char *test, const struct n
     }
     size_t np = 0;
     char title[200], legend[64], name[64];
-    int used = snprintf(title, sizeof title, "%s: improvement B-A, %% points;", test);
+    const char *groups[MAX_GROUPS]; // the x axis names each group: "control", "variable points", ...
+    snprintf(title, sizeof title, "%s: grade improvement from run A to run B, per group", test);
     for (size_t k = 0; k < ng; k++) {
+        groups[k] = g[k].name;
         for (size_t q = 0; q < g[k].n; q++) {
             xs[np] = (double)(k + 1) - 0.1;
             ys[np++] = g[k].imp[q];
@@ -265,8 +267,6 @@ static void improvement_chart(struct report *r, const char *test, const struct n
         mx[k] = (double)(k + 1) + 0.1;
         my[k] = si[k].mean;
         me[k] = isfinite(lo) ? 0.5 * (hi - lo) : 0;
-        if (used > 0 && (size_t)used < sizeof title)
-            used += snprintf(title + used, sizeof title - (size_t)used, " %zu %s", k + 1, g[k].name);
     }
     snprintf(legend, sizeof legend, "mean, %g%% interval", 100 * r->a->level);
     snprintf(name, sizeof name, "grades_%s.png", test);
@@ -278,10 +278,12 @@ static void improvement_chart(struct report *r, const char *test, const struct n
                            &(asp_chart_desc){.width = 640,
                                              .height = 380,
                                              .title = title,
-                                             .x_label = "group",
-                                             .y_label = "points",
+                                             .x_label = "group (by run B's condition)",
+                                             .y_label = "improvement B - A (grade, % points)",
                                              .flags = ASP_CHART_MARKERS | ASP_CHART_X_INTEGER,
-                                             .y_err = errs},
+                                             .y_err = errs,
+                                             .x_categories = groups,
+                                             .x_category_count = ng},
                            name);
     free(xs);
     free(ys);

@@ -35,6 +35,12 @@ int asp__address_space_headroom(size_t need, const char *what, asp_error *err);
  */
 #define ASP_GL_SHADER_HEADROOM ((size_t)320 << 20)
 #define ASP_GL_DRAW_HEADROOM ((size_t)160 << 20)
+/*
+ * Creating a headless GL context (Mesa maps its driver and LLVM, llvmpipe starts its threads), the
+ * same 2M-point render: it died (SIGSEGV in swrast_dri.so, or epoxy's abort when libGL could not be
+ * mapped) with 490 MB left and passed with 495 MB.
+ */
+#define ASP_GL_CONTEXT_HEADROOM ((size_t)512 << 20)
 
 /* What runs in the child: writes its result to fd; its return value is ignored. */
 typedef void (*asp__child_work)(void *user, int fd);

@@ -97,8 +97,8 @@ for png in frame_time_vs_drawn drawn_far drawn_near drawn_lowspeed grades_lowspe
   [[ -s "$T/report/$png.png" ]] || fail "missing $png.png"
   check "$T/report/$png.png" "w >= 600 and h >= 300 and len(set(px(x, y)[:3] for x in range(0, w, 5) for y in range(0, h, 5))) > 3"
 done
-# polygons blue, points red in the histogram's plot area (left of the legend): both drawn
-check "$T/report/drawn_lowspeed.png" "any(px(x, y)[0] > 180 and px(x, y)[1] < 80 for x in range(60, w - 140) for y in range(h)) and any(px(x, y)[2] > 150 and px(x, y)[0] < 80 for x in range(60, w - 140) for y in range(h))"
+# polygons blue, points vermillion (Okabe-Ito) in the histogram's plot area (left of the legend): both drawn
+check "$T/report/drawn_lowspeed.png" "any(px(x, y)[0] > 180 and px(x, y)[1] < 110 and px(x, y)[2] < 60 for x in range(60, w - 140) for y in range(h)) and any(px(x, y)[2] > 150 and px(x, y)[0] < 80 for x in range(60, w - 140) for y in range(h))"
 
 # ---- bad input: clean errors naming the file and line, never a crash
 mkdir -p "$T/bad/S01" "$T/fmt/S01" "$T/empty"

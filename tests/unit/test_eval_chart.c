@@ -4,8 +4,9 @@
 
 #include "harness.h"
 #include "amgsplat/eval.h"
+#include "chart_probe.h"
 
-static const uint8_t blue[3] = {31, 119, 180}; /* palette colour 0 */
+static const uint8_t *const blue = chart_blue; /* palette colour 0 */
 
 /* Mean x of the pixels of colour c in the top and bottom halves of the image; count of such pixels. */
 static size_t colour_halves(const asp_image *img, const uint8_t c[3], double *top_x, double *bottom_x)
@@ -14,8 +15,7 @@ static size_t colour_halves(const asp_image *img, const uint8_t c[3], double *to
     size_t n[2] = {0, 0};
     for (uint32_t y = 0; y < img->height; y++)
         for (uint32_t x = 0; x < img->width; x++) {
-            const uint8_t *p = img->pixels + ((size_t)y * img->width + x) * 4;
-            if (p[0] == c[0] && p[1] == c[1] && p[2] == c[2]) {
+            if (chart_pixel_is(img, x, y, c, 30)) {
                 int h = y >= img->height / 2;
                 sx[h] += x;
                 n[h]++;
@@ -68,7 +68,7 @@ static void test_legend_and_log(void)
     CHECK_OK(asp_chart_draw(s, 2, &d, &a, NULL), (asp_error *)NULL);
     CHECK_OK(asp_chart_draw(s, 2, &d, &b, NULL), (asp_error *)NULL);
     CHECK(memcmp(a.pixels, b.pixels, (size_t)a.width * a.height * 4) == 0);
-    static const uint8_t red[3] = {214, 39, 40}; /* palette colour 1: the second series */
+    const uint8_t *red = chart_vermillion; /* palette colour 1: the second series */
     double top, bottom;
     CHECK(colour_halves(&a, red, &top, &bottom) > 50);
     /* y in 0..1: the second series (0.9 .. 0.95) lies in the top half only */

@@ -2,19 +2,15 @@
  * The chart kinds the experiment report draws (src/eval/chart.c): markers
  * without lines (seed 004 Fig 4.1 as a scatter), error bars, histogram bars
  * (Figs 4.2-4.5) and whole-number x ticks. Pixels are checked at the places
- * the plot maps the data to (plot area 58..w-14 by 22..h-34 without a legend).
+ * the plot maps the data to (the plot area found from its frame, chart_probe.h).
  */
 #include "amgsplat/eval.h"
+#include "chart_probe.h"
 #include "harness.h"
-
-static const uint8_t blue[3] = {31, 119, 180}; // palette colour 0
 
 static int is_blue(const asp_image *img, long x, long y)
 {
-    if (x < 0 || y < 0 || x >= (long)img->width || y >= (long)img->height)
-        return 0;
-    const uint8_t *p = img->pixels + ((size_t)y * img->width + (size_t)x) * 4;
-    return p[0] == blue[0] && p[1] == blue[1] && p[2] == blue[2];
+    return chart_pixel_is(img, x, y, chart_blue, 40); // palette colour 0
 }
 
 /* Any blue pixel within r of (x, y). */
@@ -27,7 +23,17 @@ static int blue_near(const asp_image *img, long x, long y, long r)
     return 0;
 }
 
-enum { W = 400, H = 300, X0 = 58, X1 = W - 14, Y0 = 22, Y1 = H - 34 };
+enum { W = 400, H = 300 };
+
+/* The plot area of the last chart framed (frame()). */
+static long X0, X1, Y0, Y1;
+
+static int frame(const asp_image *img)
+{
+    int ok = chart_frame(img, &X0, &Y0, &X1, &Y1);
+    CHECK_MSG(ok, "no plot frame found in the %ux%u chart", img->width, img->height);
+    return ok;
+}
 
 static long map(double v, double lo, double hi, long p0, long p1)
 {
@@ -42,6 +48,8 @@ static void test_markers_only(void)
     CHECK_OK(asp_chart_draw(&s, 1, &(asp_chart_desc){.width = W, .height = H}, &lines, NULL), (asp_error *)NULL);
     CHECK_OK(asp_chart_draw(&s, 1, &(asp_chart_desc){.width = W, .height = H, .flags = ASP_CHART_MARKERS}, &dots, NULL),
              (asp_error *)NULL);
+    if (!frame(&lines))
+        return;
     // the middle of the segment: drawn as a line, empty as a scatter; the markers in both
     long mx = (X0 + X1) / 2, my = (Y0 + Y1) / 2;
     CHECK(blue_near(&lines, mx, my, 2));
@@ -62,6 +70,8 @@ static void test_error_bars_widen_the_range(void)
                             &(asp_chart_desc){.width = W, .height = H, .flags = ASP_CHART_MARKERS, .y_err = errs}, &img,
                             NULL),
              (asp_error *)NULL);
+    if (!frame(&img))
+        return;
     // y range -4..6 padded by 5%: the bar of the first point reaches y = 5 and -3
     double lo = -4 - 0.5, hi = 6 + 0.5;
     long bx = map(0, -0.05, 1.05, X0, X1) + 1;
@@ -79,12 +89,16 @@ static void test_bars(void)
     asp_image img = {0};
     CHECK_OK(asp_chart_draw(&s, 1, &(asp_chart_desc){.width = W, .height = H, .flags = ASP_CHART_BARS}, &img, NULL),
              (asp_error *)NULL);
-    // x range -0.5..2.5 (half a slot each side), y from 0 (bars stand on the axis) to 3 + 5%
-    long bx = map(2, -0.5, 2.5, X0, X1);
-    CHECK(is_blue(&img, bx, Y1 - 3));                                            // the bottom of the tallest bar
-    CHECK(is_blue(&img, bx, map(2.9, 3.15, 0, Y0, Y1)));                         // near its top
-    CHECK(!is_blue(&img, map(0, -0.5, 2.5, X0, X1), map(1.5, 3.15, 0, Y0, Y1))); // above the first bar
-    CHECK(!is_blue(&img, map(0.5, -0.5, 2.5, X0, X1), Y1 - 3));                  // the gap between bars
+    if (!frame(&img))
+        return;
+    // x range -0.5..2.5 (half a slot each side) padded by 5%, y from 0 (bars stand on the axis) to 3 + 5%
+    const double xl = -0.65, xh = 2.65;
+    long bx = map(2, xl, xh, X0, X1);
+    CHECK(is_blue(&img, bx, Y1 - 3));                                    // the bottom of the tallest bar
+    CHECK(is_blue(&img, bx, map(2.9, 3.15, 0, Y0, Y1)));                 // near its top
+    CHECK(!is_blue(&img, bx, map(3.1, 3.15, 0, Y0, Y1)));                // above its top
+    CHECK(!is_blue(&img, map(0, xl, xh, X0, X1), map(1.5, 3.15, 0, Y0, Y1))); // above the first bar
+    CHECK(!is_blue(&img, map(0.5, xl, xh, X0, X1), Y1 - 3));             // the gap between bars
     asp_image_release(&img);
 }
 
@@ -97,8 +111,10 @@ static void test_integer_ticks(void)
     CHECK_OK(asp_chart_draw(&s, 1, &(asp_chart_desc){.width = W, .height = H}, &a, NULL), (asp_error *)NULL);
     CHECK_OK(asp_chart_draw(&s, 1, &(asp_chart_desc){.width = W, .height = H, .flags = ASP_CHART_X_INTEGER}, &b, NULL),
              (asp_error *)NULL);
+    if (!frame(&a))
+        return;
     size_t ink_a = 0, ink_b = 0;
-    for (long yy = Y1 + 4; yy < Y1 + 16; yy++) // the x tick labels' row
+    for (long yy = Y1 + 4; yy < Y1 + 20; yy++) // the x tick labels' row
         for (long xx = 0; xx < W; xx++) {
             ink_a += a.pixels[((size_t)yy * W + (size_t)xx) * 4] < 100;
             ink_b += b.pixels[((size_t)yy * W + (size_t)xx) * 4] < 100;
