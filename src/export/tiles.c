@@ -182,8 +182,10 @@ static cJSON *write_tile(tiles_run *t, asp_index id, uint32_t min_c, double max_
     cJSON_AddNumberToObject(tile, "geometricError", error);
     cJSON *content = cJSON_AddObjectToObject(tile, "content");
     cJSON_AddStringToObject(content, "uri", uri);
-    if (points_only || nd->child_count == 0)
+    if (points_only || nd->child_count == 0) {
+        cJSON_AddItemToObject(tile, "boundingVolume", z_up_box(box));
         return tile;
+    }
     cJSON *children = cJSON_AddArrayToObject(tile, "children");
     for (uint32_t k = 0; k < nd->child_count; k++) {
         double cb[6];
@@ -198,6 +200,7 @@ static cJSON *write_tile(tiles_run *t, asp_index id, uint32_t min_c, double max_
             box[3 + j] = fmax(box[3 + j], cb[3 + j]);
         }
     }
+    cJSON_AddItemToObject(tile, "boundingVolume", z_up_box(box));
     return tile;
 }
 
@@ -232,7 +235,6 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
     double origin[3];
     asp_hier_origin(hier, origin);
     const asp_frame *frame = asp_hier_frame(hier);
-    cJSON_AddItemToObject(root_tile, "boundingVolume", z_up_box(box));
     cJSON_AddStringToObject(root_tile, "refine", "REPLACE");
     if (origin[0] != 0 || origin[1] != 0 || origin[2] != 0) {
         double m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, origin[0], -origin[2], origin[1], 1};
