@@ -45,6 +45,7 @@ async function main() {
   const browser = await puppeteer.launch({
     executablePath: o.chromium,
     headless: true,
+    protocolTimeout: 1000 * Number(o.timeout) + 60000, // waitForFunction's polls run under it
     userDataDir: userDir,
     args: ['--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking',
       '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
