@@ -259,7 +259,7 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
     cJSON_AddItemToObject(root, "extras", extras);
     // the root tile's error, for a client that starts from it
     t.st.root_error = cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(root_tile, "geometricError"));
-    char *json = cJSON_Print(root);
+    char *json = cJSON_PrintUnformatted(root); // bytes the first frame waits for
     cJSON_Delete(root);
     if (!json)
         return asp_error_set(err, ASP_ENOMEM, "out of memory printing the tileset of '%s'", dir);
