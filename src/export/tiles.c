@@ -86,11 +86,15 @@ static size_t cut(const tiles_run *t, asp_index root, uint32_t c, asp_index *ids
     return n;
 }
 
-/* Grows box (lo xyz, hi xyz) by the ellipse of splat s (its centre +- a on every axis). */
+/*
+ * Grows box (lo xyz, hi xyz) by the ellipse of splat s, center + a cos(t) u + b sin(t) v: its
+ * extent along axis k is sqrt((a u_k)^2 + (b v_k)^2), so a flat patch gets a flat box.
+ */
 static void box_add(double box[6], const asp_hier_splat *s)
 {
-    double r = s->a > 0 ? s->a : 0;
+    double a = s->a > 0 ? s->a : 0, b = s->b > 0 ? s->b : 0;
     for (int k = 0; k < 3; k++) {
+        double r = sqrt(a * a * s->u[k] * s->u[k] + b * b * s->v[k] * s->v[k]);
         box[k] = fmin(box[k], (double)s->center[k] - r);
         box[3 + k] = fmax(box[3 + k], (double)s->center[k] + r);
     }
