@@ -47,7 +47,8 @@ typedef struct tiles_run {
     const asp_tiles_desc *desc;
     const char *dir;
     asp_tiles_stats st;
-    asp_error *err;
+    asp_error *err; /* the caller's, or local when the caller passed NULL: its code is the result */
+    asp_error local;
 } tiles_run;
 
 /*
@@ -222,8 +223,8 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
                    .node_count = asp_hier_node_count(hier),
                    .tile_points = d->tile_points ? d->tile_points : TILE_POINTS_DEFAULT,
                    .desc = d,
-                   .dir = dir,
-                   .err = err};
+                   .dir = dir};
+    t.err = err ? err : &t.local;
     char sub[4096];
     if (snprintf(sub, sizeof sub, "%s/tiles", dir) >= (int)sizeof sub)
         return asp_error_set(err, ASP_EINVAL, "tileset directory name '%s' is too long", dir);
@@ -235,7 +236,7 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
     double box[6];
     cJSON *root_tile = write_tile(&t, 0, 0, INFINITY, 0, box);
     if (!root_tile)
-        return err ? err->code : ASP_EIO;
+        return t.err->code; // the tiles written so far stay; without tileset.json they are no tileset
     double origin[3];
     asp_hier_origin(hier, origin);
     const asp_frame *frame = asp_hier_frame(hier);
