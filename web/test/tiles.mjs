@@ -5,7 +5,7 @@
 //        [--light off|head] [--error PX] [--point-budget N] [--timeout S] [--chromium PATH]
 // writes OUT_PREFIX_first.png and OUT_PREFIX_refined.png; prints one JSON line: tileset_bytes (every
 // file under DIR), first_frame {bytes (the page's count), server_bytes (the server's, read when the
-// page reported it: an upper bound), requests, ms}, refined {bytes, requests, tiles, points,
+// page reported its first frame, before it requests more), requests, ms}, refined {bytes, requests, tiles, points,
 // error_target}. Exit 1 when the page reports an error or does not settle in time, 2 on usage errors.
 import fs from 'node:fs';
 import path from 'node:path';
@@ -79,9 +79,14 @@ async function main() {
     if (o['point-budget']) q.set('point-budget', o['point-budget']);
     const { port } = server.address();
     const timeout = 1000 * Number(o.timeout);
+    // the page calls this at its first frame and holds refinement until it returns: the server's
+    // count is then exactly what the first frame cost
+    let serverBytes = null;
+    await page.exposeFunction('amgsplatOnFirstFrame', () => {
+      serverBytes = server.bytesServed;
+    });
     await page.goto(`http://127.0.0.1:${port}/index.html?${q}`, { waitUntil: 'load' });
     await page.waitForFunction('window.amgsplatViewer && window.amgsplatViewer.ready', { timeout });
-    const serverBytes = server.bytesServed;
     const first = await page.evaluate(() => ({ error: window.amgsplatViewer.error, firstFrame: window.amgsplatViewer.firstFrame,
       image: window.amgsplatViewer.firstFrameImage }));
     if (first.error) throw new Error(`the viewer failed: ${first.error}`);
