@@ -25,8 +25,8 @@ packages=(
   libplplot-dev plplot-driver-cairo fonts-dejavu-core   # charts (PLplot, drawn in memory by its cairo driver) and their font
   chromium                         # the web page's test in headless Chromium (puppeteer-core)
 )
-# Node.js and npm for the web page and its tests (three.js, gltf-validator, puppeteer-core, loaders.gl,
-# pinned in web/package-lock.json). Debian's packages when no node is on the PATH; a node that is
+# Node.js and npm for the web page and its tests (three.js, 3d-tiles-renderer, cesium, gltf-validator,
+# puppeteer-core, loaders.gl, pinned in web/package-lock.json). Debian's packages when no node is on the PATH; a node that is
 # already installed (another distribution of it) is kept, since Debian's npm would conflict with it.
 if ! command -v npm >/dev/null 2>&1; then
   packages+=(nodejs npm)

@@ -1,6 +1,9 @@
 // A tiny static server for the viewer (docs/web.md): web/ at /, a model directory at /model/.
 //   node web/serve.mjs [--port N] [DIR]      then open http://localhost:N/?file=/model/X.glb
 // Listens on 127.0.0.1 only. web/test/screenshot.mjs uses the same server on a free port.
+// Sends Content-Length, answers single byte ranges (Range: bytes=A-B, 206) and allows any origin
+// (CORS), as a tileset's server should (docs/web.md); server.bytesServed counts the body bytes sent
+// from DIR (what the tileset tests compare with the page's own count).
 import fs from 'node:fs';
 import http from 'node:http';
 import path from 'node:path';
@@ -28,9 +31,28 @@ export function serve(modelDir, port = 0) {
       res.writeHead(404).end('not found');
       return;
     }
-    res.writeHead(200, { 'content-type': types[path.extname(file)] || 'application/octet-stream' });
-    fs.createReadStream(file).pipe(res);
+    const size = fs.statSync(file).size;
+    const head = { 'content-type': types[path.extname(file)] || 'application/octet-stream',
+      'access-control-allow-origin': '*', 'accept-ranges': 'bytes' };
+    let start = 0, end = size - 1, code = 200;
+    const range = /^bytes=(\d*)-(\d*)$/.exec(req.headers.range || '');
+    if (range && (range[1] || range[2])) {
+      start = range[1] ? Number(range[1]) : Math.max(0, size - Number(range[2]));
+      end = range[1] && range[2] ? Math.min(Number(range[2]), size - 1) : size - 1;
+      if (start > end || start >= size) {
+        res.writeHead(416, { 'content-range': `bytes */${size}` }).end();
+        return;
+      }
+      code = 206;
+      head['content-range'] = `bytes ${start}-${end}/${size}`;
+    }
+    head['content-length'] = String(size === 0 ? 0 : end - start + 1);
+    res.writeHead(code, head);
+    if (root === modelDir) server.bytesServed += size === 0 ? 0 : end - start + 1;
+    if (size === 0) res.end();
+    else fs.createReadStream(file, { start, end }).pipe(res);
   });
+  server.bytesServed = 0;
   return new Promise((resolve, reject) => {
     server.once('error', reject);
     server.listen(port, '127.0.0.1', () => resolve(server));

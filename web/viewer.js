@@ -4,12 +4,15 @@
 // (docs/render-methods.md): "normalized" (Pajarola et al. 2003 5.3-5.4: front layer, window,
 // division) or "blend-all" (additive), in linear light; points are drawn as three.js points.
 // URL: ?file=URL&view=AZ,EL[,DIST]&size=WxH&bg=R,G,B&level=NAME&method=M&light=off|head&points=splats|points&ui=0
+// A 3D Tiles tileset from `amgsplat export --tiles` streams instead (tileset=URL, tiles.js):
+// ?tileset=URL&error=PX&point-budget=N&...
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 // EXT_meshopt_compression (amgsplat export's default for points, docs/cli/export.md): the decoder
 // three ships (meshoptimizer's WebAssembly decoder, filters included)
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
+import { TileStream } from './tiles.js';
 
 const status = { ready: false, error: null, info: null };
 window.amgsplatViewer = status;
@@ -25,6 +28,10 @@ function parseParams() {
   const p = new URLSearchParams(location.search);
   const o = {
     file: p.get('file'),
+    tileset: p.get('tileset'),
+    errorTarget: 1.5, // pixels: the projected splat diameter a tile may show (the hierarchy's tau)
+    pointBudget: 4000000, // splats drawn at most; the error target grows until the visible tiles fit
+    moveFactor: 4, // while the camera moves, the error target x this: coarse tiles while moving
     view: [30, 20, 0], // amgsplat render's default --view
     size: null,
     bg: [255, 255, 255], // amgsplat render's default --background
@@ -42,6 +49,12 @@ function parseParams() {
     o.size = [+m[1], +m[2]];
   }
   if (p.get('bg')) o.bg = numbers(p.get('bg'), 3, 3, 'bg');
+  if (p.get('error')) o.errorTarget = numbers(p.get('error'), 1, 1, 'error')[0];
+  if (p.get('point-budget')) o.pointBudget = numbers(p.get('point-budget'), 1, 1, 'point-budget')[0];
+  if (p.get('move-factor')) o.moveFactor = numbers(p.get('move-factor'), 1, 1, 'move-factor')[0];
+  if (!(o.errorTarget > 0) || !(o.pointBudget >= 1) || !(o.moveFactor >= 1))
+    throw new Error('error, point-budget and move-factor: expected error > 0, point-budget >= 1, move-factor >= 1');
+  if (o.file && o.tileset) throw new Error('file and tileset: give one of them');
   if (p.get('point-size')) o.pointSize = numbers(p.get('point-size'), 1, 1, 'point-size')[0];
   if (!['normalized', 'blend-all', 'gltf'].includes(o.method))
     throw new Error(`method: expected normalized, blend-all or gltf, got '${o.method}'`);
@@ -146,23 +159,23 @@ in vec3 axisU;
 in vec3 axisV;
 in vec3 splatNormal;
 in vec4 splatColor;
-uniform mat4 viewMatrix;
+uniform mat4 modelViewMatrix;
 uniform mat4 projectionMatrix;
-uniform vec3 uEye;
 uniform float uEpsilon;
 uniform int uLit;
 out vec2 vLocal;
 out vec3 vColor;
 void main() {
   vec2 q = position.xy * 1.05;
-  vec3 p = center + q.x * axisU + q.y * axisV;
-  vec3 ray = p - uEye;
-  if (uEpsilon > 0.0 && dot(ray, ray) > 0.0) p += uEpsilon * length(axisU) * normalize(ray);
+  // in eye space (the eye at 0): the model matrix (a tile's transform; identity for a GLB) is
+  // rigid, so this is the push along the eye ray of the splat renderer
+  vec3 e = (modelViewMatrix * vec4(center + q.x * axisU + q.y * axisV, 1.0)).xyz;
+  if (uEpsilon > 0.0 && dot(e, e) > 0.0) e += uEpsilon * length(mat3(modelViewMatrix) * axisU) * normalize(e);
   vLocal = q;
-  vec3 n = mat3(viewMatrix) * splatNormal;
+  vec3 n = mat3(modelViewMatrix) * splatNormal;
   float shade = dot(n, n) > 0.0 ? 0.25 + 0.75 * abs(normalize(n).z) : 1.0;
   vColor = splatColor.rgb * (uLit != 0 ? shade : 1.0);
-  gl_Position = projectionMatrix * (viewMatrix * vec4(p, 1.0));
+  gl_Position = projectionMatrix * vec4(e, 1.0);
 }`;
 
 const splatDepthFragment = `
@@ -407,7 +420,7 @@ class Viewer {
     geo.setAttribute('splatNormal', new THREE.InstancedBufferAttribute(normals, 3));
     geo.setAttribute('splatColor', new THREE.InstancedBufferAttribute(C, 4));
     geo.instanceCount = n;
-    const uniforms = { uEye: { value: new THREE.Vector3() }, uEpsilon: { value: 1 }, uLit: { value: 0 },
+    const uniforms = { uEpsilon: { value: 1 }, uLit: { value: 0 },
       frontDepth: { value: this.front.depthTexture } };
     const common = { glslVersion: THREE.GLSL3, vertexShader: splatVertex, side: THREE.DoubleSide };
     const depth = new THREE.RawShaderMaterial({ ...common, fragmentShader: splatDepthFragment, uniforms });
@@ -419,7 +432,8 @@ class Viewer {
     });
     const mesh = new THREE.Mesh(geo, depth);
     mesh.frustumCulled = false;
-    // at the identity: the centres already hold the node's transform (uEye is in the same frame)
+    // at the identity: the centres already hold the node's transform (the shader takes the model matrix of
+    // whatever holds the mesh: a tile's transform in tiles.js)
     return { mesh, points, depth, accum, uniforms };
   }
 
@@ -466,7 +480,6 @@ class Viewer {
     if (splatting) {
       this.scene.background = null;
       for (const sp of this.splats) {
-        sp.uniforms.uEye.value.copy(this.camera.position).sub(sp.mesh.position);
         sp.uniforms.uLit.value = o.light ? 1 : 0;
         sp.uniforms.frontDepth.value = this.front.depthTexture;
         sp.uniforms.uEpsilon.value = 1;
@@ -590,7 +603,10 @@ async function main() {
     drop.classList.remove('on');
     if (e.dataTransfer.files[0]) openFile(e.dataTransfer.files[0]);
   });
-  if (opts.file) {
+  if (opts.tileset) {
+    // streaming: ready at the first frame; window.amgsplatViewer.settled once refined (tiles.js)
+    await new TileStream(viewer, opts, status).start();
+  } else if (opts.file) {
     const base = opts.file.slice(0, opts.file.lastIndexOf('/') + 1);
     await viewer.open(await fetchBytes(opts.file), opts.file, base);
   }

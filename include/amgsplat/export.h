@@ -115,6 +115,47 @@ int asp_gltf_export_cloud(const asp_cloud *cloud, const char *path, const asp_gl
 void asp_gltf_gaussian_from_ellipse(const float u[3], const float v[3], float a, float b, float quat[4],
                                     float log_scale[3]);
 
+/* ---- streamed tilesets (issue 32, docs/web.md) ---- */
+
+/** Tileset options; the zero value means the defaults. */
+typedef struct asp_tiles_desc {
+    asp_gltf_desc gltf;  /* each tile's GLB: flags (ASP_GLTF_NO_SPLATS, ASP_GLTF_PLAIN); no levels */
+    size_t tile_points;  /* most splats in a tile's content where the tree allows it; 0 = 32768 */
+} asp_tiles_desc;
+
+/** What a tileset export wrote. */
+typedef struct asp_tiles_stats {
+    size_t tiles;        /* tiles (one GLB each) */
+    size_t splats;       /* splats in all tiles' contents (node splats and points) */
+    size_t points;       /* the hierarchy's points */
+    size_t leaf_points;  /* points in leaf tiles (full resolution) */
+    size_t largest;      /* splats of the largest tile */
+    uint32_t depth;      /* deepest tile (root = 0) */
+    double root_error;   /* the root tile's geometricError */
+    size_t json_bytes;   /* tileset.json */
+    size_t file_bytes;   /* every file written */
+    double origin[3];    /* world origin in the root transform */
+} asp_tiles_stats;
+
+/**
+ * Writes hier as a 3D Tiles 1.1 tileset in directory dir (created if
+ * missing): dir/tileset.json (explicit tiling, refine REPLACE, boxes) and
+ * one compact GLB a tile, dir/tiles/<node id>.glb, as
+ * asp_gltf_export_hier writes points (positions relative to the origin,
+ * y up; the root transform holds the origin, z up). A tile is an octree
+ * node; its content is the cut of its subtree at the deepest depth that
+ * keeps at most tile_points splats (node splats where the cut stops above
+ * the leaves), one depth deeper at least than its parent's; geometricError
+ * is the largest splat diameter in it (0 for full resolution), so a
+ * client's screen-space error in pixels is asp_hier_select's tau. Written
+ * tile by tile: memory beyond the hierarchy is one tile's content. Files
+ * are written atomically, tileset.json last. stats may be NULL.
+ * Errors: ASP_EINVAL (desc with levels, directory name too long),
+ * ASP_EIO (cannot create or write), ASP_ENOMEM. Thread-safe.
+ */
+int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles_desc *desc, asp_tiles_stats *stats,
+                          asp_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -7,6 +7,7 @@ static const char usage[] =
     "usage: amgsplat export IN -o OUT.glb|OUT.gltf [--level L[,L...]|all] [--alpha-mode blend|mask]\n"
     "                       [--alpha-cutoff X] [--lit] [--no-normal-map] [--no-splats] [--plain]\n"
     "                       [--json]\n"
+    "       amgsplat export IN -o DIR --tiles [--tile-points N] [--no-splats] [--plain]\n"
     "\n"
     "Writes glTF 2.0: one binary .glb, or a .gltf with OUT.bin and OUT_<image>.png beside it.\n"
     "A .dps becomes one textured quad per domain primitive (its support rectangle, as amgsplat\n"
@@ -15,7 +16,9 @@ static const char usage[] =
     "a node and a scene named by level. A point set (.ply, .xyz, ...) or .hier becomes POINTS with\n"
     "POSITION, NORMAL, COLOR_0 and seed 001's splat ellipses as KHR_gaussian_splatting Gaussians,\n"
     "quantised (KHR_mesh_quantization) and compressed (EXT_meshopt_compression) unless --plain.\n"
-    "Positions are relative to the model's origin, kept in the node translation.";
+    "Positions are relative to the model's origin, kept in the node translation.\n"
+    "--tiles writes a point set or .hier as a streamed 3D Tiles 1.1 tileset: DIR/tileset.json and\n"
+    "one GLB a tile under DIR/tiles/ (docs/web.md).";
 
 #include <stdio.h>
 #include <string.h>
@@ -29,8 +32,13 @@ static const char usage[] =
 struct export_opts {
     const char *output, *level, *alpha_mode;
     double alpha_cutoff;
-    int lit, no_normal_map, no_splats, plain;
+    int lit, no_normal_map, no_splats, plain, tiles;
+    size_t tile_points;
 };
+
+/* cmd_export_tiles.c: --tiles (asp_tiles_export_hier) */
+int export_tiles(struct cli_env *env, const char *in, int hier_file, const char *dir, size_t tile_points,
+                 unsigned flags);
 
 /* --level "L-6,L" or "all" into indices of dps->levels; returns the count, 0 on error (printed). */
 static int parse_levels(struct cli_env *env, const asp_dps *dps, const char *path, const char *text, size_t *out,
@@ -115,7 +123,7 @@ static int check_options(struct cli_env *env, const struct export_opts *o, asp_g
 {
     if (!o->output)
         return cli_usage_error(env, "missing -o OUT.glb or OUT.gltf");
-    if (!asp_file_name_is(o->output, "glb") && !asp_file_name_is(o->output, "gltf"))
+    if (!o->tiles && !asp_file_name_is(o->output, "glb") && !asp_file_name_is(o->output, "gltf"))
         return cli_usage_error(env, "output '%s' must end in .glb or .gltf", o->output);
     if (o->alpha_mode) {
         if (strcmp(o->alpha_mode, "blend") == 0)
@@ -200,6 +208,8 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
         {"no-splats", 0, CLI_FLAG, &o.no_splats, NULL, "points: plain POINTS without the KHR_gaussian_splatting ellipses"},
         {"plain", 0, CLI_FLAG, &o.plain, NULL, "points: float attributes, uncompressed, in input order (default: "
                                                 "quantised, meshopt-compressed)"},
+        {"tiles", 0, CLI_FLAG, &o.tiles, NULL, "points: a 3D Tiles 1.1 tileset in directory OUT (tileset.json, tiles/*.glb)"},
+        {"tile-points", 0, CLI_SIZE, &o.tile_points, "N", "--tiles: most splats in a tile (default 32768)"},
         {0},
     };
     int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -213,7 +223,7 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
     if (rc)
         return rc;
     const char *inputs[1] = {in};
-    if (cli_check_output(env, o.output, asp_file_name_is(o.output, "glb") ? "glb" : "gltf", 0, inputs, 1))
+    if (!o.tiles && cli_check_output(env, o.output, asp_file_name_is(o.output, "glb") ? "glb" : "gltf", 0, inputs, 1))
         return 2;
     asp_error err = {0};
     asp_file_type type;
@@ -231,5 +241,11 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--no-splats is for point inputs");
     if (is_dps && o.plain)
         return cli_usage_error(env, "--plain is for point inputs (primitive levels are always written plain)");
+    if (o.tile_points && !o.tiles)
+        return cli_usage_error(env, "--tile-points needs --tiles");
+    if (o.tiles && is_dps)
+        return cli_usage_error(env, "--tiles takes a point file or a .hier (not yet a .dps)");
+    if (o.tiles)
+        return export_tiles(env, in, type.kind == ASP_FILE_HIER, o.output, o.tile_points, d.flags);
     return is_dps ? export_dps(env, in, &o, &d) : export_points(env, in, type.kind == ASP_FILE_HIER, &o, &d);
 }

@@ -76,10 +76,11 @@ typedef struct point_arrays {
     float lo[3], hi[3];
 } point_arrays;
 
-static void fill_points(const asp_hier *hier, point_arrays *a, int splats)
+/* ids: n indices into asp_hier_splats (a tile's cut), or NULL: every point, in input order */
+static void fill_points(const asp_hier *hier, const asp_index *ids, size_t n, point_arrays *a, int splats)
 {
     const asp_hier_splat *all = asp_hier_splats(hier);
-    size_t nodes = asp_hier_node_count(hier), n = asp_hier_point_count(hier);
+    size_t nodes = asp_hier_node_count(hier);
     int colored = (asp_hier_flags(hier) & ASP_HIER_HAS_COLORS) != 0;
     // a splat without extent (a lone point) gets a tiny one: log(0) is not a number
     double tiny = asp_hier_frame(hier)->radius > 0 ? 1e-6 * asp_hier_frame(hier)->radius : 1e-6;
@@ -88,8 +89,8 @@ static void fill_points(const asp_hier *hier, point_arrays *a, int splats)
         a->hi[k] = -INFINITY;
     }
     for (size_t j = 0; j < n; j++) {
-        const asp_hier_splat *s = &all[nodes + j];
-        size_t i = s->index < n ? s->index : j; // input order
+        const asp_hier_splat *s = ids ? &all[ids[j]] : &all[nodes + j];
+        size_t i = ids ? j : s->index < n ? s->index : j; // input order
         float nl = sqrtf(s->normal[0] * s->normal[0] + s->normal[1] * s->normal[1] + s->normal[2] * s->normal[2]);
         for (int k = 0; k < 3; k++) {
             a->pos[3 * i + k] = s->center[k];
@@ -276,18 +277,16 @@ done:
     return mesh;
 }
 
-int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,
-                         asp_error *err)
+int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n, const double origin[3],
+                           const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats, asp_error *err)
 {
-    ASP_ASSERT(hier && path);
     static const asp_gltf_desc zero;
     const asp_gltf_desc *d = desc ? desc : &zero;
     int splats = !(d->flags & ASP_GLTF_NO_SPLATS);
-    size_t n = asp_hier_point_count(hier);
     if (n == 0)
         return asp_error_set(err, ASP_EDEGENERATE, "no points to export");
     asp_gltf_stats st = {0};
-    asp_hier_origin(hier, st.origin);
+    memcpy(st.origin, origin, sizeof st.origin);
     asp__gltf g;
     int rc = asp__gltf_init(&g, path, splats ? "(points, KHR_gaussian_splatting)" : "(points)", NULL, err);
     if (rc)
@@ -306,7 +305,7 @@ int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the glTF arrays of %zu points", n);
         goto done;
     }
-    fill_points(hier, &a, splats);
+    fill_points(hier, ids, n, &a, splats);
     int plain = (d->flags & ASP_GLTF_PLAIN) != 0;
     compact_node cn = {{0, 0, 0}, 1};
     int mesh = plain ? add_points_mesh(&g, &a, n, splats) : add_points_compact(&g, &a, n, splats, st.origin, &cn);
@@ -342,6 +341,15 @@ done:
     if (!rc && stats)
         *stats = st;
     return rc;
+}
+
+int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,
+                         asp_error *err)
+{
+    ASP_ASSERT(hier && path);
+    double origin[3];
+    asp_hier_origin(hier, origin);
+    return asp__gltf_points_write(hier, NULL, asp_hier_point_count(hier), origin, path, desc, stats, err);
 }
 
 int asp_gltf_export_cloud(const asp_cloud *cloud, const char *path, const asp_gltf_desc *desc,

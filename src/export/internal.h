@@ -83,4 +83,14 @@ int asp__gltf_write(asp__gltf *g, const char *path, asp_gltf_stats *stats, asp_e
 /* The scene extras both exports write (origin, frame, kind) for viewers that frame like amgsplat. */
 cJSON *asp__gltf_extras(const char *kind, const char *source, const double origin[3], const asp_frame *frame);
 
+/*
+ * The points export (asp_gltf_export_hier) of n splats of hier: ids are indices into
+ * asp_hier_splats (node and point splats, e.g. a tile's cut, tiles.c), or NULL for every point in
+ * input order (n = the point count). Positions are relative to origin, which the node translation
+ * adds back (tiles pass 0: their tileset.json transform holds the world offset). Errors as
+ * asp_gltf_export_hier.
+ */
+int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n, const double origin[3],
+                           const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats, asp_error *err);
+
 #endif

@@ -1,0 +1,95 @@
+# export --tiles (issue 32): a point set as a 3D Tiles 1.1 tileset. tileset.json's structure (asset
+# 1.1, a root with children, refine REPLACE, boxes holding their children's, geometricError never
+# growing downwards and 0 exactly at the full-resolution leaves), every content URI a GLB on disk
+# and every GLB named once, the leaves' points summing to the input's (each point in exactly one
+# leaf), the root within the tile budget, the first frame's files (tileset.json + root) under 5% of
+# the bytes, identical output twice, and the errors of bad options. No browser needed (web_tiles.sh
+# has the page, the validator and Cesium).
+source "$(dirname "$0")/common.sh"
+
+"$AMGSPLAT" synth torus -o "$T/torus.ply" --points 60000 -q
+"$AMGSPLAT" export "$T/torus.ply" -o "$T/tiles" --tiles --tile-points 2048 --json >"$T/run.json"
+"$AMGSPLAT" export "$T/torus.ply" -o "$T/again" --tiles --tile-points 2048 -q
+cmp "$T/tiles/tileset.json" "$T/again/tileset.json" || fail "two exports of the same points differ"
+
+python3 - "$T/tiles" "$T/run.json" 60000 2048 <<'PY' || fail "tileset structure"
+import json, os, struct, sys
+d, run, n_in, budget = sys.argv[1], json.load(open(sys.argv[2])), int(sys.argv[3]), int(sys.argv[4])
+ts = json.load(open(os.path.join(d, 'tileset.json')))
+assert ts['asset']['version'] == '1.1', ts['asset']
+root = ts['root']
+assert root['refine'] == 'REPLACE' and root.get('children'), 'root without REPLACE or children'
+assert ts['geometricError'] > root['geometricError'] > 0, (ts['geometricError'], root['geometricError'])
+
+def glb_points(path):  # POSITION count of the one points primitive
+    b = open(path, 'rb').read()
+    magic, version, length = struct.unpack_from('<4sII', b, 0)
+    assert magic == b'glTF' and version == 2 and length == len(b), path
+    clen, ctype = struct.unpack_from('<II', b, 12)
+    g = json.loads(b[20:20 + clen])
+    pr = g['meshes'][0]['primitives'][0]
+    assert pr['mode'] == 0, path
+    return g['accessors'][pr['attributes']['POSITION']]['count']
+
+def box_bounds(bv):
+    c, h = bv['box'][:3], bv['box'][3:]
+    assert h[1] == h[2] == h[3] == h[5] == h[6] == h[7] == 0, 'boxes are axis-aligned'
+    ext = [h[0], h[4], h[8]]
+    return [c[k] - ext[k] for k in range(3)], [c[k] + ext[k] for k in range(3)]
+
+uris, leaf_points, tiles = [], 0, 0
+def walk(t, parent_error, parent_box, depth):
+    global leaf_points, tiles
+    tiles += 1
+    assert 'refine' not in t or depth == 0, 'refine is inherited from the root'
+    e = t['geometricError']
+    assert 0 <= e <= parent_error, f'geometricError grows downwards: {e} > {parent_error}'
+    lo, hi = box_bounds(t['boundingVolume'])
+    if parent_box:
+        plo, phi = parent_box
+        for k in range(3):
+            assert plo[k] - 1e-6 <= lo[k] and hi[k] <= phi[k] + 1e-6, 'a child box sticks out of its parent'
+    uri = t['content']['uri']
+    uris.append(uri)
+    path = os.path.join(d, uri)
+    assert os.path.isfile(path), f'content {uri} missing'
+    n = glb_points(path)
+    kids = t.get('children', [])
+    if not kids:
+        assert e == 0 or n <= 1, f'leaf {uri} has error {e}'
+    if e == 0:
+        assert not kids, f'{uri}: error 0 with children'
+        leaf_points += n
+    if depth == 0:
+        assert n <= budget, f'root holds {n} splats, budget {budget}'
+    for c in kids:
+        assert c['geometricError'] < e or c['geometricError'] == 0, 'error does not fall'
+        walk(c, e, (lo, hi), depth + 1)
+walk(root, ts['geometricError'], None, 0)
+assert len(set(uris)) == len(uris), 'a GLB is named twice'
+on_disk = set('tiles/' + f for f in os.listdir(os.path.join(d, 'tiles')))
+assert on_disk == set(uris), f'files not in the tileset: {sorted(on_disk - set(uris))[:5]}'
+assert leaf_points == n_in, f'leaves hold {leaf_points} points, input {n_in}'
+assert run['tiles'] == tiles and run['points'] == n_in and run['leaf_points'] == n_in, run
+assert run['largest_tile'] <= 4 * budget, run
+total = sum(os.path.getsize(os.path.join(d, u)) for u in uris) + os.path.getsize(os.path.join(d, 'tileset.json'))
+assert total == run['bytes'], (total, run['bytes'])
+first = os.path.getsize(os.path.join(d, root['content']['uri'])) + os.path.getsize(os.path.join(d, 'tileset.json'))
+assert first <= 0.05 * total, f'first frame needs {first} of {total} bytes'
+a = ts['extras']['amgsplat']
+assert a['points'] == n_in and a['frame']['radius'] > 0, a
+print(f'{tiles} tiles, {run["splats"]} splats, depth {run["depth"]}, {total} bytes; root + tileset.json '
+      f'{first} bytes ({100 * first / total:.1f}%); root error {root["geometricError"]:.4g}')
+PY
+
+# plain and no-splat tiles are what the flags say
+"$AMGSPLAT" export "$T/torus.ply" -o "$T/plain" --tiles --tile-points 2048 --plain --no-splats -q
+grep -o '"KHR_mesh_quantization"\|"KHR_gaussian_splatting"' "$T/plain/tiles/0.glb" >/dev/null &&
+  fail "--plain --no-splats tiles carry quantisation or splats"
+grep -o '"KHR_gaussian_splatting"' "$T/tiles/tiles/0.glb" >/dev/null || fail "default tiles lack the splats"
+
+# errors
+expect_fail 2 "--tile-points needs --tiles" "$AMGSPLAT" export "$T/torus.ply" -o "$T/x.glb" --tile-points 10
+: >"$T/file"
+expect_fail 1 "cannot create directory" "$AMGSPLAT" export "$T/torus.ply" -o "$T/file" --tiles
+echo "export_tiles: ok"

@@ -1,0 +1,98 @@
+// CesiumJS reads an `amgsplat export --tiles` tileset (docs/web.md): opens web/cesium.html in
+// headless Chromium on DIR/tileset.json, waits until Cesium3DTileset has loaded every tile the view
+// needs, and fails on any error: a tile that did not load, a render error, a page error or an error
+// on the console.
+//   node web/test/cesium.mjs DIR [--size WxH] [--sse PX] [--png OUT.png] [--timeout S] [--chromium PATH]
+// Prints one JSON line {loaded, failed, ...}. Exit 1 on an error, 2 on usage errors.
+import fs from 'node:fs';
+import path from 'node:path';
+import puppeteer from 'puppeteer-core';
+import { serve } from '../serve.mjs';
+
+const usage = 'usage: node web/test/cesium.mjs DIR [--size WxH] [--sse PX] [--png OUT.png] [--timeout S] [--chromium PATH]';
+
+function parseArgs(argv) {
+  const o = { size: '320x240', sse: '2', png: null, timeout: '300', chromium: process.env.CHROMIUM || '/usr/bin/chromium', pos: [] };
+  for (let i = 0; i < argv.length; i++) {
+    const a = argv[i];
+    if (a.startsWith('--')) {
+      const key = a.slice(2);
+      if (!(key in o) || key === 'pos' || i + 1 >= argv.length) throw new Error(`unknown option or missing value: ${a}`);
+      o[key] = argv[++i];
+    } else o.pos.push(a);
+  }
+  if (o.pos.length !== 1) throw new Error('expected DIR');
+  if (!/^\d+x\d+$/.test(o.size)) throw new Error(`--size expects WxH, got '${o.size}'`);
+  return o;
+}
+
+async function main() {
+  let o;
+  try {
+    o = parseArgs(process.argv.slice(2));
+  } catch (e) {
+    console.error(`cesium: ${e.message}\n${usage}`);
+    process.exit(2);
+  }
+  const dir = o.pos[0];
+  if (!fs.existsSync(path.join(dir, 'tileset.json'))) {
+    console.error(`cesium: cannot read '${path.join(dir, 'tileset.json')}'`);
+    process.exit(1);
+  }
+  const [w, h] = o.size.split('x').map(Number);
+  const server = await serve(path.resolve(dir));
+  const userDir = fs.mkdtempSync(path.join(process.env.TMPDIR || '/tmp', 'amgsplat-chromium-'));
+  const browser = await puppeteer.launch({
+    executablePath: o.chromium,
+    headless: true,
+    protocolTimeout: 1000 * Number(o.timeout) + 60000, // waitForFunction's polls run under it
+    userDataDir: userDir,
+    args: ['--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking',
+      '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  });
+  let code = 0;
+  const errors = [], logs = [];
+  try {
+    const page = await browser.newPage();
+    page.on('console', (m) => {
+      logs.push(`${m.type()}: ${m.text()}`);
+      // swiftshader's performance notes are not errors of the tileset
+      if (m.type() === 'error') errors.push(`console: ${m.text()}`);
+    });
+    page.on('pageerror', (e) => errors.push(`pageerror: ${e.message}`));
+    page.on('requestfailed', (r) => errors.push(`request failed: ${r.url()}: ${r.failure()?.errorText}`));
+    page.on('response', (r) => {
+      if (r.status() >= 400) errors.push(`HTTP ${r.status()}: ${r.url()}`);
+    });
+    await page.setViewport({ width: w, height: h, deviceScaleFactor: 1 });
+    const { port } = server.address();
+    const q = new URLSearchParams({ tileset: '/model/tileset.json', sse: o.sse });
+    await page.goto(`http://127.0.0.1:${port}/cesium.html?${q}`, { waitUntil: 'load' });
+    await page.waitForFunction('window.amgsplatCesium && (window.amgsplatCesium.ready || window.amgsplatCesium.errors.length)',
+      { timeout: 1000 * Number(o.timeout) });
+    const s = await page.evaluate(() => window.amgsplatCesium);
+    errors.push(...s.errors);
+    if (o.png) await page.screenshot({ path: o.png });
+    console.log(JSON.stringify({ loaded: s.loaded, failed: s.failed, errors: errors.length, ...s.info }));
+    if (errors.length || !(s.loaded > 0)) {
+      code = 1;
+      console.error(`cesium: ${errors.length} errors, ${s.loaded} tiles loaded`);
+      for (const e of errors) console.error(`  ${e}`);
+    }
+  } catch (e) {
+    console.error(`cesium: ${e.message}`);
+    for (const e2 of errors) console.error(`  ${e2}`);
+    code = 1;
+  } finally {
+    if (process.env.ASP_WEB_DEBUG) for (const l of logs) console.error(`  ${l}`);
+    await browser.close();
+    server.close();
+    fs.rmSync(userDir, { recursive: true, force: true });
+  }
+  process.exit(code);
+}
+
+main().catch((e) => {
+  console.error(`cesium: ${e.message}`);
+  process.exit(1);
+});
