@@ -281,8 +281,11 @@ static int practice(exp_study *st, asp_error *err)
         r.subject = "practice";
         say(st, "practice: %s (not recorded)", asp_experiment_test_name(kinds[k]));
         rc = src->ops->intro ? src->ops->intro(src, kinds[k], 1, err) : 0;
-        if (!rc && !st->aborted)
+        if (!rc && !st->aborted) {
             rc = asp__exp_trial_navigation(&r, err); // r.log.fp NULL: nothing is written
+            say(st, "practice: %s over, %zu frames, %.0f%% of the way", asp_experiment_test_name(kinds[k]),
+                r.res.frames, 100.0 * r.res.progress);
+        }
     }
     if (!rc && !st->aborted && src->ops->intro)
         rc = src->ops->intro(src, ASP_EXPERIMENT_LOWSPEED, 2, err);
