@@ -123,7 +123,8 @@ int asp__exp_prepare(const asp_experiment_scenes *scenes, asp_experiment_test te
         p.scene.primitives = p.scene.primitives / 4 > 50 ? p.scene.primitives / 4 : 50;
         /* but fine enough that the path is three cells across: vertex colours blend over a cell, and a
            coarser grid smears the sand of the path over its verge (issue 29) */
-        uint32_t path_grid = p.scene.half_width > 0.0f ? (uint32_t)ceilf(p.scene.size / (0.75f * p.scene.half_width)) + 1u : 0u;
+        uint32_t path_grid =
+            p.scene.half_width > 0.0f ? (uint32_t)ceilf(p.scene.size / (0.75f * p.scene.half_width)) + 1u : 0u;
         uint32_t coarse = path_grid > 97 ? path_grid : 97;
         if (p.scene.grid > coarse)
             p.scene.grid = coarse;
