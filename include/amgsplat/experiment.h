@@ -47,9 +47,10 @@ int asp_experiment_condition_parse(const char *name, asp_experiment_condition *o
 
 /** Group assignment for asp_experiment_plan_draw. */
 enum asp_experiment_group_rule {
-    ASP_EXPERIMENT_GROUP_RANDOM = 0,  /* a seeded draw per test, as in seed 004 2.3 */
-    ASP_EXPERIMENT_GROUP_CONTROL = 1, /* every run B is polygons */
-    ASP_EXPERIMENT_GROUP_VARIABLE = 2 /* every run B is a variable condition */
+    ASP_EXPERIMENT_GROUP_BALANCED = 0, /* permuted blocks over control + each variable condition (default) */
+    ASP_EXPERIMENT_GROUP_CONTROL = 1,  /* every run B is polygons */
+    ASP_EXPERIMENT_GROUP_VARIABLE = 2, /* every run B a variable condition, subjects in blocks over them */
+    ASP_EXPERIMENT_GROUP_RANDOM = 3    /* a seeded coin per test, as seed 004 2.3 words it (unbalanced) */
 };
 
 /** One subject's plan: the test order and, per test, what run B shows. */
@@ -61,16 +62,39 @@ typedef struct asp_experiment_plan {
 
 /**
  * Draws subject number subject's plan (0-based) from seed: the tests in a
- * random order, and for each test a fair coin (rule RANDOM) choosing the
- * control group (run B polygons again) or the variable group (run B one of
- * variable[0..nvariable-1], drawn uniformly). Run A is always polygons. The
- * same (seed, subject, variable, rule) give the same plan on every machine
- * (a 64-bit generator, no floating point in the draws). Returns 0 or
- * ASP_EINVAL (nvariable == 0 for a rule that needs one, polygons in variable).
- * Pure, thread safe.
+ * random order (seed 004 2.3's counterbalancing), and what run B shows.
+ * BALANCED: the groups are control (run B polygons again) and one per
+ * variable[i]; subjects 0..G-1 form the first block, G..2G-1 the next, each
+ * block a seeded permutation of the G groups, and a subject keeps its group
+ * in every test; so every complete block covers every group once. VARIABLE:
+ * the same over the variable conditions only; CONTROL: always polygons;
+ * RANDOM: a fair coin per test and a uniform variable[i]. Run A is always
+ * polygons. The same (seed, subject, variable, rule) give the same plan on
+ * every machine (a 64-bit generator, no floating point in the draws); adding
+ * subjects never changes the earlier ones' plans. Returns 0 or ASP_EINVAL
+ * (nvariable == 0 for a rule that needs one, polygons or a repeat in
+ * variable). Pure, thread safe.
  */
 int asp_experiment_plan_draw(uint64_t seed, size_t subject, const asp_experiment_condition *variable,
                              size_t nvariable, int rule, asp_experiment_plan *out, asp_error *err);
+
+/** How a design spreads subjects 0..n-1 over its groups (asp_experiment_design_check). */
+typedef struct asp_experiment_design {
+    asp_experiment_condition groups[ASP_EXPERIMENT_CONDITION_COUNT]; /* run B's condition; polygons = control */
+    size_t group_count;
+    size_t runs_b[ASP_EXPERIMENT_CONDITION_COUNT]; /* by condition: runs B over all subjects and tests */
+    int balanced;                                  /* every group got as many runs B */
+    char warning[320];                             /* why not, naming the counts; "" when balanced */
+} asp_experiment_design;
+
+/**
+ * Checks the design of nsubjects subjects (asp_experiment_plan_draw for each):
+ * balanced when every group gets as many runs B, which for the block rules
+ * means a multiple of the group count. Returns 0 (out filled, out->warning
+ * set when unbalanced) or asp_experiment_plan_draw's errors.
+ */
+int asp_experiment_design_check(uint64_t seed, size_t nsubjects, const asp_experiment_condition *variable,
+                                size_t nvariable, int rule, asp_experiment_design *out, asp_error *err);
 
 /* ------------------------------------------------------------------------ */
 /* Scenes (seed 004 2.1-2.2)                                                */
@@ -215,7 +239,10 @@ typedef struct asp_experiment_desc {
     const char *subject;           /* person: the subject id (letters, digits, '-', '_') */
     int short_tests;               /* short runs (CI): a fifth of each time limit, smaller meshes */
     int resume;                    /* add missing runs to existing subject directories */
-    int practice;                  /* person: a short practice walk before the tests, not logged */
+    int practice;                  /* person: a short walk and flight before the tests, not logged, then a
+                                      "practice over" screen */
+    size_t subject_number;         /* person: the subject's 1-based place in the design (its block and
+                                      group); 0 = 1. The observer numbers S01.. itself */
     uint32_t width, height;        /* frame size; 0 = 160 x 120 (observer), 1024 x 640 (window) */
     const asp_experiment_condition *variable; /* conditions of the variable group; NULL = points, primitives */
     size_t variable_count;
@@ -232,6 +259,8 @@ typedef struct asp_experiment_desc {
     const char *screenshots_dir;   /* write PNGs of the first frame of each test and condition; NULL = none */
     asp_experiment_run_fn on_run;
     asp_experiment_log_fn log;
+    /* an unbalanced design (asp_experiment_design_check), shown whatever the verbosity; NULL = log */
+    asp_experiment_log_fn warn;
     void *user;
 } asp_experiment_desc;
 

@@ -247,6 +247,8 @@ void asp_stats_analysis_destroy(asp_stats_analysis *a);
 /** Counts of an analysis (for a CLI summary line). */
 typedef struct asp_stats_analysis_info {
     size_t logs, subjects, frames, lost_frames, answers;
+    size_t groups;             /* groups of the design (control, each variable condition) */
+    char design_warning[512];  /* why the design is unbalanced (groups of unequal size, one missing); "" if not */
 } asp_stats_analysis_info;
 void asp_stats_analysis_info_get(const asp_stats_analysis *a, asp_stats_analysis_info *out);
 

@@ -11,8 +11,10 @@ static const char usage[] =
     "\n"
     "run: the four tests of seed 004 2.3 (far and near object recognition, low-speed\n"
     "navigation on a terrain path, high-speed flight through a canyon) in a seeded random\n"
-    "order per subject, each twice: run A polygons, run B polygons (control group) or a\n"
-    "variable condition (points, primitives; blank with --conditions) by a seeded draw.\n"
+    "order per subject, each twice: run A polygons, run B polygons (control group) or the\n"
+    "subject's variable condition (points, primitives; blank with --conditions). Subjects go\n"
+    "to the groups in seeded blocks (control + each condition: 3 subjects = one each); a\n"
+    "subject count that cannot be balanced is warned about on stderr and in study.json.\n"
     "Every frame goes to DIR/<subject>/<test>-<A|B>.jsonl (docs/experiment-log.md),\n"
     "answers to DIR/<subject>/answers.jsonl. Scenes come from --scenes FILE (the defaults\n"
     "are written to DIR/scenes.json); derived points and primitives are cached in\n"
@@ -38,6 +40,13 @@ static void on_log(void *user, const char *line)
 {
     struct run_table *t = user;
     cli_info(t->env, "%s", line);
+}
+
+/* an unbalanced design: on stderr even with -q, as a result the user has to know about */
+static void on_warn(void *user, const char *line)
+{
+    struct run_table *t = user;
+    fprintf(stderr, "amgsplat %s: warning: %s\n", t->env->cmd ? t->env->cmd : "experiment run", line);
 }
 
 static void on_run(void *user, const asp_experiment_run_result *r)
@@ -114,7 +123,7 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
 {
     const char *output = NULL, *scenes = NULL, *cache = NULL, *subject = NULL, *conditions = NULL, *group = NULL,
                *size = NULL, *shots = NULL, *keys = NULL;
-    size_t subjects = 0, seed = 1, depth = 0;
+    size_t subjects = 0, seed = 1, depth = 0, number = 0;
     int observer = 0, short_tests = 0, resume = 0, practice = 0, adapt = 0, realtime = 0;
     double tau = 0.0;
     const struct cli_option opts[] = {
@@ -122,11 +131,13 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
         {"observer", 0, CLI_FLAG, &observer, NULL, "the machine observer instead of a person (headless)"},
         {"subjects", 'n', CLI_SIZE, &subjects, "N", "observer: simulated subjects S01..SNN (default 1)"},
         {"subject", 0, CLI_STRING, &subject, "ID", "person: the subject's id (letters, digits, - and _)"},
+        {"subject-number", 0, CLI_SIZE, &number, "K", "person: place 1..999 in the design (its group; default 1)"},
         {"seed", 0, CLI_SIZE, &seed, "S", "seed of the design and the observer (default 1)"},
         {"scenes", 0, CLI_STRING, &scenes, "FILE", "scene file (JSON, see docs/cli/experiment.md)"},
         {"cache", 0, CLI_STRING, &cache, "DIR", "cache of sampled points and primitives (default DIR/scenes)"},
         {"conditions", 0, CLI_STRING, &conditions, "LIST", "variable group's conditions (default points,primitives)"},
-        {"group", 0, CLI_STRING, &group, "G", "random (default), control or variable: every run B"},
+        {"group", 0, CLI_STRING, &group, "G",
+         "balanced (default: blocks over control + conditions), control, variable or random (per test)"},
         {"coarse", 0, CLI_DOUBLE, &tau, "PX", "points: octree cut tolerance in pixels (default 1; e.g. 8 = coarse)"},
         {"depth", 0, CLI_SIZE, &depth, "K", "points: deepest octree level drawn (seed 004 3.2.5; coarse cut)"},
         {"adapt", 0, CLI_FLAG, &adapt, NULL, "points: seed 004 3.2.5 depth control by frame time"},
@@ -135,7 +146,7 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
         {"size", 0, CLI_STRING, &size, "WxH", "frame size (default 160x120 for the observer)"},
         {"screenshots", 0, CLI_STRING, &shots, "DIR", "PNG of every test in every condition"},
         {"resume", 0, CLI_FLAG, &resume, NULL, "add the missing runs to existing subject directories"},
-        {"practice", 0, CLI_FLAG, &practice, NULL, "person: a short practice run first (not logged)"},
+        {"practice", 0, CLI_FLAG, &practice, NULL, "person: practice walking and flying first (not logged)"},
         {"keys", 0, CLI_STRING, &keys, "KEYS", "person: scripted keys, one per frame (tests; docs/cli/experiment.md)"},
         {0},
     };
@@ -150,6 +161,10 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "give either --observer or --subject ID");
     if (keys && !subject)
         return cli_usage_error(env, "--keys scripts a person's session (--subject ID)");
+    if (number && !subject)
+        return cli_usage_error(env, "--subject-number places a person (--subject ID); the observer numbers S01..");
+    if (number > 999)
+        return cli_usage_error(env, "--subject-number expects 1..999, got %zu", number);
     if (subject && subjects)
         return cli_usage_error(env, "--subjects is for the observer; a person is one --subject");
     if (tau < 0.0 || tau > 1024.0)
@@ -160,7 +175,8 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
                              .observer = observer, .subjects = subjects, .subject = subject,
                              .short_tests = short_tests, .resume = resume, .practice = practice,
                              .coarse_tau = (float)tau, .adapt = adapt, .realtime = realtime,
-                             .screenshots_dir = shots, .keys = keys};
+                             .screenshots_dir = shots, .keys = keys,
+                             .subject_number = number};
     asp_experiment_condition conds[ASP_EXPERIMENT_CONDITION_COUNT];
     size_t nconds = 0;
     if (conditions) {
@@ -170,14 +186,16 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
         d.variable_count = nconds;
     }
     if (group) {
-        if (strcmp(group, "random") == 0)
+        if (strcmp(group, "balanced") == 0)
+            d.group_rule = ASP_EXPERIMENT_GROUP_BALANCED;
+        else if (strcmp(group, "random") == 0)
             d.group_rule = ASP_EXPERIMENT_GROUP_RANDOM;
         else if (strcmp(group, "control") == 0)
             d.group_rule = ASP_EXPERIMENT_GROUP_CONTROL;
         else if (strcmp(group, "variable") == 0)
             d.group_rule = ASP_EXPERIMENT_GROUP_VARIABLE;
         else
-            return cli_usage_error(env, "--group expects random, control or variable, got '%s'", group);
+            return cli_usage_error(env, "--group expects balanced, control, variable or random, got '%s'", group);
     }
     if (size) {
         unsigned w = 0, h = 0;
@@ -189,6 +207,7 @@ static int cmd_experiment_run(int argc, char **argv, struct cli_env *env)
     struct run_table table = {.env = env, .rows_json = env->json ? cJSON_CreateArray() : NULL};
     d.on_run = on_run;
     d.log = on_log;
+    d.warn = on_warn;
     d.user = &table;
     asp_error err = {0};
     rc = asp_experiment_run(&d, &env->ctx, &err);

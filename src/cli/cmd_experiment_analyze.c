@@ -17,13 +17,15 @@ static const char usage[] =
     "usage: amgsplat experiment analyze DIR -o REPORT_DIR [--level P] [--all-runs] [--json]\n"
     "\n"
     "Reads the logs DIR/<subject>/<test>-<A|B>.jsonl written by 'amgsplat experiment run' and\n"
-    "writes REPORT_DIR/report.md, report.json, CSV tables and PNG charts: frame time per test\n"
-    "and condition and against primitives drawn (seed 004 Table 4.1, Figs 4.1-4.5), recognition\n"
+    "writes REPORT_DIR/report.md, report.json, CSV tables and PNG charts: frame time\n"
+    "per run (mean, median, p95 ms) and per test and condition, compared over run means (one\n"
+    "value per run), and against primitives drawn (seed 004 Table 4.1, Figs 4.1-4.5), recognition\n"
     "accuracy and naming time (Tables 4.2-4.3), navigation grades and the improvement from run\n"
     "A to B per group (Tables 4.4-4.7) with the pooled t test, Welch's test, one-sided p and\n"
     "P-level intervals (default 0.95). A log cut off mid-line (a crash) still analyses: the\n"
     "report counts its lost frames. Recognition uses run B only, as the seed does (run A is\n"
-    "practice); --all-runs counts both.";
+    "practice); --all-runs counts both. Groups of unequal size are warned about on stderr and\n"
+    "in the report.";
 
 int cmd_experiment_analyze(int argc, char **argv, struct cli_env *env)
 {
@@ -60,6 +62,9 @@ int cmd_experiment_analyze(int argc, char **argv, struct cli_env *env)
     asp_stats_analysis_info info;
     asp_stats_analysis_info_get(a, &info);
     asp_stats_analysis_destroy(a);
+    // an unbalanced design weakens every comparison of the report: said even with -q
+    if (info.design_warning[0])
+        fprintf(stderr, "amgsplat experiment analyze: warning: %s\n", info.design_warning);
     if (env->json) {
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "dir", argv[0]);
@@ -69,6 +74,10 @@ int cmd_experiment_analyze(int argc, char **argv, struct cli_env *env)
         cJSON_AddNumberToObject(o, "frames", (double)info.frames);
         cJSON_AddNumberToObject(o, "lost_frames", (double)info.lost_frames);
         cJSON_AddNumberToObject(o, "answers", (double)info.answers);
+        cJSON_AddNumberToObject(o, "groups", (double)info.groups);
+        cJSON_AddBoolToObject(o, "balanced", info.design_warning[0] == 0);
+        if (info.design_warning[0])
+            cJSON_AddStringToObject(o, "design_warning", info.design_warning);
         if (cli_json_print(env, o))
             return 1;
     } else if (!env->quiet) {

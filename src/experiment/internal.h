@@ -185,7 +185,8 @@ typedef struct exp_source_ops {
     void (*look_keys)(exp_source *s, int deciding, char keys[8]);
     int (*look)(exp_source *s, exp_run *r, double t, double dt, float *yaw, float *pitch);
     int (*name)(exp_source *s, exp_run *r, double t, double t_recognised, char answer[32]);
-    /* before a test (a person's instruction screen; Esc sets st->aborted); NULL = none */
+    /* before a test (a person's instruction screen; Esc sets st->aborted); practice: 1 before a practice
+       run, 2 the "practice over" screen after the practice (test unused); NULL = none */
     int (*intro)(exp_source *s, asp_experiment_test test, int practice, asp_error *err);
     /* once the tests are prepared (the observer's reference frames); NULL = nothing */
     int (*ready)(exp_source *s, asp_error *err);

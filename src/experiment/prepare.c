@@ -20,11 +20,12 @@ static uint64_t fnv(uint64_t h, const void *data, size_t n)
     return h;
 }
 
-/* the cache key: everything the derived files depend on */
+/* the cache key: everything the derived files depend on; the version changes with the worlds' colours
+   (v2: the path's verge, issue 29), which the sampled points carry */
 static uint64_t scene_key(const asp_experiment_scene *s, const char *model, int short_tests)
 {
     char text[1024];
-    int n = snprintf(text, sizeof text, "v1|%d|%s|%llu|%u|%.6g|%.6g|%.6g|%zu|%zu|%d", s->kind, model,
+    int n = snprintf(text, sizeof text, "v2|%d|%s|%llu|%u|%.6g|%.6g|%.6g|%zu|%zu|%d", s->kind, model,
                      (unsigned long long)s->seed, s->grid, s->size, s->half_width, s->relief, s->points,
                      s->primitives, short_tests);
     return fnv(0xCBF29CE484222325ull, text, n > 0 ? (size_t)n : 0);
@@ -120,8 +121,13 @@ int asp__exp_prepare(const asp_experiment_scenes *scenes, asp_experiment_test te
         /* CI size: a quarter of the points and a coarser field; the scenes stay the same shape */
         p.scene.points = p.scene.points / 4 > 2000 ? p.scene.points / 4 : 2000;
         p.scene.primitives = p.scene.primitives / 4 > 50 ? p.scene.primitives / 4 : 50;
-        if (p.scene.grid > 97)
-            p.scene.grid = 97;
+        /* but fine enough that the path is three cells across: vertex colours blend over a cell, and a
+           coarser grid smears the sand of the path over its verge (issue 29) */
+        uint32_t path_grid =
+            p.scene.half_width > 0.0f ? (uint32_t)ceilf(p.scene.size / (0.75f * p.scene.half_width)) + 1u : 0u;
+        uint32_t coarse = path_grid > 97 ? path_grid : 97;
+        if (p.scene.grid > coarse)
+            p.scene.grid = coarse;
     }
     const char *model = "";
     int rc = 0;

@@ -1,7 +1,7 @@
 /*
  * The experiment program of seed 004 2.3: for each subject the four tests in
- * a random order, each run twice (A polygons; B polygons or the variable
- * condition), every frame logged (docs/experiment-log.md). The runs' input
+ * a random order, each run twice (A polygons; B polygons or the subject's
+ * group's condition, design.c), every frame logged (docs/experiment-log.md). The runs' input
  * comes from one source, a person at the window (window.c) or the machine
  * observer (observer_source.c); the trial loops (trial.c) are the same for both.
  */
@@ -144,7 +144,10 @@ static int run_one(exp_study *st, const char *subject, size_t subject_index, con
 
 /* ---------------------------------------------------------------- study setup */
 
-static int write_study(exp_study *st, char subjects[][32], size_t nsubjects, const char *path, asp_error *err)
+static void add_design(cJSON *root, const asp_experiment_desc *d, const asp_experiment_design *des, size_t nsubjects);
+
+static int write_study(exp_study *st, char subjects[][32], size_t nsubjects, const asp_experiment_design *des,
+                       const char *path, asp_error *err)
 {
     const asp_experiment_desc *d = st->desc;
     cJSON *root = cJSON_CreateObject();
@@ -160,6 +163,8 @@ static int write_study(exp_study *st, char subjects[][32], size_t nsubjects, con
     for (int c = 0; c < 3; c++)
         cJSON_AddItemToArray(conds, cJSON_CreateString(asp_experiment_condition_name((asp_experiment_condition)c)));
     cJSON_AddBoolToObject(root, "observer", d->observer != 0);
+    if (des)
+        add_design(root, d, des, nsubjects);
     cJSON *scenes = cJSON_AddObjectToObject(root, "scenes");
     for (int t = 0; t < ASP_EXPERIMENT_TEST_COUNT; t++) {
         const exp_prepared *p = &st->prep[t];
@@ -252,21 +257,68 @@ static int has_logs(const char *dir)
     return exists(path);
 }
 
-/* a person's practice: a quarter of the walking test in polygons, shown but not logged */
+/*
+ * A person's practice, shown but not logged: a quarter of the walking test and
+ * a quarter of the flight, each in polygons after its instruction screen, so
+ * both kinds of navigation are tried before anything counts (seed 004 2.3 has
+ * the learning effect measured by run A against run B, not by the first
+ * contact with the keys); then a "practice over" screen, so the subject knows
+ * the measured tests start. The same with --short (shorter runs).
+ */
 static int practice(exp_study *st, asp_error *err)
 {
-    exp_run r;
-    memset(&r, 0, sizeof r);
-    r.st = st;
-    r.p = &st->prep[ASP_EXPERIMENT_LOWSPEED];
-    r.test = ASP_EXPERIMENT_LOWSPEED;
-    r.cond = ASP_EXPERIMENT_POLYGONS;
-    r.run = 'A';
-    r.subject = "practice";
-    int rc = st->source->ops->intro ? st->source->ops->intro(st->source, ASP_EXPERIMENT_LOWSPEED, 1, err) : 0;
-    if (!rc && !st->aborted)
-        rc = asp__exp_trial_navigation(&r, err); // r.log.fp NULL: nothing is written
+    static const asp_experiment_test kinds[2] = {ASP_EXPERIMENT_LOWSPEED, ASP_EXPERIMENT_HIGHSPEED};
+    exp_source *src = st->source;
+    int rc = 0;
+    for (int k = 0; k < 2 && !rc && !st->aborted; k++) {
+        exp_run r;
+        memset(&r, 0, sizeof r);
+        r.st = st;
+        r.p = &st->prep[kinds[k]];
+        r.test = kinds[k];
+        r.cond = ASP_EXPERIMENT_POLYGONS;
+        r.run = 'A';
+        r.subject = "practice";
+        say(st, "practice: %s (not recorded)", asp_experiment_test_name(kinds[k]));
+        rc = src->ops->intro ? src->ops->intro(src, kinds[k], 1, err) : 0;
+        if (!rc && !st->aborted) {
+            rc = asp__exp_trial_navigation(&r, err); // r.log.fp NULL: nothing is written
+            say(st, "practice: %s over, %zu frames, %.0f%% of the way", asp_experiment_test_name(kinds[k]),
+                r.res.frames, 100.0 * r.res.progress);
+        }
+    }
+    if (!rc && !st->aborted && src->ops->intro)
+        rc = src->ops->intro(src, ASP_EXPERIMENT_LOWSPEED, 2, err);
     return rc;
+}
+
+static const char *group_name(asp_experiment_condition c)
+{
+    return c == ASP_EXPERIMENT_POLYGONS ? "control" : asp_experiment_condition_name(c);
+}
+
+static const char *rule_name(int rule)
+{
+    return rule == ASP_EXPERIMENT_GROUP_CONTROL    ? "control"
+           : rule == ASP_EXPERIMENT_GROUP_VARIABLE ? "variable"
+           : rule == ASP_EXPERIMENT_GROUP_RANDOM   ? "random"
+                                                   : "balanced";
+}
+
+/* study.json's "design": the groups, how many subjects each got, and the warning when they differ */
+static void add_design(cJSON *root, const asp_experiment_desc *d, const asp_experiment_design *des, size_t nsubjects)
+{
+    cJSON *o = cJSON_AddObjectToObject(root, "design");
+    cJSON_AddStringToObject(o, "rule", rule_name(d->group_rule));
+    cJSON *groups = cJSON_AddArrayToObject(o, "groups"), *counts = cJSON_AddObjectToObject(o, "runs_b");
+    for (size_t i = 0; i < des->group_count; i++) {
+        cJSON_AddItemToArray(groups, cJSON_CreateString(group_name(des->groups[i])));
+        cJSON_AddNumberToObject(counts, group_name(des->groups[i]), (double)des->runs_b[des->groups[i]]);
+    }
+    cJSON_AddNumberToObject(o, "subjects", (double)nsubjects);
+    cJSON_AddBoolToObject(o, "balanced", des->balanced);
+    if (des->warning[0])
+        cJSON_AddStringToObject(o, "warning", des->warning);
 }
 
 int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, asp_error *err)
@@ -291,10 +343,22 @@ int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, 
     static const asp_experiment_condition default_variable[2] = {ASP_EXPERIMENT_POINTS, ASP_EXPERIMENT_PRIMITIVES};
     const asp_experiment_condition *variable = desc->variable ? desc->variable : default_variable;
     size_t nvariable = desc->variable ? desc->variable_count : 2;
-    asp_experiment_plan probe;
-    int rc = asp_experiment_plan_draw(desc->seed, 0, variable, nvariable, desc->group_rule, &probe, err);
+    if (desc->subject_number > 999)
+        return asp_error_set(err, ASP_EINVAL, "subject number %zu is over 999", desc->subject_number);
+    /* a person's session is one subject, placed in the design by its number; the observer's are 0..n-1 */
+    size_t first_index = !desc->observer && desc->subject_number ? desc->subject_number - 1 : 0;
+    asp_experiment_design design;
+    int rc = asp_experiment_design_check(desc->seed, desc->observer ? nsubjects : first_index + 1, variable, nvariable,
+                                         desc->group_rule, &design, err);
     if (rc)
         return rc;
+    /* the person's sessions add up to a design only across sessions: the lab's numbering decides */
+    if (desc->observer && !design.balanced) {
+        if (desc->warn)
+            desc->warn(desc->user, design.warning);
+        else if (desc->log)
+            desc->log(desc->user, design.warning);
+    }
 
     char (*subjects)[32] = asp_calloc(ctx, nsubjects, 32);
     exp_study *st = asp_calloc(ctx, 1, sizeof *st);
@@ -352,7 +416,7 @@ int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, 
         rc = st->source->ops->ready(st->source, err);
     pathf(path, sizeof path, "%s/study.json", desc->output_dir);
     if (!rc && !study_exists)
-        rc = write_study(st, subjects, nsubjects, path, err);
+        rc = write_study(st, subjects, nsubjects, desc->observer ? &design : NULL, path, err);
     if (!rc && desc->screenshots_dir)
         rc = write_screenshots(st, err);
     if (!rc && !desc->observer && desc->practice)
@@ -362,15 +426,16 @@ int asp_experiment_run(const asp_experiment_desc *desc, const asp_context *ctx, 
         char dir[4200];
         pathf(dir, sizeof dir, "%s/%s", desc->output_dir, subjects[s]);
         rc = make_dir(dir, err);
+        size_t index = first_index + s;
         if (!rc)
-            rc = asp_experiment_plan_draw(desc->seed, s, variable, nvariable, desc->group_rule, &plan, err);
+            rc = asp_experiment_plan_draw(desc->seed, index, variable, nvariable, desc->group_rule, &plan, err);
         for (int k = 0; k < ASP_EXPERIMENT_TEST_COUNT && !rc && !st->aborted; k++) {
             asp_experiment_test t = plan.order[k];
-            say(st, "%s %s: A polygons, B %s", subjects[s], asp_experiment_test_name(t),
-                asp_experiment_condition_name(plan.run_b[t]));
-            rc = run_one(st, subjects[s], s, dir, t, 'A', ASP_EXPERIMENT_POLYGONS, plan.variable[t], err);
+            say(st, "%s %s: A polygons, B %s (group %s)", subjects[s], asp_experiment_test_name(t),
+                asp_experiment_condition_name(plan.run_b[t]), group_name(plan.run_b[t]));
+            rc = run_one(st, subjects[s], index, dir, t, 'A', ASP_EXPERIMENT_POLYGONS, plan.variable[t], err);
             if (!rc && !st->aborted)
-                rc = run_one(st, subjects[s], s, dir, t, 'B', plan.run_b[t], plan.variable[t], err);
+                rc = run_one(st, subjects[s], index, dir, t, 'B', plan.run_b[t], plan.variable[t], err);
         }
     }
     if (!rc && st->aborted)

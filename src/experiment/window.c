@@ -176,14 +176,24 @@ static int intro(exp_source *s, asp_experiment_test test, int practice, asp_erro
     exp_study *st = s->st;
     static const uint8_t bg[4] = {30, 32, 40, 255};
     char text[768];
-    snprintf(text, sizeof text, "%s%s", practice ? "PRACTICE (not recorded)\n\n" : "", instructions(test));
     char png[2200];
-    snprintf(png, sizeof png, "%s/instructions-%s.png", st->desc->screenshots_dir ? st->desc->screenshots_dir : "",
-             asp_experiment_test_name(test));
+    const char *shots = st->desc->screenshots_dir;
+    if (practice == 2) {
+        /* after the practice: the subject knows that what follows counts (seed 004 2.3's measured tests) */
+        snprintf(text, sizeof text, "PRACTICE OVER\n\n"
+                                    "You have walked and flown once.\n"
+                                    "From now on every test is recorded.\n\n"
+                                    "ENTER: start the tests      ESC: stop the session");
+        snprintf(png, sizeof png, "%s/practice-over.png", shots ? shots : "");
+    } else {
+        snprintf(text, sizeof text, "%s%s", practice ? "PRACTICE (not recorded)\n\n" : "", instructions(test));
+        snprintf(png, sizeof png, "%s/%s-%s.png", shots ? shots : "", practice ? "practice" : "instructions",
+                 asp_experiment_test_name(test));
+    }
     int rc = 0;
     for (int first = 1; !rc; first = 0) {
         // shown before any key counts, so the screen is seen (and saved) even when Enter comes at once
-        rc = text_screen(ps, text, bg, first && st->desc->screenshots_dir && !practice ? png : NULL, err);
+        rc = text_screen(ps, text, bg, first && shots ? png : NULL, err);
         poll_keys(ps->window, &ps->keys);
         if (ps->keys.esc) {
             st->aborted = 1;

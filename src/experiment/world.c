@@ -184,16 +184,28 @@ int asp_experiment_world_generate(const asp_experiment_scene *s, const asp_conte
                 float wall = smoothstep(hw, 1.7f * hw, d);
                 h = 0.02f * s->relief * rock + wall * s->relief * (0.85f + 0.3f * rock);
             }
-            if (d < hw) { // sandy: the colour the observer (and a person) follows
-                c[0] = (uint8_t)(222 + 10 * grain);
-                c[1] = (uint8_t)(190 + 10 * grain);
-                c[2] = (uint8_t)(128 + 10 * grain);
+            /*
+             * The path must stand out from the ground it runs through (seed 004 2.3: the subject is to
+             * stay on it): light sand on the path, on the terrain a dark green verge at least one grid
+             * cell wide just outside it (vertex colours blend over a cell, so a narrower verge would be lost), and
+             * cool grey rock beyond. Only the path is "sandy" to the observer (observer.c: red well
+             * above blue); the verge and the rock have red at most a little above blue.
+             */
+            float verge = s->kind == 1 ? fmaxf(0.45f * hw, 1.05f * cell) : 0.0f; // the canyon's walls stand out
+            if (d < hw) {
+                c[0] = (uint8_t)(236 + 8 * grain);
+                c[1] = (uint8_t)(204 + 8 * grain);
+                c[2] = (uint8_t)(136 + 8 * grain);
+            } else if (d < hw + verge) {
+                c[0] = (uint8_t)(58 + 8 * grain);
+                c[1] = (uint8_t)(92 + 10 * grain);
+                c[2] = (uint8_t)(54 + 6 * grain);
             } else {
-                float grey = (s->kind == 1 ? 128.0f : 92.0f) + 26.0f * grain + 30.0f * rock;
-                grey = grey < 30.0f ? 30.0f : grey > 200.0f ? 200.0f : grey;
-                c[0] = (uint8_t)(grey + 3.0f);
+                float grey = (s->kind == 1 ? 112.0f : 92.0f) + 26.0f * grain + 30.0f * rock;
+                grey = grey < 30.0f ? 30.0f : grey > 190.0f ? 190.0f : grey;
+                c[0] = (uint8_t)(grey - 4.0f);
                 c[1] = (uint8_t)grey;
-                c[2] = (uint8_t)(grey - 4.0f);
+                c[2] = (uint8_t)(grey + 8.0f);
             }
             c[3] = 255;
             w.heights[v] = h;

@@ -141,7 +141,85 @@ static void read_study(asp_stats_analysis *a)
         snprintf(a->study_version, sizeof a->study_version, "%s", v->valuestring);
     if (cJSON_IsNumber(seed))
         a->study_seed = seed->valuedouble;
+    // the groups the design meant to fill, so a group nobody reached is seen as missing, not unknown
+    const cJSON *g, *groups = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(s, "design"), "groups");
+    cJSON_ArrayForEach (g, groups)
+        if (cJSON_IsString(g) && a->group_count < sizeof a->groups / sizeof a->groups[0]) {
+            snprintf(a->groups[a->group_count].name, sizeof a->groups[0].name, "%s", g->valuestring);
+            a->groups[a->group_count++].subjects = 0;
+        }
     cJSON_Delete(s);
+}
+
+static const struct stats_group *find_group_const(const asp_stats_analysis *a, const char *name)
+{
+    for (size_t i = 0; i < a->group_count; i++)
+        if (strcmp(a->groups[i].name, name) == 0)
+            return &a->groups[i];
+    return NULL;
+}
+
+static struct stats_group *find_group(asp_stats_analysis *a, const char *name)
+{
+    for (size_t i = 0; i < a->group_count; i++)
+        if (strcmp(a->groups[i].name, name) == 0)
+            return &a->groups[i];
+    if (a->group_count == sizeof a->groups / sizeof a->groups[0])
+        return NULL;
+    struct stats_group *g = &a->groups[a->group_count++];
+    snprintf(g->name, sizeof g->name, "%s", name);
+    g->subjects = 0;
+    return g;
+}
+
+/*
+ * Subjects per group, a subject's group being the condition of its runs B
+ * (polygons: control), and a warning when the groups differ in size or one
+ * is empty: the between-group comparisons of seed 004 4.2 then rest on
+ * fewer subjects on one side, or cannot be made at all.
+ */
+static void read_design(asp_stats_analysis *a)
+{
+    const char *last = NULL;
+    for (size_t i = 0; i < a->run_count; i++) {
+        const char *subject = a->runs[i].log.subject;
+        if (last && strcmp(last, subject) == 0)
+            continue; // runs are sorted by subject: one pass per subject
+        last = subject;
+        const char *cond = NULL;
+        int mixed = 0;
+        for (size_t k = i; k < a->run_count && strcmp(a->runs[k].log.subject, subject) == 0; k++) {
+            const asp_stats_log *l = &a->runs[k].log;
+            if (strcmp(l->run, "B") != 0)
+                continue;
+            mixed |= cond && strcmp(cond, l->condition) != 0;
+            cond = l->condition;
+        }
+        if (!cond)
+            continue; // no run B (yet): in no group
+        struct stats_group *g = find_group(a, mixed ? "mixed" : strcmp(cond, "polygons") == 0 ? "control" : cond);
+        if (g)
+            g->subjects++;
+    }
+    size_t lo = SIZE_MAX, hi = 0, used = 0;
+    char list[256] = "";
+    for (size_t i = 0; i < a->group_count && used < sizeof list; i++) {
+        size_t n = a->groups[i].subjects;
+        lo = n < lo ? n : lo;
+        hi = n > hi ? n : hi;
+        int k = snprintf(list + used, sizeof list - used, "%s%s %zu", i ? ", " : "", a->groups[i].name, n);
+        used += k > 0 ? (size_t)k : 0;
+    }
+    if (find_group_const(a, "mixed"))
+        snprintf(a->design_warning, sizeof a->design_warning,
+                 "unbalanced design: subjects change group from test to test (%s subjects); the comparisons "
+                 "between groups then mix people across conditions",
+                 list);
+    else if (a->group_count && lo != hi)
+        snprintf(a->design_warning, sizeof a->design_warning,
+                 "unbalanced design: the groups have %s subjects; comparisons with a group of fewer than 2 "
+                 "subjects have no test",
+                 list);
 }
 
 static const struct stats_run *find_run(const asp_stats_analysis *a, const char *subject, const char *test,
@@ -281,6 +359,8 @@ int asp_stats_analyze(const char *dir, const asp_stats_analyze_desc *desc, asp_s
     free_names(subjects, ns);
     if (!rc && a->run_count == 0)
         rc = asp_error_set(err, ASP_EDEGENERATE, "no experiment log (<subject>/<test>-<A|B>.jsonl) in '%s'", dir);
+    if (!rc)
+        read_design(a);
     if (rc) {
         asp_stats_analysis_destroy(a);
         return rc;
@@ -306,6 +386,8 @@ void asp_stats_analysis_info_get(const asp_stats_analysis *a, asp_stats_analysis
     out->logs = a->run_count;
     out->subjects = a->subjects;
     out->answers = a->answers;
+    out->groups = a->group_count;
+    snprintf(out->design_warning, sizeof out->design_warning, "%s", a->design_warning);
     for (size_t i = 0; i < a->run_count; i++) {
         out->frames += a->runs[i].log.frame_count;
         out->lost_frames += a->runs[i].log.lost_frames;

@@ -30,6 +30,13 @@ struct asp_stats_analysis {
     size_t answers_mismatch; /* answers whose naming time or correctness differs from the log's events */
     char study_version[64];
     double study_seed; /* NaN without study.json */
+    /* the design as the logs show it (analyze.c): subjects per group, a group being run B's condition */
+    struct stats_group {
+        char name[16]; /* "control" (run B polygons), a condition, or "mixed" (group changed by test) */
+        size_t subjects;
+    } groups[8];
+    size_t group_count;
+    char design_warning[512]; /* "" when every group has as many subjects */
 };
 
 #endif

@@ -67,6 +67,38 @@ static void test_rules_and_seeds(void)
     CHECK(asp_experiment_test_name((asp_experiment_test)4) == NULL);
 }
 
+/* issue 29: permuted blocks fill every group once per block; a subject keeps its group; the check warns */
+static void test_balanced_blocks(void)
+{
+    for (uint64_t seed = 1; seed <= 20; seed++) {
+        size_t got[ASP_EXPERIMENT_CONDITION_COUNT] = {0};
+        for (size_t s = 0; s < 6; s++) {
+            asp_experiment_plan p, r;
+            CHECK_OK(asp_experiment_plan_draw(seed, s, vars, 2, ASP_EXPERIMENT_GROUP_BALANCED, &p, NULL), NULL);
+            CHECK_OK(asp_experiment_plan_draw(seed, s, vars, 2, ASP_EXPERIMENT_GROUP_RANDOM, &r, NULL), NULL);
+            CHECK(memcmp(p.order, r.order, sizeof p.order) == 0); // the seed's order draw is kept
+            for (int t = 1; t < ASP_EXPERIMENT_TEST_COUNT; t++)
+                CHECK(p.run_b[t] == p.run_b[0] && p.variable[t] == p.variable[0]);
+            CHECK(p.variable[0] == (p.run_b[0] != ASP_EXPERIMENT_POLYGONS));
+            got[p.run_b[0]]++;
+            if (s == 2 || s == 5) // a complete block: one subject per group so far in each block
+                CHECK(got[ASP_EXPERIMENT_POLYGONS] == got[ASP_EXPERIMENT_POINTS] &&
+                      got[ASP_EXPERIMENT_POINTS] == got[ASP_EXPERIMENT_PRIMITIVES] &&
+                      got[ASP_EXPERIMENT_POLYGONS] == (s + 1) / 3);
+        }
+    }
+    asp_experiment_design d;
+    CHECK_OK(asp_experiment_design_check(1, 3, vars, 2, ASP_EXPERIMENT_GROUP_BALANCED, &d, NULL), NULL);
+    CHECK(d.balanced && d.group_count == 3 && d.warning[0] == 0 && d.runs_b[ASP_EXPERIMENT_PRIMITIVES] == 4);
+    CHECK_OK(asp_experiment_design_check(1, 2, vars, 2, ASP_EXPERIMENT_GROUP_BALANCED, &d, NULL), NULL);
+    CHECK_MSG(!d.balanced && strstr(d.warning, "2 subjects over 3 groups") != NULL, "%s", d.warning);
+    CHECK_OK(asp_experiment_design_check(1, 4, vars, 2, ASP_EXPERIMENT_GROUP_VARIABLE, &d, NULL), NULL);
+    CHECK(d.balanced && d.group_count == 2 && d.runs_b[ASP_EXPERIMENT_POLYGONS] == 0);
+    asp_error err = {0};
+    const asp_experiment_condition twice[2] = {ASP_EXPERIMENT_POINTS, ASP_EXPERIMENT_POINTS};
+    CHECK(asp_experiment_design_check(1, 3, twice, 2, 0, &d, &err) == ASP_EINVAL && strstr(err.msg, "twice"));
+}
+
 static void write_text(const char *path, const char *text)
 {
     FILE *fp = fopen(path, "w");
@@ -114,4 +146,5 @@ static void test_scene_file(void)
     rmdir(dir);
 }
 
-TEST_MAIN(TEST_CASE(test_plan_is_a_design), TEST_CASE(test_rules_and_seeds), TEST_CASE(test_scene_file))
+TEST_MAIN(TEST_CASE(test_plan_is_a_design), TEST_CASE(test_rules_and_seeds), TEST_CASE(test_balanced_blocks),
+          TEST_CASE(test_scene_file))
