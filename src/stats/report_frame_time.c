@@ -57,7 +57,7 @@ static void hist_chart(struct report *r, const char *test)
                                              .height = 360,
                                              .title = title,
                                              .x_label = "primitives drawn per frame",
-                                             .y_label = "frames",
+                                             .y_label = "frames (count)",
                                              .flags = ASP_CHART_BARS},
                            name);
 }
@@ -124,7 +124,7 @@ static void scatter_chart(struct report *r)
                           .height = 380,
                           .title = "frame time against primitives drawn (seed 004 Fig 4.1; bars: sd)",
                           .x_label = "primitives drawn per frame",
-                          .y_label = "ms",
+                          .y_label = "frame time (ms)",
                           .flags = ASP_CHART_LOG_X | ASP_CHART_MARKERS,
                           .y_err = err_ptr},
         "frame_time_vs_drawn.png");

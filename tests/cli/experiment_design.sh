@@ -1,3 +1,4 @@
+# ctest-label: e2e
 # amgsplat experiment, issue 29: three observer subjects fill the control group and the two variable
 # conditions (points, primitives) one each, keeping their group in every test; analyze reports the
 # design, frame time per run (mean, median, p95), the condition-vs-polygons frame-time test over run

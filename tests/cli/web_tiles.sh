@@ -1,3 +1,4 @@
+# ctest-label: e2e
 # The streamed tileset in the browser (issue 32): `export --tiles` of Spot's textured points, opened
 # by the page (web/test/tiles.mjs: three.js + 3d-tiles-renderer in headless Chromium).
 #  - its GLBs pass gltf-validator (root, an inner tile, a leaf);
