@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "hier/internal.h"
+#include "amgsplat/hier_ooc.h"
 #include "util/atomic_file.h"
 #include "util/byte_io.h"
 #include "util/checksum.h"
@@ -328,6 +329,9 @@ static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
                  node_rec, splat_rec, hsize, NODE_REC, SPLAT_REC);
         return asp__byte_bad(r, msg);
     }
+    if (flags & ASP_HIER_STREAMED) // issue 28: the out-of-core layout has its own reader
+        return asp_error_set(r->err, ASP_EUNSUPPORTED, "'%s' is a streamed hierarchy (out-of-core layout): it is read "
+                             "in parts by asp_ooc_open (amgsplat render draws it)", r->path);
     if (points == 0 || points > (UINT32_MAX - 1) / 3 || nodes == 0 || nodes > 2 * points - 1 || leaf == 0 ||
         leaf > ASP_HIER_MAX_LEAF || (flags & ~7u)) {
         r->at = 16;
