@@ -128,9 +128,11 @@ int asp_ooc_select(const asp_ooc *ooc, const asp_hier_view *view, uint64_t max_p
 /**
  * Loads the points of the given nodes (a cut from asp_ooc_select: closed
  * under parents) into a new cloud with positions (hierarchy-local, origin
- * set), colours and radii: each point's disc radius is 2 / sqrt(pi) times the
- * spacing of the deepest listed node whose cube holds it, so discs close the
- * surface at the density of the loaded detail. Returns 0, ASP_EIO, ASP_EFORMAT
+ * set), colours and radii. A point whose deepest listed node (holding it) is
+ * a leaf gets the disc radius the whole set gets when drawn from memory
+ * (asp_cloud_default_radius, recorded at conversion), so a cut at full detail
+ * draws as the point file does; elsewhere 2 / sqrt(pi) times that node's
+ * spacing, if larger, so coarse cuts stay closed. Returns 0, ASP_EIO, ASP_EFORMAT
  * (file shorter than its node table says), ASP_EINVAL (more than 2^32 - 2
  * points), ASP_ENOMEM.
  */

@@ -24,7 +24,7 @@
 #include "util/checksum.h"
 #include "util/banned.h"
 
-enum { BATCH = 1 << 20, KEY_LEVELS = 21, MAX_CHUNKS = 1 << 20 };
+enum { BATCH = 1 << 20, KEY_LEVELS = 21, MAX_CHUNKS = 1 << 20, FLIGHT = 4 };
 #define NO_NODE UINT32_MAX
 
 /* A node while building: cube by level and integer cell, children by proto id. */
@@ -34,6 +34,7 @@ typedef struct proto {
     uint32_t child[8];
     uint32_t nchild;
     uint32_t point_count;
+    float spacing;
     uint64_t first_point;
     uint64_t subtree;
 } proto;
@@ -139,15 +140,23 @@ static int pass_bounds(build *b, double *xyz, double lo[3], double hi[3])
             return rc;
         if (!got)
             break;
-        for (size_t i = 0; i < got; i++)
-            for (int k = 0; k < 3; k++) {
-                double v = xyz[3 * i + (size_t)k];
-                if (!isfinite(v))
+        double l0 = lo[0], l1 = lo[1], l2 = lo[2], h0 = hi[0], h1 = hi[1], h2 = hi[2];
+        int finite = 1;
+        int threads = asp_context_threads(b->ctx);
+        (void)threads;
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(min : l0, l1, l2) reduction(max : h0, h1, h2) reduction(&& : finite)
+        for (size_t i = 0; i < got; i++) {
+            const double *p = xyz + 3 * i;
+            finite = finite && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+            l0 = p[0] < l0 ? p[0] : l0, l1 = p[1] < l1 ? p[1] : l1, l2 = p[2] < l2 ? p[2] : l2;
+            h0 = p[0] > h0 ? p[0] : h0, h1 = p[1] > h1 ? p[1] : h1, h2 = p[2] > h2 ? p[2] : h2;
+        }
+        lo[0] = l0, lo[1] = l1, lo[2] = l2, hi[0] = h0, hi[1] = h1, hi[2] = h2;
+        for (size_t i = 0; i < got && !finite; i++)
+            for (int k = 0; k < 3; k++)
+                if (!isfinite(xyz[3 * i + (size_t)k]))
                     return asp_error_set(b->err, ASP_EFORMAT, "point %llu: coordinate %c is not finite",
                                          (unsigned long long)(seen + i), "xyz"[k]);
-                lo[k] = v < lo[k] ? v : lo[k];
-                hi[k] = v > hi[k] ? v : hi[k];
-            }
         seen += got;
         if ((rc = progress(b, "bounds", (double)seen / (double)b->n)) != 0)
             return rc;
@@ -163,24 +172,29 @@ static size_t cell_index(const build *b, const double *p)
     return ((size_t)q[2] << (2 * b->grid_bits)) | ((size_t)q[1] << b->grid_bits) | q[0];
 }
 
-static int pass_count(build *b, double *xyz, uint32_t *counts, double *max_dist2)
+static int pass_count(build *b, double *xyz, uint32_t *cells, uint32_t *counts, double *max_dist2)
 {
     uint64_t seen = 0;
     double m = 0;
+    int threads = asp_context_threads(b->ctx);
+    (void)threads;
     int rc = asp_point_reader_rewind(b->in, b->err);
     while (!rc) {
         size_t got;
         if ((rc = asp_point_reader_read(b->in, xyz, NULL, BATCH, &got, b->err)) != 0 || !got)
             break;
+        // cells in parallel, then one thread counts (the grid is shared)
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(max : m)
         for (size_t i = 0; i < got; i++) {
             const double *p = xyz + 3 * i;
-            size_t c = cell_index(b, p);
-            counts[c] += counts[c] != UINT32_MAX; // a cell of 2^32 points is split by the octree anyway
+            cells[i] = (uint32_t)cell_index(b, p);
             double d = 0;
             for (int k = 0; k < 3; k++)
                 d += (p[k] - b->origin[k]) * (p[k] - b->origin[k]);
             m = d > m ? d : m;
         }
+        for (size_t i = 0; i < got; i++)
+            counts[cells[i]] += counts[cells[i]] != UINT32_MAX; // a cell of 2^32 points is split by the octree anyway
         seen += got;
         rc = progress(b, "count", (double)seen / (double)b->n);
     }
@@ -293,8 +307,11 @@ static int flush_chunk(build *b, size_t c, const asp_ooc_point *recs, size_t n)
     return bad ? asp_error_set(b->err, ASP_EIO, "cannot write '%s': %s", path, strerror(errno)) : 0;
 }
 
-static int pass_distribute(build *b, double *xyz, uint8_t *rgba, const uint32_t *lut)
+static int pass_distribute(build *b, double *xyz, uint8_t *rgba, uint32_t *cells, asp_ooc_point *recs,
+                           const uint32_t *lut)
 {
+    int threads = asp_context_threads(b->ctx);
+    (void)threads;
     size_t per = (b->memory / 8) / sizeof(asp_ooc_point) / b->nchunks;
     per = per < 4096 ? 4096 : per > (1u << 16) ? (1u << 16) : per;
     asp_ooc_point *buf = malloc(per * b->nchunks * sizeof *buf);
@@ -307,13 +324,17 @@ static int pass_distribute(build *b, double *xyz, uint8_t *rgba, const uint32_t 
         size_t got;
         if ((rc = asp_point_reader_read(b->in, xyz, rgba, BATCH, &got, b->err)) != 0 || !got)
             break;
-        for (size_t i = 0; i < got && !rc; i++) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (size_t i = 0; i < got; i++) {
             const double *p = xyz + 3 * i;
-            uint32_t c = lut[cell_index(b, p)];
-            asp_ooc_point *r = &buf[(size_t)c * per + fill[c]];
+            cells[i] = lut[cell_index(b, p)];
             for (int k = 0; k < 3; k++)
-                r->position[k] = (float)(p[k] - b->origin[k]);
-            memcpy(r->color, rgba + 4 * i, 4);
+                recs[i].position[k] = (float)(p[k] - b->origin[k]);
+            memcpy(recs[i].color, rgba + 4 * i, 4);
+        }
+        for (size_t i = 0; i < got && !rc; i++) {
+            uint32_t c = cells[i];
+            buf[(size_t)c * per + fill[c]] = recs[i];
             if (++fill[c] == per) {
                 rc = flush_chunk(b, c, buf + (size_t)c * per, per);
                 fill[c] = 0;
@@ -338,6 +359,7 @@ typedef struct lnode {
     uint32_t child[8], nchild; /* local ids */
     uint32_t *list;            /* candidate and own points (indices), owner tells which are still its */
     size_t nlist;
+    float spacing;             /* see leaf_spacing and sample */
 } lnode;
 
 typedef struct scratch {
@@ -350,6 +372,7 @@ typedef struct sub {
     uint32_t *owner;
     lnode *nodes;
     size_t nnodes, cap;
+    unsigned sorted_from; /* keys are sorted on bits from here up */
     int failed;
 } sub;
 
@@ -401,7 +424,8 @@ static void sample(sub *s, uint32_t id, scratch *sc)
     }
     float center[3], half;
     cube_of(s->b, p->level, p->cell, center, &half);
-    const double g = ASP__OOC_SAMPLE_GRID, inv = g / (2.0 * half);
+    const float inv = (float)ASP__OOC_SAMPLE_GRID / (2.0f * half);
+    const float lo[3] = {center[0] - half, center[1] - half, center[2] - half};
     for (uint32_t c = 0; c < p->nchild; c++) {
         const lnode *ch = &s->nodes[p->child[c]];
         uint32_t cid = p->child[c];
@@ -417,10 +441,12 @@ static void sample(sub *s, uint32_t id, scratch *sc)
             if (s->owner[i] != cid)
                 continue;
             const float *q = s->pts[i].position;
-            size_t cx = (size_t)fmax(0.0, fmin(g - 1, floor((q[0] - (center[0] - half)) * inv)));
-            size_t cy = (size_t)fmax(0.0, fmin(g - 1, floor((q[1] - (center[1] - half)) * inv)));
-            size_t cz = (size_t)fmax(0.0, fmin(g - 1, floor((q[2] - (center[2] - half)) * inv)));
-            size_t cell = (cz * ASP__OOC_SAMPLE_GRID + cy) * ASP__OOC_SAMPLE_GRID + cx;
+            size_t cell = 0;
+            for (int a = 2; a >= 0; a--) {
+                int v = (int)((q[a] - lo[a]) * inv);
+                v = v < 0 ? 0 : v > ASP__OOC_SAMPLE_GRID - 1 ? ASP__OOC_SAMPLE_GRID - 1 : v;
+                cell = cell * ASP__OOC_SAMPLE_GRID + (size_t)v;
+            }
             uint64_t bit = 1ull << (cell & 63);
             if (sc->bits[cell >> 6] & bit)
                 continue;
@@ -429,18 +455,104 @@ static void sample(sub *s, uint32_t id, scratch *sc)
             p->list[p->nlist++] = i;
         }
     }
-    for (size_t j = 0; j < p->nlist; j++) { // clear only what was set
-        const float *q = s->pts[p->list[j]].position;
-        size_t cx = (size_t)fmax(0.0, fmin(g - 1, floor((q[0] - (center[0] - half)) * inv)));
-        size_t cy = (size_t)fmax(0.0, fmin(g - 1, floor((q[1] - (center[1] - half)) * inv)));
-        size_t cz = (size_t)fmax(0.0, fmin(g - 1, floor((q[2] - (center[2] - half)) * inv)));
-        size_t cell = (cz * ASP__OOC_SAMPLE_GRID + cy) * ASP__OOC_SAMPLE_GRID + cx;
-        sc->bits[cell >> 6] = 0;
+    // one point per occupied grid cell: the cell size, shrunk by the ancestors' share (1/4 + 1/16 + ... on a surface)
+    p->spacing = 2.0f * half / (float)ASP__OOC_SAMPLE_GRID * 0.866f;
+    // 256 KiB once per inner node: cheaper than remembering the cells
+    memset(sc->bits, 0, (size_t)ASP__OOC_SAMPLE_GRID * ASP__OOC_SAMPLE_GRID * ASP__OOC_SAMPLE_GRID / 8);
+}
+
+/*
+ * LSD radix sort of (key, index) pairs on key bits [lo, hi): the octants of
+ * the levels those bits hold come out in order; bits below lo stay unsorted.
+ */
+static int radix_sort(uint64_t *keys, uint32_t *idx, size_t n, unsigned lo, unsigned hi)
+{
+    uint64_t *k2 = malloc(n * sizeof *k2);
+    uint32_t *i2 = malloc(n * sizeof *i2);
+    if (!k2 || !i2) {
+        free(k2);
+        free(i2);
+        return ASP_ENOMEM;
     }
+    for (unsigned shift = lo; shift < hi; shift += 8) {
+        size_t count[257] = {0};
+        uint64_t mask = hi - shift >= 8 ? 255 : (1u << (hi - shift)) - 1;
+        for (size_t i = 0; i < n; i++)
+            count[((keys[i] >> shift) & mask) + 1]++;
+        for (int d = 0; d < 256; d++)
+            count[d + 1] += count[d];
+        for (size_t i = 0; i < n; i++) {
+            size_t at = count[(keys[i] >> shift) & mask]++;
+            k2[at] = keys[i];
+            i2[at] = idx[i];
+        }
+        memcpy(keys, k2, n * sizeof *keys);
+        memcpy(idx, i2, n * sizeof *idx);
+    }
+    free(k2);
+    free(i2);
+    return 0;
+}
+
+/*
+ * The first sort orders a chunk's keys only as deep as its octree is likely
+ * to go (surfaces: a quarter of the points per level); a node still too big
+ * below that depth sorts its own range on the next levels' bits.
+ */
+static int sort_deeper(sub *s, uint64_t *keys, size_t a, size_t b, unsigned shift)
+{
+    size_t m = b - a;
+    uint32_t *idx = malloc(m * sizeof *idx);
+    asp_ooc_point *tmp = malloc(m * sizeof *tmp);
+    unsigned lo = shift + 3 > 24 ? shift + 3 - 24 : 0;
+    int rc = !idx || !tmp ? ASP_ENOMEM : 0;
+    if (!rc) {
+        for (size_t i = 0; i < m; i++)
+            idx[i] = (uint32_t)i;
+        rc = radix_sort(keys + a, idx, m, lo, shift + 3);
+    }
+    if (!rc) {
+        for (size_t i = 0; i < m; i++)
+            tmp[i] = s->pts[a + idx[i]];
+        memcpy(s->pts + a, tmp, m * sizeof *tmp);
+    }
+    free(idx);
+    free(tmp);
+    return rc;
+}
+
+/*
+ * A leaf holds all its cube's points but those its ancestors took. Its
+ * surface area is estimated by the occupied cells of a 64^3 grid (the parent's
+ * sampling grid), so a cube the surface only grazes is not taken for a full
+ * one; the spacing is then sqrt(area / points).
+ */
+static float leaf_spacing(const sub *s, const lnode *n, size_t a, size_t b, scratch *sc)
+{
+    enum { G = 64 };
+    float center[3], half;
+    cube_of(s->b, n->level, n->cell, center, &half);
+    const float inv = (float)G / (2.0f * half);
+    size_t occupied = 0;
+    for (size_t i = a; i < b; i++) {
+        const float *q = s->pts[i].position;
+        size_t cell = 0;
+        for (int k = 2; k >= 0; k--) {
+            int v = (int)((q[k] - (center[k] - half)) * inv);
+            v = v < 0 ? 0 : v > G - 1 ? G - 1 : v;
+            cell = cell * G + (size_t)v;
+        }
+        uint64_t bit = 1ull << (cell & 63);
+        occupied += !(sc->bits[cell >> 6] & bit);
+        sc->bits[cell >> 6] |= bit;
+    }
+    memset(sc->bits, 0, (size_t)G * G * G / 8);
+    double cell = 2.0 * half / G, area = (double)occupied * cell * cell;
+    return (float)sqrt(area / (double)(b - a > 0 ? b - a : 1));
 }
 
 /* Sorted keys [a, b) of one cube at level; returns its local id. Children are built and sampled first. */
-static uint32_t split(sub *s, const uint64_t *keys, size_t a, size_t b, uint32_t level, const uint32_t cell[3],
+static uint32_t split(sub *s, uint64_t *keys, size_t a, size_t b, uint32_t level, const uint32_t cell[3],
                       scratch *sc)
 {
     uint32_t id = add_lnode(s, level, cell);
@@ -458,9 +570,16 @@ static uint32_t split(sub *s, const uint64_t *keys, size_t a, size_t b, uint32_t
             s->owner[i] = id;
         }
         n->nlist = b - a;
+        n->spacing = leaf_spacing(s, n, a, b, sc);
         return id;
     }
     unsigned shift = 3 * (KEY_LEVELS - 1 - level);
+    if (shift < s->sorted_from) {
+        if (sort_deeper(s, keys, a, b, shift)) {
+            s->failed = 1;
+            return id;
+        }
+    }
     size_t lo = a;
     for (uint32_t o = 0; o < 8 && lo < b; o++) {
         size_t hi = lo;
@@ -486,35 +605,6 @@ static uint32_t split(sub *s, const uint64_t *keys, size_t a, size_t b, uint32_t
     }
     sample(s, id, sc);
     return id;
-}
-
-/* LSD radix sort of (key, index) pairs on the key bits below the chunk's level. */
-static int radix_sort(uint64_t *keys, uint32_t *idx, size_t n, unsigned bits)
-{
-    uint64_t *k2 = malloc(n * sizeof *k2);
-    uint32_t *i2 = malloc(n * sizeof *i2);
-    if (!k2 || !i2) {
-        free(k2);
-        free(i2);
-        return ASP_ENOMEM;
-    }
-    for (unsigned shift = 0; shift < bits; shift += 8) {
-        size_t count[257] = {0};
-        for (size_t i = 0; i < n; i++)
-            count[((keys[i] >> shift) & 255) + 1]++;
-        for (int d = 0; d < 256; d++)
-            count[d + 1] += count[d];
-        for (size_t i = 0; i < n; i++) {
-            size_t at = count[(keys[i] >> shift) & 255]++;
-            k2[at] = keys[i];
-            i2[at] = idx[i];
-        }
-        memcpy(keys, k2, n * sizeof *keys);
-        memcpy(idx, i2, n * sizeof *idx);
-    }
-    free(k2);
-    free(i2);
-    return 0;
 }
 
 typedef struct chunk_result {
@@ -565,7 +655,11 @@ static int index_chunk(const build *b, size_t c, chunk_result *out, scratch *sc,
             keys[i] = morton(raw[i].position, b->half);
             idx[i] = (uint32_t)i;
         }
-        if (radix_sort(keys, idx, n, 3 * (KEY_LEVELS - ch->level)))
+        unsigned hi = 3 * (KEY_LEVELS - ch->level), levels = 2;
+        for (double m = (double)n / (double)b->leaf_max; m > 1; m /= 4)
+            levels++;
+        s->sorted_from = hi > 3 * levels ? hi - 3 * levels : 0;
+        if (radix_sort(keys, idx, n, s->sorted_from, hi))
             rc = asp_error_set(err, ASP_ENOMEM, "out of memory sorting chunk %zu", c);
     }
     if (!rc) {
@@ -627,6 +721,7 @@ static int emit_chunk(build *b, size_t c, sub *s)
     for (size_t i = 0; i < s->nnodes && !rc; i++) {
         proto *p = &b->protos[map[i]];
         p->nchild = s->nodes[i].nchild;
+        p->spacing = s->nodes[i].spacing;
         for (uint32_t k = 0; k < p->nchild; k++)
             p->child[k] = map[s->nodes[i].child[k]];
         if (i > 0)
@@ -718,6 +813,7 @@ static int build_top(build *b, scratch *sc)
             for (uint32_t k = 0; k < l->nchild; k++)
                 l->child[k] = local[b->protos[i].child[k]];
             sample(&s, local[i], sc);
+            b->protos[i].spacing = s.nodes[local[i]].spacing;
             if (s.failed)
                 rc = asp_error_set(b->err, ASP_ENOMEM, "out of memory for the top");
         }
@@ -745,17 +841,6 @@ static uint64_t subtree_of(build *b, uint32_t id)
     return s;
 }
 
-/*
- * Node spacing: an inner node's points sample its cube's surface, so about
- * own * 4/3 points (itself and its ancestors' share) cover side^2; a leaf
- * holds all its cube's points but those taken up, subtree points in all.
- */
-static float spacing_of(const proto *p, float half)
-{
-    double side = 2.0 * half, n = p->nchild ? (double)p->point_count * 4.0 / 3.0 : (double)p->subtree;
-    return (float)(side / sqrt(n > 1 ? n : 1));
-}
-
 static void put32(uint8_t *p, uint32_t v)
 {
     for (int i = 0; i < 4; i++)
@@ -775,7 +860,7 @@ static void putf64(uint8_t *p, double d)
     put64(p, v);
 }
 
-static int write_table(build *b, uint32_t root, const asp_frame *frame, asp_ooc_build_stats *st)
+static int write_table(build *b, uint32_t root, const asp_frame *frame, double radius, asp_ooc_build_stats *st)
 {
     size_t n = b->nprotos;
     uint32_t *order = malloc(n * sizeof *order);
@@ -796,7 +881,7 @@ static int write_table(build *b, uint32_t root, const asp_frame *frame, asp_ooc_
         const proto *p = &b->protos[order[head++]];
         asp_ooc_node *o = &nodes[id];
         cube_of(b, p->level, p->cell, o->center, &o->half);
-        o->spacing = spacing_of(p, o->half);
+        o->spacing = p->spacing > 0 ? p->spacing : o->half; // > 0 always; a guard for an empty leaf
         o->first_child = p->nchild ? (uint32_t)tail : 0;
         o->child_count = p->nchild;
         o->first_point = p->first_point;
@@ -834,6 +919,7 @@ static int write_table(build *b, uint32_t root, const asp_frame *frame, asp_ooc_
     for (int k = 0; k < 3; k++)
         putf64(hd + ASP__OOC_FRAME_AT + 8 * k, frame->center[k]);
     putf64(hd + ASP__OOC_FRAME_AT + 24, frame->radius);
+    putf64(hd + ASP__OOC_RADIUS_AT, radius);
     put64(hd + ASP__OOC_HEADER - 8, asp__fnv1a64(ASP__FNV1A64_START, hd, ASP__OOC_HEADER - 8));
     if (!rc && (fseeko(b->out.fp, 0, SEEK_SET) != 0 || fwrite(hd, 1, sizeof hd, b->out.fp) != sizeof hd))
         rc = asp_error_set(b->err, ASP_EIO, "cannot write '%s': %s", b->out.tmp, strerror(errno));
@@ -887,20 +973,25 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
     }
     int threads = asp_context_threads(ctx);
     /*
-     * Working set: the chunks in flight take about 56 bytes a point (records
-     * twice while sorting, keys twice, indices, owners), half the budget; the
-     * counting grid, the chunk buffers and the roots' points share the rest.
+     * Working set: up to FLIGHT chunks in flight take about 56 bytes a point
+     * (records twice while sorting, keys twice, indices, owners), half the
+     * budget; the counting grid, the chunk buffers and the roots' points share
+     * the rest.
      */
-    b.chunk_max = b.memory / 2 / (size_t)threads / 56;
+    b.chunk_max = b.memory / 2 / FLIGHT / 56;
+    if (threads > FLIGHT) // chunks are sized for FLIGHT at once, whatever the thread count, so the file is too
+        threads = FLIGHT;
     b.grid_bits = b.n < 100000000u ? 7 : 8;
     st.grid = 1u << b.grid_bits;
     double *xyz = malloc(sizeof(double) * 3 * BATCH);
+    uint32_t *cells_buf = malloc(sizeof(uint32_t) * BATCH);
+    asp_ooc_point *recs = malloc(sizeof(asp_ooc_point) * BATCH);
     uint8_t *rgba = malloc((size_t)4 * BATCH);
     size_t cells = (size_t)1 << (3 * b.grid_bits);
     uint32_t *counts = calloc(cells, sizeof *counts), *lut = malloc(cells * sizeof *lut);
     scratch *sc = calloc((size_t)threads, sizeof *sc);
     chunk_result *res = calloc((size_t)threads, sizeof *res);
-    if (!xyz || !rgba || !counts || !lut || !sc || !res)
+    if (!xyz || !rgba || !cells_buf || !recs || !counts || !lut || !sc || !res)
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the conversion buffers");
     for (int t = 0; t < threads && !rc; t++)
         if (!(sc[t].bits = calloc((size_t)ASP__OOC_SAMPLE_GRID * ASP__OOC_SAMPLE_GRID * ASP__OOC_SAMPLE_GRID / 64,
@@ -911,6 +1002,7 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
         rc = pass_bounds(&b, xyz, lo, hi);
     st.seconds_bounds = asp_time_now() - t0;
     asp_frame frame = {{0, 0, 0}, 0};
+    double full_radius = 0;
     if (!rc) {
         double ext = 0;
         for (int k = 0; k < 3; k++) {
@@ -921,13 +1013,14 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
         b.half = ext > 0 ? 0.5 * ext * (1 + 1e-6) + 1e-9 * fabs(b.origin[0] + b.origin[1] + b.origin[2]) : 1.0;
         double md2;
         double t1 = asp_time_now();
-        rc = pass_count(&b, xyz, counts, &md2);
+        rc = pass_count(&b, xyz, cells_buf, counts, &md2);
         st.seconds_count = asp_time_now() - t1;
         // the frame asp_cloud_frame gives the same points: bounds centre, farthest point plus the default disc radius
         double sx = hi[0] - lo[0], sy = hi[1] - lo[1], sz = hi[2] - lo[2], area = sx * sy + sy * sz + sz * sx;
         double dr = area > 0 ? 2.0 * sqrt(area / (ASP_HIER_PI * (double)b.n)) : fmax(sx, fmax(sy, sz)) / (double)b.n;
         memcpy(frame.center, b.origin, sizeof frame.center);
         frame.radius = sqrt(md2) + dr;
+        full_radius = dr;
         if (!(frame.radius > 0))
             frame.radius = 1;
     }
@@ -944,7 +1037,7 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
     int made_dir = !rc;
     double t2 = asp_time_now();
     if (!rc)
-        rc = pass_distribute(&b, xyz, rgba, lut);
+        rc = pass_distribute(&b, xyz, rgba, cells_buf, recs, lut);
     st.seconds_distribute = asp_time_now() - t2;
     free(lut);
     lut = NULL;
@@ -952,6 +1045,10 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
     xyz = NULL;
     free(rgba);
     rgba = NULL;
+    free(cells_buf);
+    cells_buf = NULL;
+    free(recs);
+    recs = NULL;
     asp_point_reader_close(b.in);
     b.in = NULL;
     double t3 = asp_time_now();
@@ -989,7 +1086,7 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
         rc = asp_error_set(err, ASP_EFORMAT, "'%s': %llu points written of %llu read (internal error)", out,
                            (unsigned long long)b.written, (unsigned long long)b.n);
     if (!rc)
-        rc = write_table(&b, 0, &frame, &st);
+        rc = write_table(&b, 0, &frame, full_radius, &st);
     if (opened)
         rc = rc ? (asp__atomic_abort(&b.out), rc) : asp__atomic_commit_checked(&b.out, reads_back, (void *)ctx, err);
     st.seconds_index = asp_time_now() - t3;
@@ -1007,6 +1104,8 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
     free(lut);
     free(xyz);
     free(rgba);
+    free(cells_buf);
+    free(recs);
     asp_point_reader_close(b.in);
     free(b.chunks);
     free(b.protos);

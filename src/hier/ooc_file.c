@@ -25,6 +25,7 @@ struct asp_ooc {
     uint32_t depth;
     double origin[3];
     asp_frame frame;
+    double full_radius; /* disc radius at full density, as the points drawn from memory get; 0 = unknown */
     asp_ooc_node *nodes;
 };
 
@@ -131,8 +132,10 @@ int asp_ooc_open(const char *path, const asp_context *ctx, asp_ooc **out, asp_er
             o->frame.center[k] = getf64(hd + ASP__OOC_FRAME_AT + 8 * k);
         }
         o->frame.radius = getf64(hd + ASP__OOC_FRAME_AT + 24);
+        o->full_radius = getf64(hd + ASP__OOC_RADIUS_AT);
         uint64_t fsize = (uint64_t)size;
-        int finite = isfinite(o->frame.radius) && o->frame.radius > 0;
+        int finite = isfinite(o->frame.radius) && o->frame.radius > 0 && isfinite(o->full_radius) &&
+                     o->full_radius >= 0;
         for (int k = 0; k < 3; k++)
             finite &= isfinite(o->origin[k]) && isfinite(o->frame.center[k]);
         if (get32(hd + 72) != ASP__OOC_NODE_REC || get32(hd + 76) != ASP__OOC_POINT_REC || nodes == 0 ||
@@ -354,7 +357,10 @@ int asp_ooc_load(asp_ooc *o, const uint32_t *nodes, size_t count, asp_cloud **ou
                         break;
                     d = next;
                 }
-                c->radii[at] = 1.1283792f * d->spacing; // 2 / sqrt(pi): asp_cloud_default_radius's closing factor
+                // full density (a leaf) draws at the radius the whole set gets in memory, coarser cuts
+                // wider: 2 / sqrt(pi) spacings, asp_cloud_default_radius's closing factor
+                float r = 1.1283792f * d->spacing, full = (float)o->full_radius;
+                c->radii[at] = full > 0 && (!d->child_count || r < full) ? full : r;
             }
             done += m;
         }

@@ -274,6 +274,10 @@ int asp_point_reader_read(asp_point_reader *r, double *xyz, uint8_t *rgba, size_
     int swap = r->las ? !host_le() : r->big_endian == host_le();
     // the common layouts (float xyz first, native order) skip the generic decoder: it is most of the time
     int fast = !swap && !r->las && r->pos_type[0] == T_F32 && r->pos_type[1] == T_F32 && r->pos_type[2] == T_F32;
+    // decoding is most of a pass's time once the file is cached: both cores share it (each point its own slots)
+    int threads = asp_context_threads(r->ctx);
+    (void)threads;
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= 65536)
     for (size_t i = 0; i < n; i++) {
         const uint8_t *p = r->buf + i * r->record;
         for (int k = 0; k < 3; k++) {
@@ -285,16 +289,16 @@ int asp_point_reader_read(asp_point_reader *r, double *xyz, uint8_t *rgba, size_
                 xyz[3 * i + (size_t)k] = read_num(p + r->pos_at[k], r->pos_type[k], swap) * r->scale[k] + r->offset[k];
             }
         }
-        if (!rgba)
-            continue;
-        uint8_t *c = rgba + 4 * i;
-        if (!r->colors) {
-            memset(c, 255, 4);
-            continue;
+        if (rgba) {
+            uint8_t *c = rgba + 4 * i;
+            if (!r->colors) {
+                memset(c, 255, 4);
+            } else {
+                for (int k = 0; k < 3; k++)
+                    c[k] = r->col16 ? (uint8_t)(le(p + r->col_at[k], 2) >> 8) : p[r->col_at[k]];
+                c[3] = r->col_at[3] == SIZE_MAX ? 255 : p[r->col_at[3]];
+            }
         }
-        for (int k = 0; k < 3; k++)
-            c[k] = r->col16 ? (uint8_t)(le(p + r->col_at[k], 2) >> 8) : p[r->col_at[k]];
-        c[3] = r->col_at[3] == SIZE_MAX ? 255 : p[r->col_at[3]];
     }
     r->next += n;
     *got = n;
