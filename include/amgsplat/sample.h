@@ -103,6 +103,20 @@ int asp_synth_shape_parse(const char *name, asp_synth_shape *out, asp_error *err
 /** Name of a shape ("checker-plane"). */
 const char *asp_synth_shape_name(asp_synth_shape shape);
 
+/**
+ * Streams a synthetic terrain of points points to path (binary little-endian
+ * PLY: float x, y, z, uchar rgb; asp_point_writer) without holding it: a
+ * 1000 m x 1000 m fractal heightfield (value noise, 2048^2 samples plus a
+ * tiled 256^2 detail texture at 16x frequency), points uniformly random
+ * within square tiles written tile by tile, coloured by height and slope.
+ * Working set about 150 MB whatever points is. Deterministic per seed, for
+ * any thread count (asp_context_threads tiles generated at once).
+ * Errors: ASP_EINVAL (points == 0), ASP_EIO, ASP_ENOMEM, ASP_ECANCELED
+ * (progress stage "synth").
+ */
+int asp_synth_terrain_stream(const char *path, uint64_t points, uint64_t seed, const asp_context *ctx,
+                             asp_error *err);
+
 #ifdef __cplusplus
 }
 #endif

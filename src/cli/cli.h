@@ -86,6 +86,29 @@ void cli_info(const struct cli_env *env, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
+/* The views render draws of a streamed .hier (render_streamed.c), as render_views makes its cameras. */
+struct cli_streamed_view {
+    size_t views;
+    double az, el, dist, fov, tau; /* tau <= 0: 1 pixel */
+    asp_up_axis up;
+    uint32_t width, height;
+    size_t memory; /* bytes; 0 = 2 GiB */
+};
+struct cli_streamed_stats {
+    size_t nodes, node_count;
+    uint64_t points, point_count, budget;
+    double load_seconds;
+};
+/*
+ * Opens the streamed hierarchy at path, selects each view's cut and loads their union into s (a
+ * point scene framed by the file's frame; release with asp_scene_release). Returns the library's errors.
+ */
+int cli_render_streamed(const char *path, const struct cli_streamed_view *v, const asp_context *ctx, asp_scene *s,
+                        struct cli_streamed_stats *st, asp_error *err);
+
+/* --memory SIZE (bytes, K/M/G/T suffixes of 1024) into *out; a usage error (returns 2) when malformed. */
+int cli_memory_option(struct cli_env *env, const char *text, size_t *out);
+
 /* Ends a progress bar line if one is drawn (call before printing results). */
 void cli_progress_end(struct cli_env *env);
 

@@ -12,7 +12,11 @@ static const char usage[] =
     "LAS output keeps the source's point format, scale, offset and VLRs when it was LAS;\n"
     "otherwise it is LAS 1.4 format 7 with colours, 6 without (8 with a 'nir' property), at\n"
     "a 0.001 scale. --las-format 0-3 (LAS 1.2) or 6-8 (LAS 1.4) and --las-scale override.\n"
-    "Text output keeps positions, normals and colours only.";
+    "Text output keeps positions, normals and colours only.\n"
+    "\n"
+    "OUT.hier builds the streamed (out-of-core) point hierarchy from a binary PLY or LAS file of any\n"
+    "size with a working set of about --memory (default 2G): a counting sort into chunks, one octree\n"
+    "per chunk, then the top (docs/hier.md). render draws it, loading only the nodes a view needs.";
 
 #include <stdio.h>
 #include <string.h>
@@ -80,17 +84,63 @@ static void note_dropped(const struct cli_env *env, const asp_cloud *c, const ch
         cli_info(env, "amgsplat convert: note: '%s' keeps only positions, normals and colours; dropped %s", out, what);
 }
 
+/* Point file -> streamed hierarchy, never holding the points (issue 28). */
+static int convert_hier(struct cli_env *env, const char *in, const char *out, const char *memory, size_t node_points,
+                        const char *temp_dir)
+{
+    asp_ooc_build_desc desc = {.node_points = node_points, .temp_dir = temp_dir};
+    if (memory && cli_memory_option(env, memory, &desc.memory))
+        return 2;
+    if (cli_given(env, &node_points) && (node_points < 64 || node_points > 1000000))
+        return cli_usage_error(env, "--node-points %zu: expected 64 to 1000000", node_points);
+    asp_error err = {0};
+    asp_ooc_build_stats st;
+    double t0 = asp_time_now();
+    if (asp_ooc_build(in, out, &desc, &env->ctx, &st, &err))
+        return cli_fail(env, &err);
+    double s = asp_time_now() - t0;
+    cli_progress_end(env);
+    if (env->json) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "input", in);
+        cJSON_AddStringToObject(o, "output", out);
+        cJSON_AddStringToObject(o, "encoding", "hier-streamed");
+        cJSON_AddNumberToObject(o, "points", (double)st.points);
+        cJSON_AddNumberToObject(o, "nodes", (double)st.nodes);
+        cJSON_AddNumberToObject(o, "chunks", (double)st.chunks);
+        cJSON_AddNumberToObject(o, "depth", st.depth);
+        cJSON_AddNumberToObject(o, "grid", st.grid);
+        cJSON_AddItemToObject(o, "seconds", cli_json_number("%.3f", s));
+        cJSON_AddItemToObject(o, "seconds_bounds", cli_json_number("%.3f", st.seconds_bounds));
+        cJSON_AddItemToObject(o, "seconds_count", cli_json_number("%.3f", st.seconds_count));
+        cJSON_AddItemToObject(o, "seconds_distribute", cli_json_number("%.3f", st.seconds_distribute));
+        cJSON_AddItemToObject(o, "seconds_index", cli_json_number("%.3f", st.seconds_index));
+        cJSON_AddItemToObject(o, "points_per_second", cli_json_number("%.0f", (double)st.points / s));
+        return cli_json_print(env, o);
+    }
+    if (!env->quiet)
+        printf("converted '%s' -> '%s' (streamed hierarchy): %llu points, %zu nodes, depth %u, %zu chunks, "
+               "%.2f s (%.2f M points/s; bounds %.1f s, count %.1f s, distribute %.1f s, index %.1f s)\n",
+               in, out, (unsigned long long)st.points, st.nodes, st.depth, st.chunks, s, (double)st.points / s / 1e6,
+               st.seconds_bounds, st.seconds_count, st.seconds_distribute, st.seconds_index);
+    return 0;
+}
+
 int cmd_convert(int argc, char **argv, struct cli_env *env)
 {
     int ascii = 0, big_endian = 0, npos = 0, las_format = -1;
     double las_scale = 0;
-    const char *output = NULL;
+    const char *output = NULL, *memory = NULL, *temp_dir = NULL;
+    size_t node_points = 0;
     const struct cli_option opts[] = {
         {"output", 'o', CLI_STRING, &output, "OUT", "output point file (.ply, .las, .xyz, .pts, .txt); or OUT as the second argument"},
         {"ascii", 0, CLI_FLAG, &ascii, NULL, "write PLY as ascii text"},
         {"big-endian", 0, CLI_FLAG, &big_endian, NULL, "write PLY as binary big endian"},
         {"las-format", 0, CLI_INT, &las_format, "N", "LAS point data record format: 0-3 or 6-8"},
         {"las-scale", 0, CLI_DOUBLE, &las_scale, "S", "LAS coordinate step (default: the source's, else 0.001)"},
+        {"memory", 0, CLI_STRING, &memory, "SIZE", ".hier output: working-set budget, e.g. 512M, 2G (default 2G)"},
+        {"node-points", 0, CLI_SIZE, &node_points, "N", ".hier output: most points in a leaf node (default 32768)"},
+        {"temp-dir", 0, CLI_STRING, &temp_dir, "DIR", ".hier output: directory for the chunk files (default: next to OUT)"},
         {0},
     };
     int rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -109,6 +159,10 @@ int cmd_convert(int argc, char **argv, struct cli_env *env)
     if (cli_check_output(env, out, NULL, 0, (const char *const[]){in}, 1))
         return 2;
     asp_file_type out_type;
+    if (asp_file_type_of_name(out, &out_type, NULL) == 0 && out_type.kind == ASP_FILE_HIER)
+        return convert_hier(env, in, out, memory, node_points, temp_dir);
+    if (memory || node_points || temp_dir)
+        return cli_usage_error(env, "--memory, --node-points and --temp-dir apply to .hier output only, not '%s'", out);
     const char *out_fmt = asp_file_type_of_name(out, &out_type, NULL) == 0 ? out_type.format : NULL;
     if ((ascii || big_endian) && out_fmt && strcmp(out_fmt, "ply") != 0)
         return cli_usage_error(env, "--%s applies to .ply output only, not '%s'", ascii ? "ascii" : "big-endian", out);

@@ -350,11 +350,45 @@ static int info_amg(const char *path, struct cli_env *env)
     return rc;
 }
 
+/* A streamed .hier (issue 28): its header and node table, never its points. */
+static int info_streamed_hier(const char *path, struct cli_env *env)
+{
+    asp_ooc *h = NULL;
+    asp_error err = {0};
+    if (asp_ooc_open(path, &env->ctx, &h, &err))
+        return cli_fail(env, &err);
+    cli_progress_end(env);
+    const asp_ooc_node *root = asp_ooc_nodes(h);
+    int rc = 0;
+    if (env->json) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "file", path);
+        cJSON_AddStringToObject(o, "kind", "hier");
+        cJSON_AddStringToObject(o, "layout", "streamed");
+        cJSON_AddNumberToObject(o, "nodes", (double)asp_ooc_node_count(h));
+        cJSON_AddNumberToObject(o, "points", (double)asp_ooc_point_count(h));
+        cJSON_AddNumberToObject(o, "depth", asp_ooc_depth(h));
+        cJSON_AddNumberToObject(o, "root_points", root->point_count);
+        add_frame_json(o, asp_ooc_frame(h));
+        rc = cli_json_print(env, o);
+    } else {
+        printf("file        %s\nkind        point hierarchy (.hier, streamed layout)\nnodes       %zu\n"
+               "points      %llu\ndepth       %u\nroot points %u\n",
+               path, asp_ooc_node_count(h), (unsigned long long)asp_ooc_point_count(h), asp_ooc_depth(h),
+               root->point_count);
+        print_frame_text(asp_ooc_frame(h));
+    }
+    asp_ooc_close(h);
+    return rc;
+}
+
 /* A .hier file (asp_hier_save): the point hierarchy's shape (thesis chapter 4). */
 static int info_hier(const char *path, struct cli_env *env)
 {
     asp_hier *h = NULL;
     asp_error err = {0};
+    if (asp_ooc_probe(path) == 1)
+        return info_streamed_hier(path, env);
     if (asp_hier_load(path, &env->ctx, &h, &err))
         return cli_fail(env, &err);
     cli_progress_end(env);

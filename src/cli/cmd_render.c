@@ -49,7 +49,10 @@ static const char usage[] =
     "A mesh (OBJ+MTL, PLY with faces, OFF, STL, glTF/GLB, 3DS) is drawn as textured triangles with\n"
     "the same lighting and framing as the points sampled from it (amgsplat sample); a texture that\n"
     "cannot be found is drawn in its material colour, with a warning. A scene file of instances\n"
-    "(docs/scene-format.md, amgsplat scene field) is drawn whole from its own camera.";
+    "(docs/scene-format.md, amgsplat scene field) is drawn whole from its own camera. A streamed\n"
+    "(out-of-core) .hier (amgsplat convert IN.ply -o OUT.hier) loads only the nodes of each view's\n"
+    "cut, coarse first, until their point spacing is below --tolerance PX (default 1) or the points\n"
+    "fill --memory (default 2G), and draws them as discs (or --renderer compute).";
 
 enum { MAX_VIEWS = 256, MAX_SIDE = 16384 };
 
@@ -67,6 +70,7 @@ struct render_opts {
      */
     struct cli_renderer_opts r;
     const char *output;
+    const char *memory; /* streamed .hier: --memory SIZE, the budget of the points loaded */
     const char *size;
     const char *view;
     const char *background;
@@ -667,6 +671,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
         {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
         {"size", 0, CLI_STRING, &o.size, "WxH", "image size of one view (default 512x512)"},
+        {"memory", 0, CLI_STRING, &o.memory, "SIZE", "streamed .hier: memory for the points loaded, e.g. 1G (default 2G)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "camera azimuth, elevation (degrees), distance in radii (default 30,20)"},
         {"views", 0, CLI_SIZE, &o.views, "N", "N views around the object in a contact sheet (default 1)"},
         {"kernel", 0, CLI_STRING, &o.kernel, "A,B,N", "splat: kernel exp(-A (r/B)^N) (default 6,1.5,3)"},
@@ -740,6 +745,14 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     if (o.r.hybrid && !o.dps_input)
         return cli_usage_error(env, "--hybrid needs a .dps input (amgsplat build makes one)");
     o.mesh_input = type.kind == ASP_FILE_MESH;
+    // issue 28: a streamed .hier is drawn from the points of its cut, like a point file
+    int streamed = type.kind == ASP_FILE_HIER && asp_ooc_probe(argv[0]) == 1;
+    size_t memory = 0;
+    if (o.memory && !streamed)
+        return cli_usage_error(env, "--memory applies to a streamed .hier (amgsplat convert IN -o OUT.hier), not '%s'",
+                               argv[0]);
+    if (o.memory && cli_memory_option(env, o.memory, &memory))
+        return 2;
     if (o.r.color_field && (o.mesh_input || type.kind == ASP_FILE_HIER))
         return cli_usage_error(env, "%s %s colours a point file's points (PLY, XYZ, LAS), not a %s", o.r.color_by_name,
                                o.r.color_field, o.mesh_input ? "mesh" : ".hier");
@@ -751,7 +764,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--renderer is for point inputs; a .dps input is drawn with --method, or with "
                                     "its levels mixed by view with --renderer cut");
     // a .hier is a hierarchy without its points: the splats draw it
-    const char *dflt = type.kind == ASP_FILE_HIER ? "splat" : o.mesh_input ? "mesh" : "disc";
+    const char *dflt = streamed ? "disc" : type.kind == ASP_FILE_HIER ? "splat" : o.mesh_input ? "mesh" : "disc";
     unsigned inputs = o.dps_input    ? (unsigned)ASP_RENDER_INPUT_PRIMS
                       : o.mesh_input ? (unsigned)(ASP_RENDER_INPUT_MESH | ASP_RENDER_INPUT_POINTS)
                                      : (unsigned)ASP_RENDER_INPUT_POINTS;
@@ -786,7 +799,15 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     asp_renderer_options ropts;
     renderer_options(&o, &ropts);
     asp_render_source src;
-    int rc = load_scene(argv[0], &o, env, &s, &err);
+    struct cli_streamed_stats sst = {0};
+    int rc = streamed ? cli_render_streamed(argv[0],
+                                            &(struct cli_streamed_view){.views = o.views, .az = o.az, .el = o.el,
+                                                                        .dist = o.dist, .fov = o.fov,
+                                                                        .tau = o.r.tolerance > 0 ? o.r.tolerance : 1.0,
+                                                                        .up = o.up_axis, .width = o.width,
+                                                                        .height = o.height, .memory = memory},
+                                            &env->ctx, &s, &sst, &err)
+                      : load_scene(argv[0], &o, env, &s, &err);
     if (!rc)
         warn_missing_textures(&s);
     // --color-by a scalar field: the library colours the points (elevation along the shown up axis)
@@ -855,6 +876,10 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                      vs.last_count,
                      1e3 * vs.seconds / (double)o.views, asp_gl_context_renderer(gl), o.output, result->width,
                      result->height, seconds);
+        if (!env->json && streamed)
+            cli_info(env, "streamed: %zu of %zu nodes, %llu of %llu points loaded in %.2f s (budget %llu points)",
+                     sst.nodes, sst.node_count, (unsigned long long)sst.points, (unsigned long long)sst.point_count,
+                     sst.load_seconds, (unsigned long long)sst.budget);
         if (!env->json && hybrid)
             cli_info(env, "hybrid: %zu of %zu primitives kept, %zu of %zu points drawn as splats (docs/hybrid.md)",
                      hc.prims_kept, hc.prims_kept + hc.prims_replaced, hc.points_drawn, hc.points_total);

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "hier/internal.h"
+#include "amgsplat/hier_ooc.h"
 #include "util/atomic_file.h"
 #include "util/byte_io.h"
 #include "util/checksum.h"
@@ -316,6 +317,9 @@ static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
                              r->path, hsize - 9);
     r->at = 12;
     const uint32_t header = asp__get_u32(r), flags = asp__get_u32(r), depth = asp__get_u32(r);
+    if (flags & ASP_HIER_STREAMED) // issue 28: the out-of-core layout has its own reader
+        return asp_error_set(r->err, ASP_EUNSUPPORTED, "'%s' is a streamed hierarchy (out-of-core layout): it is read "
+                             "in parts by asp_ooc_open (amgsplat render draws it)", r->path);
     const uint64_t nodes = asp__get_u64(r), points = asp__get_u64(r), leaf = asp__get_u64(r);
     double origin[3];
     for (int i = 0; i < 3; i++)
