@@ -53,7 +53,8 @@ static inline int asp__bb_interval(const asp__bb_elem *e, const float n[3], floa
         float a = n[0] * e->p[0] + n[1] * e->p[1] + n[2] * e->p[2];
         float b = n[0] * e->p[3] + n[1] * e->p[4] + n[2] * e->p[5];
         float c = n[0] * e->p[6] + n[1] * e->p[7] + n[2] * e->p[8];
-        float mx = fmaxf(a, fmaxf(b, c)), mn = fminf(a, fminf(b, c));
+        float mx = a > b ? a : b, mn = a < b ? a : b; /* not fmaxf: a libm call without -ffinite-math-only */
+        mx = mx > c ? mx : c, mn = mn < c ? mn : c;
         *lo = mx - eps;
         *hi = mn + eps;
     }

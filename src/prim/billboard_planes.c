@@ -55,32 +55,102 @@ void asp__bb_space_release(asp__bb_space *s, const asp_context *ctx)
     memset(s, 0, sizeof *s);
 }
 
+enum { CHUNK = 256 };
+
+/*
+ * The elements' data as structure of arrays (x, y, z of up to three points, normal, area, radius), so
+ * the intervals of a chunk of elements for one direction compute in SIMD lanes before the scatter.
+ */
+typedef struct soa {
+    float *c[9], *n[3], *area, *r;
+} soa;
+
 void asp__bb_space_add(asp__bb_space *s, const asp__bb_elem *elems, const uint32_t *idx, size_t n, double sign,
                        const asp_context *ctx)
 {
+    if (!n)
+        return;
+    const int discs = elems[idx ? idx[0] : 0].r > 0;
+    float *buf = asp_alloc(ctx, 14 * n * sizeof *buf);
+    soa a;
+    if (buf) {
+        for (int k = 0; k < 9; k++)
+            a.c[k] = buf + (size_t)k * n;
+        for (int k = 0; k < 3; k++)
+            a.n[k] = buf + (size_t)(9 + k) * n;
+        a.area = buf + 12 * n, a.r = buf + 13 * n;
+        for (size_t q = 0; q < n; q++) {
+            const asp__bb_elem *e = &elems[idx ? idx[q] : q];
+            for (int k = 0; k < 9; k++)
+                a.c[k][q] = e->p[k];
+            for (int k = 0; k < 3; k++)
+                a.n[k][q] = e->n[k];
+            a.area[q] = e->area, a.r[q] = e->r;
+        }
+    }
     const long dirs = (long)s->dirs;
     const int nth = asp_context_threads(ctx);
+    const float inv = 1.0f / s->rw, eps = s->eps;
     (void)nth;
     /* each direction's row is written by one thread, elements in order: the sums do not depend on the threads */
 #pragma omp parallel for schedule(static) num_threads(nth)
     for (long k = 0; k < dirs; k++) {
-        const float *dir = s->dir + 3 * k;
+        const float dx = s->dir[3 * k], dy = s->dir[3 * k + 1], dz = s->dir[3 * k + 2];
         double *row = s->density + (size_t)k * s->nr;
-        for (size_t q = 0; q < n; q++) {
-            const asp__bb_elem *e = &elems[idx ? idx[q] : q];
-            float lo, hi;
-            if (!asp__bb_interval(e, dir, s->eps, &lo, &hi))
-                continue;
-            double w = sign * asp__bb_weight(e, dir);
-            long b0 = (long)floorf((lo - s->rmin) / s->rw), b1 = (long)floorf((hi - s->rmin) / s->rw);
-            if (b0 < 0)
-                b0 = 0;
-            if (b1 >= (long)s->nr)
-                b1 = (long)s->nr - 1;
-            for (long b = b0; b <= b1; b++)
-                row[b] += w;
+        float lo[CHUNK], hi[CHUNK], w[CHUNK];
+        for (size_t q0 = 0; q0 < n; q0 += CHUNK) {
+            const size_t m = n - q0 < CHUNK ? n - q0 : CHUNK;
+            if (!buf) { /* out of memory for the copy: the same numbers element by element */
+                for (size_t q = 0; q < m; q++) {
+                    const asp__bb_elem *e = &elems[idx ? idx[q0 + q] : q0 + q];
+                    if (!asp__bb_interval(e, s->dir + 3 * k, eps, &lo[q], &hi[q]))
+                        lo[q] = 1, hi[q] = 0;
+                    w[q] = asp__bb_weight(e, s->dir + 3 * k);
+                }
+            } else if (discs) {
+                const float *cx = a.c[0] + q0, *cy = a.c[1] + q0, *cz = a.c[2] + q0, *nx = a.n[0] + q0,
+                            *ny = a.n[1] + q0, *nz = a.n[2] + q0, *ar = a.area + q0, *rr = a.r + q0;
+#pragma omp simd
+                for (size_t q = 0; q < m; q++) {
+                    float sd = dx * cx[q] + dy * cy[q] + dz * cz[q], c = dx * nx[q] + dy * ny[q] + dz * nz[q];
+                    float has = nx[q] * nx[q] + ny[q] * ny[q] + nz[q] * nz[q];
+                    float s2 = 1.0f - c * c, ext = has > 0 && s2 > 0 ? rr[q] * sqrtf(s2) : 0.0f;
+                    lo[q] = sd + ext - eps, hi[q] = sd - ext + eps;
+                    w[q] = has > 0 ? ar[q] * fabsf(c) : ar[q];
+                }
+            } else {
+                float *const *c = a.c;
+                const float *nx = a.n[0] + q0, *ny = a.n[1] + q0, *nz = a.n[2] + q0, *ar = a.area + q0;
+                const float *x0 = c[0] + q0, *y0 = c[1] + q0, *z0 = c[2] + q0, *x1 = c[3] + q0, *y1 = c[4] + q0,
+                            *z1 = c[5] + q0, *x2 = c[6] + q0, *y2 = c[7] + q0, *z2 = c[8] + q0;
+#pragma omp simd
+                for (size_t q = 0; q < m; q++) {
+                    float p0 = dx * x0[q] + dy * y0[q] + dz * z0[q], p1 = dx * x1[q] + dy * y1[q] + dz * z1[q],
+                          p2 = dx * x2[q] + dy * y2[q] + dz * z2[q];
+                    /* ternaries, not fmaxf: without -ffinite-math-only fmaxf is a libm call per lane */
+                    float mx = p0 > p1 ? p0 : p1, mn = p0 < p1 ? p0 : p1;
+                    mx = mx > p2 ? mx : p2, mn = mn < p2 ? mn : p2;
+                    lo[q] = mx - eps;
+                    hi[q] = mn + eps;
+                    w[q] = ar[q] * fabsf(dx * nx[q] + dy * ny[q] + dz * nz[q]);
+                }
+            }
+            for (size_t q = 0; q < m; q++) {
+                if (!(lo[q] <= hi[q]))
+                    continue;
+                /* offsets are above rmin by construction (rmin is below every point by eps) */
+                long b0 = (long)((lo[q] - s->rmin) * inv), b1 = (long)((hi[q] - s->rmin) * inv);
+                if (b0 < 0)
+                    b0 = 0;
+                if (b1 >= (long)s->nr)
+                    b1 = (long)s->nr - 1;
+                const double wq = sign * w[q];
+                for (long b = b0; b <= b1; b++)
+                    row[b] += wq;
+            }
         }
     }
+    asp_free(ctx, buf);
 }
 
 double asp__bb_space_best(const asp__bb_space *s, size_t *k, uint32_t *b)
