@@ -304,6 +304,45 @@ static int table61(struct cli_env *env, const char *model, const char *texture, 
         asp_mesh_destroy(mesh);
         return cli_fail(env, &err);
     }
+    if (env->json) {
+        cJSON *o = cJSON_CreateObject(), *rows = cJSON_CreateArray();
+        cJSON_AddStringToObject(o, "model", model);
+        cJSON_AddNumberToObject(o, "triangles", (double)mesh->triangle_count);
+        cJSON_AddNumberToObject(o, "points", (double)cloud->count);
+        cJSON_AddNumberToObject(o, "views", (double)res->views);
+        cJSON_AddItemToObject(o, "t_decompose", cli_json_number("%.4f", res->t_decompose));
+        for (size_t i = 0; i < res->row_count; i++) {
+            const asp_eval_row *a = &res->rows[i];
+            int bb = strcmp(a->representation, "billboards") == 0;
+            if (!bb && strcmp(a->representation, "dp-normalized") != 0)
+                continue;
+            cJSON *j = cJSON_CreateObject();
+            cJSON_AddStringToObject(j, "level", a->level_name);
+            cJSON_AddStringToObject(j, "method", bb ? "billboards" : "domain");
+            cJSON_AddNumberToObject(j, "size", a->size);
+            cJSON_AddNumberToObject(j, "count", (double)a->primitives);
+            cJSON_AddNumberToObject(j, "texels", (double)a->texels);
+            cJSON_AddItemToObject(j, "error_bound", cli_json_number("%.6g", a->error_bound));
+            cJSON_AddItemToObject(j, "build_seconds", cli_json_number("%.4f", a->build_seconds));
+            cJSON_AddNumberToObject(j, "bytes", (double)a->bytes);
+            cJSON_AddItemToObject(j, "ssim", cli_json_number("%.6f", a->ssim_mean));
+            cJSON_AddItemToObject(j, "psnr", cli_json_number("%.4f", a->psnr_mean));
+            cJSON_AddItemToObject(j, "iou", cli_json_number("%.6f", a->iou_mean));
+            cJSON_AddItemToArray(rows, j);
+        }
+        cJSON_AddItemToObject(o, "rows", rows);
+        cJSON *m6 = cJSON_CreateObject();
+        cJSON_AddNumberToObject(m6, "planes", (double)st6.planes);
+        cJSON_AddNumberToObject(m6, "texels", (double)st6.texels);
+        cJSON_AddItemToObject(m6, "seconds", cli_json_number("%.4f", st6.t_search + st6.t_texture));
+        cJSON_AddItemToObject(o, "bound_6_percent", m6);
+        rc = cli_json_print(env, o);
+        asp_dps_destroy(bb6);
+        asp_eval_result_destroy(res);
+        asp_cloud_destroy(cloud);
+        asp_mesh_destroy(mesh);
+        return rc;
+    }
     char text[256];
     snprintf(text, sizeof text, "Thesis Table 6.1 measured: domain primitives (%zu samples) against billboard clouds of "
              "'%s' (%zu triangles), %zu views, against the mesh's render", cloud->count, model, mesh->triangle_count,
