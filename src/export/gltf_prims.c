@@ -250,6 +250,9 @@ static int export_level(asp__gltf *g, const asp_dps *dps, size_t index, const do
         // what the renderer's normalized method needs to blend as `amgsplat render` does
         cJSON_AddNumberToObject(am, "alphaRef", 0.1);
         cJSON_AddNumberToObject(am, "depthWindow", 0.5 * mean_radius(lv));
+        // issue 30: a billboard cloud is drawn by its material (alphaMode MASK), never blended
+        if (lv->billboards)
+            cJSON_AddTrueToObject(am, "billboards");
     }
     if (imesh < 0 || asp__gltf_append(g, g->nodes, node) < 0) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory exporting level %s", lname);
