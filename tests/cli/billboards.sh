@@ -48,7 +48,7 @@ assert d['iou'] > 0.85 and d['ssim'] > 0.6, d
 PY
 # export: a glTF whose material masks
 "$A" export "$T/bb.dps" -o "$T/bb.gltf" -q || fail "export"
-python3 -c 'import json,sys; m=json.load(open(sys.argv[1]))["materials"]; assert m and all(x["alphaMode"] == "MASK" for x in m), m' \
+python3 -c 'import json,sys; g=json.load(open(sys.argv[1])); m=g["materials"]; assert m and all(x["alphaMode"] == "MASK" for x in m), m; assert all(n["extras"]["amgsplat"]["billboards"] for n in g["nodes"] if "mesh" in n), g["nodes"]' \
   "$T/bb.gltf" || fail "export: not every material masks"
 # bad options
 expect_fail 2 "--billboards needs --error" "$A" simplify "$T/soup.obj" --billboards -o "$T/x.dps"
