@@ -114,6 +114,10 @@ for m, c in claims:
       "yes" if ok else "**no**"))
 w("\n%d of %d cases hold.\n" % (len(claims) - fails, len(claims)))
 w(open(os.path.join(os.path.dirname(dest), "..", "bench", "results_remarks.md")).read())
+# issue 30: thesis Table 6.1 measured (bench-paper --table 6.1), kept in its own file and carried over
+billboards = os.path.join(os.path.dirname(dest), "results", "billboards.md")
+if os.path.exists(billboards):
+    w(open(billboards).read())
 w("\nRenderer: `%s`. Frame rates on a CPU rasteriser are not the seeds' GeForce4 figures; compare them with"
   " each other, not with the papers.\n" % gl)
 open(dest, "w").write("\n".join(L) + "\n")

@@ -22,6 +22,7 @@
 #include "amg.h"
 #include "amg_distributed.h"
 #include "prim.h"
+#include "billboard.h"
 #include "export.h"
 #include "render.h"
 #include "fit.h"

@@ -245,6 +245,13 @@ typedef struct asp_eval_desc {
      * primitives and splats, bytes the level's plus 32 per point drawn.
      */
     int hybrid;
+    /*
+     * 1: every level also gets a "billboards" row (issue 30; Decoret et al.
+     * 2003, billboard.h): a billboard cloud of the mesh (else of the points as
+     * discs) at the level's texel count, its error bound chosen so that its
+     * plane count is nearest the level's primitive count; drawn alpha-tested.
+     */
+    int billboards;
 } asp_eval_desc;
 
 /** Figures of one representation at one level and image size, over all views. */
@@ -279,6 +286,13 @@ typedef struct asp_eval_row {
      * e.g. "texture alone 1398101 bytes exceeds 52160"; "" otherwise. No commas.
      */
     char note[96];
+    /*
+     * Seconds to build what the row draws where the evaluation built it per level: a level's domain
+     * primitives (t_basis + t_construct, the decomposition not included), a billboard cloud (plane
+     * search and textures at the bound chosen); 0 otherwise. billboards rows also give that bound,
+     * a fraction of the diagonal, in error_bound (0 otherwise).
+     */
+    double build_seconds, error_bound;
 } asp_eval_row;
 
 /** Result of asp_eval_run; free with asp_eval_result_destroy. */

@@ -188,6 +188,11 @@ typedef struct asp_dps_level {
      * through the level's context; any change of the atlas texels must drop them (asp_free, NULL).
      */
     uint8_t *atlas_bc3, *normal_bc3;
+    /*
+     * 1: a billboard cloud (issue 30, asp_billboard_mesh in billboard.h): textured planes with a binary
+     * alpha mask, drawn alpha-tested and opaque with depth test and write, never blended or normalised.
+     */
+    uint32_t billboards;
 } asp_dps_level;
 
 /** A set of levels; create with asp_prim_build or asp_dps_load, free with asp_dps_destroy. */

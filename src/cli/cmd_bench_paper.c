@@ -2,7 +2,9 @@
  * amgsplat bench-paper: the seeds' tables measured on this build, printed in
  * their layouts: journal Table 1 (pre-processing) and Table 2 / thesis Table
  * 5.2 (per level), thesis Table 5.3 (points against domain primitives) and
- * Table 5.4 (texture construction methods).
+ * Table 5.4 (texture construction methods); and, with --table 6.1, thesis
+ * Table 6.1 measured for real (issue 30): domain primitives against billboard
+ * clouds at one texel count and the nearest plane count, against the mesh.
  */
 #include <math.h>
 #include <stdio.h>
@@ -16,6 +18,7 @@ static const char usage[] =
     "usage: amgsplat bench-paper MODEL [--sizes 128,256,512] [--frames 10] [--max-primitives 2000]\n"
     "                            [--budget 500] [--no-texture-methods] [--points N] [--texture IMG]\n"
     "                            [--markdown]\n"
+    "       amgsplat bench-paper MESH --table 6.1 [--budget 300] [--views 16] [--sizes 128,256] [--points N]\n"
     "\n"
     "Measures and prints, in the layouts of the seeds: journal Table 1 (points, level, polygons,\n"
     "texels, decomposition and construction time), thesis Table 5.1 (the same level with texture\n"
@@ -24,7 +27,16 @@ static const char usage[] =
     "screen size), thesis Table 5.3 (frame rate of the point set against domain primitives, speed-up)\n"
     "and thesis Table 5.4 (construction time per texture method at texel sizes 2, 1 and 0.5). The\n"
     "Table 1 / 5.1 / 5.3 / 5.4 level is the finest with at most --budget primitives. MODEL as for\n"
-    "'amgsplat eval'. --markdown prints the tables as Markdown (docs/results.md uses it).";
+    "'amgsplat eval'. --markdown prints the tables as Markdown (docs/results.md uses it).\n"
+    "\n"
+    "--table 6.1 prints thesis Table 6.1 instead, measured: for every level with at most --budget\n"
+    "domain primitives (of --points samples of MESH, default 50000), the level drawn normalized\n"
+    "against a billboard cloud of the mesh (simplify --billboards) with the level's texel count and\n"
+    "the error bound whose plane count is nearest its primitive count: count, texels, bound, build\n"
+    "seconds (domain: decomposition + the level's basis and construction; billboards: plane search +\n"
+    "textures), GPU bytes and SSIM, PSNR and silhouette IoU against the mesh's own render, means over\n"
+    "--views views at each size; then the thesis's madcat row (59,855 triangles at a 6% bound: 171\n"
+    "planes, 1,638k texels, 529 s) next to this mesh's billboard cloud at 6%.";
 
 enum { MAX_SIZES = 8 };
 
@@ -246,16 +258,180 @@ static int print_json(const struct cli_env *env, const asp_eval_paper *p, const 
     return cli_json_print(env, o);
 }
 
+/* The rows of representation name at the level named level_name and image size size (SIZE_MAX: none). */
+static size_t find_row61(const asp_eval_result *res, const char *name, const char *level_name, uint32_t size)
+{
+    for (size_t i = 0; i < res->row_count; i++)
+        if (strcmp(res->rows[i].representation, name) == 0 && strcmp(res->rows[i].level_name, level_name) == 0 &&
+            res->rows[i].size == size)
+            return i;
+    return SIZE_MAX;
+}
+
+/*
+ * Thesis Table 6.1 for real (issue 30): the thesis took billboard clouds' figures from Decoret et al.
+ * 2003 (madcat) against its own dinosaur; here both methods run on one mesh, at one texel count and
+ * the nearest plane count, against the mesh's render (asp_eval_run with the billboards row).
+ */
+static int table61(struct cli_env *env, const char *model, const char *texture, size_t points, size_t budget,
+                   size_t views, const uint32_t *sizes, size_t nsizes, int md)
+{
+    asp_error err = {0};
+    asp_cloud *cloud = NULL;
+    asp_mesh *mesh = NULL;
+    int rc = asp_eval_load_model_mesh(model, points ? points : 50000, texture, &env->ctx, &cloud, &mesh, &err);
+    if (!rc && !mesh) {
+        asp_cloud_destroy(cloud);
+        return cli_usage_error(env, "--table 6.1 compares against a mesh's render: '%s' is not a mesh", model);
+    }
+    static const asp_prim_render_method normalized = ASP_PRIM_RENDER_NORMALIZED;
+    asp_eval_result *res = NULL;
+    if (!rc) {
+        asp_eval_desc d = {.views = views, .sizes = sizes, .size_count = nsizes, .max_primitives = budget,
+                           .frames = 1, .methods = &normalized, .method_count = 1, .mesh = mesh, .billboards = 1};
+        rc = asp_eval_run(cloud, &d, &env->ctx, &res, &err);
+    }
+    /* the madcat row: this mesh at the 6% bound Decoret et al. quote, default texel */
+    asp_dps *bb6 = NULL;
+    asp_billboard_stats st6 = {0};
+    if (!rc)
+        rc = asp_billboard_mesh(mesh, &(asp_billboard_desc){.error = 0.06}, model, &env->ctx, &bb6, &st6, &err);
+    asp_amg_shutdown();
+    cli_progress_end(env);
+    if (rc) {
+        asp_eval_result_destroy(res);
+        asp_cloud_destroy(cloud);
+        asp_mesh_destroy(mesh);
+        return cli_fail(env, &err);
+    }
+    if (env->json) {
+        cJSON *o = cJSON_CreateObject(), *rows = cJSON_CreateArray();
+        cJSON_AddStringToObject(o, "model", model);
+        cJSON_AddNumberToObject(o, "triangles", (double)mesh->triangle_count);
+        cJSON_AddNumberToObject(o, "points", (double)cloud->count);
+        cJSON_AddNumberToObject(o, "views", (double)res->views);
+        cJSON_AddItemToObject(o, "t_decompose", cli_json_number("%.4f", res->t_decompose));
+        for (size_t i = 0; i < res->row_count; i++) {
+            const asp_eval_row *a = &res->rows[i];
+            int bb = strcmp(a->representation, "billboards") == 0;
+            if (!bb && strcmp(a->representation, "dp-normalized") != 0)
+                continue;
+            cJSON *j = cJSON_CreateObject();
+            cJSON_AddStringToObject(j, "level", a->level_name);
+            cJSON_AddStringToObject(j, "method", bb ? "billboards" : "domain");
+            cJSON_AddNumberToObject(j, "size", a->size);
+            cJSON_AddNumberToObject(j, "count", (double)a->primitives);
+            cJSON_AddNumberToObject(j, "texels", (double)a->texels);
+            cJSON_AddItemToObject(j, "error_bound", cli_json_number("%.6g", a->error_bound));
+            cJSON_AddItemToObject(j, "build_seconds", cli_json_number("%.4f", a->build_seconds));
+            cJSON_AddNumberToObject(j, "bytes", (double)a->bytes);
+            cJSON_AddItemToObject(j, "ssim", cli_json_number("%.6f", a->ssim_mean));
+            cJSON_AddItemToObject(j, "psnr", cli_json_number("%.4f", a->psnr_mean));
+            cJSON_AddItemToObject(j, "iou", cli_json_number("%.6f", a->iou_mean));
+            cJSON_AddItemToArray(rows, j);
+        }
+        cJSON_AddItemToObject(o, "rows", rows);
+        cJSON *m6 = cJSON_CreateObject();
+        cJSON_AddNumberToObject(m6, "planes", (double)st6.planes);
+        cJSON_AddNumberToObject(m6, "texels", (double)st6.texels);
+        cJSON_AddItemToObject(m6, "seconds", cli_json_number("%.4f", st6.t_search + st6.t_texture));
+        cJSON_AddItemToObject(o, "bound_6_percent", m6);
+        rc = cli_json_print(env, o);
+        asp_dps_destroy(bb6);
+        asp_eval_result_destroy(res);
+        asp_cloud_destroy(cloud);
+        asp_mesh_destroy(mesh);
+        return rc;
+    }
+    char text[256];
+    snprintf(text, sizeof text, "Thesis Table 6.1 measured: domain primitives (%zu samples) against billboard clouds of "
+             "'%s' (%zu triangles), %zu views, against the mesh's render", cloud->count, model, mesh->triangle_count,
+             res->views);
+    title(md, text);
+    struct table t = {.md = md, .widths = {6, 11, 6, 9, 6, 8, 9}, .ncols = 7 + 3 * (int)nsizes};
+    const char *head[7 + 3 * MAX_SIZES] = {"level", "method", "count", "texels", "bound", "build s", "bytes"};
+    char hb[3 * MAX_SIZES][24];
+    for (size_t k = 0; k < nsizes; k++) {
+        snprintf(hb[3 * k], sizeof hb[0], "SSIM %u", sizes[k]);
+        snprintf(hb[3 * k + 1], sizeof hb[0], "PSNR %u", sizes[k]);
+        snprintf(hb[3 * k + 2], sizeof hb[0], "IoU %u", sizes[k]);
+        for (int j = 0; j < 3; j++)
+            head[7 + 3 * k + (size_t)j] = hb[3 * k + (size_t)j], t.widths[7 + 3 * k + (size_t)j] = 8;
+    }
+    row(&t, head);
+    static const char *const reps[2] = {"dp-normalized", "billboards"};
+    for (size_t l = 0; l < res->level_count; l++)
+        for (int m = 0; m < 2; m++) {
+            /* the level names in the order the rows hold them */
+            size_t first = SIZE_MAX;
+            for (size_t i = 0, seen = 0; i < res->row_count && first == SIZE_MAX; i++)
+                if (strcmp(res->rows[i].representation, "dp-normalized") == 0 && res->rows[i].size == sizes[0] &&
+                    seen++ == l)
+                    first = i;
+            if (first == SIZE_MAX)
+                continue;
+            const char *lname = res->rows[first].level_name;
+            size_t r0 = find_row61(res, reps[m], lname, sizes[0]);
+            if (r0 == SIZE_MAX)
+                continue;
+            const asp_eval_row *a = &res->rows[r0];
+            char c[7 + 3 * MAX_SIZES][24];
+            const char *cells[7 + 3 * MAX_SIZES];
+            snprintf(c[0], sizeof c[0], "%s", lname);
+            snprintf(c[1], sizeof c[1], "%s", m ? "billboards" : "domain");
+            snprintf(c[2], sizeof c[2], "%zu", a->primitives);
+            snprintf(c[3], sizeof c[3], "%lluk", (unsigned long long)((a->texels + 500) / 1000));
+            if (m)
+                snprintf(c[4], sizeof c[4], "%.1f%%", 100 * a->error_bound);
+            else
+                snprintf(c[4], sizeof c[4], "-");
+            fmt_time(c[5], sizeof c[5], m ? a->build_seconds : res->t_decompose + a->build_seconds);
+            snprintf(c[6], sizeof c[6], "%.2fM", (double)a->bytes / 1e6);
+            for (size_t k = 0; k < nsizes; k++) {
+                size_t r = find_row61(res, reps[m], lname, sizes[k]);
+                const asp_eval_row *b = r == SIZE_MAX ? NULL : &res->rows[r];
+                snprintf(c[7 + 3 * k], sizeof c[0], b ? "%.3f" : "-", b ? b->ssim_mean : 0.0);
+                snprintf(c[8 + 3 * k], sizeof c[0], b ? "%.1f" : "-", b ? b->psnr_mean : 0.0);
+                snprintf(c[9 + 3 * k], sizeof c[0], b ? "%.3f" : "-", b ? b->iou_mean : 0.0);
+            }
+            for (int i = 0; i < t.ncols; i++)
+                cells[i] = c[i];
+            row(&t, cells);
+        }
+    title(md, "The madcat row of thesis Table 6.1 (Decoret et al. 2003) next to this mesh at a 6% bound");
+    struct table u = {.md = md, .widths = {34, 10, 7, 8, 10}, .ncols = 5};
+    row(&u, (const char *const[]){"model", "triangles", "planes", "texels", "seconds"});
+    row(&u, (const char *const[]){"madcat (thesis, 2003 hardware)", "59,855", "171", "1,638k", "529"});
+    char c6[5][64];
+    snprintf(c6[0], sizeof c6[0], "%s (this machine)", strrchr(model, '/') ? strrchr(model, '/') + 1 : model);
+    snprintf(c6[1], sizeof c6[1], "%zu", mesh->triangle_count);
+    snprintf(c6[2], sizeof c6[2], "%zu", st6.planes);
+    snprintf(c6[3], sizeof c6[3], "%lluk", (unsigned long long)((st6.texels + 500) / 1000));
+    snprintf(c6[4], sizeof c6[4], "%.2f", st6.t_search + st6.t_texture);
+    row(&u, (const char *const[]){c6[0], c6[1], c6[2], c6[3], c6[4]});
+    if (!env->quiet)
+        printf("%stexel of the 6%% cloud: 1/512 of the diagonal; images on %s\n", md ? "\n" : "",
+               res->gl_renderer);
+    asp_dps_destroy(bb6);
+    asp_eval_result_destroy(res);
+    asp_cloud_destroy(cloud);
+    asp_mesh_destroy(mesh);
+    return 0;
+}
+
 int cmd_bench_paper(int argc, char **argv, struct cli_env *env)
 {
     const char *sizes_text = NULL, *texture = NULL;
-    size_t frames = 10, max_prims = 2000, budget = 500, points = 0;
+    const char *table_name = NULL;
+    size_t frames = 10, max_prims = 2000, budget = SIZE_MAX, points = 0, views = 0; // SIZE_MAX: not given
     int no_t54 = 0, markdown = 0;
     const struct cli_option opts[] = {
         {"sizes", 's', CLI_STRING, &sizes_text, "LIST", "screen sizes of the frame rates (default 128,256,512)"},
         {"frames", 0, CLI_SIZE, &frames, "N", "timed frames per figure, median (default 10)"},
         {"max-primitives", 'p', CLI_SIZE, &max_prims, "N", "Table 5.2 levels with at most N primitives (2000)"},
-        {"budget", 'b', CLI_SIZE, &budget, "N", "Table 1/5.3/5.4 level: the finest with at most N (500)"},
+        {"budget", 'b', CLI_SIZE, &budget, "N", "Table 1/5.3/5.4 level: the finest with at most N (500); 6.1: levels (300)"},
+        {"table", 0, CLI_STRING, &table_name, "T", "6.1: thesis Table 6.1, domain primitives against billboard clouds"},
+        {"views", 0, CLI_SIZE, &views, "N", "Table 6.1: cameras around the model (default 16)"},
         {"no-texture-methods", 0, CLI_FLAG, &no_t54, NULL, "leave out Table 5.4 (12 extra builds)"},
         {"points", 'n', CLI_SIZE, &points, "N", "samples of a mesh or synthetic MODEL"},
         {"texture", 0, CLI_STRING, &texture, "IMG", "texture of a mesh MODEL without material textures"},
@@ -271,8 +447,13 @@ int cmd_bench_paper(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--frames expects 1..1000, got %zu", frames);
     if (max_prims < 1 || budget < 1)
         return cli_usage_error(env, "--max-primitives and --budget expect at least 1");
+    if (table_name && strcmp(table_name, "6.1") != 0)
+        return cli_usage_error(env, "--table expects 6.1 (the other tables are printed without it), got '%s'",
+                               table_name);
+    if (views > 256)
+        return cli_usage_error(env, "--views expects 1..256, got %zu", views);
     uint32_t sizes[MAX_SIZES] = {128, 256, 512};
-    size_t nsizes = 3;
+    size_t nsizes = table_name ? 2 : 3;
     if (sizes_text) {
         double v[MAX_SIZES];
         int k = cli_parse_doubles(sizes_text, v, MAX_SIZES);
@@ -286,6 +467,11 @@ int cmd_bench_paper(int argc, char **argv, struct cli_env *env)
         }
         nsizes = (size_t)k;
     }
+    if (table_name)
+        return table61(env, argv[0], texture, points, budget == SIZE_MAX ? 300 : budget, views, sizes, nsizes,
+                       markdown);
+    if (budget == SIZE_MAX)
+        budget = 500;
     asp_error err = {0};
     asp_cloud *cloud = NULL;
     rc = asp_eval_load_model(argv[0], points, texture, &env->ctx, &cloud, &err);

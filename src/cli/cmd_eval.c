@@ -36,6 +36,9 @@ static const char usage[] =
     "about four times as long as 256 x 256 on a CPU rasteriser: ask for them with --sizes. Writes into DIR\n"
     "(default eval-<model name>): eval.csv, eval.json, ssim-<size>.png, frametime-<size>.png and\n"
     "sheet.png (view 0: one row per representation, the reference first, then the levels).\n"
+    "--methods may also name 'hybrid' and 'billboards': the latter adds per level a billboard cloud\n"
+    "(simplify --billboards) of the mesh, or of the points as discs, at the level's texel count with the\n"
+    "error bound whose plane count is nearest the level's primitive count.\n"
     "Sharp creases: the reference's splats and the primitives are clipped where flat parts meet at\n"
     "more than --crease-angle degrees (default 60; 'off' compares the seeds' unclipped renders).\n"
     "A scene file of instances (docs/scene-format.md) is measured as a whole from its camera: the\n"
@@ -64,7 +67,8 @@ static int parse_sizes(struct cli_env *env, const char *text, uint32_t *sizes, s
     return 0;
 }
 
-static int parse_methods(struct cli_env *env, const char *text, asp_prim_render_method *m, size_t *n, int *hybrid)
+static int parse_methods(struct cli_env *env, const char *text, asp_prim_render_method *m, size_t *n, int *hybrid,
+                         int *billboards)
 {
     *n = 0;
     if (strcmp(text, "none") == 0)
@@ -85,6 +89,11 @@ static int parse_methods(struct cli_env *env, const char *text, asp_prim_render_
         asp_error err = {0};
         if (strcmp(item, "hybrid") == 0) { // issue 18 item 3: not a primitive method but a row of its own
             *hybrid = 1;
+            item = comma ? comma + 1 : NULL;
+            continue;
+        }
+        if (strcmp(item, "billboards") == 0) { // issue 30: a billboard cloud matched to each level, a row of its own
+            *billboards = 1;
             item = comma ? comma + 1 : NULL;
             continue;
         }
@@ -434,8 +443,8 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
         return 2;
     asp_prim_render_method methods[MAX_METHODS];
     size_t nmethods = 0;
-    int hybrid = 0;
-    if (methods_text && parse_methods(env, methods_text, methods, &nmethods, &hybrid))
+    int hybrid = 0, billboards = 0;
+    if (methods_text && parse_methods(env, methods_text, methods, &nmethods, &hybrid, &billboards))
         return 2;
     char dir[4000];
     if (out_dir && strlen(out_dir) >= sizeof dir)
@@ -467,7 +476,7 @@ int cmd_eval(int argc, char **argv, struct cli_env *env)
     asp_eval_desc desc = {.views = views, .sizes = sizes, .size_count = nsizes, .max_primitives = max_prims,
                           .frames = frames, .elevation = (float)elevation, .crease_angle = (float)crease,
                           .methods = methods_text ? methods : NULL, .method_count = nmethods, .mesh = mesh,
-                          .hybrid = hybrid};
+                          .hybrid = hybrid, .billboards = billboards};
     double t0 = asp_time_now();
     asp_eval_result *res = NULL;
     rc = asp_eval_run(cloud, &desc, &env->ctx, &res, &err);

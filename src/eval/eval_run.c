@@ -17,6 +17,7 @@
 #include "amgsplat/hier.h"
 #include "amgsplat/render.h"
 #include "amgsplat/scene.h"
+#include "eval/internal.h"
 #include "util/banned.h"
 
 void asp_eval_result_destroy(asp_eval_result *res)
@@ -53,7 +54,7 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_co
 
 #else
 
-enum { MAX_SIZES = 8, MAX_VIEWS = 256, MAX_FRAMES = 1000, MAX_REPS = 20, MAX_LEVELS = 64 };
+enum { MAX_SIZES = 8, MAX_VIEWS = 256, MAX_FRAMES = 1000, MAX_REPS = 21, MAX_LEVELS = 64 };
 
 /* asp_eval_row.bytes of a point: 12 position + 12 normal + 4 RGBA8 + 4 radius, as asp_cloud holds it */
 #define POINT_BYTES 32
@@ -66,7 +67,8 @@ enum { MAX_SIZES = 8, MAX_VIEWS = 256, MAX_FRAMES = 1000, MAX_REPS = 20, MAX_LEV
  * count (prim = 0, drawn by the shared splat renderer), or the level's domain
  * primitives drawn with one method (journal section 4, thesis 4.4).
  */
-enum rep_kind { REP_CUT, REP_PRIM, REP_MESH_TRIS, REP_MESH_BYTES, REP_FULL_DISCS, REP_FULL_SPLATS, REP_HYBRID };
+enum rep_kind { REP_CUT, REP_PRIM, REP_MESH_TRIS, REP_MESH_BYTES, REP_FULL_DISCS, REP_FULL_SPLATS, REP_HYBRID,
+                REP_BILLBOARDS };
 
 struct rep {
     char name[32];
@@ -90,6 +92,8 @@ struct eval_state {
     asp_mesh *bytes[MAX_LEVELS];     /* per level: the mesh at <= the level's GPU bytes */
     char tris_note[MAX_LEVELS][96];  /* why tris[l] is NULL */
     char bytes_note[MAX_LEVELS][96]; /* why bytes[l] is NULL */
+    asp_dps *bb[MAX_LEVELS];         /* per level: the billboard cloud matched to it (issue 30), or NULL */
+    double bb_seconds[MAX_LEVELS], bb_error[MAX_LEVELS];
     float elevation;
     float crease_angle;  /* resolved: degrees, or -1 for none */
     size_t views, frames;
@@ -468,6 +472,15 @@ static int prepare(struct eval_state *s, const asp_eval_desc *d, asp_eval_result
         rc = asp_hier_build(s->cloud, NULL, s->ctx, &s->hier, err);
     if (!rc && s->mesh)
         rc = simplify_levels(s, res, err);
+    for (size_t l = 0; !rc && d->billboards && l < s->dps->level_count; l++) {
+        const asp_dps_level *lv = &s->dps->levels[l];
+        asp_billboard_stats st = {0};
+        rc = asp__eval_billboards(s->mesh, s->cloud, lv->prim_count, lv->texels, s->ctx, &s->bb[l], &st,
+                                  &s->bb_error[l], err);
+        s->bb_seconds[l] = st.t_search + st.t_texture;
+        if (!rc)
+            rc = asp_progress(s->ctx, "billboards", (double)(l + 1) / (double)s->dps->level_count);
+    }
     // with a mesh, every picture is framed as `render MESH` frames it
     if (!rc)
         rc = s->mesh ? asp_scene_mesh_frame(s->mesh, &s->frame, err) : asp_cloud_frame(s->cloud, &s->frame, err);
@@ -502,6 +515,7 @@ static void state_release(struct eval_state *s)
     for (size_t l = 0; l < MAX_LEVELS; l++) {
         asp_mesh_destroy(s->tris[l]);
         asp_mesh_destroy(s->bytes[l]);
+        asp_dps_destroy(s->bb[l]);
     }
     asp_gl_context_destroy(s->gl);
     asp_hier_destroy(s->hier);
@@ -551,15 +565,21 @@ static int run_size(struct eval_state *s, uint32_t size, asp_eval_result *res, s
             const asp_mesh *mesh = rp->kind == REP_MESH_TRIS    ? s->tris[l]
                                    : rp->kind == REP_MESH_BYTES ? s->bytes[l]
                                                                 : NULL;
+            // a billboard cloud is drawn in its level's place: its own planes, texels and bytes
+            const asp_dps_level *draw = rp->kind == REP_BILLBOARDS ? &s->bb[l]->levels[0] : lv;
             if ((rp->kind == REP_MESH_TRIS || rp->kind == REP_MESH_BYTES) && !mesh)
                 row_without_figures(s, rp, lv, size, rp->kind == REP_MESH_TRIS ? s->tris_note[l] : s->bytes_note[l],
                                     &res->rows[r], res->ssim + r * s->views, res->psnr + r * s->views);
             else
-                rc = measure(s, rp, lv, mesh, size, refs, NULL, sh, k, l + 1, &res->rows[r], res->ssim + r * s->views,
-                             res->psnr + r * s->views, err);
+                rc = measure(s, rp, draw, mesh, size, refs, NULL, sh, k, l + 1, &res->rows[r],
+                             res->ssim + r * s->views, res->psnr + r * s->views, err);
             if (rc)
                 break;
             name_level(s, lv, &res->rows[r]);
+            if (rp->kind == REP_BILLBOARDS)
+                res->rows[r].build_seconds = s->bb_seconds[l], res->rows[r].error_bound = s->bb_error[l];
+            else if (rp->kind == REP_PRIM)
+                res->rows[r].build_seconds = lv->t_basis + lv->t_construct;
             (*row)++;
             rc = asp_progress(s->ctx, "render", (double)*row / (double)res->row_count);
         }
@@ -666,6 +686,8 @@ int asp_eval_run(const asp_cloud *cloud, const asp_eval_desc *desc, const asp_co
     }
     if (d.hybrid)
         s.reps[s.nreps++] = (struct rep){.name = "hybrid", .kind = REP_HYBRID};
+    if (d.billboards) // drawn by the prim renderer, which draws a billboard level alpha-tested whatever the method
+        s.reps[s.nreps++] = (struct rep){.name = "billboards", .kind = REP_BILLBOARDS, .prim = 1};
     if (d.mesh) {
         s.reps[s.nreps++] = (struct rep){.name = "mesh-tris", .kind = REP_MESH_TRIS};
         s.reps[s.nreps++] = (struct rep){.name = "mesh-bytes", .kind = REP_MESH_BYTES};

@@ -112,7 +112,7 @@ static cJSON *texture_info(int texture)
 }
 
 static int add_material(asp__gltf *g, const char *name, int color_tex, int normal_tex, const asp_gltf_desc *d,
-                        float cutoff)
+                        float cutoff, int billboards)
 {
     cJSON *m = cJSON_CreateObject();
     if (!m) {
@@ -129,7 +129,11 @@ static int add_material(asp__gltf *g, const char *name, int color_tex, int norma
     }
     if (normal_tex >= 0)
         cJSON_AddItemToObject(m, "normalTexture", texture_info(normal_tex));
-    if (d->alpha_mode == ASP_GLTF_ALPHA_MASK) {
+    if (billboards) {
+        /* a billboard cloud's alpha is a binary mask (issue 30): always MASK, at 0.5 unless a cutoff is given */
+        cJSON_AddStringToObject(m, "alphaMode", "MASK");
+        cJSON_AddNumberToObject(m, "alphaCutoff", d->alpha_cutoff > 0 ? d->alpha_cutoff : 0.5);
+    } else if (d->alpha_mode == ASP_GLTF_ALPHA_MASK) {
         cJSON_AddStringToObject(m, "alphaMode", "MASK");
         cJSON_AddNumberToObject(m, "alphaCutoff", cutoff);
     } else {
@@ -217,7 +221,7 @@ static int export_level(asp__gltf *g, const asp_dps *dps, size_t index, const do
         normal_tex = asp__gltf_texture(g, asp__gltf_image(g, normals, lv->atlas.width, lv->atlas.height, img));
     }
     snprintf(name, sizeof name, "%s (%zu primitives)", lname, n);
-    int mat = add_material(g, name, color_tex, normal_tex, d, cutoff);
+    int mat = add_material(g, name, color_tex, normal_tex, d, cutoff, lv->billboards != 0);
     if (g->failed || ipos < 0 || inrm < 0 || (has_normals && itan < 0) || iuv < 0 || iidx < 0 || color_tex < 0 || mat < 0) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory exporting level %s", lname);
         goto done;
@@ -246,6 +250,9 @@ static int export_level(asp__gltf *g, const asp_dps *dps, size_t index, const do
         // what the renderer's normalized method needs to blend as `amgsplat render` does
         cJSON_AddNumberToObject(am, "alphaRef", 0.1);
         cJSON_AddNumberToObject(am, "depthWindow", 0.5 * mean_radius(lv));
+        // issue 30: a billboard cloud is drawn by its material (alphaMode MASK), never blended
+        if (lv->billboards)
+            cJSON_AddTrueToObject(am, "billboards");
     }
     if (imesh < 0 || asp__gltf_append(g, g->nodes, node) < 0) {
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory exporting level %s", lname);

@@ -133,8 +133,9 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
         asp__put_u64(&w, lv->neighbour_total);
         asp__put_u32(&w, lv->atlas.width);
         asp__put_u32(&w, lv->atlas.height);
-        /* bit 0: a normal atlas follows; bit 1: the atlases are BC3 blocks (issue 27) */
-        asp__put_u32(&w, (lv->normal_atlas.width ? 1u : 0u) | (lv->atlas_bc3 ? 2u : 0u));
+        /* bit 0: a normal atlas follows; bit 1: the atlases are BC3 blocks (issue 27); bit 2: a billboard
+           cloud, drawn alpha-tested and opaque (issue 30; older readers refuse the unknown bit) */
+        asp__put_u32(&w, (lv->normal_atlas.width ? 1u : 0u) | (lv->atlas_bc3 ? 2u : 0u) | (lv->billboards ? 4u : 0u));
         asp__put_u32(&w, lv->skipped);
         asp__put_u32(&w, lv->degenerate);
         asp__put_u32(&w, lv->capped);
@@ -271,6 +272,7 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, uint32_t version,
     uint64_t np = asp__get_u64(r), nn = asp__get_u64(r);
     uint32_t aw = asp__get_u32(r), ah = asp__get_u32(r), aflags = asp__get_u32(r);
     const uint32_t has_n = aflags & 1u, bc3 = (aflags >> 1) & 1u;
+    lv->billboards = (aflags >> 2) & 1u;
     lv->skipped = asp__get_u32(r), lv->degenerate = asp__get_u32(r);
     lv->capped = asp__get_u32(r), lv->merges = asp__get_u32(r);
     uint32_t strict = asp__get_u32(r); /* spare (0) before version 3 */
@@ -318,9 +320,9 @@ static int read_level(asp__byte_reader *r, const asp_dps *dps, uint32_t version,
                  "left after the primitives)", li, (unsigned long long)nn, after_prims / 4, after_prims);
         return asp__byte_bad(r, msg);
     }
-    if (aw == 0 || ah == 0 || aw > DPS_SIDE || ah > DPS_SIDE || aflags > 3 || (bc3 && (aw % 4 || ah % 4))) {
+    if (aw == 0 || ah == 0 || aw > DPS_SIDE || ah > DPS_SIDE || aflags > 7 || (bc3 && (aw % 4 || ah % 4))) {
         snprintf(msg, sizeof msg, "level %zu: %ux%u atlas with flags %u, expected sides 1..%d (multiples of 4 when "
-                 "BC3) and flags 0..3 (1 normal atlas, 2 BC3 blocks)", li, aw, ah, aflags, DPS_SIDE);
+                 "BC3) and flags 0..7 (1 normal atlas, 2 BC3 blocks, 4 billboards)", li, aw, ah, aflags, DPS_SIDE);
         return asp__byte_bad(r, msg);
     }
     const size_t after_lists = after_prims - (size_t)nn * 4,

@@ -85,6 +85,7 @@ typedef struct asp__prim_renderer {
     float default_window;        /* depth window when opt.depth_window is 0 */
     size_t count, neighbour_total;
     int has_normal_map;
+    int billboards;              /* the level is a billboard cloud (asp_dps_level.billboards): always no-blend */
     /* CPU copies for sorting and the overlap traversal */
     float *centres;              /* 3 per primitive, local frame */
     float *normals;              /* 3 per primitive */

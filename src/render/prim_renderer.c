@@ -132,6 +132,15 @@ static void resolve_options(const asp__prim_renderer *r, const asp_prim_render_o
 {
     *o = *in;
     o->alpha_ref = in->alpha_ref > 0 ? in->alpha_ref : in->alpha_ref < 0 ? 0.0f : 0.1f;
+    if (r->billboards) {
+        /* a billboard cloud's alpha is a binary mask (issue 30; Decoret et al. 2003): drawn opaque and
+           depth-tested where it is set, halfway between 0 and 1 under linear filtering, never blended or
+           normalised; polygons (outlines of the planes) stay available */
+        if (o->method != ASP_PRIM_RENDER_POLYGONS)
+            o->method = ASP_PRIM_RENDER_NO_BLEND;
+        if (in->alpha_ref == 0)
+            o->alpha_ref = 0.5f;
+    }
     o->transparency = in->transparency > 0 ? in->transparency : 1.0f;
     o->depth_window = in->depth_window > 0 ? in->depth_window : in->depth_window < 0 ? 0.0f : r->default_window;
     float angle = in->crease_angle == 0 ? ASP_PRIM_CREASE_ANGLE_DEFAULT : in->crease_angle;
@@ -439,6 +448,7 @@ int asp_prim_renderer_create(asp_gl_context *gl, const asp_dps_level *level, con
     r->count = level->prim_count;
     r->neighbour_total = level->neighbour_total;
     r->has_normal_map = level->normal_atlas.width > 0;
+    r->billboards = level->billboards != 0;
     rc = alloc_cpu(r, err);
     if (!rc)
         rc = build_programs(r, err);
