@@ -336,6 +336,9 @@ class Viewer {
       if (o.isPoints && o.geometry.attributes['khr_gaussian_splatting:rotation']) this.splats.push(this.splatPasses(o));
     });
     for (const sp of this.splats) src.add(sp.mesh);
+    // a billboard cloud (simplify --billboards, issue 30) is drawn as its material says: alpha-tested
+    // (MASK), depth-tested, never blended or normalised, whatever the method
+    this.billboards = this.prims.some((p) => (p.mesh.userData.amgsplat || {}).billboards);
     if (extras.frame && extras.frame.radius > 0) {
       const c = new THREE.Vector3(...extras.frame.center).sub(origin);
       this.frame = { center: c, radius: extras.frame.radius };
@@ -499,7 +502,7 @@ class Viewer {
       this.resolve(true);
       return;
     }
-    if (this.prims.length === 0 || o.method === 'gltf') {
+    if (this.prims.length === 0 || o.method === 'gltf' || this.billboards) {
       for (const p of this.prims) p.mesh.material = p.gltf;
       this.scene.background = bg;
       r.setRenderTarget(null);
