@@ -76,8 +76,10 @@ typedef struct point_arrays {
     float lo[3], hi[3];
 } point_arrays;
 
+/* The splats of hier, turned from the source's up axis to glTF's +y (asp__gltf_turn_up). */
 static void fill_points(const asp_hier *hier, point_arrays *a, int splats)
 {
+    const asp_up_axis up = asp_hier_frame(hier)->up;
     const asp_hier_splat *all = asp_hier_splats(hier);
     size_t nodes = asp_hier_node_count(hier), n = asp_hier_point_count(hier);
     int colored = (asp_hier_flags(hier) & ASP_HIER_HAS_COLORS) != 0;
@@ -90,13 +92,22 @@ static void fill_points(const asp_hier *hier, point_arrays *a, int splats)
     for (size_t j = 0; j < n; j++) {
         const asp_hier_splat *s = &all[nodes + j];
         size_t i = s->index < n ? s->index : j; // input order
-        float nl = sqrtf(s->normal[0] * s->normal[0] + s->normal[1] * s->normal[1] + s->normal[2] * s->normal[2]);
+        float c[3], nm[3], u[3], v[3];
+        memcpy(c, s->center, sizeof c);
+        memcpy(nm, s->normal, sizeof nm);
+        memcpy(u, s->u, sizeof u);
+        memcpy(v, s->v, sizeof v);
+        asp__gltf_turn_up_f(up, c);
+        asp__gltf_turn_up_f(up, nm);
+        asp__gltf_turn_up_f(up, u);
+        asp__gltf_turn_up_f(up, v);
+        float nl = sqrtf(nm[0] * nm[0] + nm[1] * nm[1] + nm[2] * nm[2]);
         for (int k = 0; k < 3; k++) {
-            a->pos[3 * i + k] = s->center[k];
-            a->lo[k] = fminf(a->lo[k], s->center[k]);
-            a->hi[k] = fmaxf(a->hi[k], s->center[k]);
+            a->pos[3 * i + k] = c[k];
+            a->lo[k] = fminf(a->lo[k], c[k]);
+            a->hi[k] = fmaxf(a->hi[k], c[k]);
             // glTF requires unit normals; a point without one faces +z
-            a->nrm[3 * i + k] = nl > 0 ? s->normal[k] / nl : (k == 2 ? 1.0f : 0.0f);
+            a->nrm[3 * i + k] = nl > 0 ? nm[k] / nl : (k == 2 ? 1.0f : 0.0f);
         }
         // the renderers' light grey 200 for a set without colours (docs/cli/render.md)
         uint8_t rgba[4] = {200, 200, 200, 255};
@@ -108,7 +119,7 @@ static void fill_points(const asp_hier *hier, point_arrays *a, int splats)
         if (!splats)
             continue;
         float ax = s->a > 0 ? s->a : (float)tiny, bx = s->a > 0 ? s->b : (float)tiny;
-        asp_gltf_gaussian_from_ellipse(s->u, s->v, ax, bx, a->rot + 4 * i, a->scale + 3 * i);
+        asp_gltf_gaussian_from_ellipse(u, v, ax, bx, a->rot + 4 * i, a->scale + 3 * i);
         a->opacity[i] = rgba[3] / 255.0f;
         for (int k = 0; k < 3; k++) // colour = SH0 * Y00 + 0.5 (srgb_rec709_display: the stored sRGB values)
             a->sh0[3 * i + k] = (float)((rgba[k] / 255.0 - 0.5) / 0.2820947917738781);
@@ -276,10 +287,10 @@ done:
     return mesh;
 }
 
-int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,
-                         asp_error *err)
+/* crs: the source's CRS (asp__gltf_crs) for asset.extras, or NULL; taken over. */
+static int export_hier(const asp_hier *hier, const char *path, const asp_gltf_desc *desc, cJSON *crs,
+                       asp_gltf_stats *stats, asp_error *err)
 {
-    ASP_ASSERT(hier && path);
     static const asp_gltf_desc zero;
     const asp_gltf_desc *d = desc ? desc : &zero;
     int splats = !(d->flags & ASP_GLTF_NO_SPLATS);
@@ -288,10 +299,20 @@ int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_
         return asp_error_set(err, ASP_EDEGENERATE, "no points to export");
     asp_gltf_stats st = {0};
     asp_hier_origin(hier, st.origin);
+    asp__gltf_turn_up(asp_hier_frame(hier)->up, st.origin, st.origin); // the node translation, y-up
     asp__gltf g;
     int rc = asp__gltf_init(&g, path, splats ? "(points, KHR_gaussian_splatting)" : "(points)", NULL, err);
-    if (rc)
+    if (rc) {
+        cJSON_Delete(crs);
         return rc;
+    }
+    if (crs) { // glTF has no CRS: the source's words, for a GIS that reads the file (asp__gltf_crs)
+        cJSON *asset = cJSON_GetObjectItem(g.root, "asset");
+        cJSON *ex = asset ? cJSON_AddObjectToObject(asset, "extras") : NULL;
+        cJSON *am = ex ? cJSON_AddObjectToObject(ex, "amgsplat") : NULL;
+        if (!am || !cJSON_AddItemToObject(am, "crs", crs))
+            cJSON_Delete(crs);
+    }
     point_arrays a = {0};
     a.pos = asp_alloc(NULL, n * 12);
     a.nrm = asp_alloc(NULL, n * 12);
@@ -344,6 +365,13 @@ done:
     return rc;
 }
 
+int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,
+                         asp_error *err)
+{
+    ASP_ASSERT(hier && path);
+    return export_hier(hier, path, desc, NULL, stats, err);
+}
+
 int asp_gltf_export_cloud(const asp_cloud *cloud, const char *path, const asp_gltf_desc *desc,
                           const asp_context *ctx, asp_gltf_stats *stats, asp_error *err)
 {
@@ -351,7 +379,7 @@ int asp_gltf_export_cloud(const asp_cloud *cloud, const char *path, const asp_gl
     asp_hier *hier = NULL;
     int rc = asp_hier_build(cloud, NULL, ctx, &hier, err);
     if (!rc)
-        rc = asp_gltf_export_hier(hier, path, desc, stats, err);
+        rc = export_hier(hier, path, desc, asp__gltf_crs(cloud->las), stats, err);
     asp_hier_destroy(hier);
     return rc;
 }
