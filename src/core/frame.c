@@ -86,8 +86,9 @@ int asp_positions_frame(const float *positions, size_t count, const double origi
 void asp_frame_half_encode(const asp_frame *f, uint16_t q[3])
 {
     for (int k = 0; k < 3; k++) {
-        // a side is at most the radius (no point is farther from the centre along an axis than in all)
-        double t = f->radius > 0 ? ceil(f->half[k] / f->radius * 65535.0) : 0.0;
+        // a side is at most the radius (no point is farther from the centre along an axis than in all);
+        // up to the next step, less a millionth of one so that a decoded side encodes to its own step
+        double t = f->radius > 0 ? ceil(f->half[k] / f->radius * 65535.0 - 1e-6) : 0.0;
         q[k] = (uint16_t)(t > 0 ? (t < 65535.0 ? t : 65535.0) : 0.0); // NaN: 0, "not known"
     }
 }

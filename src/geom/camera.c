@@ -185,14 +185,17 @@ void asp_camera_frame(asp_camera *cam, const asp_frame *frame, const double orig
         return;
     }
     /*
-     * A flat or thin set (its shortest box side at most a third of its longest: a site, a road, a
-     * pole) fills a small part of its bounding sphere's view (issue 29: a 60 x 40 m site filled a
-     * third of the image), so the camera comes as close as its box allows; compact models keep the
-     * sphere fit, and the nearer of the two is taken, so nothing the sphere fit showed is cut.
+     * A flat, wide set (its side along the shown up axis at most a third of its longest other side:
+     * a site, a terrain, a floor) fills a small part of its bounding sphere's view (issue 29: a
+     * 60 x 40 m site filled a third of the image), so the camera comes as close as its box allows;
+     * compact models and upright ones (a wall seen head on) keep the sphere fit, and the nearer of
+     * the two is taken, so nothing the sphere fit showed is cut.
      */
     const double *h = frame->half;
-    double lo = fmin(h[0], fmin(h[1], h[2])), hi = fmax(h[0], fmax(h[1], h[2]));
-    if (hi > 0 && 3.0 * lo <= hi && isfinite(lo + hi)) {
+    asp_up_axis axis = cam->up >= ASP_UP_NEG_Y && cam->up <= ASP_UP_NEG_X ? cam->up - ASP_UP_NEG_Y : cam->up;
+    int u = axis == ASP_UP_Z ? 2 : axis == ASP_UP_X ? 0 : 1; // the index of the up axis in xyz
+    double wide = fmax(h[(u + 1) % 3], h[(u + 2) % 3]);
+    if (wide > 0 && 3.0 * h[u] <= wide && isfinite(wide + h[u])) {
         double d = box_fit_distance(cam, h);
         if (d > 0 && d < cam->distance) {
             cam->distance = (float)d;
