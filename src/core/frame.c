@@ -7,6 +7,7 @@
  */
 #include <float.h>
 #include <math.h>
+#include <string.h>
 
 #include "amgsplat/cloud.h"
 #include "util/banned.h"
@@ -70,7 +71,9 @@ int asp_positions_frame(const float *positions, size_t count, const double origi
     if (!(r > 0))
         return asp_error_set(err, ASP_EDEGENERATE,
                              "cannot frame %zu points: they are all at the same position and have no radius", count);
-    asp_frame f = {.radius = r};
+    asp_frame f;
+    memset(&f, 0, sizeof f); // padding too: frames are compared bit for bit (memcmp) after a file round trip
+    f.radius = r;
     for (int k = 0; k < 3; k++) {
         f.center[k] = origin[k] + c[k];
         f.half[k] = 0.5 * ((double)hi[k] - lo[k]) + radius; // the box a flat, wide set is framed by
@@ -79,7 +82,7 @@ int asp_positions_frame(const float *positions, size_t count, const double origi
     uint16_t q[3];
     asp_frame_half_encode(&f, q);
     asp_frame_half_decode(&f, q);
-    *out = f;
+    memcpy(out, &f, sizeof f);
     return 0;
 }
 

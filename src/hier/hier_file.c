@@ -360,7 +360,8 @@ static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': file has %zu bytes, header says %llu%s", r->path,
                              r->size, (unsigned long long)(hsize + payload),
                              r->size - hsize < payload ? " (truncated)" : " (trailing bytes)");
-    asp_frame frame = {.radius = 0};
+    asp_frame frame;
+    memset(&frame, 0, sizeof frame); // padding too: frames are compared bit for bit
     if (version >= 2) {
         r->at = FRAME_AT;
         for (int i = 0; i < 3; i++)
@@ -406,7 +407,7 @@ static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
         return rc;
     }
     if (version >= 2) {
-        h->frame = frame;
+        memcpy(&h->frame, &frame, sizeof frame);
     } else { // version 1 predates the recorded frame: the root bounding sphere is close to it
         for (int i = 0; i < 3; i++)
             h->frame.center[i] = h->origin[i] + h->nodes[0].sphere[i];
