@@ -60,9 +60,12 @@ void asp_camera_fit(asp_camera *cam, const float center[3], float radius, float 
  * .dps, .hier, and later meshes): fits cam to frame (a world-space sphere,
  * asp_frame in cloud.h, recorded in the files) seen in a renderer whose local
  * frame is centred on origin (the cloud's origin, asp_prim_renderer_desc.origin;
- * NULL = world origin), as asp_camera_fit with aspect. distance_radii > 0 puts
- * the eye at that many frame radii from the centre instead of fitting. Keeps
- * azimuth, elevation, fov_y and up. frame->radius must be > 0. Thread safe.
+ * NULL = world origin), as asp_camera_fit with aspect; a flat, wide set
+ * (frame->half known, its side along cam->up at most a third of its longest
+ * other side) is then brought as close as its box allows in this view, so a
+ * wide site fills the image. distance_radii > 0 puts the eye at that many frame radii from the
+ * centre instead of fitting. Keeps azimuth, elevation, fov_y and up (set
+ * cam->up first, e.g. to frame->up). frame->radius must be > 0. Thread safe.
  */
 void asp_camera_frame(asp_camera *cam, const asp_frame *frame, const double origin[3], float aspect,
                       float distance_radii);

@@ -66,6 +66,20 @@ typedef struct asp_las_meta {
     asp_las_vlr *vlrs;
 } asp_las_meta;
 
+/**
+ * Which world axis points up: for the orbit camera (asp_camera.up) and for the
+ * mesh loader (asp_mesh.up, the axis of the file taken as up). The zero value
+ * is +y (OpenGL, OBJ, glTF, PLY from most meshes).
+ */
+typedef enum asp_up_axis {
+    ASP_UP_Y = 0, /* azimuth 0 looks from +z */
+    ASP_UP_Z = 1, /* scanners, CAD, 3DS: azimuth 0 looks from -y (the "front" view of z-up tools) */
+    ASP_UP_X = 2, /* azimuth 0 looks from +z */
+    ASP_UP_NEG_Y = 3, /* the negative axes: the positive one's frame turned 180 degrees about its view axis */
+    ASP_UP_NEG_Z = 4,
+    ASP_UP_NEG_X = 5
+} asp_up_axis;
+
 /** Which optional attributes a cloud holds (bit set). */
 enum asp_cloud_attr {
     ASP_ATTR_NORMALS = 1 << 0,
@@ -108,6 +122,8 @@ typedef struct asp_cloud {
     asp_scalar_type color_type;    /* UINT8 or FLOAT32 (NONE = uchar) */
 
     asp_las_meta *las; /* the LAS header and VLRs when read from LAS, else NULL; owned, copied by asp_cloud_clone */
+    asp_up_axis up;    /* the source's up axis: ASP_UP_Z for LAS (ASPRS LAS 1.4: Z is elevation), else ASP_UP_Y;
+                          asp_cloud_frame records it, so .amg/.dps/.hier and render/view/export keep it */
 
     asp_context ctx; /* copy of the context that allocated the arrays */
 } asp_cloud;
@@ -166,20 +182,6 @@ int asp_cloud_validate(const asp_cloud *cloud, asp_error *err);
 int asp_cloud_clone(const asp_cloud *src, asp_cloud **out, asp_error *err);
 
 /**
- * Which world axis points up: for the orbit camera (asp_camera.up) and for the
- * mesh loader (asp_mesh.up, the axis of the file taken as up). The zero value
- * is +y (OpenGL, OBJ, glTF, PLY from most meshes).
- */
-typedef enum asp_up_axis {
-    ASP_UP_Y = 0, /* azimuth 0 looks from +z */
-    ASP_UP_Z = 1, /* scanners, CAD, 3DS: azimuth 0 looks from -y (the "front" view of z-up tools) */
-    ASP_UP_X = 2, /* azimuth 0 looks from +z */
-    ASP_UP_NEG_Y = 3, /* the negative axes: the positive one's frame turned 180 degrees about its view axis */
-    ASP_UP_NEG_Z = 4,
-    ASP_UP_NEG_X = 5
-} asp_up_axis;
-
-/**
  * The sphere every representation of one point set is framed by: render, view
  * and eval point the camera at it whatever the file (.ply, .amg, .dps, .hier),
  * so one --view means one picture. .amg, .dps and .hier files record the frame
@@ -189,6 +191,10 @@ typedef enum asp_up_axis {
 typedef struct asp_frame {
     double center[3]; /* world coordinates: middle of the position bounding box */
     double radius;    /* largest distance of a point from center plus the largest disc radius */
+    double half[3];   /* half sides of that box plus the largest disc radius, rounded up to steps of radius /
+                         65535 (asp_frame_half_encode: as the files store them); 0 0 0 = not known (files
+                         that predate it): the camera then fits the sphere alone (asp_camera_frame) */
+    asp_up_axis up;   /* the source's up axis (asp_cloud.up); ASP_UP_Y also for files that predate it */
 } asp_frame;
 
 /**
@@ -205,7 +211,8 @@ float asp_cloud_default_radius(const asp_cloud *cloud);
 /**
  * Frame of cloud (asp_frame): centre of the position bounds in world
  * coordinates, radius = largest distance from it plus the largest radius (the
- * cloud's radii, else asp_cloud_default_radius). Returns 0; ASP_EDEGENERATE
+ * cloud's radii, else asp_cloud_default_radius), the box's half sides plus
+ * that radius and the cloud's up axis. Returns 0; ASP_EDEGENERATE
  * (empty cloud; all points equal without radii); ASP_EFORMAT (non-finite
  * values, naming the point). *out is unchanged on failure. Thread safe.
  */
@@ -214,7 +221,8 @@ int asp_cloud_frame(const asp_cloud *cloud, asp_frame *out, asp_error *err);
 /**
  * The frame of count float positions (3 each, offsets from origin): centre of
  * their float bounding box, radius = largest distance from it plus radius
- * (the largest splat radius; 0 for mesh vertices). asp_cloud_frame and the
+ * (the largest splat radius; 0 for mesh vertices), half = the box's half
+ * sides plus radius, up = ASP_UP_Y (asp_cloud_frame sets the cloud's). asp_cloud_frame and the
  * mesh frame of the scene loader both come from here, so a mesh and the points
  * sampled from it frame alike. Returns 0; ASP_EDEGENERATE (count 0, or all
  * positions equal with radius 0); ASP_EFORMAT (a non-finite position, naming
@@ -222,6 +230,14 @@ int asp_cloud_frame(const asp_cloud *cloud, asp_frame *out, asp_error *err);
  */
 int asp_positions_frame(const float *positions, size_t count, const double origin[3], double radius, asp_frame *out,
                         asp_error *err);
+
+/**
+ * asp_frame.half as .dps and .hier files store it: each side in 16 bits, in
+ * steps of radius / 65535, rounded up (so the box still holds the set);
+ * decode gives back the same doubles from f->radius. Pure.
+ */
+void asp_frame_half_encode(const asp_frame *f, uint16_t q[3]);
+void asp_frame_half_decode(asp_frame *f, const uint16_t q[3]);
 
 #ifdef __cplusplus
 }

@@ -44,7 +44,9 @@ typedef struct asp_viewer_desc {
     float azimuth;           /* degrees (asp_camera conventions) */
     float elevation;         /* degrees, -90..90 */
     float distance;          /* eye distance in bounding-sphere radii; 0 = the sphere fills the view */
-    asp_up_axis up;          /* world axis shown upright (asp_camera.up); the zero value is +y */
+    int set_up;              /* nonzero: show up below upright; 0: the file's recorded up axis (asp_frame.up:
+                                z for LAS and the .amg/.dps/.hier made from it, else +y) */
+    asp_up_axis up;          /* world axis shown upright (asp_camera.up) when set_up */
     unsigned amg_color;      /* .amg input: first colour mode, an asp_amg_color_mode (amg.h; 0 = classifier),
                                 or 3 = the points' own colours (refused when they have none) */
     const char *amg_level;   /* .amg input: first level, "L", "L-2" or an index; NULL = "L";

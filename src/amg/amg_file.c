@@ -52,10 +52,10 @@ void asp__amg_put_header(asp__crc_writer *w, const asp__amg_header *h)
     asp__put_f64(w, h->frame.radius);
 }
 
-void asp__amg_put_attr_set(asp__crc_writer *w, unsigned attrs)
+void asp__amg_put_attr_set(asp__crc_writer *w, unsigned attrs, asp_up_axis up)
 {
     asp__put_u32(w, attrs);
-    asp__put_u32(w, 0);
+    asp__put_u32(w, (uint32_t)up + 1u);
 }
 
 void asp__amg_put_options(asp__crc_writer *w, const asp_amg_desc *d, const size_t *level_size, size_t nlevels)
@@ -127,7 +127,7 @@ int asp_amg_save(const asp_amg *amg, const char *path, asp_error *err)
     asp__crc_put(&w, amg->tangent, 3 * n * sizeof(float));
     asp__crc_put(&w, amg->classifier, n * sizeof(float));
     /* the input's attributes (version 2): a bit set, then one array per bit in this order */
-    asp__amg_put_attr_set(&w, h.attrs);
+    asp__amg_put_attr_set(&w, h.attrs, amg->frame.up);
     const void *const arrays[ASP__AMG_NATTRS] = {c->normals, c->colors, c->radii, c->uvs, c->labels};
     for (int i = 0; i < ASP__AMG_NATTRS; i++)
         if (h.attrs & asp__amg_attr_bit[i])
@@ -369,6 +369,14 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
         (rc = asp__byte_take(r, a->classifier, 4 * (size_t)n, "classifier values")) ||
         (rc = asp__byte_take(r, u32, 8, "the attribute set")))
         return rc;
+    if (u32[1] > (uint32_t)ASP_UP_NEG_X + 1u) { // the up axis plus 1; 0: written before it was recorded
+        r->at -= 4;
+        snprintf(msg, sizeof msg, "up axis code %u, expected 0 (not recorded) or 1..%u", (unsigned)u32[1],
+                 (unsigned)ASP_UP_NEG_X + 1u);
+        return asp__byte_bad(r, msg);
+    }
+    const asp_up_axis up = u32[1] ? (asp_up_axis)(u32[1] - 1u) : ASP_UP_Y;
+    c->up = up;
     if (attrs & ASP_ATTR_NORMALS)
         rc = asp__byte_take(r, c->normals, 12 * (size_t)n, "normals");
     else
@@ -417,9 +425,17 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_amg *a)
     a->info.k_min = a->desc.k_min;
     a->info.k_max = a->desc.k_max;
     a->info.fan_k = a->desc.fan_k;
-    // a version-2 file predates the recorded frame: computed as decompose does (radius 0 if nothing to frame)
-    if (!recorded && asp_cloud_frame(a->cloud, &a->frame, NULL) != 0)
-        memset(&a->frame, 0, sizeof a->frame);
+    // a version-2 file predates the recorded frame: computed as decompose does (radius 0 if nothing to frame);
+    // the box is not recorded: the file holds every point, so it is the points' box again
+    asp_frame box;
+    if (asp_cloud_frame(a->cloud, &box, NULL) != 0)
+        memset(&box, 0, sizeof box);
+    if (recorded) {
+        memcpy(box.center, a->frame.center, sizeof box.center);
+        box.radius = a->frame.radius;
+    }
+    a->frame = box;
+    a->frame.up = up;
     return 0;
 }
 

@@ -48,8 +48,11 @@ typedef struct asp__amg_header {
 
 /* The header (ASP__AMG_HEADER bytes), its payload size computed from h. */
 void asp__amg_put_header(asp__crc_writer *w, const asp__amg_header *h);
-/* The attribute set between the classifier and the optional arrays: the bits, then a reserved word. */
-void asp__amg_put_attr_set(asp__crc_writer *w, unsigned attrs);
+/*
+ * The attribute set between the classifier and the optional arrays: the bits, then the source's
+ * up axis plus 1 (issue 29; the word was reserved, 0 in older files: not recorded, taken as y).
+ */
+void asp__amg_put_attr_set(asp__crc_writer *w, unsigned attrs, asp_up_axis up);
 /* The options block (ASP__AMG_OPTIONS bytes: what produced the hierarchy), then the nlevels level sizes. */
 void asp__amg_put_options(asp__crc_writer *w, const asp_amg_desc *d, const size_t *level_size, size_t nlevels);
 

@@ -100,7 +100,7 @@ int asp__dist_write_amg(const asp__dist *d, const asp__dist_result *res, const c
     put_all(&s, res->tangent, 3 * n * sizeof(float));
     put_all(&s, res->classifier, n * sizeof(float));
     if (d->rank == 0)
-        asp__amg_put_attr_set(&w, h.attrs);
+        asp__amg_put_attr_set(&w, h.attrs, h.frame.up);
     for (int i = 0; i < ASP__AMG_NATTRS; i++)
         if (h.attrs & asp__amg_attr_bit[i])
             put_all(&s, arrays[i], asp__amg_attr_size[i] * n);

@@ -167,12 +167,15 @@ static int print_json(const struct cli_env *env, const char *path, const asp_clo
     return cli_json_print(env, o);
 }
 
+static const char *up_name(asp_up_axis up);
+
 /* The framing sphere recorded with a representation (asp_frame); radius 0 means the file predates it. */
 static void print_frame_text(const asp_frame *f)
 {
     if (f && f->radius > 0)
-        printf("frame       centre %.9g %.9g %.9g radius %.9g\n", f->center[0], f->center[1], f->center[2],
-               f->radius);
+        printf("frame       centre %.9g %.9g %.9g radius %.9g box %.6g %.6g %.6g up %s\n", f->center[0],
+               f->center[1], f->center[2], f->radius, 2 * f->half[0], 2 * f->half[1], 2 * f->half[2],
+               up_name(f->up));
     else
         printf("frame       not recorded\n");
 }
@@ -183,6 +186,9 @@ static void add_frame_json(cJSON *o, const asp_frame *f)
         cJSON *fr = cJSON_CreateObject();
         cJSON_AddItemToObject(fr, "center", cli_json_doubles(f->center, 3));
         cJSON_AddItemToObject(fr, "radius", cli_json_number("%.17g", f->radius));
+        double box[3] = {2 * f->half[0], 2 * f->half[1], 2 * f->half[2]};
+        cJSON_AddItemToObject(fr, "box", cli_json_doubles(box, 3)); // 0 0 0: not recorded (older files)
+        cJSON_AddStringToObject(fr, "up", up_name(f->up));
         cJSON_AddItemToObject(o, "frame", fr);
     } else {
         cJSON_AddNullToObject(o, "frame");

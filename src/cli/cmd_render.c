@@ -700,7 +700,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"light", 0, CLI_STRING, &o.light, "AZ,EL", "light direction relative to the view (default 0,0: headlight)"},
         {"samples", 0, CLI_SIZE, &o.samples, "N", "multisamples per pixel, 0..64 (default 4)"},
         {"fov", 0, CLI_DOUBLE, &o.fov, "DEG", "vertical field of view (default 40)"},
-        {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y, z (scans, CAD), x, -y, -z or -x (default: z for LAS, else y)"},
+        {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y, z (scans, CAD), x, -y, -z or -x (default: the file's, z for LAS and what was made from it, else y)"},
         {"flat", 0, CLI_FLAG, &o.flat, NULL, "mesh: light each triangle by its face normal (default: smooth vertex normals)"},
         {"radius-scale", 0, CLI_DOUBLE, &o.radius_scale, "X", "multiply every disc, ellipse or square size by X (default 1)"},
         {"edl", 0, CLI_FLAG, &o.edl, NULL, "disc, square: eye-dome lighting (default: on for points without normals, unless --unlit)"},
@@ -735,9 +735,6 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         o.r.renderer = NULL;
     if (parse_options(env, &o))
         return 2;
-    // LAS is z-up (ASPRS LAS 1.4: Z is the elevation of a projected CRS), so a scan stands upright unless --up says otherwise
-    if (!o.up && (strcmp(type.format, "las") == 0 || strcmp(type.format, "laz") == 0))
-        o.up_axis = ASP_UP_Z;
     if (type.kind == ASP_FILE_SCENE)
         return render_instance_scene(argv[0], &o, env);
     if (o.hybrid_points)
@@ -810,6 +807,10 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                       : load_scene(argv[0], &o, env, &s, &err);
     if (!rc)
         warn_missing_textures(&s);
+    // the file's up axis unless --up says otherwise: z for LAS (ASPRS LAS 1.4: Z is the elevation of its
+    // CRS) and the .amg/.dps/.hier made from it, which record it (asp_frame.up)
+    if (!rc && !o.up)
+        o.up_axis = s.frame.up;
     // --color-by a scalar field: the library colours the points (elevation along the shown up axis)
     if (!rc && o.r.color_field && s.cloud && (rc = asp_cloud_color_by(s.cloud, o.r.color_field, o.up_axis, &err))) {
         if (rc == ASP_EINVAL) {

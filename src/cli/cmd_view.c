@@ -82,6 +82,7 @@ static int parse_into(struct cli_env *env, const char *path, struct view_opts *o
     }
     if (o->up && cli_parse_up(o->up, &d->up) != 0)
         return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
+    d->set_up = o->up != NULL; // else the file's own: z for LAS and what was made from it (asp_frame.up)
     if (cli_renderer_check(env, &o->r, VIEW_OPTIONS))
         return 2;
     d->tolerance = isnan(o->r.tolerance) ? 0.0f : (float)o->r.tolerance;
@@ -92,9 +93,6 @@ static int parse_into(struct cli_env *env, const char *path, struct view_opts *o
     asp_file_type type = {ASP_FILE_UNKNOWN, "", 0};
     if (asp_file_recognise(path, &type, NULL) != 0)
         asp_file_type_of_name(path, &type, NULL);
-    // LAS is z-up (ASPRS LAS 1.4: Z is the elevation of a projected CRS), so a scan stands upright unless --up says otherwise
-    if (!o->up && (strcmp(type.format, "las") == 0 || strcmp(type.format, "laz") == 0))
-        d->up = ASP_UP_Z;
     // a point file's own fields, coloured as render --color-by colours them (asp_cloud_color_by)
     if (o->r.color_field && type.kind != ASP_FILE_POINTS && type.kind != ASP_FILE_UNKNOWN)
         return cli_usage_error(env, "%s expects classifier, domains, strict or input, got '%s' (a field such as "
@@ -200,7 +198,7 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
         {"preset", 0, CLI_STRING, &o.preset, "SEED", "the seed's options: thesis, journal, pajarola, schwarz (docs/seeds.md)"},
         {"view", 0, CLI_STRING, &o.view, "AZ,EL[,DIST]", "first view as in 'amgsplat render' (default 30,20)"},
-        {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y, z (scans, CAD), x, -y, -z or -x (default: z for LAS, else y)"},
+        {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y, z (scans, CAD), x, -y, -z or -x (default: the file's, z for LAS and what was made from it, else y)"},
         {"background", 0, CLI_STRING, &o.background, "R,G,B", "background colour, 0..255 or #RRGGBB (default 255,255,255)"},
         {"verbose", 'v', CLI_FLAG, &o.verbose, NULL, "print frame time and primitive count once a second"},
         {"frames", 0, CLI_SIZE, &o.frames, "N", "scripted: draw N frames, then exit"},

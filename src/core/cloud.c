@@ -286,6 +286,7 @@ int asp_cloud_clone(const asp_cloud *src, asp_cloud **out, asp_error *err)
     if (src->uvs) memcpy(c->uvs, src->uvs, 2 * n * sizeof(float));
     if (src->labels) memcpy(c->labels, src->labels, n * sizeof(uint32_t));
     c->position_type = src->position_type;
+    c->up = src->up;
     c->color_type = src->color_type;
     for (size_t i = 0; i < src->property_count && rc == 0; i++) {
         asp_property *p;

@@ -7,6 +7,7 @@
  */
 #include <float.h>
 #include <math.h>
+#include <string.h>
 
 #include "amgsplat/cloud.h"
 #include "util/banned.h"
@@ -70,10 +71,35 @@ int asp_positions_frame(const float *positions, size_t count, const double origi
     if (!(r > 0))
         return asp_error_set(err, ASP_EDEGENERATE,
                              "cannot frame %zu points: they are all at the same position and have no radius", count);
-    for (int k = 0; k < 3; k++)
-        out->center[k] = origin[k] + c[k];
-    out->radius = r;
+    asp_frame f;
+    memset(&f, 0, sizeof f); // padding too: frames are compared bit for bit (memcmp) after a file round trip
+    f.radius = r;
+    for (int k = 0; k < 3; k++) {
+        f.center[k] = origin[k] + c[k];
+        f.half[k] = 0.5 * ((double)hi[k] - lo[k]) + radius; // the box a flat, wide set is framed by
+    }
+    // in the steps the files store, so a frame read back is the frame written, bit for bit
+    uint16_t q[3];
+    asp_frame_half_encode(&f, q);
+    asp_frame_half_decode(&f, q);
+    memcpy(out, &f, sizeof f);
     return 0;
+}
+
+void asp_frame_half_encode(const asp_frame *f, uint16_t q[3])
+{
+    for (int k = 0; k < 3; k++) {
+        // a side is at most the radius (no point is farther from the centre along an axis than in all);
+        // up to the next step, less a millionth of one so that a decoded side encodes to its own step
+        double t = f->radius > 0 ? ceil(f->half[k] / f->radius * 65535.0 - 1e-6) : 0.0;
+        q[k] = (uint16_t)(t > 0 ? (t < 65535.0 ? t : 65535.0) : 0.0); // NaN: 0, "not known"
+    }
+}
+
+void asp_frame_half_decode(asp_frame *f, const uint16_t q[3])
+{
+    for (int k = 0; k < 3; k++)
+        f->half[k] = f->radius * (double)q[k] / 65535.0;
 }
 
 int asp_cloud_frame(const asp_cloud *cloud, asp_frame *out, asp_error *err)
@@ -91,5 +117,8 @@ int asp_cloud_frame(const asp_cloud *cloud, asp_frame *out, asp_error *err)
     } else {
         max_r = asp_cloud_default_radius(cloud);
     }
-    return asp_positions_frame(cloud->positions, cloud->count, cloud->origin, max_r, out, err);
+    rc = asp_positions_frame(cloud->positions, cloud->count, cloud->origin, max_r, out, err);
+    if (!rc)
+        out->up = cloud->up;
+    return rc;
 }

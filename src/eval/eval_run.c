@@ -159,6 +159,7 @@ static uint64_t mesh_texels(const asp_mesh *m)
 static void view_camera(const struct eval_state *s, size_t v, asp_camera *cam)
 {
     asp_camera_init(cam);
+    cam->up = s->frame.up; // the source's up axis: a LAS scan stands upright as in render and view
     cam->azimuth = (float)(360.0 * (double)v / (double)s->views);
     cam->elevation = v % 2 ? -s->elevation : s->elevation;
     asp_camera_frame(cam, &s->frame, s->cloud->origin, 1.0f, 0.0f);

@@ -42,6 +42,7 @@ static int fps(asp_gl_context *gl, asp_renderer *r, const asp_frame *frame, cons
 {
     asp_camera cam;
     asp_camera_init(&cam);
+    cam.up = frame->up;
     cam.azimuth = 30;
     cam.elevation = 20;
     asp_camera_frame(&cam, frame, origin, 1.0f, 0.0f); // the one framing of render, view and eval

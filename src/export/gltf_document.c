@@ -349,6 +349,44 @@ void asp__gltf_require_extension(asp__gltf *g, const char *name)
         g->failed = 1;
 }
 
+void asp__gltf_turn_up(asp_up_axis up, const double in[3], double out[3])
+{
+    double x = in[0], y = in[1], z = in[2];
+    int neg = up >= ASP_UP_NEG_Y && up <= ASP_UP_NEG_X;
+    asp_up_axis axis = neg ? (asp_up_axis)(up - ASP_UP_NEG_Y) : up;
+    if (axis == ASP_UP_Z) { // -90 degrees about x: z -> y, y -> -z
+        out[0] = x;
+        out[1] = z;
+        out[2] = -y;
+    } else if (axis == ASP_UP_X) { // +90 degrees about z: x -> y, y -> -x
+        out[0] = -y;
+        out[1] = x;
+        out[2] = z;
+    } else {
+        out[0] = x;
+        out[1] = y;
+        out[2] = z;
+    }
+    if (neg) { // then 180 degrees about z: the negative axis, now at -y, to +y
+        out[0] = -out[0];
+        out[1] = -out[1];
+    }
+}
+
+void asp__gltf_turn_up_f(asp_up_axis up, float v[3])
+{
+    double d[3] = {v[0], v[1], v[2]};
+    asp__gltf_turn_up(up, d, d);
+    for (int k = 0; k < 3; k++)
+        v[k] = (float)d[k];
+}
+
+static const char *up_name(asp_up_axis up)
+{
+    static const char *const names[] = {"y", "z", "x", "-y", "-z", "-x"};
+    return (unsigned)up < 6 ? names[up] : "y";
+}
+
 cJSON *asp__gltf_extras(const char *kind, const char *source, const double origin[3], const asp_frame *frame)
 {
     cJSON *extras = cJSON_CreateObject();
@@ -364,11 +402,34 @@ cJSON *asp__gltf_extras(const char *kind, const char *source, const double origi
         // amgsplat render's camera (asp_camera_frame): this sphere, fov_y 40, y up, fitted to the nearer sides
         cJSON *f = cJSON_AddObjectToObject(a, "frame");
         if (f) {
-            cJSON_AddItemToObject(f, "center", asp__gltf_numbers(frame->center, 3));
+            double c[3];
+            asp__gltf_turn_up(frame->up, frame->center, c);
+            cJSON_AddItemToObject(f, "center", asp__gltf_numbers(c, 3));
             cJSON_AddNumberToObject(f, "radius", frame->radius);
+            if (frame->half[0] > 0 || frame->half[1] > 0 || frame->half[2] > 0) {
+                // the box of a flat, wide set (asp_camera_frame fits it), its sides along glTF's axes
+                double h[3];
+                asp__gltf_turn_up(frame->up, frame->half, h);
+                for (int k = 0; k < 3; k++)
+                    h[k] = fabs(h[k]);
+                cJSON_AddItemToObject(f, "half", asp__gltf_numbers(h, 3));
+            }
         }
         cJSON_AddNumberToObject(a, "fovY", 40);
     }
+    // the source's up axis, and the matrix (column-major, glTF's) from these coordinates back to its
+    // own: where the source has a CRS (asset.extras.amgsplat.crs), toSource x gives its coordinates
+    asp_up_axis up = frame ? frame->up : ASP_UP_Y;
+    cJSON_AddStringToObject(a, "sourceUp", up_name(up));
+    double m[16] = {0};
+    for (int c = 0; c < 3; c++) {
+        double e[3] = {c == 0, c == 1, c == 2}, t[3];
+        asp__gltf_turn_up(up, e, t); // column c of the turn; the inverse of a rotation is its transpose
+        for (int r = 0; r < 3; r++)
+            m[4 * r + c] = t[r];
+    }
+    m[15] = 1;
+    cJSON_AddItemToObject(a, "toSource", asp__gltf_numbers(m, 16));
     return extras;
 }
 

@@ -76,9 +76,13 @@ typedef struct point_arrays {
     float lo[3], hi[3];
 } point_arrays;
 
-/* ids: n indices into asp_hier_splats (a tile's cut), or NULL: every point, in input order */
+/*
+ * The splats ids (n indices into asp_hier_splats, a tile's cut), or with ids NULL every point in input
+ * order, turned from the source's up axis to glTF's +y (asp__gltf_turn_up).
+ */
 static void fill_points(const asp_hier *hier, const asp_index *ids, size_t n, point_arrays *a, int splats)
 {
+    const asp_up_axis up = asp_hier_frame(hier)->up;
     const asp_hier_splat *all = asp_hier_splats(hier);
     size_t nodes = asp_hier_node_count(hier);
     int colored = (asp_hier_flags(hier) & ASP_HIER_HAS_COLORS) != 0;
@@ -91,13 +95,22 @@ static void fill_points(const asp_hier *hier, const asp_index *ids, size_t n, po
     for (size_t j = 0; j < n; j++) {
         const asp_hier_splat *s = ids ? &all[ids[j]] : &all[nodes + j];
         size_t i = ids ? j : s->index < n ? s->index : j; // input order
-        float nl = sqrtf(s->normal[0] * s->normal[0] + s->normal[1] * s->normal[1] + s->normal[2] * s->normal[2]);
+        float c[3], nm[3], u[3], v[3];
+        memcpy(c, s->center, sizeof c);
+        memcpy(nm, s->normal, sizeof nm);
+        memcpy(u, s->u, sizeof u);
+        memcpy(v, s->v, sizeof v);
+        asp__gltf_turn_up_f(up, c);
+        asp__gltf_turn_up_f(up, nm);
+        asp__gltf_turn_up_f(up, u);
+        asp__gltf_turn_up_f(up, v);
+        float nl = sqrtf(nm[0] * nm[0] + nm[1] * nm[1] + nm[2] * nm[2]);
         for (int k = 0; k < 3; k++) {
-            a->pos[3 * i + k] = s->center[k];
-            a->lo[k] = fminf(a->lo[k], s->center[k]);
-            a->hi[k] = fmaxf(a->hi[k], s->center[k]);
+            a->pos[3 * i + k] = c[k];
+            a->lo[k] = fminf(a->lo[k], c[k]);
+            a->hi[k] = fmaxf(a->hi[k], c[k]);
             // glTF requires unit normals; a point without one faces +z
-            a->nrm[3 * i + k] = nl > 0 ? s->normal[k] / nl : (k == 2 ? 1.0f : 0.0f);
+            a->nrm[3 * i + k] = nl > 0 ? nm[k] / nl : (k == 2 ? 1.0f : 0.0f);
         }
         // the renderers' light grey 200 for a set without colours (docs/cli/render.md)
         uint8_t rgba[4] = {200, 200, 200, 255};
@@ -109,7 +122,7 @@ static void fill_points(const asp_hier *hier, const asp_index *ids, size_t n, po
         if (!splats)
             continue;
         float ax = s->a > 0 ? s->a : (float)tiny, bx = s->a > 0 ? s->b : (float)tiny;
-        asp_gltf_gaussian_from_ellipse(s->u, s->v, ax, bx, a->rot + 4 * i, a->scale + 3 * i);
+        asp_gltf_gaussian_from_ellipse(u, v, ax, bx, a->rot + 4 * i, a->scale + 3 * i);
         a->opacity[i] = rgba[3] / 255.0f;
         for (int k = 0; k < 3; k++) // colour = SH0 * Y00 + 0.5 (srgb_rec709_display: the stored sRGB values)
             a->sh0[3 * i + k] = (float)((rgba[k] / 255.0 - 0.5) / 0.2820947917738781);
@@ -277,20 +290,31 @@ done:
     return mesh;
 }
 
-int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n, const double origin[3],
+int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n, const double origin[3], cJSON *crs,
                            const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats, asp_error *err)
 {
     static const asp_gltf_desc zero;
     const asp_gltf_desc *d = desc ? desc : &zero;
     int splats = !(d->flags & ASP_GLTF_NO_SPLATS);
-    if (n == 0)
+    if (n == 0) {
+        cJSON_Delete(crs);
         return asp_error_set(err, ASP_EDEGENERATE, "no points to export");
+    }
     asp_gltf_stats st = {0};
-    memcpy(st.origin, origin, sizeof st.origin);
+    asp__gltf_turn_up(asp_hier_frame(hier)->up, origin, st.origin); // the node translation, y-up
     asp__gltf g;
     int rc = asp__gltf_init(&g, path, splats ? "(points, KHR_gaussian_splatting)" : "(points)", NULL, err);
-    if (rc)
+    if (rc) {
+        cJSON_Delete(crs);
         return rc;
+    }
+    if (crs) { // glTF has no CRS: the source's words, for a GIS that reads the file (asp__gltf_crs)
+        cJSON *asset = cJSON_GetObjectItem(g.root, "asset");
+        cJSON *ex = asset ? cJSON_AddObjectToObject(asset, "extras") : NULL;
+        cJSON *am = ex ? cJSON_AddObjectToObject(ex, "amgsplat") : NULL;
+        if (!am || !cJSON_AddItemToObject(am, "crs", crs))
+            cJSON_Delete(crs);
+    }
     point_arrays a = {0};
     a.pos = asp_alloc(NULL, n * 12);
     a.nrm = asp_alloc(NULL, n * 12);
@@ -349,7 +373,7 @@ int asp_gltf_export_hier(const asp_hier *hier, const char *path, const asp_gltf_
     ASP_ASSERT(hier && path);
     double origin[3];
     asp_hier_origin(hier, origin);
-    return asp__gltf_points_write(hier, NULL, asp_hier_point_count(hier), origin, path, desc, stats, err);
+    return asp__gltf_points_write(hier, NULL, asp_hier_point_count(hier), origin, NULL, path, desc, stats, err);
 }
 
 int asp_gltf_export_cloud(const asp_cloud *cloud, const char *path, const asp_gltf_desc *desc,
@@ -358,8 +382,12 @@ int asp_gltf_export_cloud(const asp_cloud *cloud, const char *path, const asp_gl
     ASP_ASSERT(cloud && path);
     asp_hier *hier = NULL;
     int rc = asp_hier_build(cloud, NULL, ctx, &hier, err);
-    if (!rc)
-        rc = asp_gltf_export_hier(hier, path, desc, stats, err);
+    if (!rc) {
+        double origin[3];
+        asp_hier_origin(hier, origin);
+        rc = asp__gltf_points_write(hier, NULL, asp_hier_point_count(hier), origin, asp__gltf_crs(cloud->las), path,
+                                    desc, stats, err);
+    }
     asp_hier_destroy(hier);
     return rc;
 }

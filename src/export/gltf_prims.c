@@ -19,7 +19,8 @@ typedef struct level_arrays {
     float lo[3], hi[3];
 } level_arrays;
 
-static void fill_level(const asp_dps_level *lv, const double origin[3], level_arrays *a, int wide)
+/* origin: the source's coordinates; up: its up axis, turned to glTF's +y (asp__gltf_turn_up). */
+static void fill_level(const asp_dps_level *lv, const double origin[3], asp_up_axis up, level_arrays *a, int wide)
 {
     // triangle-strip corner order of the renderer (prim_shaders.c): counter-clockwise seen from the normal
     static const float corner[4][2] = {{-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
@@ -31,15 +32,19 @@ static void fill_level(const asp_dps_level *lv, const double origin[3], level_ar
         const asp_prim *p = &lv->prims[i];
         for (int c = 0; c < 4; c++) {
             size_t v = 4 * i + (size_t)c;
-            double su = corner[c][0] * (double)p->half_u, sv = corner[c][1] * (double)p->half_v;
+            double su = corner[c][0] * (double)p->half_u, sv = corner[c][1] * (double)p->half_v, x[3], n[3], t[3];
+            // in double until the offset from origin is taken: centres are world coordinates
+            for (int k = 0; k < 3; k++)
+                x[k] = p->centre[k] - origin[k] + su * p->axis_u[k] + sv * p->axis_v[k];
+            asp__gltf_turn_up(up, x, x);
+            asp__gltf_turn_up(up, (const double[3]){p->normal[0], p->normal[1], p->normal[2]}, n);
+            asp__gltf_turn_up(up, (const double[3]){p->axis_u[0], p->axis_u[1], p->axis_u[2]}, t);
             for (int k = 0; k < 3; k++) {
-                // in double until the offset from origin is taken: centres are world coordinates
-                float x = (float)(p->centre[k] - origin[k] + su * p->axis_u[k] + sv * p->axis_v[k]);
-                a->pos[3 * v + k] = x;
-                a->lo[k] = fminf(a->lo[k], x);
-                a->hi[k] = fmaxf(a->hi[k], x);
-                a->nrm[3 * v + k] = p->normal[k];
-                a->tan[4 * v + k] = p->axis_u[k];
+                a->pos[3 * v + k] = (float)x[k];
+                a->lo[k] = fminf(a->lo[k], (float)x[k]);
+                a->hi[k] = fmaxf(a->hi[k], (float)x[k]);
+                a->nrm[3 * v + k] = (float)n[k];
+                a->tan[4 * v + k] = (float)t[k]; // the tangent-space normal map is unchanged by the turn
             }
             // w = +1: bitangent = normal x axis_u = axis_v, the direction of increasing v (rows)
             a->tan[4 * v + 3] = 1.0f;
@@ -171,6 +176,7 @@ static double mean_radius(const asp_dps_level *lv)
     return s / (double)lv->prim_count;
 }
 
+/* origin: the source's coordinates (the node's translation is it turned to y-up). */
 static int export_level(asp__gltf *g, const asp_dps *dps, size_t index, const double origin[3],
                         const asp_gltf_desc *d, float cutoff, asp_gltf_stats *st, asp_error *err)
 {
@@ -199,7 +205,7 @@ static int export_level(asp__gltf *g, const asp_dps *dps, size_t index, const do
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the %zu quads of level %s", n, lname);
         goto done;
     }
-    fill_level(lv, origin, &a, wide);
+    fill_level(lv, origin, dps->frame.up, &a, wide);
     int ipos = asp__gltf_accessor(g, asp__gltf_view(g, a.pos, nv * 12, ASP__GL_ARRAY_BUFFER), ASP__GL_FLOAT, nv,
                                   "VEC3", 0, a.lo, a.hi);
     int inrm = asp__gltf_accessor(g, asp__gltf_view(g, a.nrm, nv * 12, ASP__GL_ARRAY_BUFFER), ASP__GL_FLOAT, nv,
@@ -240,7 +246,9 @@ static int export_level(asp__gltf *g, const asp_dps *dps, size_t index, const do
     if (node) {
         cJSON_AddStringToObject(node, "name", name);
         cJSON_AddNumberToObject(node, "mesh", imesh);
-        cJSON_AddItemToObject(node, "translation", asp__gltf_numbers(origin, 3));
+        double t[3];
+        asp__gltf_turn_up(dps->frame.up, origin, t);
+        cJSON_AddItemToObject(node, "translation", asp__gltf_numbers(t, 3));
         cJSON *ex = cJSON_AddObjectToObject(node, "extras");
         cJSON *am = cJSON_AddObjectToObject(ex, "amgsplat");
         cJSON_AddStringToObject(am, "level", lname);
@@ -315,11 +323,13 @@ int asp_gltf_export_dps(const asp_dps *dps, const char *path, const asp_gltf_des
         }
     }
     asp_gltf_stats st = {0};
-    prim_origin(dps, levels, count, st.origin);
+    double origin[3]; // the source's coordinates; st.origin is it turned to glTF's y-up
+    prim_origin(dps, levels, count, origin);
+    asp__gltf_turn_up(dps->frame.up, origin, st.origin);
     asp__gltf g;
     int rc = asp__gltf_init(&g, path, "(domain primitives)", &dps->ctx, err);
     for (size_t i = 0; !rc && i < count; i++)
-        rc = export_level(&g, dps, levels[i], st.origin, d, cutoff, &st, err);
+        rc = export_level(&g, dps, levels[i], origin, d, cutoff, &st, err);
     if (!rc) {
         // one scene per level, named by it: plain viewers show one level, not all of them on top of each other
         cJSON *scenes = cJSON_AddArrayToObject(g.root, "scenes");

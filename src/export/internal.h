@@ -80,17 +80,41 @@ cJSON *asp__gltf_numbers(const double *v, int n);
 /* Writes the document and its files atomically; fills stats' byte and file counts. */
 int asp__gltf_write(asp__gltf *g, const char *path, asp_gltf_stats *stats, asp_error *err);
 
-/* The scene extras both exports write (origin, frame, kind) for viewers that frame like amgsplat. */
+/*
+ * glTF is y-up (spec 3.4: "+Y is up"): out = in turned by the proper rotation that takes the
+ * source's up axis to +y (identity for ASP_UP_Y); in and out may alias. The inverse of the turn
+ * asp_camera gives its y-up orbit (camera.c orbit_axes), so a glTF viewer's front view (from +z)
+ * is amgsplat render's azimuth 0. A signed permutation: exact in float and double.
+ */
+void asp__gltf_turn_up(asp_up_axis up, const double in[3], double out[3]);
+/* The same on a float vector in place. */
+void asp__gltf_turn_up_f(asp_up_axis up, float v[3]);
+
+/*
+ * The scene extras both exports write for viewers that frame like amgsplat: kind, source, origin
+ * (glTF coordinates: already turned), the frame (the source's coordinates, turned here by
+ * frame->up), and the source's up axis with the matrix back to its coordinates.
+ */
 cJSON *asp__gltf_extras(const char *kind, const char *source, const double origin[3], const asp_frame *frame);
 
 /*
  * The points export (asp_gltf_export_hier) of n splats of hier: ids are indices into
  * asp_hier_splats (node and point splats, e.g. a tile's cut, tiles.c), or NULL for every point in
  * input order (n = the point count). Positions are relative to origin, which the node translation
- * adds back (tiles pass 0: their tileset.json transform holds the world offset). Errors as
+ * adds back (tiles pass 0: their tileset.json transform holds the world offset); origin and the
+ * splats are turned from the source's up axis to glTF's +y. crs: the source's CRS (asp__gltf_crs)
+ * for asset.extras, or NULL; taken over. Errors as
  * asp_gltf_export_hier.
  */
-int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n, const double origin[3],
+int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n, const double origin[3], cJSON *crs,
                            const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats, asp_error *err);
+
+/*
+ * The coordinate reference system a LAS file names (ASPRS LAS 1.4 2.5: the LASF_Projection VLRs,
+ * OGC WKT record 2112, GeoTIFF GeoKeyDirectory 34735 with its 34736 doubles and 34737 ASCII
+ * params) as a JSON object {"wkt": ..., "epsg": ..., "geoKeys": [...], ...}, or NULL when it
+ * names none (or las is NULL).
+ */
+cJSON *asp__gltf_crs(const asp_las_meta *las);
 
 #endif

@@ -49,6 +49,7 @@ typedef struct tiles_run {
     asp_tiles_stats st;
     asp_error *err; /* the caller's, or local when the caller passed NULL: its code is the result */
     asp_error local;
+    asp_up_axis up; /* the source's, turned to the GLBs' +y */
 } tiles_run;
 
 /*
@@ -88,16 +89,22 @@ static size_t cut(const tiles_run *t, asp_index root, uint32_t c, asp_index *ids
 }
 
 /*
- * Grows box (lo xyz, hi xyz) by the ellipse of splat s, center + a cos(t) u + b sin(t) v: its
+ * Grows box (lo xyz, hi xyz, in the GLBs' y-up frame) by the ellipse of splat s, center + a cos(t)
+ * u + b sin(t) v turned from the source's up axis as the GLB turns it (asp__gltf_turn_up): its
  * extent along axis k is sqrt((a u_k)^2 + (b v_k)^2), so a flat patch gets a flat box.
  */
-static void box_add(double box[6], const asp_hier_splat *s)
+static void box_add(double box[6], const asp_hier_splat *s, asp_up_axis up)
 {
     double a = s->a > 0 ? s->a : 0, b = s->b > 0 ? s->b : 0;
+    float c[3] = {s->center[0], s->center[1], s->center[2]}, u[3] = {s->u[0], s->u[1], s->u[2]},
+          v[3] = {s->v[0], s->v[1], s->v[2]};
+    asp__gltf_turn_up_f(up, c);
+    asp__gltf_turn_up_f(up, u);
+    asp__gltf_turn_up_f(up, v);
     for (int k = 0; k < 3; k++) {
-        double r = sqrt(a * a * s->u[k] * s->u[k] + b * b * s->v[k] * s->v[k]);
-        box[k] = fmin(box[k], (double)s->center[k] - r);
-        box[3 + k] = fmax(box[3 + k], (double)s->center[k] + r);
+        double r = sqrt(a * a * u[k] * u[k] + b * b * v[k] * v[k]);
+        box[k] = fmin(box[k], (double)c[k] - r);
+        box[3 + k] = fmax(box[3 + k], (double)c[k] + r);
     }
 }
 
@@ -161,17 +168,17 @@ static cJSON *write_tile(tiles_run *t, asp_index id, uint32_t min_c, double max_
     }
     static const double zero[3] = {0, 0, 0};
     asp_gltf_stats gs = {0};
-    int rc = asp__gltf_points_write(t->hier, ids, n, zero, path, &t->desc->gltf, &gs, t->err);
+    int rc = asp__gltf_points_write(t->hier, ids, n, zero, NULL, path, &t->desc->gltf, &gs, t->err);
     for (int k = 0; k < 3; k++) {
         box[k] = INFINITY;
         box[3 + k] = -INFINITY;
     }
     // the subtree's points (contiguous in hierarchy order) and the content's node splats
     for (uint32_t j = 0; j < nd->point_count; j++)
-        box_add(box, &t->splats[t->node_count + nd->first_point + j]);
+        box_add(box, &t->splats[t->node_count + nd->first_point + j], t->up);
     for (size_t i = 0; i < n; i++)
         if (ids[i] < t->node_count)
-            box_add(box, &t->splats[ids[i]]);
+            box_add(box, &t->splats[ids[i]], t->up);
     asp_free(NULL, ids);
     if (rc)
         return NULL;
@@ -218,6 +225,7 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
     if (d->gltf.levels || d->gltf.level_count)
         return asp_error_set(err, ASP_EINVAL, "tiles of a hierarchy take no levels");
     tiles_run t = {.hier = hier,
+                   .up = asp_hier_frame(hier)->up,
                    .nodes = asp_hier_nodes(hier),
                    .splats = asp_hier_splats(hier),
                    .node_count = asp_hier_node_count(hier),
@@ -240,6 +248,9 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
     double origin[3];
     asp_hier_origin(hier, origin);
     const asp_frame *frame = asp_hier_frame(hier);
+    // the origin in the GLBs' y-up frame, as their content is (a z-up scan turns to y-up there, and
+    // 3D Tiles turns it back to z-up below)
+    asp__gltf_turn_up(frame->up, origin, origin);
     cJSON_AddStringToObject(root_tile, "refine", "REPLACE");
     if (origin[0] != 0 || origin[1] != 0 || origin[2] != 0) {
         double m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, origin[0], -origin[2], origin[1], 1};

@@ -34,7 +34,7 @@ static asp_frame level_frame(const asp_dps *dps, const asp_dps_level *lv)
     for (size_t i = 0; i < lv->prim_count; i++)
         for (int a = 0; a < 3; a++)
             lo[a] = fmin(lo[a], lv->prims[i].centre[a]), hi[a] = fmax(hi[a], lv->prims[i].centre[a]);
-    asp_frame f = {{0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])}, 0};
+    asp_frame f = {.center = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])}};
     for (size_t i = 0; i < lv->prim_count; i++) {
         const asp_prim *p = &lv->prims[i];
         double d2 = 0;

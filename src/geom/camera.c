@@ -147,6 +147,30 @@ int asp_camera_project(const asp_camera *cam, const float p[3], uint32_t width, 
     return 1;
 }
 
+/*
+ * The eye distance at which the box centre +- half (world axes) fills the view as the camera
+ * looks now: each corner, at view coordinates (x, y) and z towards the eye, lies d - z in front
+ * of it and inside the frustum when |x| <= (d - z) tan(half fov x), likewise y. The largest such
+ * d over the 8 corners is the tightest fit (the box is drawn from its centre, as the sphere is).
+ */
+static double box_fit_distance(const asp_camera *cam, const double half[3])
+{
+    double back[3], up[3];
+    orbit_axes(cam, back, up);
+    double right[3] = {up[1] * back[2] - up[2] * back[1], up[2] * back[0] - up[0] * back[2],
+                       up[0] * back[1] - up[1] * back[0]};
+    double ty = tan(0.5 * cam->fov_y * deg), tx = ty * (cam->aspect > 0 ? cam->aspect : 1.0);
+    double d = 0;
+    for (int i = 0; i < 8; i++) {
+        double c[3] = {i & 1 ? half[0] : -half[0], i & 2 ? half[1] : -half[1], i & 4 ? half[2] : -half[2]};
+        double x = c[0] * right[0] + c[1] * right[1] + c[2] * right[2];
+        double y = c[0] * up[0] + c[1] * up[1] + c[2] * up[2];
+        double z = c[0] * back[0] + c[1] * back[1] + c[2] * back[2];
+        d = fmax(d, fmax(z + fabs(x) / tx, z + fabs(y) / ty));
+    }
+    return d;
+}
+
 void asp_camera_frame(asp_camera *cam, const asp_frame *frame, const double origin[3], float aspect,
                       float distance_radii)
 {
@@ -158,6 +182,25 @@ void asp_camera_frame(asp_camera *cam, const asp_frame *frame, const double orig
     if (distance_radii > 0) {
         cam->distance = distance_radii * r;
         asp_camera_clip_to_sphere(cam, c, r);
+        return;
+    }
+    /*
+     * A flat, wide set (its side along the shown up axis at most a third of its longest other side:
+     * a site, a terrain, a floor) fills a small part of its bounding sphere's view (issue 29: a
+     * 60 x 40 m site filled a third of the image), so the camera comes as close as its box allows;
+     * compact models and upright ones (a wall seen head on) keep the sphere fit, and the nearer of
+     * the two is taken, so nothing the sphere fit showed is cut.
+     */
+    const double *h = frame->half;
+    asp_up_axis axis = cam->up >= ASP_UP_NEG_Y && cam->up <= ASP_UP_NEG_X ? cam->up - ASP_UP_NEG_Y : cam->up;
+    int u = axis == ASP_UP_Z ? 2 : axis == ASP_UP_X ? 0 : 1; // the index of the up axis in xyz
+    double wide = fmax(h[(u + 1) % 3], h[(u + 2) % 3]);
+    if (wide > 0 && 3.0 * h[u] <= wide && isfinite(wide + h[u])) {
+        double d = box_fit_distance(cam, h);
+        if (d > 0 && d < cam->distance) {
+            cam->distance = (float)d;
+            asp_camera_clip_to_sphere(cam, c, r);
+        }
     }
 }
 

@@ -25,7 +25,7 @@
  * checksum moves to byte 152. Version 1 (128-byte header) still loads, framed
  * by the root bounding sphere.
  */
-enum { VERSION = 2, HEADER_SIZE = 160, HEADER_V1 = 128, FRAME_AT = 96, NODE_REC = 48, SPLAT_REC = 64,
+enum { VERSION = 2, HEADER_SIZE = 160, HEADER_V1 = 128, FRAME_AT = 96, UP_AT = 128, NODE_REC = 48, SPLAT_REC = 64,
        COV_REC = 8 * ASP_HIER_COV };
 enum { CHUNK = 1 << 16 };
 
@@ -121,7 +121,14 @@ static void encode_header(const asp_hier *h, uint64_t payload, uint64_t payload_
     for (int i = 0; i < 3; i++)
         putf64(hd + FRAME_AT + 8 * i, h->frame.center[i]);
     putf64(hd + FRAME_AT + 24, h->frame.radius);
-    /* bytes 128-151 are reserved (zero); the header checksum covers everything before it */
+    /* issue 29, in bytes that were reserved (zero, "not recorded"): the source's up axis + 1, and the
+       frame's box half sides (asp_frame_half_encode: the camera fits flat, wide sets by them) */
+    put32(hd + UP_AT, (uint32_t)h->frame.up + 1u);
+    uint16_t q[3];
+    asp_frame_half_encode(&h->frame, q);
+    put32(hd + UP_AT + 4, (uint32_t)q[0] | (uint32_t)q[1] << 16);
+    put32(hd + UP_AT + 8, q[2]);
+    /* bytes 140-151 are reserved (zero); the header checksum covers everything before it */
     put64(hd + HEADER_SIZE - 8, asp__fnv1a64(ASP__FNV1A64_START, hd, HEADER_SIZE - 8));
 }
 
@@ -357,7 +364,8 @@ static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
         return asp_error_set(r->err, ASP_EFORMAT, "cannot read '%s': file has %zu bytes, header says %llu%s", r->path,
                              r->size, (unsigned long long)(hsize + payload),
                              r->size - hsize < payload ? " (truncated)" : " (trailing bytes)");
-    asp_frame frame = {{0, 0, 0}, 0};
+    asp_frame frame;
+    memset(&frame, 0, sizeof frame); // padding too: frames are compared bit for bit
     if (version >= 2) {
         r->at = FRAME_AT;
         for (int i = 0; i < 3; i++)
@@ -370,6 +378,17 @@ static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
                      frame.center[0], frame.center[1], frame.center[2], frame.radius);
             return asp__byte_bad(r, msg);
         }
+        r->at = UP_AT;
+        const uint32_t up = asp__get_u32(r), q01 = asp__get_u32(r), q2 = asp__get_u32(r);
+        if (up > (uint32_t)ASP_UP_NEG_X + 1u || q2 > 0xffffu) {
+            r->at = UP_AT;
+            snprintf(msg, sizeof msg, "frame: up axis code %u, box side code %u, expected 0..%u and 0..65535", up,
+                     q2, (unsigned)ASP_UP_NEG_X + 1u);
+            return asp__byte_bad(r, msg);
+        }
+        frame.up = up ? (asp_up_axis)(up - 1u) : ASP_UP_Y; // 0: written before it was recorded
+        asp_frame_half_decode(&frame, (const uint16_t[3]){(uint16_t)(q01 & 0xffffu), (uint16_t)(q01 >> 16),
+                                                          (uint16_t)q2});
     }
     /* the whole payload is hashed before anything large is allocated */
     if (asp__fnv1a64(ASP__FNV1A64_START, r->buf + hsize, (size_t)payload) != payload_hash)
@@ -392,7 +411,7 @@ static int load(asp__byte_reader *r, const asp_context *ctx, asp_hier **out)
         return rc;
     }
     if (version >= 2) {
-        h->frame = frame;
+        memcpy(&h->frame, &frame, sizeof frame);
     } else { // version 1 predates the recorded frame: the root bounding sphere is close to it
         for (int i = 0; i < 3; i++)
             h->frame.center[i] = h->origin[i] + h->nodes[0].sphere[i];

@@ -1001,7 +1001,8 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
     if (!rc)
         rc = pass_bounds(&b, xyz, lo, hi);
     st.seconds_bounds = asp_time_now() - t0;
-    asp_frame frame = {{0, 0, 0}, 0};
+    asp_frame frame;
+    memset(&frame, 0, sizeof frame); // up y, no box: the streamed layout records neither (NEEDSWORK)
     double full_radius = 0;
     if (!rc) {
         double ext = 0;

@@ -618,6 +618,7 @@ static int read_las(reader *r, asp_cloud **out)
         if (c->colors)
             fill_colors(c);
         c->position_type = ASP_SCALAR_FLOAT64;
+        c->up = ASP_UP_Z; // ASPRS LAS 1.4 (2.6 point records): Z is the elevation of the file's CRS
         c->las = meta;
         meta = NULL;
         *out = c;

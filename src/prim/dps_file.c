@@ -99,7 +99,7 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
     asp__put_u32(&w, dps->amg_levels);
     asp__put_u32(&w, normals ? 1u : 0u);
     asp__put_u32(&w, dps->skipped_levels);
-    asp__put_u32(&w, 0);
+    asp__put_u32(&w, (uint32_t)dps->frame.up + 1u); // issue 29: the source's up axis + 1 (0 before: not recorded)
     for (int k = 0; k < 3; k++)
         asp__put_f64(&w, dps->frame.center[k]);
     asp__put_f64(&w, dps->frame.radius);
@@ -122,7 +122,9 @@ int asp_dps_save(const asp_dps *dps, const char *path, asp_error *err)
     const uint32_t v3[4] = {(uint32_t)d->normalise_color, (uint32_t)d->no_model_colors, (uint32_t)d->strict, 0};
     for (int k = 0; k < 4; k++)
         asp__put_u32(&w, v3[k]);
-    asp__put_u64(&w, 0);
+    uint16_t half[3]; // issue 29: the frame's box (asp_frame_half_encode) in the spare u64; 0 before
+    asp_frame_half_encode(&dps->frame, half);
+    asp__put_u64(&w, (uint64_t)half[0] | (uint64_t)half[1] << 16 | (uint64_t)half[2] << 32);
     asp__put_u32(&w, (uint32_t)slen);
     asp__crc_put(&w, dps->source, slen);
     for (size_t i = 0; i < dps->level_count; i++) {
@@ -457,6 +459,11 @@ static int read_params(asp__byte_reader *r, asp_dps *dps, uint32_t version)
         }
         d->normalise_color = (int)nc, d->no_model_colors = (int)nm, d->strict = (int)st;
         r->at += DPS_PARAMS - 88 - 28;
+        // issue 29: the frame's box sides in the last 8 bytes (0: written before them, "not known")
+        uint64_t q = 0;
+        for (int b = 0; b < 8; b++)
+            q |= (uint64_t)r->buf[r->at - 8 + b] << 8 * b;
+        asp_frame_half_decode(&dps->frame, (const uint16_t[3]){(uint16_t)q, (uint16_t)(q >> 16), (uint16_t)(q >> 32)});
     } else {
         r->at += DPS_PARAMS - 88;
     }
@@ -501,7 +508,13 @@ static int parse(asp__byte_reader *r, const asp_context *ctx, asp_dps *dps)
     dps->amg_levels = asp__get_u32(r);
     (void)asp__get_u32(r);
     dps->skipped_levels = asp__get_u32(r);
-    (void)asp__get_u32(r);
+    const uint32_t up = asp__get_u32(r); // the up axis + 1; 0: written before it was recorded (issue 29)
+    if (up > (uint32_t)ASP_UP_NEG_X + 1u) {
+        r->at -= 4;
+        snprintf(msg, sizeof msg, "up axis code %u, expected 0 (not recorded) or 1..%u", up, (unsigned)ASP_UP_NEG_X + 1u);
+        return asp__byte_bad(r, msg);
+    }
+    dps->frame.up = up ? (asp_up_axis)(up - 1u) : ASP_UP_Y;
     const size_t frame_at = r->at;
     if (version >= 2) {
         for (int k = 0; k < 3; k++)

@@ -194,7 +194,7 @@ static void reset_view(viewer *v)
     const asp_viewer_desc *d = v->desc;
     float aspect = v->cam.aspect > 0 ? v->cam.aspect : 1.0f;
     asp_camera_init(&v->cam);
-    v->cam.up = d->up;
+    v->cam.up = d->set_up ? d->up : v->scene.frame.up; // the file's own (asp_frame.up: z for a LAS scan)
     v->cam.azimuth = d->set_view ? d->azimuth : 30.0f;
     v->cam.elevation = d->set_view ? d->elevation : 20.0f;
     // the one framing of amgsplat render, so a scripted view matches its --view

@@ -4,7 +4,10 @@ VLR Table 4, point formats Tables 7-17, Extra Bytes Table 24), independent of
 amgsplat's writer, and prints what it holds as JSON: the true world coordinate
 of every point (from the integers), the 16-bit colours and the other fields.
 
-usage: las_handmade.py OUT.las VERSION_MINOR FORMAT [N] [--extra]
+usage: las_handmade.py OUT.las VERSION_MINOR FORMAT [N] [--extra] [--crs]
+
+--crs adds the CRS VLRs of LAS 1.4 2.5 (user LASF_Projection): an OGC WKT (record 2112) and
+GeoTIFF keys (34735) naming EPSG:32633 (WGS 84 / UTM zone 33N) and vertical EPSG:5703.
 """
 import json
 import math
@@ -62,13 +65,27 @@ def extra_bytes_vlr():
     return struct.pack('<H16sHH32s', 0, b'LASF_Spec', 4, 192, b'Extra Bytes') + bytes(d)
 
 
+WKT = ('PROJCS["WGS 84 / UTM zone 33N",GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,'
+       '298.257223563]],PRIMEM["Greenwich",0],UNIT["degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],'
+       'PARAMETER["central_meridian",15],PARAMETER["scale_factor",0.9996],PARAMETER["false_easting",500000],'
+       'UNIT["metre",1],AUTHORITY["EPSG","32633"]]')
+
+
+def crs_vlrs():
+    wkt = WKT.encode() + b'\0'
+    keys = struct.pack('<16H', 1, 1, 0, 3, 1024, 0, 1, 1, 3072, 0, 1, 32633, 4096, 0, 1, 5703)
+    return (struct.pack('<H16sHH32s', 0, b'LASF_Projection', 2112, len(wkt), b'OGC WKT') + wkt +
+            struct.pack('<H16sHH32s', 0, b'LASF_Projection', 34735, len(keys), b'GeoKeyDirectoryTag') + keys)
+
+
 def main():
     path, minor, fmt = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
     n = int(sys.argv[4]) if len(sys.argv) > 4 and not sys.argv[4].startswith('--') else 1000
     extra = '--extra' in sys.argv
+    crs = '--crs' in sys.argv
     pts = points(n)
     header_size = {2: 227, 3: 235, 4: 375}[minor]
-    vlrs = extra_bytes_vlr() if extra else b''
+    vlrs = (extra_bytes_vlr() if extra else b'') + (crs_vlrs() if crs else b'')
     reclen = FORMAT_SIZE[fmt] + (4 if extra else 0)
     body = b''.join(record(fmt, p, extra) for p in pts)
     world = [[OFFSET[k] + SCALE[k] * p['XYZ'[k]] for k in range(3)] for p in pts]
@@ -79,7 +96,7 @@ def main():
     h = bytearray(header_size)
     struct.pack_into('<4sHH16sBB32s32sHHHIIBHI', h, 0, b'LASF', 7, 0, bytes(range(16)), 1, minor,
                      b'hand-built', b'las_handmade.py', 200, 2024, header_size, header_size + len(vlrs),
-                     1 if extra else 0, fmt, reclen, n if legacy else 0)
+                     (1 if extra else 0) + (2 if crs else 0), fmt, reclen, n if legacy else 0)
     struct.pack_into('<5I', h, 111, *[c if legacy else 0 for c in by_return[:5]])
     struct.pack_into('<3d3d6d', h, 131, *SCALE, *OFFSET, hi[0], lo[0], hi[1], lo[1], hi[2], lo[2])
     if minor >= 4:

@@ -161,7 +161,7 @@ static void make_dps(asp_dps *d, asp_dps_level *lv, asp_prim p[2], uint8_t atlas
     d->level_count = 1;
     d->levels = lv;
     d->amg_levels = 5;
-    d->frame = (asp_frame){{500000.625, 5000000.25, 312.5}, 1.5};
+    d->frame = (asp_frame){.center = {500000.625, 5000000.25, 312.5}, .radius = 1.5};
     d->desc.padding = 2;
 }
 

@@ -107,7 +107,7 @@ static void test_raster_matches_gl(void)
         CHECK_OK(asp_renderer_kind_find("prim", 0, &kind, &err), &err);
     if (kind)
         CHECK_OK(kind->create(gl, &src, &o, NULL, &r, &err), &err);
-    asp_frame frame = {{0, 0, 0}, 1.05};
+    asp_frame frame = {.radius = 1.05};
     for (int v = 0; v < 4 && r; v++) {
         asp_camera cam;
         asp_camera_init(&cam);

@@ -29,7 +29,7 @@ static asp_dps *wrap(asp_dps_level *lv)
     d->mean_radius = 0.01;
     d->desc = (asp_prim_desc){.tau = 0.05, .texel_size = 1};
     snprintf(d->source, sizeof d->source, "octahedron");
-    d->frame = (asp_frame){{0, 0, 0}, 1.05};
+    d->frame = (asp_frame){.radius = 1.05};
     return d;
 }
 
@@ -183,7 +183,7 @@ static void test_render_matches(void)
         CHECK_OK(kind->create(gl, &sa, NULL, NULL, &ra, &err), &err);
         CHECK_OK(kind->create(gl, &sb, NULL, NULL, &rb, &err), &err);
     }
-    asp_frame frame = {{0, 0, 0}, 1.05};
+    asp_frame frame = {.radius = 1.05};
     for (int v = 0; v < 4 && ra && rb; v++) {
         asp_camera cam;
         asp_camera_init(&cam);

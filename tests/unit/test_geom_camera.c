@@ -247,6 +247,62 @@ static void test_up_axis(void)
 }
 
 /* An instance placed by model seen through view: view * model on local points, and the eye moved into the local frame. */
+/*
+ * The box framing of a flat, wide set (issue 29): a 60 x 40 x 5 m z-up site seen with up z from
+ * several views and aspects has every box corner inside the image and one on its edge (the box
+ * fills the view), nearer than the sphere fit; the same box seen with up y (then it stands 40 m
+ * tall: not flat along up), a compact box and a box of unknown sides keep the sphere distance.
+ */
+static void test_frame_flat_box(void)
+{
+    const asp_frame site = {.center = {500030, 4100020, 102.5}, .radius = 36.15, .half = {30, 20, 2.5},
+                            .up = ASP_UP_Z};
+    const double origin[3] = {500000, 4100000, 100};
+    static const float views[][3] = {{30, 20, 1}, {30, 20, 16.0f / 9}, {0, 90, 1}, {-60, 45, 0.75f}};
+    for (size_t v = 0; v < sizeof views / sizeof views[0]; v++) {
+        asp_camera cam, sphere;
+        asp_camera_init(&cam);
+        cam.up = ASP_UP_Z;
+        cam.azimuth = views[v][0];
+        cam.elevation = views[v][1];
+        sphere = cam;
+        asp_camera_frame(&cam, &site, origin, views[v][2], 0.0f);
+        float c[3] = {30, 20, 2.5f};
+        asp_camera_fit(&sphere, c, (float)site.radius, views[v][2]);
+        CHECK_MSG(cam.distance < sphere.distance, "view %zu: box distance %g, sphere %g", v, cam.distance,
+                  sphere.distance);
+        uint32_t w = (uint32_t)lround(300 * views[v][2]), h = 300;
+        double margin = 1e9;
+        for (int i = 0; i < 8; i++) {
+            float p[3] = {c[0] + (i & 1 ? 30.0f : -30.0f), c[1] + (i & 2 ? 20.0f : -20.0f), c[2] + (i & 4 ? 2.5f : -2.5f)};
+            float o[3];
+            CHECK(asp_camera_project(&cam, p, w, h, o));
+            CHECK_MSG(o[0] >= -0.01 && o[0] <= w + 0.01 && o[1] >= -0.01 && o[1] <= h + 0.01 && o[2] > 0 && o[2] < 1,
+                      "view %zu: corner %d at (%g, %g, %g), outside the %ux%u view", v, i, o[0], o[1], o[2], w, h);
+            margin = fmin(margin, fmin(fmin(o[0], w - o[0]), fmin(o[1], h - o[1])));
+        }
+        CHECK_MSG(margin < 0.01, "view %zu: the box is %g pixels from the nearest side, expected touching", v, margin);
+    }
+    static const asp_frame keep[] = {
+        {.center = {0, 0, 0}, .radius = 36.15, .half = {30, 20, 2.5}, .up = ASP_UP_Y}, // up y: 40 m tall
+        {.center = {0, 0, 0}, .radius = 1.7, .half = {1, 1, 0.8}, .up = ASP_UP_Y},     // compact
+        {.center = {0, 0, 0}, .radius = 36.15, .up = ASP_UP_Z},                        // sides unknown
+    };
+    for (size_t k = 0; k < sizeof keep / sizeof keep[0]; k++) {
+        asp_camera cam, sphere;
+        asp_camera_init(&cam);
+        cam.up = keep[k].up;
+        cam.azimuth = 30;
+        cam.elevation = 20;
+        sphere = cam;
+        asp_camera_frame(&cam, &keep[k], NULL, 1.0f, 0.0f);
+        const float zero[3] = {0, 0, 0};
+        asp_camera_fit(&sphere, zero, (float)keep[k].radius, 1.0f);
+        CHECK_MSG(cam.distance == sphere.distance, "case %zu: distance %g, the sphere's %g", k, cam.distance,
+                  sphere.distance);
+    }
+}
+
 static void test_fold_model(void)
 {
     asp_camera cam;
@@ -322,4 +378,4 @@ static void test_frustum_planes(void)
 
 TEST_MAIN(TEST_CASE(test_defaults), TEST_CASE(test_view_frame), TEST_CASE(test_project_known_points),
           TEST_CASE(test_fit_sphere_in_frustum), TEST_CASE(test_clip_inside_sphere), TEST_CASE(test_up_axis),
-          TEST_CASE(test_fold_model), TEST_CASE(test_frustum_planes))
+          TEST_CASE(test_fold_model), TEST_CASE(test_frustum_planes), TEST_CASE(test_frame_flat_box))

@@ -129,6 +129,50 @@ static int load_bytes(const uint8_t *b, size_t n, asp_error *err)
     return rc;
 }
 
+/*
+ * The up axis and box of the frame (issue 29): a z-up cloud's hierarchy keeps ASP_UP_Z and the box
+ * through save and load, bit for bit; a file from before them (bytes 128-139 zero) loads as y-up
+ * with no box; an up axis code beyond -x is refused naming byte 128.
+ */
+static void test_up_axis(void)
+{
+    asp_cloud *cl = small_cloud(500);
+    cl->up = ASP_UP_Z;
+    asp_error errbuf = {0}, *err = &errbuf;
+    asp_hier *h = NULL, *back = NULL;
+    CHECK_OK(asp_hier_build(cl, NULL, NULL, &h, err), err);
+    char path[600];
+    path_of(path, sizeof path, "up.asph");
+    CHECK_OK(asp_hier_save(h, path, err), err);
+    CHECK_OK(asp_hier_load(path, NULL, &back, err), err);
+    asp_frame want;
+    CHECK_OK(asp_cloud_frame(cl, &want, err), err);
+    CHECK(want.up == ASP_UP_Z && want.half[0] > 0 && want.half[1] > 0 && want.half[2] > 0);
+    const asp_frame *got = back ? asp_hier_frame(back) : &want;
+    CHECK_MSG(memcmp(got, &want, sizeof want) == 0, "up %d half %.17g %.17g %.17g, want up %d half %.17g %.17g %.17g",
+              (int)got->up, got->half[0], got->half[1], got->half[2], (int)want.up, want.half[0], want.half[1],
+              want.half[2]);
+    asp_hier_destroy(back);
+    back = NULL;
+    size_t size = 0;
+    uint8_t *b = read_all(path, &size);
+    CHECK(b && size > 160 && b[128] == ASP_UP_Z + 1);
+    if (b && size > 160) {
+        memset(b + 128, 0, 12);
+        reseal_header(b, size, 160);
+        CHECK_OK(asp_hier_load_memory(b, size, "old.asph", NULL, &back, err), err);
+        CHECK(back && asp_hier_frame(back)->up == ASP_UP_Y && asp_hier_frame(back)->half[0] == 0 &&
+              asp_hier_frame(back)->radius == want.radius);
+        asp_hier_destroy(back);
+        b[128] = 7; // beyond ASP_UP_NEG_X + 1
+        reseal_header(b, size, 160);
+        CHECK(load_bytes(b, size, err) == ASP_EFORMAT && strstr(err->msg, "byte 128") != NULL);
+    }
+    free(b);
+    asp_hier_destroy(h);
+    asp_cloud_destroy(cl);
+}
+
 static void test_truncated(void)
 {
     if (!image)
@@ -323,7 +367,7 @@ int main(void)
     static const asp_test_case cases[] = {TEST_CASE(test_round_trip), TEST_CASE(test_truncated),
                                           TEST_CASE(test_corrupted), TEST_CASE(test_version_1),
                                           TEST_CASE(test_inconsistent_tree),
-                                          TEST_CASE(test_io_errors)};
+                                          TEST_CASE(test_io_errors), TEST_CASE(test_up_axis)};
     int rc = asp_test_run(__FILE__, cases, sizeof cases / sizeof cases[0]);
     cleanup();
     char cmd[700];

@@ -275,7 +275,7 @@ static void test_memory_cuts_and_forged_counts(void)
         asp_dps *old = NULL;
         CHECK_OK(asp_dps_load_memory(v1, v1_size, "v1.dps", NULL, &old, &err), &err);
         if (old) {
-            const asp_frame zero = {{0, 0, 0}, 0};
+            const asp_frame zero = {.radius = 0};
             CHECK(memcmp(&old->frame, &zero, sizeof zero) == 0);
             old->frame = dps.frame; /* everything else is the same */
             CHECK(same_dps(&dps, old));
