@@ -12,6 +12,7 @@
 
 #include "export/internal.h"
 #include "util/atomic_file.h"
+#include "util/byte_io.h"
 #include "util/banned.h"
 
 static int ends_with(const char *s, const char *suffix)
@@ -492,12 +493,6 @@ static int write_file(const char *path, const void *a, size_t na, const void *b,
     return asp__atomic_commit(&f, err);
 }
 
-static void put_u32(uint8_t *p, uint32_t v)
-{
-    for (int i = 0; i < 4; i++)
-        p[i] = (uint8_t)(v >> (8 * i));
-}
-
 static int write_glb(const char *path, const char *json, const uint8_t *bin, size_t bin_size, asp_gltf_stats *st,
                      asp_error *err)
 {
@@ -507,13 +502,13 @@ static int write_glb(const char *path, const char *json, const uint8_t *bin, siz
         return asp_error_set(err, ASP_EUNSUPPORTED, "cannot write '%s': %zu bytes exceed the 4 GiB of a GLB file",
                              path, total);
     uint8_t head[20], bin_head[8];
-    put_u32(head, 0x46546C67u); // "glTF"
-    put_u32(head + 4, 2);
-    put_u32(head + 8, (uint32_t)total);
-    put_u32(head + 12, (uint32_t)jpad);
-    put_u32(head + 16, 0x4E4F534Au); // "JSON"
-    put_u32(bin_head, (uint32_t)bpad);
-    put_u32(bin_head + 4, 0x004E4942u); // "BIN\0"
+    asp__store_u32(head, 0x46546C67u); // "glTF"
+    asp__store_u32(head + 4, 2);
+    asp__store_u32(head + 8, (uint32_t)total);
+    asp__store_u32(head + 12, (uint32_t)jpad);
+    asp__store_u32(head + 16, 0x4E4F534Au); // "JSON"
+    asp__store_u32(bin_head, (uint32_t)bpad);
+    asp__store_u32(bin_head + 4, 0x004E4942u); // "BIN\0"
     static const char spaces[3] = {' ', ' ', ' '}; // the spec pads the JSON chunk with spaces
     static const uint8_t zeros[3] = {0, 0, 0};      // and the binary chunk with zeros
     asp__atomic_file f;

@@ -38,25 +38,6 @@ static int host_is_le(void)
     return b == 1;
 }
 
-static void put32(uint8_t *p, uint32_t v)
-{
-    for (int i = 0; i < 4; i++)
-        p[i] = (uint8_t)(v >> (8 * i));
-}
-
-static void put64(uint8_t *p, uint64_t v)
-{
-    for (int i = 0; i < 8; i++)
-        p[i] = (uint8_t)(v >> (8 * i));
-}
-
-static void putf64(uint8_t *p, double d)
-{
-    uint64_t v;
-    memcpy(&v, &d, 8);
-    put64(p, v);
-}
-
 /*
  * Records are arrays of 4-byte words (floats, uint32) except the splat colour
  * (4 single bytes, word 3) and covariances (8-byte doubles). On a
@@ -105,31 +86,31 @@ static void encode_header(const asp_hier *h, uint64_t payload, uint64_t payload_
 {
     memset(hd, 0, HEADER_SIZE);
     memcpy(hd, MAGIC, 8);
-    put32(hd + 8, VERSION);
-    put32(hd + 12, HEADER_SIZE);
-    put32(hd + 16, h->flags);
-    put32(hd + 20, h->depth);
-    put64(hd + 24, h->node_count);
-    put64(hd + 32, h->point_count);
-    put64(hd + 40, h->leaf_size);
+    asp__store_u32(hd + 8, VERSION);
+    asp__store_u32(hd + 12, HEADER_SIZE);
+    asp__store_u32(hd + 16, h->flags);
+    asp__store_u32(hd + 20, h->depth);
+    asp__store_u64(hd + 24, h->node_count);
+    asp__store_u64(hd + 32, h->point_count);
+    asp__store_u64(hd + 40, h->leaf_size);
     for (int i = 0; i < 3; i++)
-        putf64(hd + 48 + 8 * i, h->origin[i]);
-    put32(hd + 72, NODE_REC);
-    put32(hd + 76, SPLAT_REC);
-    put64(hd + 80, payload);
-    put64(hd + 88, payload_hash);
+        asp__store_f64(hd + 48 + 8 * i, h->origin[i]);
+    asp__store_u32(hd + 72, NODE_REC);
+    asp__store_u32(hd + 76, SPLAT_REC);
+    asp__store_u64(hd + 80, payload);
+    asp__store_u64(hd + 88, payload_hash);
     for (int i = 0; i < 3; i++)
-        putf64(hd + FRAME_AT + 8 * i, h->frame.center[i]);
-    putf64(hd + FRAME_AT + 24, h->frame.radius);
+        asp__store_f64(hd + FRAME_AT + 8 * i, h->frame.center[i]);
+    asp__store_f64(hd + FRAME_AT + 24, h->frame.radius);
     /* issue 29, in bytes that were reserved (zero, "not recorded"): the source's up axis + 1, and the
        frame's box half sides (asp_frame_half_encode: the camera fits flat, wide sets by them) */
-    put32(hd + UP_AT, (uint32_t)h->frame.up + 1u);
+    asp__store_u32(hd + UP_AT, (uint32_t)h->frame.up + 1u);
     uint16_t q[3];
     asp_frame_half_encode(&h->frame, q);
-    put32(hd + UP_AT + 4, (uint32_t)q[0] | (uint32_t)q[1] << 16);
-    put32(hd + UP_AT + 8, q[2]);
+    asp__store_u32(hd + UP_AT + 4, (uint32_t)q[0] | (uint32_t)q[1] << 16);
+    asp__store_u32(hd + UP_AT + 8, q[2]);
     /* bytes 140-151 are reserved (zero); the header checksum covers everything before it */
-    put64(hd + HEADER_SIZE - 8, asp__fnv1a64(ASP__FNV1A64_START, hd, HEADER_SIZE - 8));
+    asp__store_u64(hd + HEADER_SIZE - 8, asp__fnv1a64(ASP__FNV1A64_START, hd, HEADER_SIZE - 8));
 }
 
 static uint64_t payload_size(uint64_t nodes, uint64_t points)

@@ -21,6 +21,7 @@
 #include "hier/internal.h"
 #include "hier/ooc_format.h"
 #include "util/atomic_file.h"
+#include "util/byte_io.h"
 #include "util/checksum.h"
 #include "util/banned.h"
 
@@ -841,25 +842,6 @@ static uint64_t subtree_of(build *b, uint32_t id)
     return s;
 }
 
-static void put32(uint8_t *p, uint32_t v)
-{
-    for (int i = 0; i < 4; i++)
-        p[i] = (uint8_t)(v >> (8 * i));
-}
-
-static void put64(uint8_t *p, uint64_t v)
-{
-    for (int i = 0; i < 8; i++)
-        p[i] = (uint8_t)(v >> (8 * i));
-}
-
-static void putf64(uint8_t *p, double d)
-{
-    uint64_t v;
-    memcpy(&v, &d, 8);
-    put64(p, v);
-}
-
 static int write_table(build *b, uint32_t root, const asp_frame *frame, double radius, asp_ooc_build_stats *st)
 {
     size_t n = b->nprotos;
@@ -903,24 +885,24 @@ static int write_table(build *b, uint32_t root, const asp_frame *frame, double r
     uint8_t hd[ASP__OOC_HEADER];
     memset(hd, 0, sizeof hd);
     memcpy(hd, "ASPHIER", 8);
-    put32(hd + 8, ASP__OOC_VERSION);
-    put32(hd + 12, ASP__OOC_HEADER);
-    put32(hd + 16, ASP_HIER_HAS_COLORS | ASP_HIER_UNORIENTED | ASP_HIER_STREAMED);
-    put32(hd + 20, depth);
-    put64(hd + 24, n);
-    put64(hd + 32, b->written);
-    put64(hd + 40, b->leaf_max);
+    asp__store_u32(hd + 8, ASP__OOC_VERSION);
+    asp__store_u32(hd + 12, ASP__OOC_HEADER);
+    asp__store_u32(hd + 16, ASP_HIER_HAS_COLORS | ASP_HIER_UNORIENTED | ASP_HIER_STREAMED);
+    asp__store_u32(hd + 20, depth);
+    asp__store_u64(hd + 24, n);
+    asp__store_u64(hd + 32, b->written);
+    asp__store_u64(hd + 40, b->leaf_max);
     for (int k = 0; k < 3; k++)
-        putf64(hd + 48 + 8 * k, b->origin[k]);
-    put32(hd + 72, ASP__OOC_NODE_REC);
-    put32(hd + 76, ASP__OOC_POINT_REC);
-    put64(hd + ASP__OOC_TABLE_AT, table_at);
-    put64(hd + ASP__OOC_TABLE_HASH, hash);
+        asp__store_f64(hd + 48 + 8 * k, b->origin[k]);
+    asp__store_u32(hd + 72, ASP__OOC_NODE_REC);
+    asp__store_u32(hd + 76, ASP__OOC_POINT_REC);
+    asp__store_u64(hd + ASP__OOC_TABLE_AT, table_at);
+    asp__store_u64(hd + ASP__OOC_TABLE_HASH, hash);
     for (int k = 0; k < 3; k++)
-        putf64(hd + ASP__OOC_FRAME_AT + 8 * k, frame->center[k]);
-    putf64(hd + ASP__OOC_FRAME_AT + 24, frame->radius);
-    putf64(hd + ASP__OOC_RADIUS_AT, radius);
-    put64(hd + ASP__OOC_HEADER - 8, asp__fnv1a64(ASP__FNV1A64_START, hd, ASP__OOC_HEADER - 8));
+        asp__store_f64(hd + ASP__OOC_FRAME_AT + 8 * k, frame->center[k]);
+    asp__store_f64(hd + ASP__OOC_FRAME_AT + 24, frame->radius);
+    asp__store_f64(hd + ASP__OOC_RADIUS_AT, radius);
+    asp__store_u64(hd + ASP__OOC_HEADER - 8, asp__fnv1a64(ASP__FNV1A64_START, hd, ASP__OOC_HEADER - 8));
     if (!rc && (fseeko(b->out.fp, 0, SEEK_SET) != 0 || fwrite(hd, 1, sizeof hd, b->out.fp) != sizeof hd))
         rc = asp_error_set(b->err, ASP_EIO, "cannot write '%s': %s", b->out.tmp, strerror(errno));
     if (st) {

@@ -13,6 +13,25 @@
 #include "util/regular_file.h"
 #include "util/banned.h"
 
+void asp__store_u32(uint8_t *p, uint32_t v)
+{
+    for (int k = 0; k < 4; k++)
+        p[k] = (uint8_t)(v >> (8 * k));
+}
+
+void asp__store_u64(uint8_t *p, uint64_t v)
+{
+    for (int k = 0; k < 8; k++)
+        p[k] = (uint8_t)(v >> (8 * k));
+}
+
+void asp__store_f64(uint8_t *p, double v)
+{
+    uint64_t u;
+    memcpy(&u, &v, 8);
+    asp__store_u64(p, u);
+}
+
 void asp__put_u32(asp__crc_writer *w, uint32_t v)
 {
     uint8_t b[4];

@@ -21,6 +21,11 @@ void asp__put_u64(asp__crc_writer *w, uint64_t v);
 void asp__put_f32(asp__crc_writer *w, float v);
 void asp__put_f64(asp__crc_writer *w, double v);
 
+/* The same little-endian bytes stored at p, for headers assembled in memory (.hier, GLB). */
+void asp__store_u32(uint8_t *p, uint32_t v);
+void asp__store_u64(uint8_t *p, uint64_t v);
+void asp__store_f64(uint8_t *p, double v);
+
 /*
  * Appends the CRC-32 trailer (of everything written before it), reads the
  * file back with check (asp__atomic_commit_checked; NULL: no check) and
