@@ -91,6 +91,7 @@ struct cli_streamed_view {
     size_t views;
     double az, el, dist, fov, tau; /* tau <= 0: 1 pixel */
     asp_up_axis up;
+    int up_given; /* else the file's own up axis (z for a LAS source) */
     uint32_t width, height;
     size_t memory; /* bytes; 0 = 2 GiB */
 };

@@ -801,7 +801,8 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
                                             &(struct cli_streamed_view){.views = o.views, .az = o.az, .el = o.el,
                                                                         .dist = o.dist, .fov = o.fov,
                                                                         .tau = o.r.tolerance > 0 ? o.r.tolerance : 1.0,
-                                                                        .up = o.up_axis, .width = o.width,
+                                                                        .up = o.up_axis, .up_given = o.up != NULL,
+                                                                        .width = o.width,
                                                                         .height = o.height, .memory = memory},
                                             &env->ctx, &s, &sst, &err)
                       : load_scene(argv[0], &o, env, &s, &err);

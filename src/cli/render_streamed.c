@@ -41,7 +41,7 @@ int cli_render_streamed(const char *path, const struct cli_streamed_view *v, con
         asp_camera cam;
         asp_camera_init(&cam);
         cam.fov_y = (float)v->fov;
-        cam.up = v->up;
+        cam.up = v->up_given ? v->up : asp_ooc_frame(ooc)->up;
         cam.azimuth = (float)(v->az + 360.0 * (double)i / (double)v->views);
         cam.elevation = (float)(i % 2 ? -v->el : v->el);
         asp_camera_frame(&cam, asp_ooc_frame(ooc), origin, (float)v->width / (float)v->height, (float)v->dist);

@@ -17,6 +17,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "amgsplat/io.h"
 #include "amgsplat/point_stream.h"
 #include "hier/internal.h"
 #include "hier/ooc_format.h"
@@ -902,6 +903,7 @@ static int write_table(build *b, uint32_t root, const asp_frame *frame, double r
         asp__store_f64(hd + ASP__OOC_FRAME_AT + 8 * k, frame->center[k]);
     asp__store_f64(hd + ASP__OOC_FRAME_AT + 24, frame->radius);
     asp__store_f64(hd + ASP__OOC_RADIUS_AT, radius);
+    asp__store_u32(hd + ASP__OOC_UP_AT, (uint32_t)frame->up + 1u);
     asp__store_u64(hd + ASP__OOC_HEADER - 8, asp__fnv1a64(ASP__FNV1A64_START, hd, ASP__OOC_HEADER - 8));
     if (!rc && (fseeko(b->out.fp, 0, SEEK_SET) != 0 || fwrite(hd, 1, sizeof hd, b->out.fp) != sizeof hd))
         rc = asp_error_set(b->err, ASP_EIO, "cannot write '%s': %s", b->out.tmp, strerror(errno));
@@ -984,7 +986,12 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
         rc = pass_bounds(&b, xyz, lo, hi);
     st.seconds_bounds = asp_time_now() - t0;
     asp_frame frame;
-    memset(&frame, 0, sizeof frame); // up y, no box: the streamed layout records neither (NEEDSWORK)
+    memset(&frame, 0, sizeof frame); // no box (NEEDSWORK: the camera fits the sphere)
+    // the up axis as a point file's load gives it (issue 29): z for LAS (ASPRS LAS 1.4: Z is the
+    // elevation of its CRS), else y
+    asp_file_type ftype;
+    if (asp_file_recognise(in, &ftype, NULL) == 0 && (strcmp(ftype.format, "las") == 0 || strcmp(ftype.format, "laz") == 0))
+        frame.up = ASP_UP_Z;
     double full_radius = 0;
     if (!rc) {
         double ext = 0;

@@ -133,9 +133,11 @@ int asp_ooc_open(const char *path, const asp_context *ctx, asp_ooc **out, asp_er
         }
         o->frame.radius = getf64(hd + ASP__OOC_FRAME_AT + 24);
         o->full_radius = getf64(hd + ASP__OOC_RADIUS_AT);
+        uint32_t up = get32(hd + ASP__OOC_UP_AT);
+        o->frame.up = up >= 1 && up <= (uint32_t)ASP_UP_NEG_X + 1u ? (asp_up_axis)(up - 1u) : ASP_UP_Y;
         uint64_t fsize = (uint64_t)size;
         int finite = isfinite(o->frame.radius) && o->frame.radius > 0 && isfinite(o->full_radius) &&
-                     o->full_radius >= 0;
+                     o->full_radius >= 0 && up <= (uint32_t)ASP_UP_NEG_X + 1u;
         for (int k = 0; k < 3; k++)
             finite &= isfinite(o->origin[k]) && isfinite(o->frame.center[k]);
         if (get32(hd + 72) != ASP__OOC_NODE_REC || get32(hd + 76) != ASP__OOC_POINT_REC || nodes == 0 ||

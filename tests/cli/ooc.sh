@@ -86,4 +86,12 @@ expect_fail 1 "binary PLY" "$A" convert "$T/asc.ply" -o "$T/x.hier"
 "$A" convert "$T/a.ply" "$T/a.las" -q
 "$A" convert "$T/a.las" -o "$T/las.hier" --json > "$T/las.json"
 [[ $(jget "$T/las.json" points) == 200000 ]] || fail "LAS: $(jget "$T/las.json" points) points"
+# the streamed file keeps the source's up axis (issue 29): a LAS is z-up, so render needs no --up
+# (the same picture as --up z, another from --up y), a PLY stays y-up
+"$A" render "$T/las.hier" -o "$T/las_default.png" --size 96x96 --view 30,40 -q
+"$A" render "$T/las.hier" -o "$T/las_z.png" --size 96x96 --view 30,40 --up z -q
+"$A" render "$T/las.hier" -o "$T/las_y.png" --size 96x96 --view 30,40 --up y -q
+at_least "$(ssim "$T/las_default.png" "$T/las_z.png")" 0.999 "streamed LAS drawn by its own up axis (z)"
+s=$(ssim "$T/las_default.png" "$T/las_y.png")
+python3 -c "import sys; sys.exit(0 if float(sys.argv[1]) < 0.9 else 1)" "$s" || fail "streamed LAS: --up y draws as z (SSIM $s)"
 exit 0
