@@ -192,8 +192,10 @@ static long long check_p(dae *d, const char *s, const char *e, int *rc)
         while (p < e && *p >= '0' && *p <= '9' && digits < 12)
             v = 10 * v + (*p++ - '0'), digits++;
         if (!digits || (p < e && *p != '<' && !is_space(*p))) {
-            *rc = asp_error_set(d->err, ASP_EFORMAT, "cannot read '%s': line %zu: <p> of <%s> holds '%.12s', not an "
-                                "index", d->name, line_of(d, t), d->prim, t);
+            // at most 12 bytes of the token, and never past the text's end (it is not NUL-terminated)
+            int shown = e - t < 12 ? (int)(e - t) : 12;
+            *rc = asp_error_set(d->err, ASP_EFORMAT, "cannot read '%s': line %zu: <p> of <%s> holds '%.*s', not an "
+                                "index", d->name, line_of(d, t), d->prim, shown, t);
             return -1;
         }
         long long off = k % stride;
