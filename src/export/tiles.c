@@ -34,6 +34,7 @@
 
 #include "export/internal.h"
 #include "util/atomic_file.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 enum { TILE_POINTS_DEFAULT = 32768, STACK = 8 * (64 + 2) };
@@ -120,17 +121,6 @@ static cJSON *z_up_box(const double box[6])
     cJSON *bv = cJSON_CreateObject();
     cJSON_AddItemToObject(bv, "box", asp__gltf_numbers(v, 12));
     return bv;
-}
-
-static int make_dir(const char *dir, asp_error *err)
-{
-    struct stat st;
-    if (mkdir(dir, 0777) == 0)
-        return 0;
-    if (errno == EEXIST && stat(dir, &st) == 0 && S_ISDIR(st.st_mode))
-        return 0;
-    return asp_error_set(err, ASP_EIO, "cannot create directory '%s': %s", dir,
-                         errno == EEXIST ? "a file of that name exists" : strerror(errno));
 }
 
 /*
@@ -236,9 +226,9 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
     char sub[4096];
     if (snprintf(sub, sizeof sub, "%s/tiles", dir) >= (int)sizeof sub)
         return asp_error_set(err, ASP_EINVAL, "tileset directory name '%s' is too long", dir);
-    int rc = make_dir(dir, err);
+    int rc = asp__dir_ensure(dir, "directory", err);
     if (!rc)
-        rc = make_dir(sub, err);
+        rc = asp__dir_ensure(sub, "directory", err);
     if (rc)
         return rc;
     double box[6];

@@ -17,6 +17,7 @@
 
 #include "stats/report_internal.h"
 #include "util/json_file.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 static const char *const file_names[F_COUNT] = {"report.md",       "logs.csv",       "frame_time.csv",
@@ -176,21 +177,10 @@ static void section_counts(struct report *r)
             a->answers, a->answers_lost, a->answers_mismatch);
 }
 
-static int make_dir(const char *dir, asp_error *err)
-{
-    struct stat st;
-    if (mkdir(dir, 0777) == 0)
-        return 0;
-    if (errno == EEXIST && stat(dir, &st) == 0 && S_ISDIR(st.st_mode))
-        return 0;
-    return asp_error_set(err, ASP_EIO, "cannot create report directory '%s': %s", dir,
-                         errno == EEXIST ? "a file of that name exists" : strerror(errno));
-}
-
 int asp_stats_report_write(const asp_stats_analysis *a, const char *report_dir, asp_error *err)
 {
     ASP_ASSERT(a && report_dir);
-    int rc = make_dir(report_dir, err);
+    int rc = asp__dir_ensure(report_dir, "report directory", err);
     if (rc)
         return rc;
     struct report r = {.a = a, .dir = report_dir, .err = err};

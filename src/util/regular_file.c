@@ -108,3 +108,14 @@ int asp__text_file_read(const char *path, size_t max, const char *what, char **t
     *len = n;
     return 0;
 }
+
+int asp__dir_ensure(const char *dir, const char *what, asp_error *err)
+{
+    struct stat st;
+    if (mkdir(dir, 0777) == 0)
+        return 0;
+    if (errno == EEXIST && stat(dir, &st) == 0 && S_ISDIR(st.st_mode))
+        return 0;
+    return asp_error_set(err, ASP_EIO, "cannot create %s '%s': %s", what, dir,
+                         errno == EEXIST ? "a file of that name exists" : strerror(errno));
+}

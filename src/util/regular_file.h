@@ -36,4 +36,11 @@ FILE *asp__regular_file_open(const char *path, asp_error *err);
  */
 int asp__text_file_read(const char *path, size_t max, const char *what, char **text, size_t *len, asp_error *err);
 
+/*
+ * dir exists as a directory afterwards: created (mode 0777 less the umask) or already there.
+ * Fails with ASP_EIO "cannot create <what> '<dir>': <strerror>" ("a file of that name exists"
+ * when one is in the way).
+ */
+int asp__dir_ensure(const char *dir, const char *what, asp_error *err);
+
 #endif

@@ -6,30 +6,15 @@
 // Prints one JSON line {loaded, failed, ...}. Exit 1 on an error, 2 on usage errors.
 import fs from 'node:fs';
 import path from 'node:path';
-import puppeteer from 'puppeteer-core';
+import { launchChromium, parseArgs } from './browser.mjs';
 import { serve } from '../serve.mjs';
 
 const usage = 'usage: node web/test/cesium.mjs DIR [--size WxH] [--sse PX] [--png OUT.png] [--timeout S] [--chromium PATH]';
 
-function parseArgs(argv) {
-  const o = { size: '320x240', sse: '2', png: null, timeout: '300', chromium: process.env.CHROMIUM || '/usr/bin/chromium', pos: [] };
-  for (let i = 0; i < argv.length; i++) {
-    const a = argv[i];
-    if (a.startsWith('--')) {
-      const key = a.slice(2);
-      if (!(key in o) || key === 'pos' || i + 1 >= argv.length) throw new Error(`unknown option or missing value: ${a}`);
-      o[key] = argv[++i];
-    } else o.pos.push(a);
-  }
-  if (o.pos.length !== 1) throw new Error('expected DIR');
-  if (!/^\d+x\d+$/.test(o.size)) throw new Error(`--size expects WxH, got '${o.size}'`);
-  return o;
-}
-
 async function main() {
   let o;
   try {
-    o = parseArgs(process.argv.slice(2));
+    o = parseArgs(process.argv.slice(2), { size: '320x240', sse: '2', png: null, timeout: '300' }, 1, 'DIR');
   } catch (e) {
     console.error(`cesium: ${e.message}\n${usage}`);
     process.exit(2);
@@ -41,15 +26,7 @@ async function main() {
   }
   const [w, h] = o.size.split('x').map(Number);
   const server = await serve(path.resolve(dir));
-  const userDir = fs.mkdtempSync(path.join(process.env.TMPDIR || '/tmp', 'amgsplat-chromium-'));
-  const browser = await puppeteer.launch({
-    executablePath: o.chromium,
-    headless: true,
-    protocolTimeout: 1000 * Number(o.timeout) + 60000, // waitForFunction's polls run under it
-    userDataDir: userDir,
-    args: ['--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking',
-      '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  });
+  const { browser, userDir } = await launchChromium(o.chromium, o.timeout);
   let code = 0;
   const errors = [], logs = [];
   try {

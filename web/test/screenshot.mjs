@@ -7,32 +7,18 @@
 // page reports an error (printed), 2 on usage errors.
 import fs from 'node:fs';
 import path from 'node:path';
-import puppeteer from 'puppeteer-core';
+import { launchChromium, parseArgs } from './browser.mjs';
 import { serve } from '../serve.mjs';
 
 const usage = 'usage: node web/test/screenshot.mjs FILE.glb OUT.png [--view AZ,EL[,DIST]] [--size WxH] ' +
   '[--bg R,G,B] [--method M] [--light off|head] [--points splats|points] [--level NAME] [--chromium PATH]';
 
-function parseArgs(argv) {
-  const o = { view: '30,20', size: '256x256', bg: '255,255,255', method: 'normalized', light: 'off', level: null, points: 'splats',
-    chromium: process.env.CHROMIUM || '/usr/bin/chromium', pos: [] };
-  for (let i = 0; i < argv.length; i++) {
-    const a = argv[i];
-    if (a.startsWith('--')) {
-      const key = a.slice(2);
-      if (!(key in o) || key === 'pos' || i + 1 >= argv.length) throw new Error(`unknown option or missing value: ${a}`);
-      o[key] = argv[++i];
-    } else o.pos.push(a);
-  }
-  if (o.pos.length !== 2) throw new Error('expected FILE.glb and OUT.png');
-  if (!/^\d+x\d+$/.test(o.size)) throw new Error(`--size expects WxH, got '${o.size}'`);
-  return o;
-}
-
 async function main() {
   let o;
   try {
-    o = parseArgs(process.argv.slice(2));
+    o = parseArgs(process.argv.slice(2),
+      { view: '30,20', size: '256x256', bg: '255,255,255', method: 'normalized', light: 'off', level: null, points: 'splats' },
+      2, 'FILE.glb and OUT.png');
   } catch (e) {
     console.error(`screenshot: ${e.message}\n${usage}`);
     process.exit(2);
@@ -44,14 +30,7 @@ async function main() {
   }
   const [w, h] = o.size.split('x').map(Number);
   const server = await serve(path.resolve(path.dirname(file)));
-  const userDir = fs.mkdtempSync(path.join(process.env.TMPDIR || '/tmp', 'amgsplat-chromium-'));
-  const browser = await puppeteer.launch({
-    executablePath: o.chromium,
-    headless: true,
-    userDataDir: userDir,
-    args: ['--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking',
-      '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  });
+  const { browser, userDir } = await launchChromium(o.chromium);
   let code = 0;
   try {
     const page = await browser.newPage();

@@ -9,27 +9,11 @@
 // error_target}. Exit 1 when the page reports an error or does not settle in time, 2 on usage errors.
 import fs from 'node:fs';
 import path from 'node:path';
-import puppeteer from 'puppeteer-core';
+import { launchChromium, parseArgs } from './browser.mjs';
 import { serve } from '../serve.mjs';
 
 const usage = 'usage: node web/test/tiles.mjs DIR OUT_PREFIX [--view AZ,EL[,DIST]] [--size WxH] [--bg R,G,B] ' +
   '[--light off|head] [--error PX] [--point-budget N] [--timeout S] [--chromium PATH]';
-
-function parseArgs(argv) {
-  const o = { view: '30,20', size: '256x256', bg: '255,255,255', light: 'off', error: null, 'point-budget': null,
-    timeout: '300', chromium: process.env.CHROMIUM || '/usr/bin/chromium', pos: [] };
-  for (let i = 0; i < argv.length; i++) {
-    const a = argv[i];
-    if (a.startsWith('--')) {
-      const key = a.slice(2);
-      if (!(key in o) || key === 'pos' || i + 1 >= argv.length) throw new Error(`unknown option or missing value: ${a}`);
-      o[key] = argv[++i];
-    } else o.pos.push(a);
-  }
-  if (o.pos.length !== 2) throw new Error('expected DIR and OUT_PREFIX');
-  if (!/^\d+x\d+$/.test(o.size)) throw new Error(`--size expects WxH, got '${o.size}'`);
-  return o;
-}
 
 function dirBytes(dir) {
   let n = 0;
@@ -45,7 +29,9 @@ function savePng(url, file) {
 async function main() {
   let o;
   try {
-    o = parseArgs(process.argv.slice(2));
+    o = parseArgs(process.argv.slice(2),
+      { view: '30,20', size: '256x256', bg: '255,255,255', light: 'off', error: null, 'point-budget': null, timeout: '300' },
+      2, 'DIR and OUT_PREFIX');
   } catch (e) {
     console.error(`tiles: ${e.message}\n${usage}`);
     process.exit(2);
@@ -57,15 +43,7 @@ async function main() {
   }
   const [w, h] = o.size.split('x').map(Number);
   const server = await serve(path.resolve(dir));
-  const userDir = fs.mkdtempSync(path.join(process.env.TMPDIR || '/tmp', 'amgsplat-chromium-'));
-  const browser = await puppeteer.launch({
-    executablePath: o.chromium,
-    headless: true,
-    protocolTimeout: 1000 * Number(o.timeout) + 60000, // waitForFunction's polls run under it
-    userDataDir: userDir,
-    args: ['--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking',
-      '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  });
+  const { browser, userDir } = await launchChromium(o.chromium, o.timeout);
   let code = 0;
   const logs = [];
   try {
