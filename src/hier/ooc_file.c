@@ -14,6 +14,7 @@
 #include "amgsplat/camera.h"
 #include "hier/ooc_format.h"
 #include "util/checksum.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 struct asp_ooc {
@@ -46,7 +47,7 @@ static double getf64(const uint8_t *p)
 
 int asp_ooc_probe(const char *path)
 {
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = asp__regular_file_open(path, NULL); // a FIFO or directory is refused, never waited on
     if (!fp)
         return ASP_EIO;
     uint8_t hd[20];
@@ -109,8 +110,10 @@ int asp_ooc_open(const char *path, const asp_context *ctx, asp_ooc **out, asp_er
     uint8_t hd[ASP__OOC_HEADER];
     int rc = 0;
     off_t size = 0;
-    if (!(o->fp = fopen(path, "rb")) || fseeko(o->fp, 0, SEEK_END) != 0 || (size = ftello(o->fp)) < 0 ||
-        fseeko(o->fp, 0, SEEK_SET) != 0)
+    asp_error open_err = {0, ""};
+    if (!(o->fp = asp__regular_file_open(path, &open_err))) // a FIFO or directory is refused, never waited on
+        rc = asp_error_set(err, open_err.code, "%s", open_err.msg);
+    else if (fseeko(o->fp, 0, SEEK_END) != 0 || (size = ftello(o->fp)) < 0 || fseeko(o->fp, 0, SEEK_SET) != 0)
         rc = asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
     else if (fread(hd, 1, sizeof hd, o->fp) != sizeof hd || memcmp(hd, "ASPHIER", 8) != 0)
         rc = asp_error_set(err, ASP_EFORMAT, "cannot read '%s': not a hierarchy file or truncated header", path);

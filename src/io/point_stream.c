@@ -11,6 +11,7 @@
 
 #include "amgsplat/point_stream.h"
 #include "util/atomic_file.h"
+#include "util/regular_file.h"
 #include "util/banned.h"
 
 enum { WINDOW = 1 << 23 };
@@ -209,10 +210,11 @@ int asp_point_reader_open(const char *path, const asp_context *ctx, asp_point_re
         return asp_error_set(err, ASP_ENOMEM, "out of memory");
     r->ctx = ctx;
     snprintf(r->name, sizeof r->name, "%s", path);
-    r->fp = fopen(path, "rb");
+    asp_error open_err = {0, ""};
+    r->fp = asp__regular_file_open(path, &open_err); // a FIFO or directory is refused, never waited on
     int rc = 0;
     if (!r->fp) {
-        rc = asp_error_set(err, ASP_EIO, "cannot open '%s': %s", path, strerror(errno));
+        rc = asp_error_set(err, open_err.code, "%s", open_err.msg);
     } else {
         char magic[4] = {0};
         size_t got = fread(magic, 1, 4, r->fp);
