@@ -81,6 +81,8 @@ typedef struct asp_viewer_desc {
                                 toggles it): 0 = on when the points have no normals and ASP_VIEWER_UNLIT is
                                 not set, > 0 = on, < 0 = off */
     float edl_strength;      /* asp_edl_desc.strength when on; 0 = 1 */
+    size_t memory;           /* a streamed .hier (hier_ooc.h): bytes for the points of a view's cut, as
+                                amgsplat render --memory (64 bytes a point); 0 = 2 GiB */
 } asp_viewer_desc;
 
 /** What a viewer run did, for scripts (amgsplat view --json). */
@@ -103,6 +105,9 @@ typedef struct asp_viewer_stats {
     char overlay[640];        /* the figures last drawn over the frame (the i key): file, renderer, level or
                                  method, colours, frame time, counts; "" when they were never shown */
     int edl;                  /* eye-dome lighting was on in the last frame */
+    size_t stream_loads;      /* a streamed .hier: cuts loaded (the first view's included) */
+    size_t stream_points;     /* a streamed .hier: points shown in the last frame's cut */
+    uint64_t stream_point_count; /* a streamed .hier: points in the file */
 } asp_viewer_stats;
 
 /**

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "amgsplat/hier_ooc.h"
 #include "cli/cli.h"
 #include "cli/commands.h"
 #include "util/banned.h"
@@ -17,6 +18,7 @@ static const char usage[] =
     "                     [--background R,G,B] [--texture IMG] [--hybrid] [--verbose]\n"
     "                     [--preset thesis|journal|pajarola|schwarz]\n"
     "                     [--frame-ms T] [--overlay | --no-overlay] [--edl | --no-edl] [--edl-strength S]\n"
+    "                     [--memory SIZE]\n"
     "       amgsplat view FILE --frames N [--screenshot OUT.png] [--keys KEYS] [options above]\n"
     "       amgsplat view FILE --fly N [--frame-ms T] [--stats-json OUT.json] [options above]\n"
     "\n"
@@ -32,7 +34,8 @@ static const char usage[] =
     "--renderer it draws with splat); --fly N draws N frames on a fixed path around the model.\n"
     "--color-by colours a point file by a field of its own (elevation, classification,\n"
     "intensity, return_number, any property) as render does; points without normals are\n"
-    "shaded by eye-dome lighting unless --no-edl or --unlit.";
+    "shaded by eye-dome lighting unless --no-edl or --unlit. A streamed .hier (amgsplat convert)\n"
+    "shows the cut of the view within --memory, and loads the new view's cut once the camera rests.";
 
 /* The renderer options view takes (renderer_options.c). */
 #define VIEW_OPTIONS                                                                                     \
@@ -57,6 +60,7 @@ struct view_opts {
     int verbose;
     int edl, no_edl;     /* eye-dome lighting forced on or off; default: on for points without normals */
     double edl_strength; /* NaN: not given */
+    const char *memory;  /* streamed .hier: --memory SIZE, as render */
 };
 
 static void log_line(void *user, const char *line)
@@ -135,6 +139,13 @@ static int parse_into(struct cli_env *env, const char *path, struct view_opts *o
         d->fly = 1;
     }
     d->frame_ms = o->r.frame_ms;
+    if (o->memory) {
+        if (type.kind != ASP_FILE_HIER || asp_ooc_probe(path) != 1)
+            return cli_usage_error(env, "--memory applies to a streamed .hier (amgsplat convert IN -o OUT.hier), not '%s'",
+                                   path);
+        if (cli_memory_option(env, o->memory, &d->memory))
+            return 2;
+    }
     if (o->stats_json && cli_check_output(env, o->stats_json, NULL, 0, (const char *const[]){path}, 1))
         return 2;
     d->stats_json = o->stats_json;
@@ -178,6 +189,11 @@ static int print_json(const struct cli_env *env, const char *path, const asp_vie
     cJSON_AddNumberToObject(o, "count_max", (double)s->count_max);
     cJSON_AddBoolToObject(o, "edl", s->edl);
     cJSON_AddStringToObject(o, "overlay", s->overlay);
+    if (s->stream_loads) {
+        cJSON_AddNumberToObject(o, "stream_loads", (double)s->stream_loads);
+        cJSON_AddNumberToObject(o, "stream_points", (double)s->stream_points);
+        cJSON_AddNumberToObject(o, "stream_point_count", (double)s->stream_point_count);
+    }
     return cli_json_print(env, o);
 }
 
@@ -211,6 +227,7 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         {"edl", 0, CLI_FLAG, &o.edl, NULL, "disc, square: eye-dome lighting (default: on for points without normals, unless --unlit; E toggles)"},
         {"no-edl", 0, CLI_FLAG, &o.no_edl, NULL, "disc, square: no eye-dome lighting"},
         {"edl-strength", 0, CLI_DOUBLE, &o.edl_strength, "S", "eye-dome lighting strength, 0..100 (default 1; implies --edl)"},
+        {"memory", 0, CLI_STRING, &o.memory, "SIZE", "streamed .hier: memory for the points loaded, e.g. 1G (default 2G)"},
         {0},
     };
     cli_renderer_rows(&o.r, VIEW_OPTIONS, opts, sizeof opts / sizeof opts[0]);

@@ -5,6 +5,7 @@
 #ifndef ASP_VIEWER_INTERNAL_H
 #define ASP_VIEWER_INTERNAL_H
 
+#include "amgsplat/hier_ooc.h"
 #include "amgsplat/instances.h"
 #include "amgsplat/scene_renderer.h"
 #include "amgsplat/scene.h"
@@ -146,6 +147,40 @@ int asp__viewer_scene_load(asp_scene *s, const char *path, const asp_viewer_desc
  * unchanged.
  */
 int asp__viewer_scene_action(asp_scene *s, enum asp__viewer_action a, char *note, size_t note_cap, asp_error *err);
+
+/* ---- a streamed .hier (stream.c): the cut of the resting camera, loaded by a second thread ---- */
+
+typedef struct asp__viewer_stream asp__viewer_stream;
+
+/*
+ * Opens the streamed hierarchy at path for viewing: cuts of at most memory / 64 points (memory 0 =
+ * 2 GiB, as render), refined to tau pixels of projected spacing (0 = 1). scripted: loads happen in
+ * the frame after the camera stops, in the caller's thread, so runs repeat exactly. Returns 0 or
+ * asp_ooc_open's errors, ASP_ENOMEM.
+ */
+int asp__viewer_stream_open(const char *path, size_t memory, float tau, int scripted, const asp_context *ctx,
+                            asp__viewer_stream **out, asp_error *err);
+/* The source's frame and the hierarchy's origin into scene (what framing and the renderers use). */
+void asp__viewer_stream_frame(const asp__viewer_stream *s, asp_scene *scene);
+/* Loads the cut of cam (w x h pixels) into scene->cloud, synchronously: the first picture. */
+int asp__viewer_stream_first(asp__viewer_stream *s, const asp_camera *cam, uint32_t w, uint32_t h, asp_scene *scene,
+                             asp_error *err);
+/*
+ * Called once per loop turn with the camera of the frame: when it has rested (REST_SECONDS, or one
+ * frame when scripted) and its cut names other nodes than those shown, loads them (in a thread
+ * unless scripted). *fresh = a new cloud to show instead (the caller owns it) or NULL. Returns 0 or
+ * the selection's or load's error (the shown points stay valid).
+ */
+int asp__viewer_stream_update(asp__viewer_stream *s, const asp_camera *cam, uint32_t w, uint32_t h, double now,
+                              asp_cloud **fresh, asp_error *err);
+/* Sets the projected spacing cuts refine to (the + and - keys); the next turn chooses the cut again. */
+void asp__viewer_stream_set_tolerance(asp__viewer_stream *s, float tau);
+/* 1 while a load runs or a resting camera is still to be checked: the loop should poll, not sleep. */
+int asp__viewer_stream_busy(const asp__viewer_stream *s);
+void asp__viewer_stream_counts(const asp__viewer_stream *s, size_t *loads, size_t *nodes, size_t *node_count,
+                               uint64_t *point_count);
+/* Waits for a running load, frees everything; NULL is accepted. */
+void asp__viewer_stream_close(asp__viewer_stream *s);
 
 /* ---- scenes of instances (instances_view.c, instances.h) ---- */
 

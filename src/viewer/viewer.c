@@ -161,6 +161,7 @@ struct viewer {
     asp__viewer_frame_log flog;
     int edl_on;               /* eye-dome lighting for the disc and square renderers (desc->edl, the E key) */
     int help_on;              /* the h key: the keys drawn over the frame */
+    asp__viewer_stream *stream; /* a streamed .hier: its cuts replace scene.cloud as the camera rests */
 };
 
 static void vlog(const viewer *v, const char *fmt, ...)
@@ -470,6 +471,13 @@ static void change_tolerance(viewer *v, int dir)
     }
     float old = v->tolerance;
     v->tolerance = asp__viewer_tolerance_step(old, dir);
+    if (v->stream) { // a streamed .hier: tau is the projected spacing its cut refines to
+        asp__viewer_stream_set_tolerance(v->stream, v->tolerance);
+        vlog(v, "tau %g px: the streamed cut refines to %g px of point spacing", v->tolerance,
+             v->tolerance > 0 ? v->tolerance : 1.0);
+        if (!K(v->kind)->has_lod)
+            return;
+    }
     if (!K(v->kind)->has_lod) {
         vlog(v, "tau %g px (renderer '%s' draws every point; tau applies to the hierarchy renderers)", v->tolerance,
              K(v->kind)->name);
@@ -1054,6 +1062,41 @@ static int draw(viewer *v, int last, asp_error *err)
     return 0;
 }
 
+/* The title's note on a streamed .hier: how much of it is shown. */
+static void stream_status(viewer *v)
+{
+    size_t loads, nodes, node_count;
+    uint64_t total;
+    asp__viewer_stream_counts(v->stream, &loads, &nodes, &node_count, &total);
+    snprintf(v->status, sizeof v->status, "streamed: %zu of %llu points, %zu of %zu nodes",
+             v->scene.cloud ? v->scene.cloud->count : 0, (unsigned long long)total, nodes, node_count);
+}
+
+/* A streamed .hier: once the camera rests, its cut's points replace those shown (stream.c). */
+static int stream_step(viewer *v, asp_error *err)
+{
+    uint32_t w = 0, h = 0;
+    asp_gl_context_framebuffer_size(v->gl, &w, &h);
+    if (w == 0 || h == 0)
+        return 0;
+    asp_cloud *fresh = NULL;
+    int rc = asp__viewer_stream_update(v->stream, &v->cam, w, h, asp_time_now(), &fresh, err);
+    if (rc || !fresh)
+        return rc;
+    asp_cloud *old = v->scene.cloud;
+    v->scene.cloud = fresh;
+    if ((rc = rebuild_renderer(v, err)) != 0) { // keep drawing the old points
+        v->scene.cloud = old;
+        asp_cloud_destroy(fresh);
+        return rc;
+    }
+    asp_cloud_destroy(old);
+    stream_status(v);
+    v->title_stale = 1;
+    vlog(v, "streamed: %s", v->status + 10);
+    return 0;
+}
+
 static int loop(viewer *v, asp_error *err)
 {
     const asp_viewer_desc *d = v->desc;
@@ -1069,7 +1112,8 @@ static int loop(viewer *v, asp_error *err)
         } else {
             if (v->title_stale)
                 update_title(v, asp_time_now(), 1);
-            glfwWaitEventsTimeout(0.5); // idle: sleep until input instead of redrawing
+            // idle: sleep until input instead of redrawing (briefly while a streamed cut is pending)
+            glfwWaitEventsTimeout(v->stream && asp__viewer_stream_busy(v->stream) ? 0.05 : 0.5);
             v->frame_top = asp_time_now(); // the frame begins when the input arrived, not while idle
         }
         if (scripted && d->fly) {
@@ -1085,6 +1129,11 @@ static int loop(viewer *v, asp_error *err)
         v->queued = 0;
         if (v->quit || glfwWindowShouldClose(v->window))
             return 0;
+        if (v->stream) {
+            asp_error e = {0, ""};
+            if (stream_step(v, &e))
+                vlog(v, "cannot load the view's points: %s", e.msg); // the shown points stay
+        }
         if (!scripted && !v->dirty && !v->screenshot_wanted)
             continue;
         v->dirty = 0;
@@ -1142,13 +1191,32 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
     v.prim.alpha_ref = desc->prim_alpha_ref;
     if (ctx)
         v.ctx = *ctx;
-    rc = asp__viewer_instances_load(&v.instances, &v.scene, path, desc, ctx, err);
-    v.is_scene = rc == 1;
-    if (rc == 0)
-        rc = asp__viewer_scene_load(&v.scene, path, desc, ctx, err);
-    if (rc < 0)
-        return rc;
-    if (v.is_scene)
+    if (asp_ooc_probe(path) == 1) { // a streamed .hier: the first view's cut (stream.c)
+        rc = asp__viewer_stream_open(path, desc->memory, desc->tolerance, desc->frames > 0, ctx, &v.stream, err);
+        if (rc)
+            return rc;
+        asp_file_type_of_name(path, &v.scene.type, NULL);
+        snprintf(v.scene.path, sizeof v.scene.path, "%s", path);
+        v.scene.ctx = v.ctx;
+        asp__viewer_stream_frame(v.stream, &v.scene);
+        uint32_t w = desc->width ? desc->width : 1280, h = desc->height ? desc->height : 800;
+        v.cam.aspect = (float)w / (float)h;
+        reset_view(&v);
+        if ((rc = asp__viewer_stream_first(v.stream, &v.cam, w, h, &v.scene, err)) != 0) {
+            asp__viewer_stream_close(v.stream);
+            return rc;
+        }
+    } else {
+        rc = asp__viewer_instances_load(&v.instances, &v.scene, path, desc, ctx, err);
+        v.is_scene = rc == 1;
+        if (rc == 0)
+            rc = asp__viewer_scene_load(&v.scene, path, desc, ctx, err);
+        if (rc < 0)
+            return rc;
+    }
+    if (v.stream)
+        stream_status(&v);
+    else if (v.is_scene)
         asp__viewer_instances_status(&v.instances, v.status, sizeof v.status);
     else
         asp__viewer_scene_status(&v.scene, v.status, sizeof v.status);
@@ -1215,6 +1283,11 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
         v.stats.last_frame_ms = v.last_ms;
         v.stats.count = asp_renderer_count(v.r);
         snprintf(v.stats.renderer, sizeof v.stats.renderer, "%s", K(v.kind)->name);
+        if (v.stream) {
+            size_t nodes, node_count;
+            asp__viewer_stream_counts(v.stream, &v.stats.stream_loads, &nodes, &node_count, &v.stats.stream_point_count);
+            v.stats.stream_points = v.scene.cloud ? v.scene.cloud->count : 0;
+        }
         *stats = v.stats;
     }
     asp_text_overlay_destroy(v.overlay);
@@ -1222,6 +1295,7 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
     asp_renderer_destroy(v.r);
     asp_hier_destroy(v.hier);
     asp_gl_context_destroy(v.gl);
+    asp__viewer_stream_close(v.stream);
     asp_scene_release(&v.scene);
     asp_instance_scene_release(&v.instances);
     return rc;
