@@ -904,6 +904,10 @@ static int write_table(build *b, uint32_t root, const asp_frame *frame, double r
     asp__store_f64(hd + ASP__OOC_FRAME_AT + 24, frame->radius);
     asp__store_f64(hd + ASP__OOC_RADIUS_AT, radius);
     asp__store_u32(hd + ASP__OOC_UP_AT, (uint32_t)frame->up + 1u);
+    uint16_t q[3]; // the frame's box, as the in-memory layout keeps it after the up axis
+    asp_frame_half_encode(frame, q);
+    asp__store_u32(hd + ASP__OOC_HALF_AT, (uint32_t)q[0] | (uint32_t)q[1] << 16);
+    asp__store_u32(hd + ASP__OOC_HALF_AT + 4, q[2]);
     asp__store_u64(hd + ASP__OOC_HEADER - 8, asp__fnv1a64(ASP__FNV1A64_START, hd, ASP__OOC_HEADER - 8));
     if (!rc && (fseeko(b->out.fp, 0, SEEK_SET) != 0 || fwrite(hd, 1, sizeof hd, b->out.fp) != sizeof hd))
         rc = asp_error_set(b->err, ASP_EIO, "cannot write '%s': %s", b->out.tmp, strerror(errno));
@@ -986,7 +990,7 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
         rc = pass_bounds(&b, xyz, lo, hi);
     st.seconds_bounds = asp_time_now() - t0;
     asp_frame frame;
-    memset(&frame, 0, sizeof frame); // no box (NEEDSWORK: the camera fits the sphere)
+    memset(&frame, 0, sizeof frame);
     // the up axis as a point file's load gives it (issue 29): z for LAS (ASPRS LAS 1.4: Z is the
     // elevation of its CRS), else y
     asp_file_type ftype;
@@ -1013,6 +1017,12 @@ int asp_ooc_build(const char *in, const char *out, const asp_ooc_build_desc *des
         full_radius = dr;
         if (!(frame.radius > 0))
             frame.radius = 1;
+        // and its box, so a flat site is framed by its extent as a point file's is (asp_cloud_frame)
+        for (int k = 0; k < 3; k++)
+            frame.half[k] = 0.5 * (hi[k] - lo[k]) + dr;
+        uint16_t q[3];
+        asp_frame_half_encode(&frame, q);
+        asp_frame_half_decode(&frame, q);
     }
     if (!rc)
         rc = make_chunks(&b, counts, lut);

@@ -138,6 +138,9 @@ int asp_ooc_open(const char *path, const asp_context *ctx, asp_ooc **out, asp_er
         o->full_radius = getf64(hd + ASP__OOC_RADIUS_AT);
         uint32_t up = get32(hd + ASP__OOC_UP_AT);
         o->frame.up = up >= 1 && up <= (uint32_t)ASP_UP_NEG_X + 1u ? (asp_up_axis)(up - 1u) : ASP_UP_Y;
+        uint32_t q01 = get32(hd + ASP__OOC_HALF_AT), q2 = get32(hd + ASP__OOC_HALF_AT + 4);
+        asp_frame_half_decode(&o->frame, (const uint16_t[3]){(uint16_t)(q01 & 0xffffu), (uint16_t)(q01 >> 16),
+                                                             (uint16_t)(q2 & 0xffffu)});
         uint64_t fsize = (uint64_t)size;
         int finite = isfinite(o->frame.radius) && o->frame.radius > 0 && isfinite(o->full_radius) &&
                      o->full_radius >= 0 && up <= (uint32_t)ASP_UP_NEG_X + 1u;

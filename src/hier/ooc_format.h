@@ -19,6 +19,7 @@ enum {
     ASP__OOC_TABLE_AT = 80,    /* byte offset of the node table (uint64) */
     ASP__OOC_TABLE_HASH = 88,  /* FNV-1a 64 of the node table */
     ASP__OOC_UP_AT = 128,      /* uint32: the source's up axis + 1 (0: not recorded, y), as the in-memory layout */
+    ASP__OOC_HALF_AT = 132,    /* 3 x uint16 (asp_frame_half_encode): the frame's box; 0 0 0 in files before it */
     ASP__OOC_RADIUS_AT = 144,  /* double: the disc radius of the whole set at full density (asp_cloud_default_radius) */
     ASP__OOC_SAMPLE_GRID = 128 /* an inner node keeps one point per cell of this grid over its cube */
 };

@@ -41,6 +41,17 @@ nodes=$(jget "$T/conv.json" nodes)
 [[ $(jget "$T/info.json" layout) == streamed && $(jget "$T/info.json" points) == 2000000 ]] ||
   fail "info: $(cat "$T/info.json")"
 
+# the frame's box is recorded (issue 29's framing of flat sites): the points' extent plus a disc
+"$A" info "$T/t.ply" --json > "$T/pinfo.json"
+python3 - "$T/info.json" "$T/pinfo.json" <<'EOF' || fail "the streamed file's frame box: $(cat "$T/info.json")"
+import json, sys
+h, p = (json.load(open(f)) for f in sys.argv[1:])
+box, r = h["frame"]["box"], h["frame"]["radius"]
+for k in range(3):
+    ext = p["bbox_max"][k] - p["bbox_min"][k]
+    assert ext <= box[k] <= ext + 0.02 * r, (k, ext, box, r)
+EOF
+
 # render: far away a coarse cut, at a fine tolerance every point; the same frame as the points
 "$A" render "$T/t.hier" -o "$T/far.png" --size 128x128 --up z --view 30,40 --json > "$T/far.json"
 far=$(jget "$T/far.json" points)
