@@ -1243,7 +1243,8 @@ int asp_viewer_run(const char *path, const asp_viewer_desc *desc, const asp_cont
     // points without normals cannot be lit: eye-dome lighting shades them (Boucheny 2009), as in CloudCompare
     int no_normals = !v.is_scene && v.scene.cloud && !v.scene.cloud->normals && !v.scene.dps;
     v.edl_on = desc->edl > 0 || (desc->edl == 0 && no_normals && !v.unlit);
-    if (no_normals && (K(v.kind)->inputs & ASP_RENDER_INPUT_POINTS))
+    // a streamed .hier keeps positions and colours only: estimate cannot give it normals, so no hint
+    if (no_normals && !v.stream && (K(v.kind)->inputs & ASP_RENDER_INPUT_POINTS))
         vlog(&v, "hint: '%s' has no normals%s; 'amgsplat estimate %s -o WITH_NORMALS.ply' estimates them for lit "
                  "discs", path, v.edl_on && edl_applies(&v, v.kind) ? ": drawn with eye-dome lighting (E toggles it)" : "",
              path);
