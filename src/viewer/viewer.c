@@ -929,14 +929,28 @@ static int draw_overlay(viewer *v, uint32_t width, uint32_t height, asp_error *e
         asp_text_overlay_measure(mid, 2.0f, &w2, &h2);
         while (two > 1.0f && ((w1 + w2 + 8) * two / 2 > room_w || (h1 > h2 ? h1 : h2) * two / 2 > room_h))
             two -= 0.5f;
-        // two columns when they allow a larger font, or when one column runs off the bottom anyway
-        if (two > one || full_h > room_h) {
+        // two columns when they allow a larger font, or when one column runs off the bottom anyway,
+        // as long as they fit side by side; a window too small for both gets the lines that fit below
+        int side_by_side = (w1 + w2 + 8) * two / 2 <= room_w;
+        if (side_by_side && (two > one || full_h > room_h)) {
             asp_text_overlay_desc a = {.x = 8, .y = top, .scale = two}, b = a;
             b.x = 8 + w1 * two / 2 + 8;
             int rc = asp_text_overlay_draw(v->overlay, help, &a, err);
             return rc ? rc : asp_text_overlay_draw(v->overlay, mid, &b, err);
         }
         mid[-1] = '\n';
+    }
+    if (full_h > room_h) { // cut at the last line that fits, and say where the rest is (print_help logged it)
+        float lw, lh;
+        asp_text_overlay_measure("X", one, &lw, &lh);
+        size_t fit = lh > 0 && room_h > lh ? (size_t)(room_h / lh) : 1, seen = 0;
+        char *cut = help;
+        while (*cut && seen + 1 < fit)
+            seen += *cut++ == '\n';
+        if (*cut && seen + 1 == fit && cut > help) {
+            size_t left = lines - seen;
+            snprintf(cut, sizeof help - (size_t)(cut - help), "... %zu more lines: the terminal lists them all", left);
+        }
     }
     asp_text_overlay_desc hd = {.x = 8, .y = top, .scale = one};
     return asp_text_overlay_draw(v->overlay, help, &hd, err);
