@@ -941,9 +941,11 @@ static int draw_overlay(viewer *v, uint32_t width, uint32_t height, asp_error *e
         mid[-1] = '\n';
     }
     if (full_h > room_h) { // cut at the last line that fits, and say where the rest is (print_help logged it)
-        float lw, lh;
-        asp_text_overlay_measure("X", one, &lw, &lh);
-        size_t fit = lh > 0 && room_h > lh ? (size_t)(room_h / lh) : 1, seen = 0;
+        float lw, h1, h2; // the line pitch, without the panel's margins
+        asp_text_overlay_measure("X", one, &lw, &h1);
+        asp_text_overlay_measure("X\nX", one, &lw, &h2);
+        float pitch = h2 - h1, margin = h1 - pitch;
+        size_t fit = pitch > 0 && room_h - margin > pitch ? (size_t)((room_h - margin) / pitch) : 1, seen = 0;
         char *cut = help;
         while (*cut && seen + 1 < fit)
             seen += *cut++ == '\n';

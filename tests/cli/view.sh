@@ -329,7 +329,11 @@ view "$T/scan.ply" --frames 2 --keys i --up z --color-by intensity --size 320x24
 # h shows the keys over the frame as well as printing them; h again hides them
 view "$T/sphere.ply" --frames 2 --keys h --size 480x400 --view 0,0 --screenshot "$T/help.png" 2>"$T/help.err"
 grep -q "^  E  toggle eye-dome lighting" "$T/help.err" || fail "h did not print: $(cat "$T/help.err")"
-check "$T/help.png" "px(10, 10)[0] < 200 and px(400, 20)[0] < 200 and px(10, 300)[:3] == (255, 255, 255)"
+# a window too narrow for two columns gets the lines that fit, nothing cut at the right edge; a wide
+# one gets both columns side by side, above the bottom
+check "$T/help.png" "px(10, 10)[0] < 200 and px(10, 380)[0] < 200 and px(470, 20)[:3] == (255, 255, 255)"
+view "$T/sphere.ply" --frames 2 --keys h --size 1024x400 --view 0,0 --screenshot "$T/help_wide.png" -q
+check "$T/help_wide.png" "px(10, 10)[0] < 200 and px(700, 20)[0] < 200 and px(10, 380)[:3] == (255, 255, 255)"
 check "$T/shot.png" "px(10, 10)[:3] == (255, 255, 255)"
 view "$T/sphere.ply" --frames 3 --keys hh --size 160x120 --view 0,0 --screenshot "$T/help2.png" -q
 [[ "$(metric "$T/help2.png" "$T/ref0.png" psnr)" == inf ]] || fail "h h leaves text on the frame"
