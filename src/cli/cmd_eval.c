@@ -343,8 +343,35 @@ static int eval_instance_scene(const char *path, const char *dir, uint32_t size,
     char json_path[4200], sheet_path[4200];
     snprintf(json_path, sizeof json_path, "%s/eval.json", dir);
     snprintf(sheet_path, sizeof sheet_path, "%s/sheet.png", dir);
+    // one row of tiles, each headed by what it is and how it measured (issue 29: a sheet says what it shows)
+    asp_image grid = {0, 0, NULL};
+    char(*text)[128] = !rc ? calloc(res->row_count, sizeof *text) : NULL;
+    const char **labels = !rc ? calloc(res->row_count, sizeof *labels) : NULL;
+    if (!rc && (!text || !labels))
+        rc = asp_error_set(&err, ASP_ENOMEM, "out of memory");
+    for (size_t i = 0; !rc && i < res->row_count; i++) {
+        const asp_instance_eval_row *r = &res->rows[i];
+        if (i == 0)
+            snprintf(text[i], sizeof text[i], "reference\nsplat, tau 0\n%zu splats", r->primitives);
+        else if (strcmp(r->renderer, "disc") == 0)
+            snprintf(text[i], sizeof text[i], "disc, every point\nSSIM %.3f\n%zu discs", r->ssim, r->primitives);
+        else
+            snprintf(text[i], sizeof text[i], "%s, tau %g px\nSSIM %.3f\n%zu %ss", r->renderer, (double)r->tolerance,
+                     r->ssim, r->primitives, r->renderer);
+        labels[i] = text[i];
+    }
     if (!rc)
-        rc = asp_image_contact_sheet(tiles, res->row_count, 0, &sheet, &err);
+        rc = asp_image_contact_sheet(tiles, res->row_count, (uint32_t)res->row_count, &grid, &err);
+    char title[160];
+    snprintf(title, sizeof title, "%zu instances from the scene's camera at %ux%u", s.instance_count, size, size);
+    if (!rc)
+        rc = asp_chart_label_sheet(&grid,
+                                   &(asp_chart_sheet_desc){.title = title, .row_count = 1,
+                                                           .col_count = res->row_count, .col_labels = labels},
+                                   &sheet, &err);
+    asp_image_release(&grid);
+    free(text);
+    free(labels);
     if (!rc) { // the report's files appear all or none (issue #13)
         asp_output_batch_begin(NULL);
         rc = asp_instance_eval_save_json(res, path, json_path, &err);

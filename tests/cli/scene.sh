@@ -70,7 +70,8 @@ assert rows[3]["primitives"] < rows[2]["primitives"] < rows[0]["primitives"], ro
 assert all(0.3 < r["ssim"] <= 1 and r["frame_ms"] > 0 for r in rows), rows
 assert len(saved["rows"]) == 5 and saved["rows"][0]["reference"] is True
 PY
-check "$T/ev/sheet.png" "fg > 0.05"
+# one row of the 5 tiles under a title and each tile's label (renderer, tau, SSIM, count)
+check "$T/ev/sheet.png" "fg > 0.05 and h > 64 + 30 and w >= 5 * 64"
 expect_fail 2 "--tolerances is for scene files" "$A" eval "$T/sphere.ply" --tolerances 1
 
 # occlusion with domain primitives: the near instance covers the centre whichever comes first
