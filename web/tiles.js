@@ -9,15 +9,77 @@
 //     grows (x1.25 a frame) and shrinks back once they hold under half of it;
 //   while the camera moves the target is `move-factor` times larger (few loads), and the view
 //     refines once it stops.
+// Two kinds of tileset (docs/web.md): REPLACE tiles of an in-memory hierarchy carry
+// KHR_gaussian_splatting ellipses, drawn by Viewer.splatPasses; ADD tiles of a streamed hierarchy
+// (one tile a node, each point once) carry plain points and their disc radius in the mesh's
+// extras.amgsplat.pointRadius, drawn here as camera-facing discs of that radius (discPasses) with
+// the same two passes, as `amgsplat render` draws a streamed cut (asp_ooc_load's radii; docs/hier.md).
 // window.amgsplatViewer: ready at the first frame (firstFrame: bytes and requests fetched by then),
 // settled once nothing loads and the visible set has not changed for a while (stream: the totals).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { TilesRenderer } from '3d-tiles-renderer/three';
+import { splatDepthFragment, splatAccumFragment } from './viewer.js';
 
 const STILL_MS = 300; // the camera counts as moving until this long after its last change
 const SETTLE_FRAMES = 20; // frames without loads or visibility changes before `settled`
+
+// A streamed tile's points as discs facing the eye (the disc renderer's normal u_eye - p,
+// src/render/disc_renderer.c) of the tile's radius, in eye space: the splat passes' triangle around
+// the unit circle, pass 1 pushed one radius away from the eye, pass 2 weighted as the splats are.
+const discVertex = `
+in vec3 position;
+in vec3 center;
+in vec4 splatColor;
+uniform mat4 modelViewMatrix;
+uniform mat4 projectionMatrix;
+uniform float uEpsilon;
+uniform float uRadius;
+out vec2 vLocal;
+out vec3 vColor;
+void main() {
+  vec2 q = position.xy * 1.05;
+  vec3 c = (modelViewMatrix * vec4(center, 1.0)).xyz;
+  vec3 n = dot(c, c) > 0.0 ? -normalize(c) : vec3(0.0, 0.0, 1.0);
+  vec3 t = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+  vec3 b = cross(n, t);
+  vec3 e = c + uRadius * (q.x * t + q.y * b);
+  if (uEpsilon > 0.0 && dot(e, e) > 0.0) e += uEpsilon * uRadius * normalize(e);
+  vLocal = q;
+  vColor = splatColor.rgb;
+  gl_Position = projectionMatrix * vec4(e, 1.0);
+}`;
+
+// the viewer's splat entry ({mesh, points, depth, accum, uniforms}, Viewer.render) for a points node
+function discPasses(viewer, points, radius) {
+  const g = points.geometry, n = g.attributes.position.count, P = g.attributes.position, C = g.attributes.color;
+  const at = new THREE.Vector3();
+  points.updateMatrix();
+  const centers = new Float32Array(3 * n), colors = new Float32Array(4 * n);
+  for (let i = 0; i < n; i++) {
+    centers.set(at.fromBufferAttribute(P, i).applyMatrix4(points.matrix).toArray(), 3 * i);
+    colors.set(C ? [C.getX(i), C.getY(i), C.getZ(i), 1] : [0.578, 0.578, 0.578, 1], 4 * i);
+  }
+  const geo = new THREE.InstancedBufferGeometry();
+  geo.setAttribute('position', new THREE.Float32BufferAttribute([-1.7320508, -1, 0, 1.7320508, -1, 0, 0, 2, 0], 3));
+  geo.setAttribute('center', new THREE.InstancedBufferAttribute(centers, 3));
+  geo.setAttribute('splatColor', new THREE.InstancedBufferAttribute(colors, 4));
+  geo.instanceCount = n;
+  const uniforms = { uEpsilon: { value: 1 }, uLit: { value: 0 }, uRadius: { value: radius },
+    frontDepth: { value: viewer.front.depthTexture } };
+  const common = { glslVersion: THREE.GLSL3, vertexShader: discVertex, side: THREE.DoubleSide };
+  const depth = new THREE.RawShaderMaterial({ ...common, fragmentShader: splatDepthFragment, uniforms });
+  const accum = new THREE.RawShaderMaterial({
+    ...common, fragmentShader: splatAccumFragment, uniforms,
+    blending: THREE.CustomBlending, blendEquation: THREE.AddEquation, blendSrc: THREE.OneFactor,
+    blendDst: THREE.OneFactor, blendSrcAlpha: THREE.OneFactor, blendDstAlpha: THREE.OneFactor,
+    depthTest: false, depthWrite: false,
+  });
+  const mesh = new THREE.Mesh(geo, depth);
+  mesh.frustumCulled = false;
+  return { mesh, points, depth, accum, uniforms };
+}
 
 export class TileStream {
   constructor(viewer, opts, status) {
@@ -113,7 +175,7 @@ export class TileStream {
     v.fit();
   }
 
-  // Each tile's points with KHR_gaussian_splatting attributes become splats beside them.
+  // Each tile's points with KHR_gaussian_splatting attributes, or a disc radius, become splats beside them.
   prepare(scene) {
     const v = this.viewer, found = [];
     let points = 0;
@@ -122,10 +184,11 @@ export class TileStream {
       if (!o.isPoints) return;
       points += o.geometry.attributes.position.count;
       o.material.size = this.opts.pointSize;
-      if (o.geometry.attributes['khr_gaussian_splatting:rotation']) found.push(o);
+      if (o.geometry.attributes['khr_gaussian_splatting:rotation'] || o.userData.amgsplat?.pointRadius > 0) found.push(o);
     });
     const splats = found.map((p) => {
-      const sp = v.splatPasses(p);
+      const r = p.userData.amgsplat?.pointRadius;
+      const sp = p.geometry.attributes['khr_gaussian_splatting:rotation'] ? v.splatPasses(p) : discPasses(v, p, r);
       p.parent.add(sp.mesh); // the centres hold the points' node transform (splatPasses)
       return sp;
     });
