@@ -64,6 +64,19 @@ typedef struct scratch {
 } scratch;
 
 /*
+ * Children with points below them: the converter can leave a node's octants empty (a node of a
+ * few points split anyway), and a tile without content or children is no tile. A node whose
+ * children are all empty is a leaf here.
+ */
+static uint32_t live_children(const ooc_run *r, const asp_ooc_node *nd)
+{
+    uint32_t n = 0;
+    for (uint32_t k = 0; k < nd->child_count; k++)
+        n += r->nodes[nd->first_child + k].subtree_points > 0;
+    return n;
+}
+
+/*
  * The GLB of n points (pos y-up, rec's colours) at path: compact (module comment) or, with plain,
  * float positions and uncompressed colours in file order.
  */
@@ -134,7 +147,7 @@ static int write_glb(const ooc_run *r, uint32_t id, const scratch *s, size_t n, 
     cJSON_AddNumberToObject(am, "spacing", nd->spacing);
     cJSON_AddNumberToObject(am, "node", id);
     cJSON_AddNumberToObject(am, "depth", nd->depth);
-    cJSON_AddBoolToObject(am, "leaf", nd->child_count == 0);
+    cJSON_AddBoolToObject(am, "leaf", live_children(r, nd) == 0);
     int m = asp__gltf_append(&g, g.meshes, mesh);
     char name[64];
     snprintf(name, sizeof name, "node %u (%zu points)", (unsigned)id, n);
@@ -167,7 +180,7 @@ static int write_glb(const ooc_run *r, uint32_t id, const scratch *s, size_t n, 
 static cJSON *tile_json(const ooc_run *r, uint32_t id, double max_error)
 {
     const asp_ooc_node *nd = &r->nodes[id];
-    double error = nd->child_count ? fmin((double)nd->spacing, max_error) : 0;
+    double error = live_children(r, nd) ? fmin((double)nd->spacing, max_error) : 0;
     cJSON *tile = cJSON_CreateObject();
     if (!tile)
         return NULL;
@@ -178,7 +191,7 @@ static cJSON *tile_json(const ooc_run *r, uint32_t id, double max_error)
         snprintf(uri, sizeof uri, "tiles/%u.glb", (unsigned)id);
         cJSON_AddStringToObject(cJSON_AddObjectToObject(tile, "content"), "uri", uri);
     }
-    if (!nd->child_count)
+    if (!live_children(r, nd))
         return tile;
     cJSON *children = cJSON_AddArrayToObject(tile, "children");
     for (uint32_t k = 0; k < nd->child_count; k++) {
@@ -265,7 +278,7 @@ int asp_tiles_export_ooc(asp_ooc *ooc, const char *dir, const asp_tiles_desc *de
             r.st.file_bytes += r.bytes[i];
             r.st.largest = n > r.st.largest ? n : r.st.largest;
             r.st.depth = nd->depth > r.st.depth ? nd->depth : r.st.depth;
-            if (!nd->child_count)
+            if (!live_children(&r, nd))
                 r.st.leaf_points += n;
         }
         for (uint32_t k = 0; k < nd->child_count; k++) { // 3D Tiles 1.1: a tile's volume holds its children's
