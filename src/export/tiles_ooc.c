@@ -24,8 +24,8 @@
  * translation and uniform scale, COLOR_0 8-bit linear, spatially sorted) without normals or
  * KHR_gaussian_splatting: the points carry none, so they are round discs. The disc radius
  * asp_ooc_load gives the node's points (asp_ooc_disc_radius) is in the mesh's
- * extras.amgsplat.pointRadius (model units) for the web page (web/tiles.js), which draws them as
- * the disc renderer draws the cut; generic clients draw plain glTF points.
+ * extras.amgsplat.pointRadius (model units), with the node's cube, for the web page (web/tiles.js),
+ * which draws them as the disc renderer draws the cut; generic clients draw plain glTF points.
  *
  * Frames are those of tiles.c: GLB content y up in the hierarchy's local frame (turned from the
  * source's up axis by asp__gltf_turn_up), boxes turned to 3D Tiles z-up (asp__tiles_box), the
@@ -144,6 +144,13 @@ static int write_glb(const ooc_run *r, uint32_t id, const scratch *s, size_t n, 
     cJSON_AddStringToObject(mesh, "name", "points");
     cJSON *am = cJSON_AddObjectToObject(cJSON_AddObjectToObject(mesh, "extras"), "amgsplat");
     cJSON_AddNumberToObject(am, "pointRadius", asp_ooc_disc_radius(r->ooc, id));
+    // the node's cube (centre y up, as the positions, and half side): the page tells a point's
+    // octant by it and draws the point at the radius of a visible child there, as asp_ooc_load
+    // sizes a point by the deepest loaded node holding it
+    float cc[3] = {nd->center[0], nd->center[1], nd->center[2]};
+    asp__gltf_turn_up_f(r->up, cc);
+    double cube[4] = {cc[0], cc[1], cc[2], nd->half};
+    cJSON_AddItemToObject(am, "cube", asp__gltf_numbers(cube, 4));
     cJSON_AddNumberToObject(am, "spacing", nd->spacing);
     cJSON_AddNumberToObject(am, "node", id);
     cJSON_AddNumberToObject(am, "depth", nd->depth);
