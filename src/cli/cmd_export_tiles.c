@@ -24,7 +24,8 @@
 int export_tiles(struct cli_env *env, const char *in, int hier_file, const char *dir, size_t tile_points,
                  const char *memory, unsigned flags);
 
-/* The streamed .hier at path (or NULL: convert in first, to a temporary file next to dir) as tiles. */
+/* The streamed .hier in as tiles; with convert, in is a point file, converted first to a temporary .hier next
+ * to dir. */
 static int tiles_streamed(struct cli_env *env, const char *in, int convert, const char *dir, size_t tile_points,
                           size_t memory, unsigned flags, asp_tiles_stats *st, asp_error *err)
 {
@@ -37,8 +38,6 @@ static int tiles_streamed(struct cli_env *env, const char *in, int convert, cons
             len--;
         if (snprintf(tmp, sizeof tmp, "%.*s.convert-%ld.hier", (int)len, dir, (long)getpid()) >= (int)sizeof tmp)
             return asp_error_set(err, ASP_EINVAL, "tileset directory name '%s' is too long", dir);
-        if (tile_points && (tile_points < 64 || tile_points > 1000000))
-            return asp_error_set(err, ASP_EINVAL, "--tile-points %zu: expected 64 to 1000000", tile_points);
         const asp_ooc_build_desc bd = {.memory = memory, .node_points = tile_points};
         asp_ooc_build_stats bs;
         if ((rc = asp_ooc_build(in, tmp, &bd, &env->ctx, &bs, err)) != 0)
@@ -70,6 +69,9 @@ int export_tiles(struct cli_env *env, const char *in, int hier_file, const char 
                                in);
     if (memory && cli_memory_option(env, memory, &budget))
         return 2;
+    if (!hier_file && tile_points && (tile_points < 64 || tile_points > 1000000))
+        return cli_usage_error(env, "--tile-points %zu: a point file's leaf nodes hold 64 to 1000000 points",
+                               tile_points);
     if (streamed && tile_points)
         return cli_usage_error(env, "--tile-points: the tiles of the streamed hierarchy '%s' are its nodes (set "
                                     "--node-points when converting)", in);

@@ -46,11 +46,9 @@ typedef struct ooc_run {
     asp_ooc *ooc;
     const asp_ooc_node *nodes;
     size_t node_count;
-    const char *dir;
     int plain;
     asp_up_axis up;
     double *boxes;         /* 6 a node: its subtree's points, y up */
-    size_t *bytes;         /* each node's GLB */
     uint8_t lut[256];      /* sRGB byte -> linear byte (glTF colours are linear) */
     asp_tiles_stats st;
 } ooc_run;
@@ -228,7 +226,6 @@ int asp_tiles_export_ooc(asp_ooc *ooc, const char *dir, const asp_tiles_desc *de
     ooc_run r = {.ooc = ooc,
                  .nodes = asp_ooc_nodes(ooc),
                  .node_count = asp_ooc_node_count(ooc),
-                 .dir = dir,
                  .plain = (d->gltf.flags & ASP_GLTF_PLAIN) != 0,
                  .up = asp_ooc_frame(ooc)->up};
     for (int c = 0; c < 256; c++) {
@@ -240,13 +237,12 @@ int asp_tiles_export_ooc(asp_ooc *ooc, const char *dir, const asp_tiles_desc *de
         largest = r.nodes[i].point_count > largest ? r.nodes[i].point_count : largest;
     scratch s = {0};
     r.boxes = asp_alloc(NULL, r.node_count * 6 * sizeof *r.boxes);
-    r.bytes = asp_alloc(NULL, r.node_count * sizeof *r.bytes);
     s.rec = asp_alloc(NULL, (largest ? largest : 1) * sizeof *s.rec);
     s.pos = asp_alloc(NULL, (largest ? largest : 1) * 12);
     s.remap = asp_alloc(NULL, (largest ? largest : 1) * sizeof *s.remap);
     s.buf = asp_alloc(NULL, (largest ? largest : 1) * 8);
     int rc = 0;
-    if (!r.boxes || !r.bytes || !s.rec || !s.pos || !s.remap || !s.buf)
+    if (!r.boxes || !s.rec || !s.pos || !s.remap || !s.buf)
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory for the tiles of %zu nodes (largest %zu points)",
                            r.node_count, largest);
     if (!rc)
@@ -259,8 +255,7 @@ int asp_tiles_export_ooc(asp_ooc *ooc, const char *dir, const asp_tiles_desc *de
             box[k] = INFINITY;
             box[3 + k] = -INFINITY;
         }
-        r.bytes[i] = 0;
-        size_t n = nd->point_count;
+        size_t n = nd->point_count, bytes = 0;
         if (n) {
             if ((rc = asp_ooc_read_points(ooc, (uint32_t)i, s.rec, err)) != 0)
                 break;
@@ -278,11 +273,11 @@ int asp_tiles_export_ooc(asp_ooc *ooc, const char *dir, const asp_tiles_desc *de
                 rc = asp_error_set(err, ASP_EINVAL, "tileset directory name '%s' is too long", dir);
                 break;
             }
-            if ((rc = write_glb(&r, (uint32_t)i, &s, n, path, &r.bytes[i], err)) != 0)
+            if ((rc = write_glb(&r, (uint32_t)i, &s, n, path, &bytes, err)) != 0)
                 break;
             r.st.tiles++;
             r.st.splats += n;
-            r.st.file_bytes += r.bytes[i];
+            r.st.file_bytes += bytes;
             r.st.largest = n > r.st.largest ? n : r.st.largest;
             r.st.depth = nd->depth > r.st.depth ? nd->depth : r.st.depth;
             if (!live_children(&r, nd))
@@ -312,7 +307,6 @@ int asp_tiles_export_ooc(asp_ooc *ooc, const char *dir, const asp_tiles_desc *de
     }
     // the tiles written before an error stay; without tileset.json they are no tileset
     asp_free(NULL, r.boxes);
-    asp_free(NULL, r.bytes);
     if (!rc && stats)
         *stats = r.st;
     return rc;

@@ -112,6 +112,7 @@ head -c $((size - 100)) "$T/torus_s.hier" >"$T/cut.hier"
 expect_fail 1 "cut.hier" "$AMGSPLAT" export "$T/cut.hier" -o "$T/cut" --tiles
 [[ ! -e "$T/cut/tileset.json" ]] || fail "a truncated .hier left a tileset"
 expect_fail 2 "--tile-points" "$AMGSPLAT" export "$T/torus_s.hier" -o "$T/x" --tiles --tile-points 100
+expect_fail 2 "64 to 1000000" "$AMGSPLAT" export "$T/torus.ply" -o "$T/x" --tiles --tile-points 10
 expect_fail 2 "--memory" "$AMGSPLAT" export "$T/torus_s.hier" -o "$T/x" --tiles --memory 100M
 expect_fail 2 "--memory needs --tiles" "$AMGSPLAT" export "$T/torus.ply" -o "$T/x.glb" --memory 100M
 expect_fail 1 "64 MiB" "$AMGSPLAT" export "$T/torus.ply" -o "$T/x" --tiles --memory 1M
