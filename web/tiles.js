@@ -9,15 +9,83 @@
 //     grows (x1.25 a frame) and shrinks back once they hold under half of it;
 //   while the camera moves the target is `move-factor` times larger (few loads), and the view
 //     refines once it stops.
+// Two kinds of tileset (docs/web.md): REPLACE tiles of an in-memory hierarchy carry
+// KHR_gaussian_splatting ellipses, drawn by Viewer.splatPasses; ADD tiles of a streamed hierarchy
+// (one tile a node, each point once) carry plain points and their disc radius in the mesh's
+// extras.amgsplat.pointRadius, drawn here as camera-facing discs of that radius (discPasses) with
+// the same two passes, as `amgsplat render` draws a streamed cut (asp_ooc_load's radii; docs/hier.md).
 // window.amgsplatViewer: ready at the first frame (firstFrame: bytes and requests fetched by then),
 // settled once nothing loads and the visible set has not changed for a while (stream: the totals).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { TilesRenderer } from '3d-tiles-renderer/three';
+import { splatDepthFragment, splatAccumFragment } from './viewer.js';
 
 const STILL_MS = 300; // the camera counts as moving until this long after its last change
 const SETTLE_FRAMES = 20; // frames without loads or visibility changes before `settled`
+
+// A streamed tile's points as discs facing the eye (the disc renderer's normal u_eye - p,
+// src/render/disc_renderer.c), in eye space: the splat passes' triangle around the unit circle,
+// pass 1 pushed one radius away from the eye, pass 2 weighted as the splats are. The radius is the
+// tile's, or in an octant of its node's cube (uCube) where a child tile is drawn, that child's
+// (uRadii, refineRadii): asp_ooc_load sizes a point by the deepest loaded node that holds it, so
+// a coarse tile's wide discs do not blur the finer tiles drawn over the same surface (ADD).
+const discVertex = `
+in vec3 position;
+in vec3 center;
+in vec4 splatColor;
+uniform mat4 modelViewMatrix;
+uniform mat4 projectionMatrix;
+uniform float uEpsilon;
+uniform float uRadii[8];
+uniform vec3 uCube;
+out vec2 vLocal;
+out vec3 vColor;
+void main() {
+  vec2 q = position.xy * 1.05;
+  int octant = (center.x > uCube.x ? 1 : 0) + (center.y > uCube.y ? 2 : 0) + (center.z > uCube.z ? 4 : 0);
+  float r = uRadii[octant];
+  vec3 c = (modelViewMatrix * vec4(center, 1.0)).xyz;
+  vec3 n = dot(c, c) > 0.0 ? -normalize(c) : vec3(0.0, 0.0, 1.0);
+  vec3 t = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+  vec3 b = cross(n, t);
+  vec3 e = c + r * (q.x * t + q.y * b);
+  if (uEpsilon > 0.0 && dot(e, e) > 0.0) e += uEpsilon * r * normalize(e);
+  vLocal = q;
+  vColor = splatColor.rgb;
+  gl_Position = projectionMatrix * vec4(e, 1.0);
+}`;
+
+// the viewer's splat entry ({mesh, points, depth, accum, uniforms}, Viewer.render) for a points node
+function discPasses(viewer, points, radius, cube) {
+  const g = points.geometry, n = g.attributes.position.count, P = g.attributes.position, C = g.attributes.color;
+  const at = new THREE.Vector3();
+  points.updateMatrix();
+  const centers = new Float32Array(3 * n), colors = new Float32Array(4 * n);
+  for (let i = 0; i < n; i++) {
+    centers.set(at.fromBufferAttribute(P, i).applyMatrix4(points.matrix).toArray(), 3 * i);
+    colors.set(C ? [C.getX(i), C.getY(i), C.getZ(i), 1] : [0.578, 0.578, 0.578, 1], 4 * i);
+  }
+  const geo = new THREE.InstancedBufferGeometry();
+  geo.setAttribute('position', new THREE.Float32BufferAttribute([-1.7320508, -1, 0, 1.7320508, -1, 0, 0, 2, 0], 3));
+  geo.setAttribute('center', new THREE.InstancedBufferAttribute(centers, 3));
+  geo.setAttribute('splatColor', new THREE.InstancedBufferAttribute(colors, 4));
+  geo.instanceCount = n;
+  const uniforms = { uEpsilon: { value: 1 }, uLit: { value: 0 }, uRadii: { value: new Array(8).fill(radius) },
+    uCube: { value: new THREE.Vector3(...(cube || [0, 0, 0])) }, frontDepth: { value: viewer.front.depthTexture } };
+  const common = { glslVersion: THREE.GLSL3, vertexShader: discVertex, side: THREE.DoubleSide };
+  const depth = new THREE.RawShaderMaterial({ ...common, fragmentShader: splatDepthFragment, uniforms });
+  const accum = new THREE.RawShaderMaterial({
+    ...common, fragmentShader: splatAccumFragment, uniforms,
+    blending: THREE.CustomBlending, blendEquation: THREE.AddEquation, blendSrc: THREE.OneFactor,
+    blendDst: THREE.OneFactor, blendSrcAlpha: THREE.OneFactor, blendDstAlpha: THREE.OneFactor,
+    depthTest: false, depthWrite: false,
+  });
+  const mesh = new THREE.Mesh(geo, depth);
+  mesh.frustumCulled = false;
+  return { mesh, points, depth, accum, uniforms };
+}
 
 export class TileStream {
   constructor(viewer, opts, status) {
@@ -113,7 +181,7 @@ export class TileStream {
     v.fit();
   }
 
-  // Each tile's points with KHR_gaussian_splatting attributes become splats beside them.
+  // Each tile's points with KHR_gaussian_splatting attributes, or a disc radius, become splats beside them.
   prepare(scene) {
     const v = this.viewer, found = [];
     let points = 0;
@@ -122,14 +190,19 @@ export class TileStream {
       if (!o.isPoints) return;
       points += o.geometry.attributes.position.count;
       o.material.size = this.opts.pointSize;
-      if (o.geometry.attributes['khr_gaussian_splatting:rotation']) found.push(o);
+      if (o.geometry.attributes['khr_gaussian_splatting:rotation'] || o.userData.amgsplat?.pointRadius > 0) found.push(o);
     });
+    let disc = null; // a streamed tile: its radius and node cube (refineRadii)
     const splats = found.map((p) => {
-      const sp = v.splatPasses(p);
-      p.parent.add(sp.mesh); // the centres hold the points' node transform (splatPasses)
+      if (p.geometry.attributes['khr_gaussian_splatting:rotation']) return v.splatPasses(p);
+      const a = p.userData.amgsplat;
+      disc = { radius: a.pointRadius, cube: a.cube };
+      return discPasses(v, p, a.pointRadius, a.cube);
+    }).map((sp) => {
+      sp.points.parent.add(sp.mesh); // the centres hold the points' node transform (splatPasses)
       return sp;
     });
-    scene.userData.amgsplat = { points, splats };
+    scene.userData.amgsplat = { points, splats, disc };
     v.splats.push(...splats);
   }
 
@@ -145,6 +218,24 @@ export class TileStream {
     this.dirty = true;
   }
 
+  // Per streamed tile and octant of its node's cube, the disc radius of the child tile drawn there
+  // (ADD: the parent's points in that octant lie among the child's denser ones), else the tile's own.
+  refineRadii() {
+    const shown = this.tiles.visibleTiles;
+    for (const t of shown) {
+      const mine = t.engineData.scene?.userData.amgsplat;
+      if (!mine?.disc?.cube) continue;
+      const c0 = mine.disc.cube, radii = new Array(8).fill(mine.disc.radius);
+      for (const child of t.children) {
+        const d = shown.has(child) && child.engineData.scene?.userData.amgsplat?.disc;
+        if (!d?.cube) continue;
+        const o = (d.cube[0] > c0[0] ? 1 : 0) + (d.cube[1] > c0[1] ? 2 : 0) + (d.cube[2] > c0[2] ? 4 : 0);
+        radii[o] = Math.min(radii[o], d.radius);
+      }
+      for (const sp of mine.splats) if (sp.uniforms.uRadii) sp.uniforms.uRadii.value = radii;
+    }
+  }
+
   visiblePoints() {
     let n = 0;
     for (const t of this.tiles.visibleTiles) n += t.engineData.scene?.userData.amgsplat?.points || 0;
@@ -158,6 +249,7 @@ export class TileStream {
     v.camera.updateMatrixWorld();
     tiles.setResolutionFromRenderer(v.camera, v.renderer);
     tiles.update();
+    if (this.dirty) this.refineRadii();
     const shown = this.visiblePoints();
     if (shown > o.pointBudget) this.scale *= 1.25;
     else if (shown < 0.5 * o.pointBudget && this.scale > 1) this.scale = Math.max(1, this.scale / 1.25);

@@ -230,6 +230,9 @@ void main() {
   color = vec4(toSrgb(c), 1.0);
 }`;
 
+// the streamed tiles' discs blend with the splats' passes (tiles.js)
+export { splatDepthFragment, splatAccumFragment };
+
 function srgbToLinear(c) {
   const x = c / 255;
   return x <= 0.04045 ? x / 12.92 : Math.pow((x + 0.055) / 1.055, 2.4);

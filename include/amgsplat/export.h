@@ -7,6 +7,7 @@
 #define AMGSPLAT_EXPORT_H
 
 #include "hier.h"
+#include "hier_ooc.h"
 #include "prim.h"
 
 #ifdef __cplusplus
@@ -155,6 +156,31 @@ typedef struct asp_tiles_stats {
  */
 int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles_desc *desc, asp_tiles_stats *stats,
                           asp_error *err);
+
+/**
+ * Writes the streamed hierarchy ooc (asp_ooc_open, docs/hier.md "Streamed
+ * layout") as a 3D Tiles 1.1 tileset in directory dir (created if missing):
+ * one tile per node with points, refine ADD (a node's points are a
+ * subsample its descendants' points complete, each point stored once, so a
+ * view draws the union of its tiles' contents, as asp_ooc_load loads a cut),
+ * dir/tiles/<node id>.glb holding the node's own points as compact glTF
+ * POINTS (POSITION 16-bit in the node's box, COLOR_0 8-bit linear; with
+ * ASP_GLTF_PLAIN float positions, uncompressed), no normals and no
+ * KHR_gaussian_splatting: they are round discs, whose radius
+ * (asp_ooc_disc_radius) is in the mesh's extras.amgsplat.pointRadius.
+ * geometricError is the node's point spacing (0 at leaves), so a client's
+ * screen-space error in pixels is asp_ooc_select's tau; boxes hold the
+ * subtree's points. Frames as asp_tiles_export_hier (y-up GLBs, z-up
+ * boxes, the origin in the root transform). Reads one node at a time:
+ * memory is the node table and the largest node. desc->tile_points must be
+ * 0 (the nodes are the tiles). Files are written atomically, tileset.json
+ * last. Moves ooc's file position (not thread safe on one ooc). stats may
+ * be NULL; splats counts points.
+ * Errors: ASP_EINVAL (desc with levels or tile_points, directory name too
+ * long), ASP_EIO (cannot read the points, create or write), ASP_ENOMEM.
+ */
+int asp_tiles_export_ooc(asp_ooc *ooc, const char *dir, const asp_tiles_desc *desc, asp_tiles_stats *stats,
+                         asp_error *err);
 
 #ifdef __cplusplus
 }

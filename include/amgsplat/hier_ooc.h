@@ -138,6 +138,26 @@ int asp_ooc_select(const asp_ooc *ooc, const asp_hier_view *view, uint64_t max_p
  */
 int asp_ooc_load(asp_ooc *ooc, const uint32_t *nodes, size_t count, asp_cloud **out, asp_error *err);
 
+/**
+ * The disc radius asp_ooc_load gives a point whose deepest loaded node is
+ * node: at a leaf, the radius the whole set gets when drawn from memory
+ * (asp_cloud_default_radius, recorded at conversion); above, 2 / sqrt(pi)
+ * times the node's spacing if that is larger, so coarse cuts stay closed.
+ * Hierarchy-local units. Pure.
+ */
+float asp_ooc_disc_radius(const asp_ooc *ooc, uint32_t node);
+
+/**
+ * Reads the points stored in node (its own, asp_ooc_node.point_count of
+ * them, hierarchy-local, in the source's frame) into dst, which holds at
+ * least that many records. Reading one node at a time keeps memory at the
+ * largest node whatever the set's size (asp_tiles_export_ooc). Returns 0,
+ * ASP_EIO (a read failed or the file is shorter than its node table says,
+ * naming the node), ASP_EINVAL (node out of range). Not thread safe on one
+ * asp_ooc (one file position), as asp_ooc_load.
+ */
+int asp_ooc_read_points(asp_ooc *ooc, uint32_t node, asp_ooc_point *dst, asp_error *err);
+
 #ifdef __cplusplus
 }
 #endif

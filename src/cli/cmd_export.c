@@ -7,7 +7,7 @@ static const char usage[] =
     "usage: amgsplat export IN -o OUT.glb|OUT.gltf [--level L[,L...]|all] [--alpha-mode blend|mask]\n"
     "                       [--alpha-cutoff X] [--lit] [--no-normal-map] [--no-splats] [--plain]\n"
     "                       [--json]\n"
-    "       amgsplat export IN -o DIR --tiles [--tile-points N] [--no-splats] [--plain]\n"
+    "       amgsplat export IN -o DIR --tiles [--tile-points N] [--memory SIZE] [--no-splats] [--plain]\n"
     "\n"
     "Writes glTF 2.0: one binary .glb, or a .gltf with OUT.bin and OUT_<image>.png beside it.\n"
     "A .dps becomes one textured quad per domain primitive (its support rectangle, as amgsplat\n"
@@ -18,7 +18,9 @@ static const char usage[] =
     "quantised (KHR_mesh_quantization) and compressed (EXT_meshopt_compression) unless --plain.\n"
     "Positions are relative to the model's origin, kept in the node translation.\n"
     "--tiles writes a point set or .hier as a streamed 3D Tiles 1.1 tileset: DIR/tileset.json and\n"
-    "one GLB a tile under DIR/tiles/ (docs/web.md).";
+    "one GLB a tile under DIR/tiles/ (docs/web.md). A point file is converted first to a streamed\n"
+    "hierarchy (as amgsplat convert, within --memory) and tiled node by node, refine ADD, in bounded\n"
+    "memory; a streamed .hier likewise; an in-memory .hier keeps its elliptical splats (REPLACE).";
 
 #include <stdio.h>
 #include <string.h>
@@ -30,15 +32,15 @@ static const char usage[] =
 #include "util/banned.h"
 
 struct export_opts {
-    const char *output, *level, *alpha_mode;
+    const char *output, *level, *alpha_mode, *memory;
     double alpha_cutoff;
     int lit, no_normal_map, no_splats, plain, tiles;
     size_t tile_points;
 };
 
-/* cmd_export_tiles.c: --tiles (asp_tiles_export_hier) */
+/* cmd_export_tiles.c: --tiles (asp_tiles_export_ooc, asp_tiles_export_hier) */
 int export_tiles(struct cli_env *env, const char *in, int hier_file, const char *dir, size_t tile_points,
-                 unsigned flags);
+                 const char *memory, unsigned flags);
 
 /* --level "L-6,L" or "all" into indices of dps->levels; returns the count, 0 on error (printed). */
 static int parse_levels(struct cli_env *env, const asp_dps *dps, const char *path, const char *text, size_t *out,
@@ -209,7 +211,10 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
         {"plain", 0, CLI_FLAG, &o.plain, NULL, "points: float attributes, uncompressed, in input order (default: "
                                                 "quantised, meshopt-compressed)"},
         {"tiles", 0, CLI_FLAG, &o.tiles, NULL, "points: a 3D Tiles 1.1 tileset in directory OUT (tileset.json, tiles/*.glb)"},
-        {"tile-points", 0, CLI_SIZE, &o.tile_points, "N", "--tiles: most splats in a tile (default 32768)"},
+        {"tile-points", 0, CLI_SIZE, &o.tile_points, "N", "--tiles: most splats in a tile (default 32768; a point "
+                                                           "file: most points in a leaf node)"},
+        {"memory", 0, CLI_STRING, &o.memory, "SIZE", "--tiles, point file: working set of the conversion, e.g. 512M "
+                                                      "(default 2G)"},
         {0},
     };
     int npos = 0, rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -241,11 +246,11 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--no-splats is for point inputs");
     if (is_dps && o.plain)
         return cli_usage_error(env, "--plain is for point inputs (primitive levels are always written plain)");
-    if (o.tile_points && !o.tiles)
-        return cli_usage_error(env, "--tile-points needs --tiles");
+    if ((o.tile_points || o.memory) && !o.tiles)
+        return cli_usage_error(env, "%s needs --tiles", o.tile_points ? "--tile-points" : "--memory");
     if (o.tiles && is_dps)
         return cli_usage_error(env, "--tiles takes a point file or a .hier (not yet a .dps)");
     if (o.tiles)
-        return export_tiles(env, in, type.kind == ASP_FILE_HIER, o.output, o.tile_points, d.flags);
+        return export_tiles(env, in, type.kind == ASP_FILE_HIER, o.output, o.tile_points, o.memory, d.flags);
     return is_dps ? export_dps(env, in, &o, &d) : export_points(env, in, type.kind == ASP_FILE_HIER, &o, &d);
 }

@@ -1,47 +1,101 @@
 /*
  * amgsplat export IN -o DIR --tiles: a point set or .hier as a streamed 3D Tiles 1.1 tileset
- * (asp_tiles_export_hier, issue 32), for the web page's streaming mode and any 3D Tiles client.
- * docs/web.md says how to serve it.
+ * (issue 32), for the web page's streaming mode and any 3D Tiles client. docs/web.md says how to
+ * serve it. Three routes:
+ *  - a streamed .hier (amgsplat convert): one tile a node, refine ADD (asp_tiles_export_ooc),
+ *    memory bounded by the largest node;
+ *  - a point file: converted first to a temporary streamed .hier next to DIR within --memory
+ *    (asp_ooc_build, as PotreeConverter does), then as above, so a scan of any size tiles in
+ *    bounded memory; the temporary file is removed;
+ *  - an in-memory .hier (amgsplat hier): its elliptical splats, refine REPLACE
+ *    (asp_tiles_export_hier).
  */
 #include <stdio.h>
+#include <string.h>
+#include <unistd.h>
 
 #include <cjson/cJSON.h>
 
+#include "amgsplat/hier_ooc.h"
 #include "cli/cli.h"
 #include "cli/commands.h"
 #include "util/banned.h"
 
 int export_tiles(struct cli_env *env, const char *in, int hier_file, const char *dir, size_t tile_points,
-                 unsigned flags);
+                 const char *memory, unsigned flags);
+
+/* The streamed .hier in as tiles; with convert, in is a point file, converted first to a temporary .hier next
+ * to dir. */
+static int tiles_streamed(struct cli_env *env, const char *in, int convert, const char *dir, size_t tile_points,
+                          size_t memory, unsigned flags, asp_tiles_stats *st, asp_error *err)
+{
+    char tmp[4096];
+    const char *path = in;
+    int rc = 0;
+    if (convert) {
+        size_t len = strlen(dir);
+        while (len > 1 && dir[len - 1] == '/')
+            len--;
+        if (snprintf(tmp, sizeof tmp, "%.*s.convert-%ld.hier", (int)len, dir, (long)getpid()) >= (int)sizeof tmp)
+            return asp_error_set(err, ASP_EINVAL, "tileset directory name '%s' is too long", dir);
+        const asp_ooc_build_desc bd = {.memory = memory, .node_points = tile_points};
+        asp_ooc_build_stats bs;
+        if ((rc = asp_ooc_build(in, tmp, &bd, &env->ctx, &bs, err)) != 0)
+            return rc;
+        cli_info(env, "amgsplat export: converted '%s' to a streamed hierarchy (%llu points, %zu nodes, depth %u)", in,
+                 (unsigned long long)bs.points, bs.nodes, bs.depth);
+        path = tmp;
+    }
+    asp_ooc *ooc = NULL;
+    rc = asp_ooc_open(path, &env->ctx, &ooc, err);
+    const asp_tiles_desc d = {.gltf = {.flags = flags}};
+    if (!rc)
+        rc = asp_tiles_export_ooc(ooc, dir, &d, st, err);
+    asp_ooc_close(ooc);
+    if (convert)
+        remove(tmp);
+    return rc;
+}
 
 int export_tiles(struct cli_env *env, const char *in, int hier_file, const char *dir, size_t tile_points,
-                 unsigned flags)
+                 const char *memory, unsigned flags)
 {
     asp_error err = {0};
     asp_hier *h = NULL;
+    int streamed = hier_file && asp_ooc_probe(in) == 1;
+    size_t budget = 0;
+    if (memory && hier_file)
+        return cli_usage_error(env, "--memory is the budget of converting a point file; '%s' is a hierarchy already",
+                               in);
+    if (memory && cli_memory_option(env, memory, &budget))
+        return 2;
+    if (!hier_file && tile_points && (tile_points < 64 || tile_points > 1000000))
+        return cli_usage_error(env, "--tile-points %zu: a point file's leaf nodes hold 64 to 1000000 points",
+                               tile_points);
+    if (streamed && tile_points)
+        return cli_usage_error(env, "--tile-points: the tiles of the streamed hierarchy '%s' are its nodes (set "
+                                    "--node-points when converting)", in);
     int rc;
-    if (hier_file)
-        rc = asp_hier_load(in, &env->ctx, &h, &err);
-    else {
-        asp_cloud *c = NULL;
-        rc = asp_cloud_load(in, &env->ctx, &c, &err);
-        if (!rc)
-            rc = asp_hier_build(c, NULL, &env->ctx, &h, &err);
-        asp_cloud_destroy(c); // only the hierarchy is needed from here on
-    }
     asp_tiles_stats st = {0};
-    const asp_tiles_desc d = {.gltf = {.flags = flags}, .tile_points = tile_points};
-    if (!rc)
-        rc = asp_tiles_export_hier(h, dir, &d, &st, &err);
-    asp_hier_destroy(h);
+    if (!hier_file || streamed)
+        rc = tiles_streamed(env, in, !hier_file, dir, tile_points, budget, flags, &st, &err);
+    else {
+        rc = asp_hier_load(in, &env->ctx, &h, &err);
+        const asp_tiles_desc d = {.gltf = {.flags = flags}, .tile_points = tile_points};
+        if (!rc)
+            rc = asp_tiles_export_hier(h, dir, &d, &st, &err);
+        asp_hier_destroy(h);
+    }
     if (rc)
         return cli_fail(env, &err);
     cli_progress_end(env);
+    const char *refine = hier_file && !streamed ? "REPLACE" : "ADD";
     if (env->json) {
         cJSON *j = cJSON_CreateObject();
         cJSON_AddStringToObject(j, "input", in);
         cJSON_AddStringToObject(j, "output", dir);
         cJSON_AddStringToObject(j, "kind", "tileset");
+        cJSON_AddStringToObject(j, "refine", refine);
         cJSON_AddNumberToObject(j, "tiles", (double)st.tiles);
         cJSON_AddNumberToObject(j, "points", (double)st.points);
         cJSON_AddNumberToObject(j, "splats", (double)st.splats);
@@ -51,7 +105,8 @@ int export_tiles(struct cli_env *env, const char *in, int hier_file, const char 
         cJSON_AddNumberToObject(j, "root_error", st.root_error);
         cJSON_AddNumberToObject(j, "json_bytes", (double)st.json_bytes);
         cJSON_AddNumberToObject(j, "bytes", (double)st.file_bytes);
-        cJSON_AddBoolToObject(j, "gaussian_splats", !(flags & ASP_GLTF_NO_SPLATS));
+        // streamed tiles are round discs (no normals to orient an ellipse)
+        cJSON_AddBoolToObject(j, "gaussian_splats", !(flags & ASP_GLTF_NO_SPLATS) && *refine == 'R');
         cJSON_AddBoolToObject(j, "compressed", !(flags & ASP_GLTF_PLAIN));
         cJSON *o = cJSON_AddArrayToObject(j, "origin");
         for (int k = 0; k < 3; k++)
@@ -59,8 +114,8 @@ int export_tiles(struct cli_env *env, const char *in, int hier_file, const char 
         return cli_json_print(env, j);
     }
     if (!env->quiet)
-        printf("exported '%s' -> '%s/tileset.json': %zu tiles (depth %u, at most %zu splats), %zu points in "
-               "%zu splats, %zu bytes\n",
-               in, dir, st.tiles, st.depth, st.largest, st.points, st.splats, st.file_bytes);
+        printf("exported '%s' -> '%s/tileset.json': %zu tiles (refine %s, depth %u, at most %zu splats), %zu points "
+               "in %zu splats, %zu bytes\n",
+               in, dir, st.tiles, refine, st.depth, st.largest, st.points, st.splats, st.file_bytes);
     return 0;
 }

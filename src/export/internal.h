@@ -117,4 +117,22 @@ int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n,
  */
 cJSON *asp__gltf_crs(const asp_las_meta *las);
 
+/* ---- tilesets (tiles.c, shared by tiles_ooc.c) ---- */
+
+/* Creates dir and dir/tiles. Returns 0, ASP_EINVAL (name too long), ASP_EIO. */
+int asp__tiles_dirs(const char *dir, asp_error *err);
+/*
+ * A box (lo xyz, hi xyz) in the GLBs' y-up frame as a 3D Tiles z-up boundingVolume.box: centre and
+ * three half-axes, turned as 3D Tiles turns glTF content ((x, y, z) -> (x, -z, y)).
+ */
+cJSON *asp__tiles_box(const double box[6]);
+/*
+ * Writes dir/tileset.json atomically around root_tile (taken over): refine on the root, the root
+ * transform to origin (y-up, as the GLBs' frame: turned to z-up here), the tileset's
+ * geometricError from box (y-up), extras.amgsplat with frame and st's counts. Adds the JSON's
+ * bytes to st and fills st->json_bytes, root_error and origin.
+ */
+int asp__tiles_write_tileset(const char *dir, cJSON *root_tile, const char *refine, const double box[6],
+                             const double origin[3], const asp_frame *frame, asp_tiles_stats *st, asp_error *err);
+
 #endif

@@ -109,8 +109,7 @@ static void box_add(double box[6], const asp_hier_splat *s, asp_up_axis up)
     }
 }
 
-/* A y-up box (glTF frame) as a 3D Tiles z-up boundingVolume.box: centre and three half-axes. */
-static cJSON *z_up_box(const double box[6])
+cJSON *asp__tiles_box(const double box[6])
 {
     double c[3], h[3];
     for (int k = 0; k < 3; k++) {
@@ -185,7 +184,7 @@ static cJSON *write_tile(tiles_run *t, asp_index id, uint32_t min_c, double max_
     cJSON *content = cJSON_AddObjectToObject(tile, "content");
     cJSON_AddStringToObject(content, "uri", uri);
     if (points_only || nd->child_count == 0) {
-        cJSON_AddItemToObject(tile, "boundingVolume", z_up_box(box));
+        cJSON_AddItemToObject(tile, "boundingVolume", asp__tiles_box(box));
         return tile;
     }
     cJSON *children = cJSON_AddArrayToObject(tile, "children");
@@ -202,8 +201,70 @@ static cJSON *write_tile(tiles_run *t, asp_index id, uint32_t min_c, double max_
             box[3 + j] = fmax(box[3 + j], cb[3 + j]);
         }
     }
-    cJSON_AddItemToObject(tile, "boundingVolume", z_up_box(box));
+    cJSON_AddItemToObject(tile, "boundingVolume", asp__tiles_box(box));
     return tile;
+}
+
+int asp__tiles_dirs(const char *dir, asp_error *err)
+{
+    char sub[4096];
+    if (snprintf(sub, sizeof sub, "%s/tiles", dir) >= (int)sizeof sub)
+        return asp_error_set(err, ASP_EINVAL, "tileset directory name '%s' is too long", dir);
+    int rc = asp__dir_ensure(dir, "directory", err);
+    return rc ? rc : asp__dir_ensure(sub, "directory", err);
+}
+
+int asp__tiles_write_tileset(const char *dir, cJSON *root_tile, const char *refine, const double box[6],
+                             const double origin[3], const asp_frame *frame, asp_tiles_stats *st, asp_error *err)
+{
+    cJSON_AddStringToObject(root_tile, "refine", refine);
+    if (origin[0] != 0 || origin[1] != 0 || origin[2] != 0) {
+        double m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, origin[0], -origin[2], origin[1], 1};
+        cJSON_AddItemToObject(root_tile, "transform", asp__gltf_numbers(m, 16));
+    }
+    cJSON *root = cJSON_CreateObject();
+    cJSON *asset = cJSON_AddObjectToObject(root, "asset");
+    cJSON_AddStringToObject(asset, "version", "1.1");
+    cJSON_AddStringToObject(asset, "generator", "amgsplat " ASP_VERSION_STRING " export --tiles");
+    double diag = 0;
+    for (int k = 0; k < 3; k++)
+        diag += (box[3 + k] - box[k]) * (box[3 + k] - box[k]);
+    // the error of showing nothing: the whole model as one pixel-sized dot
+    cJSON_AddNumberToObject(root, "geometricError", sqrt(diag));
+    cJSON_AddItemToObject(root, "root", root_tile);
+    cJSON *extras = asp__gltf_extras("tileset", NULL, origin, frame);
+    cJSON *a = cJSON_GetObjectItemCaseSensitive(extras, "amgsplat");
+    cJSON_AddNumberToObject(a, "points", (double)st->points);
+    cJSON_AddNumberToObject(a, "tiles", (double)st->tiles);
+    cJSON_AddNumberToObject(a, "splats", (double)st->splats);
+    cJSON_AddNumberToObject(a, "bytes", (double)st->file_bytes);
+    cJSON_AddStringToObject(a, "refine", refine);
+    cJSON_AddItemToObject(root, "extras", extras);
+    // the root tile's error, for a client that starts from it
+    st->root_error = cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(root_tile, "geometricError"));
+    char *json = cJSON_PrintUnformatted(root); // bytes the first frame waits for
+    cJSON_Delete(root);
+    if (!json)
+        return asp_error_set(err, ASP_ENOMEM, "out of memory printing the tileset of '%s'", dir);
+    char path[4096 + 16];
+    snprintf(path, sizeof path, "%s/tileset.json", dir);
+    asp__atomic_file f;
+    size_t len = strlen(json);
+    int rc = asp__atomic_open(&f, path, err);
+    if (!rc) {
+        if (fwrite(json, 1, len, f.fp) != len) {
+            asp__atomic_abort(&f);
+            rc = asp_error_set(err, ASP_EIO, "cannot write '%s'", path);
+        } else
+            rc = asp__atomic_commit(&f, err);
+    }
+    cJSON_free(json);
+    if (rc)
+        return rc;
+    st->json_bytes = len;
+    st->file_bytes += len;
+    memcpy(st->origin, origin, sizeof st->origin);
+    return 0;
 }
 
 int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles_desc *desc, asp_tiles_stats *stats,
@@ -223,12 +284,7 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
                    .desc = d,
                    .dir = dir};
     t.err = err ? err : &t.local;
-    char sub[4096];
-    if (snprintf(sub, sizeof sub, "%s/tiles", dir) >= (int)sizeof sub)
-        return asp_error_set(err, ASP_EINVAL, "tileset directory name '%s' is too long", dir);
-    int rc = asp__dir_ensure(dir, "directory", err);
-    if (!rc)
-        rc = asp__dir_ensure(sub, "directory", err);
+    int rc = asp__tiles_dirs(dir, err);
     if (rc)
         return rc;
     double box[6];
@@ -237,57 +293,13 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
         return t.err->code; // the tiles written so far stay; without tileset.json they are no tileset
     double origin[3];
     asp_hier_origin(hier, origin);
-    const asp_frame *frame = asp_hier_frame(hier);
     // the origin in the GLBs' y-up frame, as their content is (a z-up scan turns to y-up there, and
     // 3D Tiles turns it back to z-up below)
-    asp__gltf_turn_up(frame->up, origin, origin);
-    cJSON_AddStringToObject(root_tile, "refine", "REPLACE");
-    if (origin[0] != 0 || origin[1] != 0 || origin[2] != 0) {
-        double m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, origin[0], -origin[2], origin[1], 1};
-        cJSON_AddItemToObject(root_tile, "transform", asp__gltf_numbers(m, 16));
-    }
-    cJSON *root = cJSON_CreateObject();
-    cJSON *asset = cJSON_AddObjectToObject(root, "asset");
-    cJSON_AddStringToObject(asset, "version", "1.1");
-    cJSON_AddStringToObject(asset, "generator", "amgsplat " ASP_VERSION_STRING " export --tiles");
-    double diag = 0;
-    for (int k = 0; k < 3; k++)
-        diag += (box[3 + k] - box[k]) * (box[3 + k] - box[k]);
-    // the error of showing nothing: the whole model as one pixel-sized dot
-    cJSON_AddNumberToObject(root, "geometricError", sqrt(diag));
-    cJSON_AddItemToObject(root, "root", root_tile);
-    cJSON *extras = asp__gltf_extras("tileset", NULL, origin, frame);
-    cJSON *a = cJSON_GetObjectItemCaseSensitive(extras, "amgsplat");
-    cJSON_AddNumberToObject(a, "points", (double)asp_hier_point_count(hier));
-    cJSON_AddNumberToObject(a, "tiles", (double)t.st.tiles);
-    cJSON_AddNumberToObject(a, "splats", (double)t.st.splats);
-    cJSON_AddNumberToObject(a, "bytes", (double)t.st.file_bytes);
-    cJSON_AddItemToObject(root, "extras", extras);
-    // the root tile's error, for a client that starts from it
-    t.st.root_error = cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(root_tile, "geometricError"));
-    char *json = cJSON_PrintUnformatted(root); // bytes the first frame waits for
-    cJSON_Delete(root);
-    if (!json)
-        return asp_error_set(err, ASP_ENOMEM, "out of memory printing the tileset of '%s'", dir);
-    char path[4096 + 16];
-    snprintf(path, sizeof path, "%s/tileset.json", dir);
-    asp__atomic_file f;
-    size_t len = strlen(json);
-    rc = asp__atomic_open(&f, path, err);
-    if (!rc) {
-        if (fwrite(json, 1, len, f.fp) != len) {
-            asp__atomic_abort(&f);
-            rc = asp_error_set(err, ASP_EIO, "cannot write '%s'", path);
-        } else
-            rc = asp__atomic_commit(&f, err);
-    }
-    cJSON_free(json);
+    asp__gltf_turn_up(asp_hier_frame(hier)->up, origin, origin);
+    t.st.points = asp_hier_point_count(hier);
+    rc = asp__tiles_write_tileset(dir, root_tile, "REPLACE", box, origin, asp_hier_frame(hier), &t.st, err);
     if (rc)
         return rc;
-    t.st.json_bytes = len;
-    t.st.file_bytes += len;
-    t.st.points = asp_hier_point_count(hier);
-    memcpy(t.st.origin, origin, sizeof origin);
     if (stats)
         *stats = t.st;
     return 0;

@@ -365,10 +365,7 @@ int asp_ooc_load(asp_ooc *o, const uint32_t *nodes, size_t count, asp_cloud **ou
                         break;
                     d = next;
                 }
-                // full density (a leaf) draws at the radius the whole set gets in memory, coarser cuts
-                // wider: 2 / sqrt(pi) spacings, asp_cloud_default_radius's closing factor
-                float r = 1.1283792f * d->spacing, full = (float)o->full_radius;
-                c->radii[at] = full > 0 && (!d->child_count || r < full) ? full : r;
+                c->radii[at] = asp_ooc_disc_radius(o, (uint32_t)(d - o->nodes));
             }
             done += m;
         }
@@ -382,4 +379,30 @@ int asp_ooc_load(asp_ooc *o, const uint32_t *nodes, size_t count, asp_cloud **ou
     }
     *out = c;
     return 0;
+}
+
+int asp_ooc_read_points(asp_ooc *o, uint32_t node, asp_ooc_point *dst, asp_error *err)
+{
+    ASP_ASSERT(o && (dst || node >= o->node_count || !o->nodes[node].point_count));
+    if (node >= o->node_count)
+        return asp_error_set(err, ASP_EINVAL, "'%s' has %zu nodes, no node %u", o->path, o->node_count, node);
+    const asp_ooc_node *n = &o->nodes[node];
+    if (!n->point_count)
+        return 0;
+    if (fseeko(o->fp, (off_t)(ASP__OOC_HEADER + n->first_point * ASP__OOC_POINT_REC), SEEK_SET) != 0)
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': %s", o->path, strerror(errno));
+    if (fread(dst, sizeof *dst, n->point_count, o->fp) != n->point_count)
+        return asp_error_set(err, ASP_EIO, "cannot read '%s': the %u points of node %u (file truncated?)", o->path,
+                             n->point_count, node);
+    return 0;
+}
+
+float asp_ooc_disc_radius(const asp_ooc *o, uint32_t node)
+{
+    ASP_ASSERT(o && node < o->node_count);
+    const asp_ooc_node *d = &o->nodes[node];
+    // full density (a leaf) draws at the radius the whole set gets in memory, coarser cuts
+    // wider: 2 / sqrt(pi) spacings, asp_cloud_default_radius's closing factor
+    float r = 1.1283792f * d->spacing, full = (float)o->full_radius;
+    return full > 0 && (!d->child_count || r < full) ? full : r;
 }

@@ -1,16 +1,140 @@
-# export --tiles (issue 32): a point set as a 3D Tiles 1.1 tileset. tileset.json's structure (asset
-# 1.1, a root with children, refine REPLACE, boxes holding their children's, geometricError never
-# growing downwards and 0 exactly at the full-resolution leaves), every content URI a GLB on disk
-# and every GLB named once, the leaves' points summing to the input's (each point in exactly one
-# leaf), the root within the tile budget, the first frame's files (tileset.json + root) under 5% of
-# the bytes, identical output twice, and the errors of bad options. No browser needed (web_tiles.sh
-# has the page, the validator and Cesium).
+# export --tiles (issue 32): point sets and hierarchies as 3D Tiles 1.1 tilesets. No browser needed
+# (web_tiles.sh has the page, the validator and Cesium).
+#  - a point file takes the bounded-memory route (converted to a temporary streamed .hier, which is
+#    removed, then one tile a node): refine ADD, every point in exactly one tile (the GLBs' counts sum
+#    to the input's), each tile's box holding its GLB's points (accessor bounds through the node
+#    transform, turned z-up) and its children's boxes, geometricError = node spacing, never growing
+#    downwards and 0 at the leaves, a disc radius in every tile's extras, no Gaussian splats,
+#    identical output twice, a streamed .hier (amgsplat convert) giving the same tileset, and a
+#    truncated streamed .hier refused with a message;
+#  - an in-memory .hier (tools/seed_hier) keeps the REPLACE route: tileset.json's structure (asset
+#    1.1, a root with children, refine REPLACE, boxes holding their children's, geometricError never
+#    growing downwards and 0 exactly at the full-resolution leaves), every content URI a GLB on disk
+#    and every GLB named once, the leaves' points summing to the input's (each point in exactly one
+#    leaf), the root within the tile budget, the first frame's files (tileset.json + root) under 5%
+#    of the bytes, identical output twice;
+#  - the errors of bad options.
 source "$(dirname "$0")/common.sh"
 
 "$AMGSPLAT" synth torus -o "$T/torus.ply" --points 60000 -q
-"$AMGSPLAT" export "$T/torus.ply" -o "$T/tiles" --tiles --tile-points 2048 --json >"$T/run.json"
-"$AMGSPLAT" export "$T/torus.ply" -o "$T/again" --tiles --tile-points 2048 -q
-cmp "$T/tiles/tileset.json" "$T/again/tileset.json" || fail "two exports of the same points differ"
+
+# ---- a point file: the streamed route (refine ADD) ----
+"$AMGSPLAT" export "$T/torus.ply" -o "$T/add" --tiles --tile-points 2048 --json >"$T/add.json"
+"$AMGSPLAT" export "$T/torus.ply" -o "$T/add2" --tiles --tile-points 2048 -q
+cmp "$T/add/tileset.json" "$T/add2/tileset.json" || fail "two exports of the same points differ"
+cmp "$T/add/tiles/0.glb" "$T/add2/tiles/0.glb" || fail "two exports of the same points differ (root GLB)"
+ls "$T" | grep '\.convert-.*\.hier' >/dev/null && fail "the temporary streamed hierarchy was left: $(ls "$T")"
+# a streamed .hier gives the same tileset
+"$AMGSPLAT" convert "$T/torus.ply" -o "$T/torus_s.hier" --node-points 2048 -q
+"$AMGSPLAT" export "$T/torus_s.hier" -o "$T/adds" --tiles -q
+cmp "$T/add/tileset.json" "$T/adds/tileset.json" || fail "a streamed .hier and its point file tile differently"
+
+python3 - "$T/add" "$T/add.json" 60000 <<'PY' || fail "streamed tileset structure"
+import json, os, struct, sys
+d, run, n_in = sys.argv[1], json.load(open(sys.argv[2])), int(sys.argv[3])
+ts = json.load(open(os.path.join(d, 'tileset.json')))
+assert ts['asset']['version'] == '1.1', ts['asset']
+root = ts['root']
+assert root['refine'] == 'ADD' and root.get('children'), 'root without ADD or children'
+assert ts['geometricError'] > root['geometricError'] > 0, (ts['geometricError'], root['geometricError'])
+
+def glb(path):
+    b = open(path, 'rb').read()
+    magic, version, length = struct.unpack_from('<4sII', b, 0)
+    assert magic == b'glTF' and version == 2 and length == len(b), path
+    clen, ctype = struct.unpack_from('<II', b, 12)
+    return json.loads(b[20:20 + clen])
+
+def box_bounds(bv):
+    c, h = bv['box'][:3], bv['box'][3:]
+    assert h[1] == h[2] == h[3] == h[5] == h[6] == h[7] == 0, 'boxes are axis-aligned'
+    ext = [h[0], h[4], h[8]]
+    return [c[k] - ext[k] for k in range(3)], [c[k] + ext[k] for k in range(3)]
+
+tiles, total_points, leaf_points, uris = 0, 0, 0, []
+def walk(t, parent_error, parent_box, depth):
+    global tiles, total_points, leaf_points
+    tiles += 1
+    assert 'refine' not in t or depth == 0, 'refine is inherited from the root'
+    e = t['geometricError']
+    assert 0 <= e <= parent_error, f'geometricError grows downwards: {e} > {parent_error}'
+    lo, hi = box_bounds(t['boundingVolume'])
+    if parent_box:
+        plo, phi = parent_box
+        for k in range(3):
+            assert plo[k] - 1e-6 <= lo[k] and hi[k] <= phi[k] + 1e-6, 'a child box sticks out of its parent'
+    uri = t['content']['uri']
+    uris.append(uri)
+    g = glb(os.path.join(d, uri))
+    assert 'KHR_gaussian_splatting' not in json.dumps(g), f'{uri}: streamed tiles carry no Gaussians'
+    mesh = g['meshes'][0]
+    pr = mesh['primitives'][0]
+    assert pr['mode'] == 0 and set(pr['attributes']) == {'POSITION', 'COLOR_0'}, (uri, pr['attributes'])
+    assert mesh['extras']['amgsplat']['pointRadius'] > 0, (uri, mesh.get('extras'))
+    acc = g['accessors'][pr['attributes']['POSITION']]
+    n = acc['count']
+    total_points += n
+    # the points' y-up bounds through the node transform, then z-up as the box: (x, y, z) -> (x, -z, y)
+    node = g['nodes'][0]
+    tr, s = node.get('translation', [0, 0, 0]), node.get('scale', [1, 1, 1])[0]
+    plo = [tr[k] + s * acc['min'][k] for k in range(3)]
+    phi = [tr[k] + s * acc['max'][k] for k in range(3)]
+    zlo, zhi = [plo[0], -phi[2], plo[1]], [phi[0], -plo[2], phi[1]]
+    tol = s + 1e-6
+    for k in range(3):
+        assert lo[k] - tol <= zlo[k] and zhi[k] <= hi[k] + tol, f'{uri}: points outside the box, axis {k}'
+    kids = t.get('children', [])
+    if not kids:
+        assert e == 0, f'leaf {uri} has error {e}'
+        leaf_points += n
+    else:
+        assert e > 0, f'inner tile {uri} with error 0'
+    for c in kids:
+        walk(c, e, (lo, hi), depth + 1)
+walk(root, ts['geometricError'], None, 0)
+assert len(set(uris)) == len(uris), 'a GLB is named twice'
+on_disk = set('tiles/' + f for f in os.listdir(os.path.join(d, 'tiles')))
+assert on_disk == set(uris), f'files not in the tileset: {sorted(on_disk - set(uris))[:5]}'
+assert total_points == n_in, f'tiles hold {total_points} points, input {n_in}: each point must be in one tile'
+assert run['refine'] == 'ADD' and run['tiles'] == tiles and run['points'] == n_in and run['splats'] == n_in, run
+assert run['leaf_points'] == leaf_points < n_in and run['largest_tile'] > 0 and not run['gaussian_splats'], run
+total = sum(os.path.getsize(os.path.join(d, u)) for u in uris) + os.path.getsize(os.path.join(d, 'tileset.json'))
+assert total == run['bytes'], (total, run['bytes'])
+a = ts['extras']['amgsplat']
+assert a['points'] == n_in and a['refine'] == 'ADD' and a['frame']['radius'] > 0, a
+print(f'streamed: {tiles} tiles, depth {run["depth"]}, {total} bytes ({total / n_in:.2f} a point); root error '
+      f'{root["geometricError"]:.4g}, {leaf_points} points in leaves')
+PY
+
+# a truncated streamed .hier is refused with a message naming it, and leaves no tileset
+size=$(stat -c %s "$T/torus_s.hier")
+head -c $((size - 100)) "$T/torus_s.hier" >"$T/cut.hier"
+expect_fail 1 "cut.hier" "$AMGSPLAT" export "$T/cut.hier" -o "$T/cut" --tiles
+[[ ! -e "$T/cut/tileset.json" ]] || fail "a truncated .hier left a tileset"
+expect_fail 2 "--tile-points" "$AMGSPLAT" export "$T/torus_s.hier" -o "$T/x" --tiles --tile-points 100
+expect_fail 2 "64 to 1000000" "$AMGSPLAT" export "$T/torus.ply" -o "$T/x" --tiles --tile-points 10
+expect_fail 2 "--memory" "$AMGSPLAT" export "$T/torus_s.hier" -o "$T/x" --tiles --memory 100M
+expect_fail 2 "--memory needs --tiles" "$AMGSPLAT" export "$T/torus.ply" -o "$T/x.glb" --memory 100M
+expect_fail 1 "64 MiB" "$AMGSPLAT" export "$T/torus.ply" -o "$T/x" --tiles --memory 1M
+# --plain: float positions, nothing compressed
+"$AMGSPLAT" export "$T/torus.ply" -o "$T/addplain" --tiles --tile-points 2048 --plain -q
+grep -o '"KHR_mesh_quantization"\|"EXT_meshopt_compression"' "$T/addplain/tiles/0.glb" >/dev/null &&
+  fail "--plain streamed tiles carry quantisation or compression"
+: >"$T/file"
+expect_fail 1 "cannot create directory" "$AMGSPLAT" export "$T/torus.ply" -o "$T/file" --tiles
+ls "$T" | grep '\.convert-.*\.hier' >/dev/null && fail "a failed export left its temporary file"
+
+# ---- an in-memory .hier: its elliptical splats, refine REPLACE ----
+seed_hier="$(dirname "$AMGSPLAT")/seed_hier"
+if [[ ! -x "$seed_hier" ]]; then
+  asp_skipped+=("$seed_hier")
+  echo "export_tiles: ok"
+  exit 0
+fi
+"$seed_hier" "$T/torus.ply" "$T/torus.hier" || fail "seed_hier"
+"$AMGSPLAT" export "$T/torus.hier" -o "$T/tiles" --tiles --tile-points 2048 --json >"$T/run.json"
+"$AMGSPLAT" export "$T/torus.hier" -o "$T/again" --tiles --tile-points 2048 -q
+cmp "$T/tiles/tileset.json" "$T/again/tileset.json" || fail "two exports of the same hierarchy differ"
 
 python3 - "$T/tiles" "$T/run.json" 60000 2048 <<'PY' || fail "tileset structure"
 import json, os, struct, sys
@@ -83,13 +207,13 @@ print(f'{tiles} tiles, {run["splats"]} splats, depth {run["depth"]}, {total} byt
 PY
 
 # plain and no-splat tiles are what the flags say
-"$AMGSPLAT" export "$T/torus.ply" -o "$T/plain" --tiles --tile-points 2048 --plain --no-splats -q
+"$AMGSPLAT" export "$T/torus.hier" -o "$T/plain" --tiles --tile-points 2048 --plain --no-splats -q
 grep -o '"KHR_mesh_quantization"\|"KHR_gaussian_splatting"' "$T/plain/tiles/0.glb" >/dev/null &&
   fail "--plain --no-splats tiles carry quantisation or splats"
 grep -o '"KHR_gaussian_splatting"' "$T/tiles/tiles/0.glb" >/dev/null || fail "default tiles lack the splats"
 
 # errors
 expect_fail 2 "--tile-points needs --tiles" "$AMGSPLAT" export "$T/torus.ply" -o "$T/x.glb" --tile-points 10
-: >"$T/file"
-expect_fail 1 "cannot create directory" "$AMGSPLAT" export "$T/torus.ply" -o "$T/file" --tiles
+expect_fail 1 "cannot create directory" "$AMGSPLAT" export "$T/torus.hier" -o "$T/file" --tiles
+expect_fail 1 "cannot create directory" "$AMGSPLAT" export "$T/torus_s.hier" -o "$T/file" --tiles
 echo "export_tiles: ok"

@@ -2,7 +2,8 @@
  * Tilesets (issue 32, asp_tiles_export_hier): a UTM-placed grid keeps its world position through
  * the root transform in 3D Tiles' z-up frame ((x, y, z) -> (x, -z, y) of the glTF content, then
  * + origin), the root box holds every point in that frame, the leaves hold every point once, and
- * bad arguments fail with their codes.
+ * bad arguments fail with their codes; the same grid's streamed hierarchy (asp_ooc_build) tiles with
+ * refine ADD (asp_tiles_export_ooc), every point in one tile, the same frames.
  */
 #include <errno.h>
 #include <sys/stat.h>
@@ -120,6 +121,79 @@ static void test_utm_floor(void)
     asp_hier_destroy(h);
 }
 
+/* A finer floor (300 x 300, 2 mm) through a streamed hierarchy: ADD tiles, one a node, every point once. */
+static void test_utm_floor_streamed(void)
+{
+    // finer than the inner nodes' 128^3 grid, so the root keeps a subsample and children the rest
+    enum { SIDE = 300, N = SIDE * SIDE };
+    asp_cloud *c = NULL;
+    asp_error err = {0};
+    CHECK_OK(asp_cloud_create(N, ASP_ATTR_COLORS, NULL, &c, &err), &err);
+    if (!c)
+        return;
+    c->origin[0] = 500000.0;
+    c->origin[1] = 250.0;
+    c->origin[2] = 5000000.0;
+    for (size_t i = 0; i < N; i++) {
+        c->positions[3 * i] = 0.002f * (float)(i % SIDE);
+        c->positions[3 * i + 1] = 0.0f;
+        c->positions[3 * i + 2] = 0.002f * (float)(i / SIDE);
+        uint8_t rgba[4] = {(uint8_t)(i % 256), 128, 255, 255};
+        memcpy(c->colors + 4 * i, rgba, 4);
+    }
+    char ply[600], hier[600], dir[600], path[700];
+    snprintf(ply, sizeof ply, "%s/floor.ply", tmpdir);
+    snprintf(hier, sizeof hier, "%s/floor.hier", tmpdir);
+    snprintf(dir, sizeof dir, "%s/floor_tiles", tmpdir);
+    CHECK_OK(asp_cloud_save(c, ply, NULL, &err), &err);
+    asp_cloud_destroy(c);
+    CHECK_OK(asp_ooc_build(ply, hier, &(asp_ooc_build_desc){.node_points = 256}, NULL, NULL, &err), &err);
+    asp_ooc *ooc = NULL;
+    CHECK_OK(asp_ooc_open(hier, NULL, &ooc, &err), &err);
+    if (!ooc)
+        return;
+    asp_tiles_stats st = {0};
+    CHECK_OK(asp_tiles_export_ooc(ooc, dir, NULL, &st, &err), &err);
+    // every point stored once: the tiles' points are the set
+    CHECK(st.points == N && st.splats == N && st.tiles >= 2 && st.leaf_points > 0 && st.leaf_points < N);
+    double o[3];
+    asp_ooc_origin(ooc, o);
+    CHECK(st.origin[0] == o[0] && st.origin[1] == o[1] && st.origin[2] == o[2]); // y up already
+    snprintf(path, sizeof path, "%s/tileset.json", dir);
+    cJSON *ts = read_json(path);
+    CHECK_MSG(ts != NULL, "cannot parse '%s'", path);
+    if (ts) {
+        const cJSON *root = cJSON_GetObjectItemCaseSensitive(ts, "root");
+        CHECK(strcmp(cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(root, "refine")), "ADD") == 0);
+        const cJSON *m = cJSON_GetObjectItemCaseSensitive(root, "transform");
+        CHECK(cJSON_GetArraySize(m) == 16);
+        CHECK(fabs(item(m, 12) - 500000.0) < 1 && fabs(item(m, 13) + 5000000.0) < 1 && fabs(item(m, 14) - 250.0) < 1);
+        CHECK(item(m, 12) == o[0] && item(m, 13) == -o[2] && item(m, 14) == o[1]);
+        // the floor, world y = 250, is the z-up box's plane z = 250 - origin y; flat, and the whole 0.598 wide
+        const cJSON *box = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(root, "boundingVolume"), "box");
+        double cx = item(box, 0), cy = item(box, 1), cz = item(box, 2);
+        double hx = item(box, 3), hy = item(box, 7), hz = item(box, 11);
+        double wx0 = 500000.0 - o[0], wz0 = 5000000.0 - o[2], y = 250.0 - o[1];
+        CHECK(cx - hx <= wx0 + 1e-3 && cx + hx >= wx0 + 0.598 - 1e-3);
+        CHECK(cy - hy <= -(wz0 + 0.598) + 1e-3 && cy + hy >= -wz0 - 1e-3);
+        CHECK(fabs(cz - y) < 1e-3 && hz < 1e-3);
+        size_t leaves = 0;
+        int bad = 0;
+        walk(root, cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(ts, "geometricError")), &leaves, &bad);
+        CHECK(bad == 0 && leaves > 1);
+        CHECK(cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(root, "geometricError")) ==
+              (double)asp_ooc_nodes(ooc)[0].spacing);
+        cJSON_Delete(ts);
+    }
+    // the nodes are the tiles: no tile budget; no levels
+    CHECK(asp_tiles_export_ooc(ooc, dir, &(asp_tiles_desc){.tile_points = 100}, NULL, &err) == ASP_EINVAL);
+    CHECK(asp_tiles_export_ooc(ooc, dir, &(asp_tiles_desc){.gltf = {.level_count = 1}}, NULL, &err) == ASP_EINVAL);
+    // a node number past the table
+    asp_ooc_point p;
+    CHECK(asp_ooc_read_points(ooc, (uint32_t)asp_ooc_node_count(ooc), &p, &err) == ASP_EINVAL);
+    asp_ooc_close(ooc);
+}
+
 static void setup(void)
 {
     const char *base = getenv("TMPDIR");
@@ -135,4 +209,5 @@ static void cleanup(void)
         fprintf(stderr, "could not remove %s\n", tmpdir);
 }
 
-TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_utm_floor), TEST_FIXTURE(cleanup))
+TEST_MAIN(TEST_FIXTURE(setup), TEST_CASE(test_utm_floor), TEST_CASE(test_utm_floor_streamed),
+          TEST_FIXTURE(cleanup))
