@@ -345,6 +345,15 @@ int asp_ooc_load(asp_ooc *o, const uint32_t *nodes, size_t count, asp_cloud **ou
             }
             for (uint32_t j = 0; j < m; j++, at++) {
                 const asp_ooc_point *p = &buf[j];
+                // the points are outside the checksums: a non-finite one is refused, as the point readers do
+                if (!(isfinite(p->position[0]) && isfinite(p->position[1]) && isfinite(p->position[2]))) {
+                    uint64_t k = n->first_point + done + j;
+                    rc = asp_error_set(err, ASP_EFORMAT,
+                                       "cannot read '%s': byte %llu: point %llu of node %u: expected a finite position",
+                                       o->path, (unsigned long long)(ASP__OOC_HEADER + k * ASP__OOC_POINT_REC),
+                                       (unsigned long long)k, order[i].node);
+                    break;
+                }
                 memcpy(c->positions + 3 * at, p->position, 12);
                 memcpy(c->colors + 4 * at, p->color, 4);
                 // the deepest selected node whose cube holds the point sets its disc size
