@@ -6,6 +6,7 @@
  * (Schuetz 2016, 3.3) loads nodes by projected size.
  */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -152,6 +153,9 @@ int asp_ooc_open(const char *path, const asp_context *ctx, asp_ooc **out, asp_er
                                "do not match the file's %llu bytes (or records, origin, frame invalid)",
                                path, (unsigned long long)nodes, (unsigned long long)o->point_count,
                                (unsigned long long)table, (unsigned long long)fsize);
+        else if (!(o->full_radius <= FLT_MAX)) // it becomes the points' float radius
+            rc = asp_error_set(err, ASP_EFORMAT, "cannot read '%s': byte %d: full-density radius %g, expected at most %g",
+                               path, ASP__OOC_RADIUS_AT, o->full_radius, (double)FLT_MAX);
         else if (nodes >= UINT32_MAX || !(o->nodes = malloc((size_t)nodes * sizeof *o->nodes)))
             rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %llu nodes of '%s'", (unsigned long long)nodes, path);
         else if (fseeko(o->fp, (off_t)table, SEEK_SET) != 0 ||
@@ -373,7 +377,7 @@ int asp_ooc_load(asp_ooc *o, const uint32_t *nodes, size_t count, asp_cloud **ou
                 }
                 // full density (a leaf) draws at the radius the whole set gets in memory, coarser cuts
                 // wider: 2 / sqrt(pi) spacings, asp_cloud_default_radius's closing factor
-                float r = 1.1283792f * d->spacing, full = (float)o->full_radius;
+                float r = (float)fmin(1.1283792 * d->spacing, FLT_MAX), full = (float)o->full_radius; // finite
                 c->radii[at] = full > 0 && (!d->child_count || r < full) ? full : r;
             }
             done += m;
