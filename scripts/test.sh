@@ -107,6 +107,7 @@ fuzz_smoke() {
   "$A" decompose "$seeds/oct.ply" -o "$seeds/oct.amg" -q
   "$A" build "$seeds/oct.amg" -o "$seeds/oct.dps" --primitives 8 -q >/dev/null
   build/seed_hier "$seeds/oct.ply" "$seeds/oct.hier"
+  "$A" convert "$seeds/oct.ply" -o "$seeds/oct_streamed.hier" --memory 64M --node-points 64 -q
   "$A" render "$seeds/oct.ply" -o "$seeds/oct.png" --size 32x32 -q
   "$A" convert "$seeds/oct.ply" "$seeds/oct.las" -q
   "$A" convert --las-format 3 "$seeds/oct.ply" "$seeds/oct3.las" -q
@@ -135,6 +136,8 @@ fuzz_smoke() {
       fuzz_gltf) seed "$corpus" tests/data/bad/assimp/*.gltf tests/data/bad/assimp/*.glb ;;
       fuzz_collada) seed "$corpus" tests/data/bad/assimp/*.dae ;;
       fuzz_las) seed "$corpus" "$seeds"/*.las ;;
+      fuzz_point_stream) seed "$corpus" "$seeds"/*.ply "$seeds"/*.las ;;
+      fuzz_ooc) seed "$corpus" "$seeds"/*.hier ;;
       fuzz_stats_log) seed "$corpus" tests/data/experiment ;;
       fuzz_scene_file) : ;; # JSON only: its committed corpus below
       *) seed "$corpus" "$seeds" tests/data/bad ;; # a new target: every format as a start

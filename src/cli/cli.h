@@ -146,7 +146,8 @@ enum cli_renderer_option {
     CLI_RO_DEPTH_LIMIT = 1u << 10, /* --depth-limit N */
     CLI_RO_FRAME_MS = 1u << 11,   /* --frame-ms T */
     CLI_RO_UNLIT = 1u << 12,      /* --unlit */
-    CLI_RO_TEXTURE = 1u << 13     /* --texture IMG */
+    CLI_RO_TEXTURE = 1u << 13,    /* --texture IMG */
+    CLI_RO_EDL = 1u << 14         /* --edl, --no-edl, --edl-strength S */
 };
 
 struct cli_renderer_opts {
@@ -155,6 +156,8 @@ struct cli_renderer_opts {
     double tolerance, tau, alpha_ref, frame_ms;
     size_t budget, depth_limit;
     int hybrid, cull_backfaces, unlit;
+    int edl, no_edl;                 /* eye-dome lighting forced on or off; default: on for points without normals */
+    double edl_strength;             /* NaN: not given (1); implies edl */
     /* set by cli_renderer_check */
     const char *tolerance_name;      /* "--tolerance" or "--tau", as given, for the command's messages */
     const char *color_by_name;       /* "--color-by" or "--color" */

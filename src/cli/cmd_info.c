@@ -28,8 +28,9 @@ static const char usage[] =
     "their colour and texture (a texture file that cannot be found is named as MISSING; info\n"
     "still succeeds), the bounds as 'sample' will see them and the up axis assumed. Primitive\n"
     "file (.dps, from 'amgsplat build'): per level primitives, texels, error, normalised error,\n"
-    "cb and dpc times, atlas size. Decomposition (.amg, from 'amgsplat decompose'): the points,\n"
-    "their attributes and the unknowns of every AMG level. Hierarchy (.hier): nodes, points,\n"
+    "cb and dpc times, atlas size and kind (domain primitives or billboards). Decomposition\n"
+    "(.amg, from 'amgsplat decompose'): the points, their attributes and the unknowns of every\n"
+    "AMG level. Hierarchy (.hier): nodes, points,\n"
     "depth, leaf size. .amg, .dps and .hier also show the recorded frame of their source\n"
     "points. Image: size and channels.";
 
@@ -266,6 +267,8 @@ static int info_dps(const char *path, struct cli_env *env)
             cJSON_AddNumberToObject(l, "neighbour_pairs", (double)rows[i].neighbour_pairs);
             cJSON_AddBoolToObject(l, "normal_map", rows[i].normal_map);
             cJSON_AddStringToObject(l, "atlas_format", rows[i].compressed ? "bc3" : "rgba8");
+            // what the level's primitives are: domain primitives, or billboard-cloud planes (atlas flags bit 2)
+            cJSON_AddStringToObject(l, "kind", dps->levels[i].billboards ? "billboards" : "domains");
             cJSON_AddNumberToObject(l, "gpu_bytes", (double)asp_dps_level_gpu_bytes(&dps->levels[i], NULL));
             cJSON_AddBoolToObject(l, "strict", dps->levels[i].strict != 0);
             cJSON_AddNumberToObject(l, "links", (double)dps->levels[i].link_total);
@@ -291,14 +294,16 @@ static int info_dps(const char *path, struct cli_env *env)
                                     : dps->level_count > 1 ? "none (rebuild for a cut across levels)" : "one level");
         // GPU bytes: what the renderer allocates (asp_dps_level_gpu_bytes; BC3 atlases at 1 byte a texel)
         printf("level  name   primitives    texels        error  normalised   cb (s)  dpc (s)  atlas          "
-               "GPU bytes\n");
+               "GPU bytes  kind\n");
         for (size_t i = 0; i < nl; i++) {
             char atlas[40];
             snprintf(atlas, sizeof atlas, "%ux%u %s", rows[i].atlas_width, rows[i].atlas_height,
                      rows[i].compressed ? "BC3" : "RGBA8");
-            printf("%5u  %-5s %11zu %9llu  %11.6g  %10.3f  %7.3f  %7.3f  %-15s %9zu\n", rows[i].level, rows[i].name,
-                   rows[i].primitives, (unsigned long long)rows[i].texels, rows[i].error, rows[i].error_norm,
-                   rows[i].t_basis, rows[i].t_construct, atlas, asp_dps_level_gpu_bytes(&dps->levels[i], NULL));
+            printf("%5u  %-5s %11zu %9llu  %11.6g  %10.3f  %7.3f  %7.3f  %-15s %9zu  %s\n", rows[i].level,
+                   rows[i].name, rows[i].primitives, (unsigned long long)rows[i].texels, rows[i].error,
+                   rows[i].error_norm, rows[i].t_basis, rows[i].t_construct, atlas,
+                   asp_dps_level_gpu_bytes(&dps->levels[i], NULL),
+                   dps->levels[i].billboards ? "billboards" : "domains");
         }
     }
     asp_dps_destroy(dps);

@@ -60,7 +60,7 @@ enum { MAX_VIEWS = 256, MAX_SIDE = 16384 };
 #define RENDER_OPTIONS                                                                                       \
     (CLI_RO_RENDERER | CLI_RO_TOLERANCE | CLI_RO_BUDGET | CLI_RO_LEVEL | CLI_RO_COLOR_BY | CLI_RO_METHOD |   \
      CLI_RO_ALPHA_REF | CLI_RO_CREASE | CLI_RO_HYBRID | CLI_RO_CULL | CLI_RO_DEPTH_LIMIT | CLI_RO_FRAME_MS | \
-     CLI_RO_UNLIT | CLI_RO_TEXTURE)
+     CLI_RO_UNLIT | CLI_RO_TEXTURE | CLI_RO_EDL)
 
 struct render_opts {
     /*
@@ -116,8 +116,6 @@ struct render_opts {
     asp_up_axis up_axis;
     double point_crease; /* point inputs: crease angle of the clip planes, degrees; 0 = no clipping */
     int point_crease_default; /* point_crease is the default (points without normals: no clipping) */
-    int edl, no_edl;     /* --edl, --no-edl: eye-dome lighting forced on or off (default: points without normals) */
-    double edl_strength; /* --edl-strength; NaN: not given (1) */
     const asp_context *ctx;
 };
 
@@ -146,9 +144,9 @@ static void edl_options(const struct render_opts *o, const asp_scene *s, const a
 {
     int points = s->cloud && !s->dps && (strcmp(kind->name, "disc") == 0 || strcmp(kind->name, "square") == 0);
     int no_normals = points && !s->cloud->normals;
-    if (!points || o->no_edl || !(o->edl || !isnan(o->edl_strength) || (no_normals && !o->r.unlit)))
+    if (!points || o->r.no_edl || !(o->r.edl || !isnan(o->r.edl_strength) || (no_normals && !o->r.unlit)))
         return;
-    asp_edl_desc e = {.strength = isnan(o->edl_strength) ? 1.0f : (float)o->edl_strength};
+    asp_edl_desc e = {.strength = isnan(o->r.edl_strength) ? 1.0f : (float)o->r.edl_strength};
     r->disc.edl = r->square.edl = e;
     if (no_normals)
         cli_info(env, "hint: '%s' has no normals: drawn with eye-dome lighting; 'amgsplat estimate %s -o "
@@ -393,10 +391,6 @@ static int parse_options(struct cli_env *env, struct render_opts *o)
         o->r.tolerance = 1.0; // render's default tau, in pixels
     if (!o->output)
         return cli_usage_error(env, "missing -o OUT.png");
-    if (o->no_edl && (o->edl || !isnan(o->edl_strength)))
-        return cli_usage_error(env, "--no-edl excludes --edl and --edl-strength");
-    if (!isnan(o->edl_strength) && !(o->edl_strength > 0 && o->edl_strength <= 100))
-        return cli_usage_error(env, "--edl-strength expects a number in (0, 100], got %g", o->edl_strength);
     if (o->up && cli_parse_up(o->up, &o->up_axis) != 0)
         return cli_usage_error(env, "--up expects x, y, z, -x, -y or -z, got '%s'", o->up);
     if (!asp_file_name_is(o->output, "png"))
@@ -665,7 +659,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
     struct render_opts o = {.views = 1, .samples = 4, .fov = 40.0, .radius_scale = 1.0, .width = 512, .height = 512,
                             .az = 30.0, .el = 20.0, .epsilon = 1.0,
                             .sigma = NAN, .epsilon_uniform = NAN, .tolerance_area = NAN,
-                            .transparency = NAN, .depth_window = NAN, .only_domain = SIZE_MAX, .edl_strength = NAN, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
+                            .transparency = NAN, .depth_window = NAN, .only_domain = SIZE_MAX, .bg = {255, 255, 255, 255}, .ctx = &env->ctx};
     cli_renderer_opts_init(&o.r);
     struct cli_option opts[80] = {
         {"output", 'o', CLI_STRING, &o.output, "OUT.png", "output PNG (required)"},
@@ -703,9 +697,6 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         {"up", 0, CLI_STRING, &o.up, "AXIS", "world axis shown upright: y, z (scans, CAD), x, -y, -z or -x (default: the file's, z for LAS and what was made from it, else y)"},
         {"flat", 0, CLI_FLAG, &o.flat, NULL, "mesh: light each triangle by its face normal (default: smooth vertex normals)"},
         {"radius-scale", 0, CLI_DOUBLE, &o.radius_scale, "X", "multiply every disc, ellipse or square size by X (default 1)"},
-        {"edl", 0, CLI_FLAG, &o.edl, NULL, "disc, square: eye-dome lighting (default: on for points without normals, unless --unlit)"},
-        {"no-edl", 0, CLI_FLAG, &o.no_edl, NULL, "disc, square: no eye-dome lighting"},
-        {"edl-strength", 0, CLI_DOUBLE, &o.edl_strength, "S", "eye-dome lighting strength, 0..100 (default 1; implies --edl)"},
         {0},
     };
     cli_renderer_rows(&o.r, RENDER_OPTIONS, opts, sizeof opts / sizeof opts[0]);
@@ -772,7 +763,7 @@ int cmd_render(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "renderer '%s' draws points; sample the mesh to points first (amgsplat sample "
                                     "'%s' -o points.ply) or draw it with --renderer mesh",
                                kind->name, argv[0]);
-    if ((o.edl || !isnan(o.edl_strength)) && strcmp(kind->name, "disc") != 0 && strcmp(kind->name, "square") != 0)
+    if ((o.r.edl || !isnan(o.r.edl_strength)) && strcmp(kind->name, "disc") != 0 && strcmp(kind->name, "square") != 0)
         return cli_usage_error(env, "--edl and --edl-strength need --renderer disc or square (points drawn opaque)");
     if ((o.r.depth_limit || o.r.cull_backfaces) && !kind->has_lod)
         return cli_usage_error(env, "--depth-limit and --cull-backfaces need --renderer splat or square");

@@ -40,7 +40,7 @@ static const char usage[] =
 /* The renderer options view takes (renderer_options.c). */
 #define VIEW_OPTIONS                                                                                     \
     (CLI_RO_RENDERER | CLI_RO_TOLERANCE | CLI_RO_LEVEL | CLI_RO_COLOR_BY | CLI_RO_METHOD | CLI_RO_ALPHA_REF | \
-     CLI_RO_HYBRID | CLI_RO_CULL | CLI_RO_DEPTH_LIMIT | CLI_RO_FRAME_MS | CLI_RO_UNLIT | CLI_RO_TEXTURE)
+     CLI_RO_HYBRID | CLI_RO_CULL | CLI_RO_DEPTH_LIMIT | CLI_RO_FRAME_MS | CLI_RO_UNLIT | CLI_RO_TEXTURE | CLI_RO_EDL)
 
 struct view_opts {
     /* shared with render and eval: hybrid (docs/hybrid.md), cull_backfaces and depth_limit (seed 004
@@ -58,9 +58,7 @@ struct view_opts {
     const char *stats_json;
     int overlay, no_overlay;
     int verbose;
-    int edl, no_edl;     /* eye-dome lighting forced on or off; default: on for points without normals */
-    double edl_strength; /* NaN: not given */
-    const char *memory;  /* streamed .hier: --memory SIZE, as render */
+    const char *memory; /* streamed .hier: --memory SIZE, as render */
 };
 
 static void log_line(void *user, const char *line)
@@ -103,12 +101,8 @@ static int parse_into(struct cli_env *env, const char *path, struct view_opts *o
                                     "elevation or classification colours a point file's points, not %s input)",
                                o->r.color_by_name, o->r.color_field, asp_file_kind_name(type.kind));
     d->color_field = o->r.color_field;
-    if (o->no_edl && (o->edl || !isnan(o->edl_strength)))
-        return cli_usage_error(env, "--no-edl excludes --edl and --edl-strength");
-    if (!isnan(o->edl_strength) && !(o->edl_strength > 0 && o->edl_strength <= 100))
-        return cli_usage_error(env, "--edl-strength expects a number in (0, 100], got %g", o->edl_strength);
-    d->edl = o->no_edl ? -1 : o->edl || !isnan(o->edl_strength) ? 1 : 0;
-    d->edl_strength = isnan(o->edl_strength) ? 0.0f : (float)o->edl_strength;
+    d->edl = o->r.no_edl ? -1 : o->r.edl || !isnan(o->r.edl_strength) ? 1 : 0;
+    d->edl_strength = isnan(o->r.edl_strength) ? 0.0f : (float)o->r.edl_strength;
     int dps = type.kind == ASP_FILE_DPS || type.kind == ASP_FILE_SCENE; // a scene's .dps sources take them
     if (o->r.hybrid && type.kind == ASP_FILE_SCENE)
         return cli_usage_error(env, "--hybrid draws one .dps with its points, not a scene");
@@ -208,7 +202,7 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
 #else
 int cmd_view(int argc, char **argv, struct cli_env *env)
 {
-    struct view_opts o = {.edl_strength = NAN};
+    struct view_opts o = {0};
     cli_renderer_opts_init(&o.r);
     struct cli_option opts[48] = {
         {"size", 0, CLI_STRING, &o.size, "WxH", "window size (default 1280x800)"},
@@ -224,9 +218,6 @@ int cmd_view(int argc, char **argv, struct cli_env *env)
         {"stats-json", 0, CLI_STRING, &o.stats_json, "OUT.json", "write every frame's time, tau, depth limit and count, with median, p10, p90"},
         {"overlay", 0, CLI_FLAG, &o.overlay, NULL, "start with the figures over the frame (i toggles; on with --frame-ms)"},
         {"no-overlay", 0, CLI_FLAG, &o.no_overlay, NULL, "start without them"},
-        {"edl", 0, CLI_FLAG, &o.edl, NULL, "disc, square: eye-dome lighting (default: on for points without normals, unless --unlit; E toggles)"},
-        {"no-edl", 0, CLI_FLAG, &o.no_edl, NULL, "disc, square: no eye-dome lighting"},
-        {"edl-strength", 0, CLI_DOUBLE, &o.edl_strength, "S", "eye-dome lighting strength, 0..100 (default 1; implies --edl)"},
         {"memory", 0, CLI_STRING, &o.memory, "SIZE", "streamed .hier: memory for the points loaded, e.g. 1G (default 2G)"},
         {0},
     };

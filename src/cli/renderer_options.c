@@ -12,7 +12,7 @@
 void cli_renderer_opts_init(struct cli_renderer_opts *o)
 {
     memset(o, 0, sizeof *o);
-    o->tolerance = o->tau = o->alpha_ref = NAN;
+    o->tolerance = o->tau = o->alpha_ref = o->edl_strength = NAN;
 }
 
 void cli_renderer_rows(struct cli_renderer_opts *o, unsigned which, struct cli_option *rows, size_t cap)
@@ -37,6 +37,9 @@ void cli_renderer_rows(struct cli_renderer_opts *o, unsigned which, struct cli_o
         {CLI_RO_FRAME_MS, {"frame-ms", 0, CLI_DOUBLE, &o->frame_ms, "T", "splat, square: frame budget: set tau (then the depth limit) so a frame takes T ms (0 = off)"}},
         {CLI_RO_UNLIT, {"unlit", 0, CLI_FLAG, &o->unlit, NULL, "colours as they are, no shading (the seeds' flat textured primitives; web viewer's light=off)"}},
         {CLI_RO_TEXTURE, {"texture", 0, CLI_STRING, &o->texture, "IMG", "mesh: texture of materials that name none or whose file is missing"}},
+        {CLI_RO_EDL, {"edl", 0, CLI_FLAG, &o->edl, NULL, "disc, square: eye-dome lighting (default: on for points without normals, unless --unlit; in the viewer, E toggles)"}},
+        {CLI_RO_EDL, {"no-edl", 0, CLI_FLAG, &o->no_edl, NULL, "disc, square: no eye-dome lighting"}},
+        {CLI_RO_EDL, {"edl-strength", 0, CLI_DOUBLE, &o->edl_strength, "S", "eye-dome lighting strength, 0..100 (default 1; implies --edl)"}},
     };
     size_t n = 0;
     while (n < cap && rows[n].name)
@@ -121,5 +124,9 @@ int cli_renderer_check(const struct cli_env *env, struct cli_renderer_opts *o, u
         return cli_usage_error(env, "--depth-limit expects 0..64, got %zu", o->depth_limit);
     if (!(o->frame_ms >= 0 && o->frame_ms <= 1e6))
         return cli_usage_error(env, "--frame-ms expects milliseconds in 0..1e6 (0 = off), got %g", o->frame_ms);
+    if (o->no_edl && (o->edl || !isnan(o->edl_strength)))
+        return cli_usage_error(env, "--no-edl excludes --edl and --edl-strength");
+    if (!isnan(o->edl_strength) && !(o->edl_strength > 0 && o->edl_strength <= 100))
+        return cli_usage_error(env, "--edl-strength expects a number in (0, 100], got %g", o->edl_strength);
     return 0;
 }

@@ -6,6 +6,7 @@
  * (Schuetz 2016, 3.3) loads nodes by projected size.
  */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -155,6 +156,9 @@ int asp_ooc_open(const char *path, const asp_context *ctx, asp_ooc **out, asp_er
                                "do not match the file's %llu bytes (or records, origin, frame invalid)",
                                path, (unsigned long long)nodes, (unsigned long long)o->point_count,
                                (unsigned long long)table, (unsigned long long)fsize);
+        else if (!(o->full_radius <= FLT_MAX)) // it becomes the points' float radius
+            rc = asp_error_set(err, ASP_EFORMAT, "cannot read '%s': byte %d: full-density radius %g, expected at most %g",
+                               path, ASP__OOC_RADIUS_AT, o->full_radius, (double)FLT_MAX);
         else if (nodes >= UINT32_MAX || !(o->nodes = malloc((size_t)nodes * sizeof *o->nodes)))
             rc = asp_error_set(err, ASP_ENOMEM, "out of memory for %llu nodes of '%s'", (unsigned long long)nodes, path);
         else if (fseeko(o->fp, (off_t)table, SEEK_SET) != 0 ||
@@ -348,6 +352,15 @@ int asp_ooc_load(asp_ooc *o, const uint32_t *nodes, size_t count, asp_cloud **ou
             }
             for (uint32_t j = 0; j < m; j++, at++) {
                 const asp_ooc_point *p = &buf[j];
+                // the points are outside the checksums: a non-finite one is refused, as the point readers do
+                if (!(isfinite(p->position[0]) && isfinite(p->position[1]) && isfinite(p->position[2]))) {
+                    uint64_t k = n->first_point + done + j;
+                    rc = asp_error_set(err, ASP_EFORMAT,
+                                       "cannot read '%s': byte %llu: point %llu of node %u: expected a finite position",
+                                       o->path, (unsigned long long)(ASP__OOC_HEADER + k * ASP__OOC_POINT_REC),
+                                       (unsigned long long)k, order[i].node);
+                    break;
+                }
                 memcpy(c->positions + 3 * at, p->position, 12);
                 memcpy(c->colors + 4 * at, p->color, 4);
                 // the deepest selected node whose cube holds the point sets its disc size
@@ -403,6 +416,6 @@ float asp_ooc_disc_radius(const asp_ooc *o, uint32_t node)
     const asp_ooc_node *d = &o->nodes[node];
     // full density (a leaf) draws at the radius the whole set gets in memory, coarser cuts
     // wider: 2 / sqrt(pi) spacings, asp_cloud_default_radius's closing factor
-    float r = 1.1283792f * d->spacing, full = (float)o->full_radius;
+    float r = (float)fmin(1.1283792 * d->spacing, FLT_MAX), full = (float)o->full_radius; // finite
     return full > 0 && (!d->child_count || r < full) ? full : r;
 }

@@ -236,6 +236,10 @@ int asp_point_reader_open(const char *path, const asp_context *ctx, asp_point_re
                                path, (unsigned long long)r->count, r->record, (unsigned long long)r->data_at,
                                (long long)size);
     }
+    // a batch holds at least one record: a wider one would read as the end of the points
+    if (!rc && r->record > WINDOW)
+        rc = asp_error_set(err, ASP_EUNSUPPORTED, "'%s': %zu-byte point records; at most %d bytes are read in batches",
+                           path, r->record, (int)WINDOW);
     if (!rc && !(r->buf = malloc(WINDOW)))
         rc = asp_error_set(err, ASP_ENOMEM, "out of memory");
     if (!rc)

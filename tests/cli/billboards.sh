@@ -35,6 +35,11 @@ assert d['max_distance'] <= d['error_world'] * 1.0001, d
 assert abs(d['texels'] - 300000) < 0.05 * 300000, d
 PY
 "$A" info "$T/bb.dps" >"$T/info" || fail "info"
+# info marks the level as billboards (atlas flags bit 2), in text and JSON
+grep -Eq "^ +0  .* billboards$" "$T/info" || fail "info does not mark the billboard level: $(cat "$T/info")"
+"$A" info "$T/bb.dps" --json >"$T/info.json" || fail "info --json"
+python3 -c 'import json,sys; l=json.load(open(sys.argv[1]))["levels"]; assert len(l) == 1 and l[0]["kind"] == "billboards", l' \
+  "$T/info.json" || fail "info --json: level kind is not billboards: $(cat "$T/info.json")"
 # the mesh and its billboards from the same cameras (a .dps is framed by the mesh's frame)
 "$A" render "$T/soup.obj" -o "$T/mesh.png" --size 192x192 --view 30,25 -q || fail "render mesh"
 "$A" render "$T/bb.dps" -o "$T/bb.png" --size 192x192 --view 30,25 -q || fail "render billboards"

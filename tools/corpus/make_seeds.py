@@ -8,7 +8,7 @@ every target from its folder here plus files made fresh by the build (and tests/
 The .amg, .dps and .hier seeds come from the CLI of a build; everything else is written here byte by
 byte (no image library needed). The lead's minimized corpora of the 10-minute runs replace or join
 these files when they exist (/tmp/fuzzcorpus/<target>/)."""
-import os, struct, subprocess, sys, tempfile, zlib
+import math, os, struct, subprocess, sys, tempfile, zlib
 
 here = os.path.dirname(os.path.abspath(__file__))
 amgsplat, seed_hier = sys.argv[1], sys.argv[2]
@@ -173,6 +173,49 @@ put('fuzz_mesh_simplify', 'grid_two_materials.bin',
     simplify_seed(25, 32, 2, 7, 4, 1, pos, tris, [t % 2 for t in range(32)]))
 put('fuzz_mesh_simplify', 'tet_raw.bin',
     simplify_seed(4, 4, 1, 1, 1, 0, [c for v in verts for c in v], [i for f in faces for i in f], [0] * 4))
+
+
+# ---- the batched point reader and the streamed .hier (issue 28): terrain from the CLI as binary PLY
+# (little and big endian), LAS from the CLI (formats 0, 7) and tests/cli/las_handmade.py (1.2-1.4,
+# formats 1, 3, 8), PLYs of other number types written here, and converted .hier files of 25 nodes
+run('synth', 'terrain', '--points', '2000', '-o', f'{tmp}/terrain.ply')
+run('convert', '--big-endian', f'{tmp}/terrain.ply', f'{tmp}/terrain_be.ply')
+put('fuzz_point_stream', 'terrain.ply', read(f'{tmp}/terrain.ply'))
+put('fuzz_point_stream', 'terrain_be.ply', read(f'{tmp}/terrain_be.ply'))
+run('synth', 'octahedron', '--points', '400', '-o', f'{tmp}/oct400.ply')
+put('fuzz_point_stream', 'oct_props.ply', read(f'{tmp}/oct400.ply'))
+for fmt in (0, 7):
+    run('convert', '--las-format', str(fmt), f'{tmp}/oct400.ply', f'{tmp}/oct_f{fmt}.las')
+    put('fuzz_point_stream', f'oct_f{fmt}.las', read(f'{tmp}/oct_f{fmt}.las'))
+las_handmade = os.path.join(here, '..', '..', 'tests', 'cli', 'las_handmade.py')
+for name, minor, fmt, extra in (('hand12_f1', 2, 1, []), ('hand13_f3', 3, 3, []), ('hand14_f8', 4, 8, ['--extra'])):
+    subprocess.run([sys.executable, las_handmade, f'{tmp}/{name}.las', str(minor), str(fmt), '200', *extra],
+                   check=True, stdout=subprocess.DEVNULL)
+    put('fuzz_point_stream', f'{name}.las', read(f'{tmp}/{name}.las'))
+
+
+def vertex_ply(fmt, props, rows, before='', after=''):
+    e = '<' if fmt == 'binary_little_endian' else '>'
+    h = f'ply\nformat {fmt} 1.0\n{before}element vertex {len(rows)}\n'
+    h += ''.join(f'property {t} {n}\n' for t, n, _ in props) + after + 'end_header\n'
+    return h.encode() + b''.join(struct.pack(e + ''.join(c for _, _, c in props), *r) for r in rows)
+
+
+put('fuzz_point_stream', 'double_rgba_be.ply', vertex_ply(
+    'binary_big_endian', [('double', 'x', 'd'), ('double', 'y', 'd'), ('double', 'z', 'd'), ('uchar', 'red', 'B'),
+                          ('uchar', 'green', 'B'), ('uchar', 'blue', 'B'), ('uchar', 'alpha', 'B')],
+    [(math.cos(i * .1), math.sin(i * .1), i * .01, i % 256, 3 * i % 256, 7 * i % 256, 200) for i in range(60)]))
+put('fuzz_point_stream', 'int16_faces.ply', vertex_ply(
+    'binary_little_endian', [('short', 'x', 'h'), ('int', 'y', 'i'), ('ushort', 'z', 'H'), ('float', 'confidence', 'f'),
+                             ('uint8', 'red', 'B')],
+    [(i, -i, 2 * i, 0.5, i % 256) for i in range(60)],
+    before='comment empty element first\nelement camera 0\nproperty float f\n',
+    after='element face 0\nproperty list uchar int vertex_indices\n'))
+run('convert', f'{tmp}/terrain.ply', '-o', f'{tmp}/terrain.hier', '--memory', '64M', '--node-points', '256')
+put('fuzz_ooc', 'terrain.hier', read(f'{tmp}/terrain.hier'))
+run('synth', 'terrain', '--points', '600', '-o', f'{tmp}/t600.ply')
+run('convert', f'{tmp}/t600.ply', '-o', f'{tmp}/terrain600.hier', '--memory', '64M', '--node-points', '64')
+put('fuzz_ooc', 'terrain600.hier', read(f'{tmp}/terrain600.hier'))
 
 total = sum(os.path.getsize(os.path.join(dp, f)) for dp, _, fs in os.walk(here) for f in fs
             if not f.endswith(('.py', '.md')))
