@@ -148,7 +148,9 @@ static void edl_options(const struct render_opts *o, const asp_scene *s, const a
         return;
     asp_edl_desc e = {.strength = isnan(o->r.edl_strength) ? 1.0f : (float)o->r.edl_strength};
     r->disc.edl = r->square.edl = e;
-    if (no_normals)
+    if (no_normals && s->type.kind == ASP_FILE_HIER) // a streamed .hier keeps no normals: estimate cannot help
+        cli_info(env, "note: '%s' (streamed) has no normals: drawn with eye-dome lighting", path);
+    else if (no_normals)
         cli_info(env, "hint: '%s' has no normals: drawn with eye-dome lighting; 'amgsplat estimate %s -o "
                       "WITH_NORMALS.ply' estimates them for lit discs", path, path);
 }
