@@ -181,11 +181,17 @@ export class TileStream {
     v.fit();
   }
 
-  // Each tile's points with KHR_gaussian_splatting attributes, or a disc radius, become splats beside them.
+  // Each tile's points with KHR_gaussian_splatting attributes, or a disc radius, become splats beside
+  // them; a .dps tile's textured quads (one level, export --tiles of a .dps) get the viewer's
+  // primitive passes, blended by the page's method as a single GLB's levels are.
   prepare(scene) {
-    const v = this.viewer, found = [];
+    const v = this.viewer, found = [], prims = [];
     let points = 0;
     scene.updateMatrixWorld(true);
+    scene.traverse((o) => {
+      if (o.isMesh && o.material && o.material.map) prims.push(v.primitivePasses(o));
+    });
+    v.prims.push(...prims);
     scene.traverse((o) => {
       if (!o.isPoints) return;
       points += o.geometry.attributes.position.count;
@@ -202,7 +208,8 @@ export class TileStream {
       sp.points.parent.add(sp.mesh); // the centres hold the points' node transform (splatPasses)
       return sp;
     });
-    scene.userData.amgsplat = { points, splats, disc };
+    for (const p of prims) points += p.count; // a primitive counts against the budget as a splat does
+    scene.userData.amgsplat = { points, splats, disc, prims };
     v.splats.push(...splats);
   }
 
@@ -210,6 +217,11 @@ export class TileStream {
     const v = this.viewer, mine = scene.userData.amgsplat;
     if (!mine) return;
     v.splats = v.splats.filter((sp) => !mine.splats.includes(sp));
+    v.prims = v.prims.filter((p) => !mine.prims.includes(p));
+    for (const p of mine.prims) {
+      p.depth.dispose();
+      p.accum.dispose();
+    }
     for (const sp of mine.splats) {
       sp.mesh.geometry.dispose();
       sp.depth.dispose();

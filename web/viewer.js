@@ -360,7 +360,8 @@ class Viewer {
     const gltfMaterial = mesh.material;
     const extras = mesh.userData.amgsplat || {};
     const map = gltfMaterial.map;
-    const assoc = this.gltf.parser.associations.get(gltfMaterial);
+    // a tileset's tiles (tiles.js) come without this.gltf: their unlit materials keep no normal map
+    const assoc = this.gltf && this.gltf.parser.associations.get(gltfMaterial);
     const normalMap = (assoc && this.normalMaps.get(assoc.materials)) || gltfMaterial.normalMap || null;
     const depth = new THREE.RawShaderMaterial({
       glslVersion: THREE.GLSL3,

@@ -182,6 +182,25 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
 int asp_tiles_export_ooc(asp_ooc *ooc, const char *dir, const asp_tiles_desc *desc, asp_tiles_stats *stats,
                          asp_error *err);
 
+/**
+ * Writes the levels of dps as a 3D Tiles 1.1 tileset in directory dir
+ * (created if missing): one tile a level, dir/tiles/<level name>.glb as
+ * asp_gltf_export_dps writes that level (positions relative to the frame
+ * centre, which the root transform adds), the coarsest level the root and
+ * each level's one child the next finer, refine REPLACE, so a client
+ * draws whole levels, coarse first. geometricError of a level is the largest
+ * error + 0.2 x half diagonal of its primitives (the cut renderer's measure,
+ * asp_dps_cut_view), at least the finer levels', 0 for the finest; boxes
+ * hold the support rectangles of the level and the finer ones. stats: tiles
+ * = levels, splats = primitives over all levels, largest = the largest
+ * level's primitives, points = the source's points. desc: gltf flags and
+ * alpha mode as asp_gltf_export_dps; no levels, tile_points 0.
+ * Errors: ASP_EINVAL (desc with levels or tile_points, directory name too
+ * long), ASP_EDEGENERATE (no level), ASP_EIO, ASP_ENOMEM.
+ */
+int asp_tiles_export_dps(const asp_dps *dps, const char *dir, const asp_tiles_desc *desc, asp_tiles_stats *stats,
+                         asp_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -38,9 +38,9 @@ struct export_opts {
     size_t tile_points;
 };
 
-/* cmd_export_tiles.c: --tiles (asp_tiles_export_ooc, asp_tiles_export_hier) */
-int export_tiles(struct cli_env *env, const char *in, int hier_file, const char *dir, size_t tile_points,
-                 const char *memory, unsigned flags);
+/* cmd_export_tiles.c: --tiles (asp_tiles_export_ooc, asp_tiles_export_hier, asp_tiles_export_dps) */
+int export_tiles(struct cli_env *env, const char *in, asp_file_kind kind, const char *dir, size_t tile_points,
+                 const char *memory, const asp_gltf_desc *gd);
 
 /* --level "L-6,L" or "all" into indices of dps->levels; returns the count, 0 on error (printed). */
 static int parse_levels(struct cli_env *env, const asp_dps *dps, const char *path, const char *text, size_t *out,
@@ -248,9 +248,11 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
         return cli_usage_error(env, "--plain is for point inputs (primitive levels are always written plain)");
     if ((o.tile_points || o.memory) && !o.tiles)
         return cli_usage_error(env, "%s needs --tiles", o.tile_points ? "--tile-points" : "--memory");
-    if (o.tiles && is_dps)
-        return cli_usage_error(env, "--tiles takes a point file or a .hier (not yet a .dps)");
+    if (o.tiles && is_dps && o.level)
+        return cli_usage_error(env, "--level: a .dps tileset holds every level, one tile each (coarse first)");
+    if (o.tiles && is_dps && (o.tile_points || o.memory))
+        return cli_usage_error(env, "%s: the tiles of a .dps are its levels", o.tile_points ? "--tile-points" : "--memory");
     if (o.tiles)
-        return export_tiles(env, in, type.kind == ASP_FILE_HIER, o.output, o.tile_points, o.memory, d.flags);
+        return export_tiles(env, in, type.kind, o.output, o.tile_points, o.memory, &d);
     return is_dps ? export_dps(env, in, &o, &d) : export_points(env, in, type.kind == ASP_FILE_HIER, &o, &d);
 }

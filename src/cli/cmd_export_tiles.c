@@ -21,8 +21,8 @@
 #include "cli/commands.h"
 #include "util/banned.h"
 
-int export_tiles(struct cli_env *env, const char *in, int hier_file, const char *dir, size_t tile_points,
-                 const char *memory, unsigned flags);
+int export_tiles(struct cli_env *env, const char *in, asp_file_kind kind, const char *dir, size_t tile_points,
+                 const char *memory, const asp_gltf_desc *gd);
 
 /* The streamed .hier in as tiles; with convert, in is a point file, converted first to a temporary .hier next
  * to dir. */
@@ -57,11 +57,13 @@ static int tiles_streamed(struct cli_env *env, const char *in, int convert, cons
     return rc;
 }
 
-int export_tiles(struct cli_env *env, const char *in, int hier_file, const char *dir, size_t tile_points,
-                 const char *memory, unsigned flags)
+int export_tiles(struct cli_env *env, const char *in, asp_file_kind kind, const char *dir, size_t tile_points,
+                 const char *memory, const asp_gltf_desc *gd)
 {
     asp_error err = {0};
     asp_hier *h = NULL;
+    unsigned flags = gd->flags;
+    int hier_file = kind == ASP_FILE_HIER;
     int streamed = hier_file && asp_ooc_probe(in) == 1;
     size_t budget = 0;
     if (memory && hier_file)
@@ -77,7 +79,14 @@ int export_tiles(struct cli_env *env, const char *in, int hier_file, const char 
                                     "--node-points when converting)", in);
     int rc;
     asp_tiles_stats st = {0};
-    if (!hier_file || streamed)
+    if (kind == ASP_FILE_DPS) { // one tile a level, coarse first (asp_tiles_export_dps)
+        asp_dps *dps = NULL;
+        rc = asp_dps_load(in, &env->ctx, &dps, &err);
+        const asp_tiles_desc d = {.gltf = *gd};
+        if (!rc)
+            rc = asp_tiles_export_dps(dps, dir, &d, &st, &err);
+        asp_dps_destroy(dps);
+    } else if (!hier_file || streamed)
         rc = tiles_streamed(env, in, !hier_file, dir, tile_points, budget, flags, &st, &err);
     else {
         rc = asp_hier_load(in, &env->ctx, &h, &err);
@@ -89,7 +98,7 @@ int export_tiles(struct cli_env *env, const char *in, int hier_file, const char 
     if (rc)
         return cli_fail(env, &err);
     cli_progress_end(env);
-    const char *refine = hier_file && !streamed ? "REPLACE" : "ADD";
+    const char *refine = (hier_file && !streamed) || kind == ASP_FILE_DPS ? "REPLACE" : "ADD";
     if (env->json) {
         cJSON *j = cJSON_CreateObject();
         cJSON_AddStringToObject(j, "input", in);
@@ -106,14 +115,20 @@ int export_tiles(struct cli_env *env, const char *in, int hier_file, const char 
         cJSON_AddNumberToObject(j, "json_bytes", (double)st.json_bytes);
         cJSON_AddNumberToObject(j, "bytes", (double)st.file_bytes);
         // streamed tiles are round discs (no normals to orient an ellipse)
-        cJSON_AddBoolToObject(j, "gaussian_splats", !(flags & ASP_GLTF_NO_SPLATS) && *refine == 'R');
+        cJSON_AddBoolToObject(j, "gaussian_splats", !(flags & ASP_GLTF_NO_SPLATS) && hier_file && !streamed);
+        if (kind == ASP_FILE_DPS)
+            cJSON_AddNumberToObject(j, "primitives", (double)st.splats);
         cJSON_AddBoolToObject(j, "compressed", !(flags & ASP_GLTF_PLAIN));
         cJSON *o = cJSON_AddArrayToObject(j, "origin");
         for (int k = 0; k < 3; k++)
             cJSON_AddItemToArray(o, cJSON_CreateNumber(st.origin[k]));
         return cli_json_print(env, j);
     }
-    if (!env->quiet)
+    if (!env->quiet && kind == ASP_FILE_DPS)
+        printf("exported '%s' -> '%s/tileset.json': %zu tiles, one a level (refine REPLACE, coarsest first), %zu "
+               "primitives in all, at most %zu in a level, %zu bytes\n",
+               in, dir, st.tiles, st.splats, st.largest, st.file_bytes);
+    else if (!env->quiet)
         printf("exported '%s' -> '%s/tileset.json': %zu tiles (refine %s, depth %u, at most %zu splats), %zu points "
                "in %zu splats, %zu bytes\n",
                in, dir, st.tiles, refine, st.depth, st.largest, st.points, st.splats, st.file_bytes);

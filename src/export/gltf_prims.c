@@ -177,7 +177,9 @@ static double mean_radius(const asp_dps_level *lv)
 }
 
 /* origin: the source's coordinates (the node's translation is it turned to y-up). */
-static int export_level(asp__gltf *g, const asp_dps *dps, size_t index, const double origin[3],
+/* Level index as one node of g, positions relative to origin; local: no node translation (a tile's
+   tileset transform adds the origin back), else the translation is origin. */
+static int export_level(asp__gltf *g, const asp_dps *dps, size_t index, const double origin[3], int local,
                         const asp_gltf_desc *d, float cutoff, asp_gltf_stats *st, asp_error *err)
 {
     const asp_dps_level *lv = &dps->levels[index];
@@ -248,7 +250,8 @@ static int export_level(asp__gltf *g, const asp_dps *dps, size_t index, const do
         cJSON_AddNumberToObject(node, "mesh", imesh);
         double t[3];
         asp__gltf_turn_up(dps->frame.up, origin, t);
-        cJSON_AddItemToObject(node, "translation", asp__gltf_numbers(t, 3));
+        if (!local)
+            cJSON_AddItemToObject(node, "translation", asp__gltf_numbers(t, 3));
         cJSON *ex = cJSON_AddObjectToObject(node, "extras");
         cJSON *am = cJSON_AddObjectToObject(ex, "amgsplat");
         cJSON_AddStringToObject(am, "level", lname);
@@ -297,8 +300,8 @@ static void prim_origin(const asp_dps *dps, const size_t *levels, size_t count, 
         origin[k] = lo[k] <= hi[k] ? 0.5 * (lo[k] + hi[k]) : 0.0;
 }
 
-int asp_gltf_export_dps(const asp_dps *dps, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,
-                        asp_error *err)
+static int export_dps(const asp_dps *dps, const char *path, const asp_gltf_desc *desc, int local,
+                      asp_gltf_stats *stats, asp_error *err)
 {
     ASP_ASSERT(dps && path);
     static const asp_gltf_desc zero;
@@ -329,7 +332,7 @@ int asp_gltf_export_dps(const asp_dps *dps, const char *path, const asp_gltf_des
     asp__gltf g;
     int rc = asp__gltf_init(&g, path, "(domain primitives)", &dps->ctx, err);
     for (size_t i = 0; !rc && i < count; i++)
-        rc = export_level(&g, dps, levels[i], origin, d, cutoff, &st, err);
+        rc = export_level(&g, dps, levels[i], origin, local, d, cutoff, &st, err);
     if (!rc) {
         // one scene per level, named by it: plain viewers show one level, not all of them on top of each other
         cJSON *scenes = cJSON_AddArrayToObject(g.root, "scenes");
@@ -340,7 +343,9 @@ int asp_gltf_export_dps(const asp_dps *dps, const char *path, const asp_gltf_des
             cJSON_AddStringToObject(s, "name", lname);
             double node = (double)i;
             cJSON_AddItemToObject(s, "nodes", asp__gltf_numbers(&node, 1));
-            cJSON_AddItemToObject(s, "extras", asp__gltf_extras("primitives", dps->source, st.origin, &dps->frame));
+            static const double none[3] = {0, 0, 0};
+            cJSON_AddItemToObject(s, "extras",
+                                  asp__gltf_extras("primitives", dps->source, local ? none : st.origin, &dps->frame));
             if (asp__gltf_append(&g, scenes, s) < 0)
                 break;
         }
@@ -353,4 +358,19 @@ int asp_gltf_export_dps(const asp_dps *dps, const char *path, const asp_gltf_des
     if (!rc && stats)
         *stats = st;
     return rc;
+}
+
+int asp_gltf_export_dps(const asp_dps *dps, const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats,
+                        asp_error *err)
+{
+    return export_dps(dps, path, desc, 0, stats, err);
+}
+
+int asp__gltf_prims_tile(const asp_dps *dps, size_t level, const char *path, const asp_gltf_desc *desc,
+                         asp_gltf_stats *stats, asp_error *err)
+{
+    asp_gltf_desc d = desc ? *desc : (asp_gltf_desc){0};
+    d.levels = &level;
+    d.level_count = 1;
+    return export_dps(dps, path, &d, 1, stats, err);
 }

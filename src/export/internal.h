@@ -117,7 +117,15 @@ int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n,
  */
 cJSON *asp__gltf_crs(const asp_las_meta *las);
 
-/* ---- tilesets (tiles.c, shared by tiles_ooc.c) ---- */
+/*
+ * One level of dps as a tile's GLB (tiles_dps.c): as asp_gltf_export_dps writes it, positions
+ * relative to the frame centre but no node translation (the tileset's root transform adds it);
+ * stats->origin is that centre turned to glTF's +y. Errors as asp_gltf_export_dps.
+ */
+int asp__gltf_prims_tile(const asp_dps *dps, size_t level, const char *path, const asp_gltf_desc *desc,
+                         asp_gltf_stats *stats, asp_error *err);
+
+/* ---- tilesets (tiles.c, shared by tiles_ooc.c and tiles_dps.c) ---- */
 
 /* Creates dir and dir/tiles. Returns 0, ASP_EINVAL (name too long), ASP_EIO. */
 int asp__tiles_dirs(const char *dir, asp_error *err);
