@@ -13,7 +13,8 @@
 # MODELS: names of ASP_TEST_DATA's OBJ files; "spot" is spot_triangulated.obj with spot_texture.png.
 # Environment:
 #   PRIMS          levels by count (default "400 100"; build --primitives N)
-#   LEVELS         levels by name instead, one .dps each (e.g. "L-4 L-3 L-2 L-1 L": build --level)
+#   LEVELS         levels by name instead, one .dps each (e.g. "L-4 L-3 L-2 L-1 L": build --level);
+#                  "le:N" = every level of the model's decomposition with at most N primitives
 #   FIT_ARGS       more fit options (e.g. "--iterations 120")
 #   BYTES_PER_PRIM a budget per level of that many GPU bytes a primitive (fit --bytes prims * X),
 #                  one run per value (e.g. "250 400"): the equal-bytes rows of issue 27
@@ -47,8 +48,13 @@ for m in $models; do
   "$bin" sample "$mesh" "${tex[@]}" -o "$out/$m.ply" --points 100000 --quiet
   "$bin" decompose "$out/$m.ply" -o "$out/$m.amg" --quiet
   sel=(); names=()
-  if [ -n "${LEVELS:-}" ]; then
-    for l in $LEVELS; do sel+=("--level $l"); names+=("$l"); done
+  levels=${LEVELS:-}
+  if [[ $levels == le:* ]]; then
+    levels=$("$bin" info --json "$out/$m.amg" | "$py" -c 'import json,sys
+print(" ".join(l["name"] for l in json.load(sys.stdin)["levels"] if l["unknowns"] <= int(sys.argv[1])))' "${levels#le:}")
+  fi
+  if [ -n "$levels" ]; then
+    for l in $levels; do sel+=("--level $l"); names+=("$l"); done
   else
     for p in ${PRIMS:-400 100}; do sel+=("--primitives $p"); names+=("p$p"); done
   fi
@@ -72,8 +78,11 @@ for m in $models; do
       if [ "$x" != none ]; then budget=(--bytes $((c * x))); tag=$n-b$x; fi
       t0=$(date +%s.%N)
       # shellcheck disable=SC2086 # FIT_ARGS is a list of options
-      "$bin" fit "$out/$m-$n.dps" -o "$out/$m-$tag-fit.dps" --reference "$mesh" "${tex[@]}" --threads "$threads" \
-        --quiet "${budget[@]}" ${FIT_ARGS:-} >/dev/null
+      if ! "$bin" fit "$out/$m-$n.dps" -o "$out/$m-$tag-fit.dps" --reference "$mesh" "${tex[@]}" \
+        --threads "$threads" --quiet "${budget[@]}" ${FIT_ARGS:-} >/dev/null; then
+        echo "run,$m,$n,$c,${budget[1]:-none},failed" # a budget below 4x4 texels a primitive
+        continue
+      fi
       t1=$(date +%s.%N)
       echo "run,$m,$n,$c,${budget[1]:-none},$(echo "$t1 - $t0" | bc)"
       mkdir -p "$out/png/$tag"
