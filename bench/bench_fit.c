@@ -316,9 +316,11 @@ static int shrink(const asp_image *img, unsigned k, asp_image *out, asp_error *e
  * by 2^k (k = 0, 1, ..., down to 8 texels a side) with its mip chain counted,
  * the triangles bisected within what is left. The caller keeps the candidate
  * with the best SSIM on the views: the mesh gets its best split of the bytes,
- * chosen on the very views it is scored on.
+ * chosen on the very views it is scored on. A textured mesh also gets the same
+ * candidates from its welded copy (weld: seams torn), which reaches the few
+ * triangles that a small budget leaves.
  */
-enum { MAX_CAND = 12 };
+enum { MAX_CAND = 24 };
 static int equal_bytes_candidates(const asp_mesh *m, size_t limit, asp_mesh **cand, size_t *count, asp_error *err)
 {
     *count = 0;
@@ -326,39 +328,45 @@ static int equal_bytes_candidates(const asp_mesh *m, size_t limit, asp_mesh **ca
     asp_mesh_gpu_bytes(m, &b);
     if (!b.texture)
         return simplify_bytes(m, limit, &cand[(*count)++], err);
-    for (unsigned k = 0; k < 16 && *count < MAX_CAND; k++) {
-        asp_mesh *copy = NULL;
-        int rc = asp_mesh_simplify(m, NULL, NULL, &copy, NULL, err);
-        if (rc)
-            return rc;
-        int small = 0;
-        for (size_t i = 0; i < copy->material_count && !rc; i++) {
-            asp_image *t = &copy->materials[i].texture;
-            if (!t->pixels)
-                continue;
-            small |= (t->width >> k) < 8 || (t->height >> k) < 8;
-            asp_image s = {0};
-            rc = shrink(t, k, &s, err);
-            if (!rc)
-                asp_image_release(t), *t = s;
-        }
-        if (rc) {
+    // the seams that stop the collapse above a small target (simplify) stop it here too: the
+    // welded mesh (seams torn) gives the candidates of few triangles
+    asp_mesh *welded = NULL;
+    int rc = weld(m, &welded, err);
+    if (rc)
+        return rc;
+    const asp_mesh *bases[2] = {m, welded};
+    for (int bi = 0; bi < 2 && !rc; bi++)
+        for (unsigned k = 0; bases[bi] && k < 16 && *count < MAX_CAND; k++) {
+            asp_mesh *copy = NULL;
+            rc = asp_mesh_simplify(bases[bi], NULL, NULL, &copy, NULL, err);
+            if (rc)
+                break;
+            int small = 0;
+            for (size_t i = 0; i < copy->material_count && !rc; i++) {
+                asp_image *t = &copy->materials[i].texture;
+                if (!t->pixels)
+                    continue;
+                small |= (t->width >> k) < 8 || (t->height >> k) < 8;
+                asp_image s = {0};
+                rc = shrink(t, k, &s, err);
+                if (!rc)
+                    asp_image_release(t), *t = s;
+            }
+            asp_mesh_gpu_bytes(copy, &b);
+            // the texture alone over budget: no candidate at this size; a smaller one may fit
+            if (!rc && b.texture < limit) {
+                asp_error e2 = {0};
+                asp_mesh *s = NULL;
+                if (!simplify_bytes(copy, limit, &s, &e2))
+                    cand[(*count)++] = s;
+            }
             asp_mesh_destroy(copy);
-            return rc;
+            if (small)
+                break;
         }
-        asp_mesh_gpu_bytes(copy, &b);
-        // the texture alone over budget: no candidate at this size; a smaller one
-        // may fit
-        if (b.texture < limit) {
-            asp_error e2 = {0};
-            asp_mesh *s = NULL;
-            if (!simplify_bytes(copy, limit, &s, &e2))
-                cand[(*count)++] = s;
-        }
-        asp_mesh_destroy(copy);
-        if (small)
-            break;
-    }
+    asp_mesh_destroy(welded);
+    if (rc)
+        return rc;
     if (!*count)
         return asp_error_set(err, ASP_EDEGENERATE, "no textured simplification within %zu bytes", limit);
     return 0;

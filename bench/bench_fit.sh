@@ -17,7 +17,8 @@
 #                  "le:N" = every level of the model's decomposition with at most N primitives
 #   FIT_ARGS       more fit options (e.g. "--iterations 120")
 #   BYTES_PER_PRIM a budget per level of that many GPU bytes a primitive (fit --bytes prims * X),
-#                  one run per value (e.g. "250 400"): the equal-bytes rows of issue 27
+#                  one run per value (e.g. "300 450"): the equal-bytes rows of issue 27; a budget
+#                  below 4x4 texels a primitive is raised to the least the fit accepts
 #   POISSON        0 skips the Poisson peer (default: on where /usr/bin/python3 imports open3d)
 # Lines starting "run," name the run (model, level, primitives, budget, fit seconds); the CSV lines
 # after them are bench_fit's.
@@ -78,10 +79,18 @@ print(" ".join(l["name"] for l in json.load(sys.stdin)["levels"] if l["unknowns"
       if [ "$x" != none ]; then budget=(--bytes $((c * x))); tag=$n-b$x; fi
       t0=$(date +%s.%N)
       # shellcheck disable=SC2086 # FIT_ARGS is a list of options
-      if ! "$bin" fit "$out/$m-$n.dps" -o "$out/$m-$tag-fit.dps" --reference "$mesh" "${tex[@]}" \
-        --threads "$threads" --quiet "${budget[@]}" ${FIT_ARGS:-} >/dev/null; then
-        echo "run,$m,$n,$c,${budget[1]:-none},failed" # a budget below 4x4 texels a primitive
-        continue
+      fit() {
+        # shellcheck disable=SC2086 # FIT_ARGS is a list of options
+        "$bin" fit "$out/$m-$n.dps" -o "$out/$m-$tag-fit.dps" --reference "$mesh" "${tex[@]}" \
+          --threads "$threads" --quiet "$@" ${FIT_ARGS:-} 2>"$out/fit.err" >/dev/null
+      }
+      if ! fit "${budget[@]}"; then
+        # a budget below 4x4 texels a primitive: the least one the fit accepts, which it names
+        least=$(sed -n 's/.*4x4 texels take (\([0-9]*\)).*/\1/p' "$out/fit.err")
+        if [ -z "$least" ] || ! budget=(--bytes "$least") || ! fit "${budget[@]}"; then
+          echo "run,$m,$n,$c,${budget[1]:-none},failed: $(cat "$out/fit.err")"
+          continue
+        fi
       fi
       t1=$(date +%s.%N)
       echo "run,$m,$n,$c,${budget[1]:-none},$(echo "$t1 - $t0" | bc)"
