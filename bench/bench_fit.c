@@ -250,7 +250,7 @@ static int simplify_bytes(const asp_mesh *m, size_t limit, asp_mesh **out, asp_e
             asp_mesh_destroy(best);
             return rc;
         }
-        if (asp_mesh_gpu_bytes(s, NULL) <= limit) {
+        if (s->triangle_count && asp_mesh_gpu_bytes(s, NULL) <= limit) {
             asp_mesh_destroy(best);
             best = s;
             lo = t;
@@ -445,8 +445,9 @@ int main(int argc, char **argv)
     for (size_t l = 0; l < fit->level_count; l++) {
         const asp_dps_level *lu = &unfit->levels[l], *lf = &fit->levels[l];
         asp_mesh *simple = NULL, *pmesh = NULL;
-        if (simplify(mesh, lf->prim_count, &simple, &err))
-            return fail("simplify", &err);
+        asp_error e1 = {0};
+        if (simplify(mesh, lf->prim_count, &simple, &e1)) // e.g. 3 primitives: no mesh that small, NaN
+            fprintf(stderr, "bench_fit: no mesh of %zu triangles: %s\n", lf->prim_count, e1.msg);
         size_t fbytes = asp_dps_level_gpu_bytes(lf, NULL);
         asp_mesh *cand[MAX_CAND] = {0};
         size_t ncand = 0;
@@ -499,7 +500,7 @@ int main(int argc, char **argv)
             char pu[512], pf[512], ps[512], pr[512], pp[512], pb[512];
             snprintf(pu, sizeof pu, "%s/%s-%s-unfitted", dir, model, name);
             snprintf(pf, sizeof pf, "%s/%s-%s-fitted", dir, model, name);
-            snprintf(ps, sizeof ps, "%s/%s-%s-mesh%zu", dir, model, name, simple->triangle_count);
+            snprintf(ps, sizeof ps, "%s/%s-%s-mesh%zu", dir, model, name, simple ? simple->triangle_count : 0);
             snprintf(pr, sizeof pr, "%s/%s-reference", dir, model);
             snprintf(pp, sizeof pp, "%s/%s-%s-poisson%zu", dir, model, name, pmesh ? pmesh->triangle_count : 0);
             int rc = make_renderer(gl, "mesh", NULL, mesh, origin, 0, &rm, &err);
@@ -517,13 +518,15 @@ int main(int argc, char **argv)
                 rc = make_renderer(gl, "prim", lu, NULL, origin, 0, &ru, &err);
             if (!rc)
                 rc = make_renderer(gl, "prim", lf, NULL, origin, 0, &rf, &err);
-            if (!rc)
+            if (!rc && simple)
                 rc = make_renderer(gl, "mesh", NULL, simple, origin, 0, &rs, &err);
             if (!rc)
                 rc = render_ssim(gl, ru, cams, refs, nviews, size, su, png_dir ? pu : NULL, &err);
             if (!rc)
                 rc = render_ssim(gl, rf, cams, refs, nviews, size, sf, png_dir ? pf : NULL, &err);
-            if (!rc)
+            for (size_t v = 0; v < nviews; v++)
+                sm[v] = NAN;
+            if (!rc && simple)
                 rc = render_ssim(gl, rs, cams, refs, nviews, size, sm, png_dir ? ps : NULL, &err);
             // equal bytes: the best candidate (texture size / triangles split) by
             // mean SSIM
@@ -563,11 +566,11 @@ int main(int argc, char **argv)
             texture_size(cand[best], tex, sizeof tex);
             printf("%s,%s,%zu,%zu,%u,%.4f,%.4f,%.4f,%zu,%zu,%zu,%zu,%.4f,%zu,%zu,%."
                    "4f,%zu,%s,%zu,%zu,%.4f,%zu\n",
-                   model, name, lf->prim_count, simple->triangle_count, size, mean(su, nviews), mean(sf, nviews),
-                   mean(sm, nviews), wins(sf, sm, nviews), wins(su, sm, nviews), wins(sf, su, nviews), nviews,
-                   cpu_gl, fbytes, cand[best]->triangle_count, mean(sb, nviews), wins(sf, sb, nviews), tex,
-                   asp_mesh_gpu_bytes(cand[best], NULL), pmesh ? pmesh->triangle_count : 0, mean(sp, nviews),
-                   wins(sf, sp, nviews));
+                   model, name, lf->prim_count, simple ? simple->triangle_count : 0, size, mean(su, nviews),
+                   mean(sf, nviews), mean(sm, nviews), wins(sf, sm, nviews), wins(su, sm, nviews),
+                   wins(sf, su, nviews), nviews, cpu_gl, fbytes, cand[best]->triangle_count, mean(sb, nviews),
+                   wins(sf, sb, nviews), tex, asp_mesh_gpu_bytes(cand[best], NULL),
+                   pmesh ? pmesh->triangle_count : 0, mean(sp, nviews), wins(sf, sp, nviews));
             fflush(stdout);
             asp_renderer_destroy(rm), asp_renderer_destroy(ru), asp_renderer_destroy(rf), asp_renderer_destroy(rs);
             for (size_t v = 0; v < nviews; v++)
