@@ -68,6 +68,7 @@ print(" ".join(l["name"] for l in json.load(sys.stdin)["levels"] if l["unknowns"
   pre=()
   if [ "$poisson" = 1 ]; then
     echo "poisson,$m: count,triangles,vertices,poisson_s,decimate_s"
+    # shellcheck disable=SC2046 # one count a word
     "$py" "$here/poisson_peer.py" "$out/$m.ply" "$out/$m-poisson" $(printf '%s\n' "${counts[@]}" | sort -un) |
       sed "s/^/poisson,$m,/"
     pre=(--poisson "$out/$m-poisson")
