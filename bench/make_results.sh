@@ -118,6 +118,10 @@ w(open(os.path.join(os.path.dirname(dest), "..", "bench", "results_remarks.md"))
 billboards = os.path.join(os.path.dirname(dest), "results", "billboards.md")
 if os.path.exists(billboards):
     w(open(billboards).read())
+# issue 27: fitted primitives against meshoptimizer and Poisson (bench/bench_fit.sh), carried over the same way
+fitted = os.path.join(os.path.dirname(dest), "results", "fit.md")
+if os.path.exists(fitted):
+    w(open(fitted).read())
 w("\nRenderer: `%s`. Frame rates on a CPU rasteriser are not the seeds' GeForce4 figures; compare them with"
   " each other, not with the papers.\n" % gl)
 open(dest, "w").write("\n".join(L) + "\n")

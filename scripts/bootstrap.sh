@@ -16,6 +16,7 @@ packages=(
   libstb-dev                       # PNG/JPEG read and write
   zlib1g-dev                       # CRC-32 of the .amg and .dps files
   libflann-dev                     # k-NN baseline for bench/bench_knn.c
+  python3-open3d                   # screened Poisson + quadric decimation peer for bench/bench_fit.sh (bench only)
   xvfb xauth                       # viewer test under a virtual display
   glmark2-data                     # ships the Stanford bunny (demo model)
   clang libclang-rt-14-dev         # the clang build and the libFuzzer targets (scripts/test.sh)
