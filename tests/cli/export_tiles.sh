@@ -124,6 +124,51 @@ grep -o '"KHR_mesh_quantization"\|"EXT_meshopt_compression"' "$T/addplain/tiles/
 expect_fail 1 "cannot create directory" "$AMGSPLAT" export "$T/torus.ply" -o "$T/file" --tiles
 ls "$T" | grep '\.convert-.*\.hier' >/dev/null && fail "a failed export left its temporary file"
 
+# a .dps: one tile a level, the coarsest the root, each level's one child the next finer (REPLACE);
+# errors fall to 0 at the finest, boxes hold the finer ones', each GLB is the level as export writes
+# it (its primitive count), the root transform holds the frame centre
+"$AMGSPLAT" build "$T/torus.ply" -o "$T/torus.dps" --level L-4..L -q || fail "build"
+"$AMGSPLAT" export "$T/torus.dps" -o "$T/dps" --tiles --json >"$T/dps.json" || fail "export --tiles of a .dps"
+"$AMGSPLAT" info "$T/torus.dps" --json >"$T/dps_info.json"
+python3 - "$T/dps" "$T/dps.json" "$T/dps_info.json" <<'PY' || fail "the .dps tileset: $(cat "$T/dps.json")"
+import json, os, struct, sys
+d, run, info = sys.argv[1], json.load(open(sys.argv[2])), json.load(open(sys.argv[3]))
+ts = json.load(open(os.path.join(d, 'tileset.json')))
+levels = sorted(info['levels'], key=lambda l: -l['primitives'])  # finest first
+def glb_json(p):
+    b = open(p, 'rb').read()
+    n = struct.unpack_from('<I', b, 12)[0]
+    return json.loads(b[20:20 + n])
+chain, t = [], ts['root']
+assert t['refine'] == 'REPLACE' and len(t['transform']) == 16, t.keys()
+while True:
+    chain.append(t)
+    if 'children' not in t: break
+    assert len(t['children']) == 1, 'a level has one finer level'
+    t = t['children'][0]
+assert len(chain) == len(levels) == run['tiles'] >= 3, (len(chain), len(levels), run)
+errors = [c['geometricError'] for c in chain]
+assert errors[-1] == 0 and all(a >= b for a, b in zip(errors, errors[1:])) and errors[0] > 0, errors
+for coarse, fine in zip(chain, chain[1:]):
+    a, b = coarse['boundingVolume']['box'], fine['boundingVolume']['box']
+    for k in range(3):
+        assert a[k] - a[3 + 4 * k] <= b[k] - b[3 + 4 * k] + 1e-9 and b[k] + b[3 + 4 * k] <= a[k] + a[3 + 4 * k] + 1e-9, (k, a, b)
+counts = []
+for c in chain:
+    g = glb_json(os.path.join(d, c['content']['uri']))
+    counts.append(g['nodes'][0]['extras']['amgsplat']['primitives'])
+    assert 'translation' not in g['nodes'][0], 'the tileset transform holds the origin'
+assert counts == [l['primitives'] for l in reversed(levels)], (counts, levels)
+assert run['refine'] == 'REPLACE' and run['primitives'] == sum(counts), run
+print(f'.dps tileset: {len(chain)} levels, primitives {counts}, errors {[round(e, 4) for e in errors]}')
+PY
+node_ok=0; command -v node >/dev/null && [[ -d "${ASP_TEST_SRC:-$(dirname "$0")/..}/../web/node_modules/gltf-validator" ]] && node_ok=1
+if ((node_ok)); then
+  node "${ASP_TEST_SRC:-$(dirname "$0")/..}/../web/test/validate.mjs" "$T/dps/tiles/L.glb" || fail "gltf-validator rejects a .dps tile"
+fi
+expect_fail 2 "a .dps tileset holds every level" "$AMGSPLAT" export "$T/torus.dps" -o "$T/x" --tiles --level L
+expect_fail 2 "the tiles of a .dps are its levels" "$AMGSPLAT" export "$T/torus.dps" -o "$T/x" --tiles --tile-points 100
+
 # ---- an in-memory .hier: its elliptical splats, refine REPLACE ----
 seed_hier="$(dirname "$AMGSPLAT")/seed_hier"
 if [[ ! -x "$seed_hier" ]]; then
@@ -211,51 +256,6 @@ PY
 grep -o '"KHR_mesh_quantization"\|"KHR_gaussian_splatting"' "$T/plain/tiles/0.glb" >/dev/null &&
   fail "--plain --no-splats tiles carry quantisation or splats"
 grep -o '"KHR_gaussian_splatting"' "$T/tiles/tiles/0.glb" >/dev/null || fail "default tiles lack the splats"
-
-# a .dps: one tile a level, the coarsest the root, each level's one child the next finer (REPLACE);
-# errors fall to 0 at the finest, boxes hold the finer ones', each GLB is the level as export writes
-# it (its primitive count), the root transform holds the frame centre
-"$AMGSPLAT" build "$T/torus.ply" -o "$T/torus.dps" --level L-4..L -q || fail "build"
-"$AMGSPLAT" export "$T/torus.dps" -o "$T/dps" --tiles --json >"$T/dps.json" || fail "export --tiles of a .dps"
-"$AMGSPLAT" info "$T/torus.dps" --json >"$T/dps_info.json"
-python3 - "$T/dps" "$T/dps.json" "$T/dps_info.json" <<'PY' || fail "the .dps tileset: $(cat "$T/dps.json")"
-import json, os, struct, sys
-d, run, info = sys.argv[1], json.load(open(sys.argv[2])), json.load(open(sys.argv[3]))
-ts = json.load(open(os.path.join(d, 'tileset.json')))
-levels = sorted(info['levels'], key=lambda l: -l['primitives'])  # finest first
-def glb_json(p):
-    b = open(p, 'rb').read()
-    n = struct.unpack_from('<I', b, 12)[0]
-    return json.loads(b[20:20 + n])
-chain, t = [], ts['root']
-assert t['refine'] == 'REPLACE' and len(t['transform']) == 16, t.keys()
-while True:
-    chain.append(t)
-    if 'children' not in t: break
-    assert len(t['children']) == 1, 'a level has one finer level'
-    t = t['children'][0]
-assert len(chain) == len(levels) == run['tiles'] >= 3, (len(chain), len(levels), run)
-errors = [c['geometricError'] for c in chain]
-assert errors[-1] == 0 and all(a >= b for a, b in zip(errors, errors[1:])) and errors[0] > 0, errors
-for coarse, fine in zip(chain, chain[1:]):
-    a, b = coarse['boundingVolume']['box'], fine['boundingVolume']['box']
-    for k in range(3):
-        assert a[k] - a[3 + 4 * k] <= b[k] - b[3 + 4 * k] + 1e-9 and b[k] + b[3 + 4 * k] <= a[k] + a[3 + 4 * k] + 1e-9, (k, a, b)
-counts = []
-for c in chain:
-    g = glb_json(os.path.join(d, c['content']['uri']))
-    counts.append(g['nodes'][0]['extras']['amgsplat']['primitives'])
-    assert 'translation' not in g['nodes'][0], 'the tileset transform holds the origin'
-assert counts == [l['primitives'] for l in reversed(levels)], (counts, levels)
-assert run['refine'] == 'REPLACE' and run['primitives'] == sum(counts), run
-print(f'.dps tileset: {len(chain)} levels, primitives {counts}, errors {[round(e, 4) for e in errors]}')
-PY
-node_ok=0; command -v node >/dev/null && [[ -d "${ASP_TEST_SRC:-$(dirname "$0")/..}/../web/node_modules/gltf-validator" ]] && node_ok=1
-if ((node_ok)); then
-  node "${ASP_TEST_SRC:-$(dirname "$0")/..}/../web/test/validate.mjs" "$T/dps/tiles/L.glb" || fail "gltf-validator rejects a .dps tile"
-fi
-expect_fail 2 "a .dps tileset holds every level" "$AMGSPLAT" export "$T/torus.dps" -o "$T/x" --tiles --level L
-expect_fail 2 "the tiles of a .dps are its levels" "$AMGSPLAT" export "$T/torus.dps" -o "$T/x" --tiles --tile-points 100
 
 # errors
 expect_fail 2 "--tile-points needs --tiles" "$AMGSPLAT" export "$T/torus.ply" -o "$T/x.glb" --tile-points 10

@@ -88,6 +88,26 @@ ssim "$T/addweb_refined.png" "$T/add_render.png" ">=" 0.9
 ssim "$T/addweb_refined.png" "$T/add_render_other.png" "<" 0.9
 node "$web/test/cesium.mjs" "$T/add" --chromium "$chromium" || fail "CesiumJS does not load the ADD tileset"
 
+# a .dps tileset (one tile a level, REPLACE): the page starts from the coarsest level and ends at the
+# finest, drawn as `amgsplat render` draws that level (normalized, headlight); Cesium loads it
+"$AMGSPLAT" synth torus -o "$T/torus.ply" --points 20000 -q
+"$AMGSPLAT" build "$T/torus.ply" -o "$T/torus.dps" --level L-4..L -q || fail "build"
+"$AMGSPLAT" export "$T/torus.dps" -o "$T/dps" --tiles -q || fail "export --tiles of a .dps"
+node "$web/test/tiles.mjs" "$T/dps" "$T/dps_web" --view 30,40 --size 256x256 --light head --chromium "$chromium" \
+  >"$T/dps_stream.json" || fail "the page did not stream the .dps tileset"
+finest=$("$AMGSPLAT" info "$T/torus.dps" --json | python3 -c "import json, sys; print(max(json.load(sys.stdin)['levels'], key=lambda l: l['primitives'])['name'])")
+"$AMGSPLAT" render "$T/torus.dps" -o "$T/dps_render.png" --level "$finest" --crease-angle off --view 30,40 --size 256x256 -q
+python3 - "$T/dps_stream.json" <<'PY' || fail ".dps tileset in the page: $(cat "$T/dps_stream.json")"
+import json, sys
+s = json.load(open(sys.argv[1]))
+f, r = s['first_frame'], s['refined']
+print(f".dps tileset: first frame after {f['bytes']} of {s['tileset_bytes']} bytes, {f['points']} primitives; "
+      f"refined {r['points']} primitives in {r['tiles']} tile")
+assert f['points'] < r['points'] and r['tiles'] == 1 and f['bytes'] < 0.25 * s['tileset_bytes'], s
+PY
+ssim "$T/dps_web_refined.png" "$T/dps_render.png" ">=" 0.95
+node "$web/test/cesium.mjs" "$T/dps" --chromium "$chromium" || fail "CesiumJS does not load the .dps tileset"
+
 # ---- an in-memory .hier: its Gaussian splats, refine REPLACE ----
 seed_hier="$(dirname "$AMGSPLAT")/seed_hier"
 if [[ ! -x "$seed_hier" ]]; then
