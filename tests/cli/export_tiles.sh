@@ -15,6 +15,7 @@
 #    of the bytes, identical output twice;
 #  - the errors of bad options.
 source "$(dirname "$0")/common.sh"
+export PYTHONPATH="$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}" # tileset_check.py
 
 "$AMGSPLAT" synth torus -o "$T/torus.ply" --points 60000 -q
 
@@ -30,7 +31,8 @@ ls "$T" | grep '\.convert-.*\.hier' >/dev/null && fail "the temporary streamed h
 cmp "$T/add/tileset.json" "$T/adds/tileset.json" || fail "a streamed .hier and its point file tile differently"
 
 python3 - "$T/add" "$T/add.json" 60000 <<'PY' || fail "streamed tileset structure"
-import json, os, struct, sys
+import json, os, sys
+from tileset_check import glb, walk, files_match, total_bytes
 d, run, n_in = sys.argv[1], json.load(open(sys.argv[2])), int(sys.argv[3])
 ts = json.load(open(os.path.join(d, 'tileset.json')))
 assert ts['asset']['version'] == '1.1', ts['asset']
@@ -38,33 +40,11 @@ root = ts['root']
 assert root['refine'] == 'ADD' and root.get('children'), 'root without ADD or children'
 assert ts['geometricError'] > root['geometricError'] > 0, (ts['geometricError'], root['geometricError'])
 
-def glb(path):
-    b = open(path, 'rb').read()
-    magic, version, length = struct.unpack_from('<4sII', b, 0)
-    assert magic == b'glTF' and version == 2 and length == len(b), path
-    clen, ctype = struct.unpack_from('<II', b, 12)
-    return json.loads(b[20:20 + clen])
-
-def box_bounds(bv):
-    c, h = bv['box'][:3], bv['box'][3:]
-    assert h[1] == h[2] == h[3] == h[5] == h[6] == h[7] == 0, 'boxes are axis-aligned'
-    ext = [h[0], h[4], h[8]]
-    return [c[k] - ext[k] for k in range(3)], [c[k] + ext[k] for k in range(3)]
-
-tiles, total_points, leaf_points, uris = 0, 0, 0, []
-def walk(t, parent_error, parent_box, depth):
+tiles, total_points, leaf_points = 0, 0, 0
+def visit(t, lo, hi, depth):
     global tiles, total_points, leaf_points
     tiles += 1
-    assert 'refine' not in t or depth == 0, 'refine is inherited from the root'
-    e = t['geometricError']
-    assert 0 <= e <= parent_error, f'geometricError grows downwards: {e} > {parent_error}'
-    lo, hi = box_bounds(t['boundingVolume'])
-    if parent_box:
-        plo, phi = parent_box
-        for k in range(3):
-            assert plo[k] - 1e-6 <= lo[k] and hi[k] <= phi[k] + 1e-6, 'a child box sticks out of its parent'
-    uri = t['content']['uri']
-    uris.append(uri)
+    e, uri = t['geometricError'], t['content']['uri']
     g = glb(os.path.join(d, uri))
     assert 'KHR_gaussian_splatting' not in json.dumps(g), f'{uri}: streamed tiles carry no Gaussians'
     mesh = g['meshes'][0]
@@ -89,16 +69,12 @@ def walk(t, parent_error, parent_box, depth):
         leaf_points += n
     else:
         assert e > 0, f'inner tile {uri} with error 0'
-    for c in kids:
-        walk(c, e, (lo, hi), depth + 1)
-walk(root, ts['geometricError'], None, 0)
-assert len(set(uris)) == len(uris), 'a GLB is named twice'
-on_disk = set('tiles/' + f for f in os.listdir(os.path.join(d, 'tiles')))
-assert on_disk == set(uris), f'files not in the tileset: {sorted(on_disk - set(uris))[:5]}'
+uris = walk(ts, visit)
+files_match(d, uris)
 assert total_points == n_in, f'tiles hold {total_points} points, input {n_in}: each point must be in one tile'
 assert run['refine'] == 'ADD' and run['tiles'] == tiles and run['points'] == n_in and run['splats'] == n_in, run
 assert run['leaf_points'] == leaf_points < n_in and run['largest_tile'] > 0 and not run['gaussian_splats'], run
-total = sum(os.path.getsize(os.path.join(d, u)) for u in uris) + os.path.getsize(os.path.join(d, 'tileset.json'))
+total = total_bytes(d, uris)
 assert total == run['bytes'], (total, run['bytes'])
 a = ts['extras']['amgsplat']
 assert a['points'] == n_in and a['refine'] == 'ADD' and a['frame']['radius'] > 0, a
@@ -131,14 +107,11 @@ ls "$T" | grep '\.convert-.*\.hier' >/dev/null && fail "a failed export left its
 "$AMGSPLAT" export "$T/torus.dps" -o "$T/dps" --tiles --json >"$T/dps.json" || fail "export --tiles of a .dps"
 "$AMGSPLAT" info "$T/torus.dps" --json >"$T/dps_info.json"
 python3 - "$T/dps" "$T/dps.json" "$T/dps_info.json" <<'PY' || fail "the .dps tileset: $(cat "$T/dps.json")"
-import json, os, struct, sys
+import json, os, sys
+from tileset_check import glb, walk, files_match
 d, run, info = sys.argv[1], json.load(open(sys.argv[2])), json.load(open(sys.argv[3]))
 ts = json.load(open(os.path.join(d, 'tileset.json')))
 levels = sorted(info['levels'], key=lambda l: -l['primitives'])  # finest first
-def glb_json(p):
-    b = open(p, 'rb').read()
-    n = struct.unpack_from('<I', b, 12)[0]
-    return json.loads(b[20:20 + n])
 chain, t = [], ts['root']
 assert t['refine'] == 'REPLACE' and len(t['transform']) == 16, t.keys()
 while True:
@@ -155,10 +128,11 @@ for coarse, fine in zip(chain, chain[1:]):
         assert a[k] - a[3 + 4 * k] <= b[k] - b[3 + 4 * k] + 1e-9 and b[k] + b[3 + 4 * k] <= a[k] + a[3 + 4 * k] + 1e-9, (k, a, b)
 counts = []
 for c in chain:
-    g = glb_json(os.path.join(d, c['content']['uri']))
+    g = glb(os.path.join(d, c['content']['uri']))
     counts.append(g['nodes'][0]['extras']['amgsplat']['primitives'])
     assert 'translation' not in g['nodes'][0], 'the tileset transform holds the origin'
 assert counts == [l['primitives'] for l in reversed(levels)], (counts, levels)
+files_match(d, walk(ts, lambda t, lo, hi, depth: None))
 assert run['refine'] == 'REPLACE' and run['primitives'] == sum(counts), run
 print(f'.dps tileset: {len(chain)} levels, primitives {counts}, errors {[round(e, 4) for e in errors]}')
 PY
@@ -182,7 +156,8 @@ fi
 cmp "$T/tiles/tileset.json" "$T/again/tileset.json" || fail "two exports of the same hierarchy differ"
 
 python3 - "$T/tiles" "$T/run.json" 60000 2048 <<'PY' || fail "tileset structure"
-import json, os, struct, sys
+import json, os, sys
+from tileset_check import glb, walk, files_match, total_bytes
 d, run, n_in, budget = sys.argv[1], json.load(open(sys.argv[2])), int(sys.argv[3]), int(sys.argv[4])
 ts = json.load(open(os.path.join(d, 'tileset.json')))
 assert ts['asset']['version'] == '1.1', ts['asset']
@@ -191,35 +166,16 @@ assert root['refine'] == 'REPLACE' and root.get('children'), 'root without REPLA
 assert ts['geometricError'] > root['geometricError'] > 0, (ts['geometricError'], root['geometricError'])
 
 def glb_points(path):  # POSITION count of the one points primitive
-    b = open(path, 'rb').read()
-    magic, version, length = struct.unpack_from('<4sII', b, 0)
-    assert magic == b'glTF' and version == 2 and length == len(b), path
-    clen, ctype = struct.unpack_from('<II', b, 12)
-    g = json.loads(b[20:20 + clen])
+    g = glb(path)
     pr = g['meshes'][0]['primitives'][0]
     assert pr['mode'] == 0, path
     return g['accessors'][pr['attributes']['POSITION']]['count']
 
-def box_bounds(bv):
-    c, h = bv['box'][:3], bv['box'][3:]
-    assert h[1] == h[2] == h[3] == h[5] == h[6] == h[7] == 0, 'boxes are axis-aligned'
-    ext = [h[0], h[4], h[8]]
-    return [c[k] - ext[k] for k in range(3)], [c[k] + ext[k] for k in range(3)]
-
-uris, leaf_points, tiles = [], 0, 0
-def walk(t, parent_error, parent_box, depth):
+leaf_points, tiles = 0, 0
+def visit(t, lo, hi, depth):
     global leaf_points, tiles
     tiles += 1
-    assert 'refine' not in t or depth == 0, 'refine is inherited from the root'
-    e = t['geometricError']
-    assert 0 <= e <= parent_error, f'geometricError grows downwards: {e} > {parent_error}'
-    lo, hi = box_bounds(t['boundingVolume'])
-    if parent_box:
-        plo, phi = parent_box
-        for k in range(3):
-            assert plo[k] - 1e-6 <= lo[k] and hi[k] <= phi[k] + 1e-6, 'a child box sticks out of its parent'
-    uri = t['content']['uri']
-    uris.append(uri)
+    e, uri = t['geometricError'], t['content']['uri']
     path = os.path.join(d, uri)
     assert os.path.isfile(path), f'content {uri} missing'
     n = glb_points(path)
@@ -233,15 +189,12 @@ def walk(t, parent_error, parent_box, depth):
         assert n <= budget, f'root holds {n} splats, budget {budget}'
     for c in kids:
         assert c['geometricError'] < e or c['geometricError'] == 0, 'error does not fall'
-        walk(c, e, (lo, hi), depth + 1)
-walk(root, ts['geometricError'], None, 0)
-assert len(set(uris)) == len(uris), 'a GLB is named twice'
-on_disk = set('tiles/' + f for f in os.listdir(os.path.join(d, 'tiles')))
-assert on_disk == set(uris), f'files not in the tileset: {sorted(on_disk - set(uris))[:5]}'
+uris = walk(ts, visit)
+files_match(d, uris)
 assert leaf_points == n_in, f'leaves hold {leaf_points} points, input {n_in}'
 assert run['tiles'] == tiles and run['points'] == n_in and run['leaf_points'] == n_in, run
 assert run['largest_tile'] <= 4 * budget, run
-total = sum(os.path.getsize(os.path.join(d, u)) for u in uris) + os.path.getsize(os.path.join(d, 'tileset.json'))
+total = total_bytes(d, uris)
 assert total == run['bytes'], (total, run['bytes'])
 first = os.path.getsize(os.path.join(d, root['content']['uri'])) + os.path.getsize(os.path.join(d, 'tileset.json'))
 assert first <= 0.05 * total, f'first frame needs {first} of {total} bytes'
