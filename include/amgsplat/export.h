@@ -78,10 +78,11 @@ int asp_gltf_export_dps(const asp_dps *dps, const char *path, const asp_gltf_des
  * ellipses of seed 001 as a KHR_gaussian_splatting primitive
  * (asp_gltf_gaussian_from_ellipse): ROTATION, SCALE, OPACITY and
  * SH_DEGREE_0_COEF_0, that extension in extensionsUsed only. By default the
- * attributes are quantised (KHR_mesh_quantization: positions 16-bit in the
+ * attributes are quantised (KHR_mesh_quantization: positions 16-bit normalized in the
  * points' box, which the node's translation and uniform scale undo; normals
  * octahedral 8-bit; colours and opacity 8-bit; rotations 12-bit quaternions;
- * scales and SH exponential-filtered floats) and compressed with
+ * scales and SH exponential-filtered floats, scales as ln(sigma / s) in
+ * the node's units, s its scale) and compressed with
  * meshoptimizer's vertex codec (EXT_meshopt_compression), points in
  * meshopt_spatialSortRemap order; both extensions are required.
  * ASP_GLTF_PLAIN writes float attributes in input order, as glTF core.

@@ -179,7 +179,7 @@ static int add_points_mesh(asp__gltf *g, const point_arrays *a, size_t n, int sp
     return ok && m >= 0 ? m : -1;
 }
 
-/* The compact points' node transform: world offset = translation + scale * q (q: 16-bit position). */
+/* The compact points' node transform: world offset = translation + scale * q / 65535 (q: 16-bit position). */
 typedef struct compact_node {
     double translation[3], scale;
 } compact_node;
@@ -187,13 +187,16 @@ typedef struct compact_node {
 /*
  * The compact form (issue 32, the encodings of gltfpack): points in meshopt_spatialSortRemap order
  * (neighbours next to each other is what the vertex codec's byte deltas compress), then
- *  POSITION  VEC3 unsigned short (stride 8): q = round((p - lo) / s), s = the box's longest side / 65535,
- *            the same s on all axes so that the node's scale leaves normals and splat shapes unskewed;
+ *  POSITION  VEC3 unsigned short normalized (stride 8): q = round((p - lo) / s * 65535), s = the box's
+ *            longest side, the node's scale: the same s on all axes so that it leaves normals and
+ *            splat shapes unskewed, and the box's side so that the splats' local sizes do not
+ *            depend on the model's units (SCALE below);
  *  NORMAL    VEC3 byte normalized (stride 4) through the OCTAHEDRAL filter (8 bits): three.js's
  *            MeshoptDecoder undoes the filter, so the page sees plain int8 xyz (KHR_mesh_quantization);
  *  COLOR_0   VEC4 unsigned byte normalized, linear (8 bits, gltfpack's choice);
  *  ROTATION  VEC4 short normalized (stride 8) through the QUATERNION filter (12 bits);
- *  SCALE     VEC3 float, EXPONENTIAL filter (12-bit mantissa: ln sigma to ~0.1 %);
+ *  SCALE     VEC3 float, EXPONENTIAL filter (12-bit mantissa: ln sigma to ~0.1 %), ln(sigma / s): in the
+ *            node's local units like the positions, so the node's scale gives world sigma back;
  *  OPACITY   unsigned byte normalized (stride 4: vertex attributes are 4-byte aligned);
  *  SH0       VEC3 float, EXPONENTIAL filter (10-bit mantissa: below half an 8-bit colour step).
  * Each view is one vertex stream of EXT_meshopt_compression (mode ATTRIBUTES).
@@ -215,22 +218,22 @@ static int add_points_compact(asp__gltf *g, const point_arrays *a, size_t n, int
         side = fmax(side, (double)a->hi[k] - a->lo[k]);
         node->translation[k] = origin[k] + a->lo[k];
     }
-    double s = side > 0 ? side / 65535.0 : 1.0;
+    double s = side > 0 ? side : 1.0;
     node->scale = s;
     uint16_t *q = (uint16_t *)buf;
     float qmin[3] = {65535, 65535, 65535}, qmax[3] = {0, 0, 0};
     for (size_t i = 0; i < n; i++) {
         uint16_t *o = q + 4 * (size_t)remap[i];
         for (int k = 0; k < 3; k++) {
-            double v = fmin(fmax(rint(((double)a->pos[3 * i + k] - a->lo[k]) / s), 0.0), 65535.0);
+            double v = fmin(fmax(rint(((double)a->pos[3 * i + k] - a->lo[k]) / s * 65535.0), 0.0), 65535.0);
             o[k] = (uint16_t)v;
-            qmin[k] = fminf(qmin[k], (float)v);
+            qmin[k] = fminf(qmin[k], (float)v); // bounds in the stored integers (glTF 3.6.2.5)
             qmax[k] = fmaxf(qmax[k], (float)v);
         }
         o[3] = 0;
     }
     int pos = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, q, n, 8, "NONE"), ASP__GL_UNSIGNED_SHORT, n, "VEC3",
-                                 0, qmin, qmax);
+                                 1, qmin, qmax);
     for (size_t i = 0; i < n; i++) {
         float *o = tmp + 4 * (size_t)remap[i];
         memcpy(o, a->nrm + 3 * i, 12);
@@ -256,8 +259,15 @@ static int add_points_compact(asp__gltf *g, const point_arrays *a, size_t n, int
         meshopt_encodeFilterQuat(buf, n, 8, 12, tmp);
         acc[0] = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, buf, n, 8, "QUATERNION"), ASP__GL_SHORT, n, "VEC4",
                                     1, NULL, NULL);
+        // glTF attributes live in the node's local space, which the node's scale s takes to the
+        // world (and viewers apply it to the Gaussian, as KHR_gaussian_splatting says): ln(sigma / s).
+        // With s the box's side, ln(sigma / s) lies near -7 (tangent) and -12 (normal) for
+        // 10^3..10^8 points of any unit: the filter's shared exponent (of the largest) stays put,
+        // which the codec's byte deltas need (s = side / 65535 put it on 4 for the 1M bunny: +1.5 B)
+        const float log_s = (float)log(s);
         for (size_t i = 0; i < n; i++)
-            memcpy(tmp + 3 * (size_t)remap[i], a->scale + 3 * i, 12);
+            for (int k = 0; k < 3; k++)
+                tmp[3 * (size_t)remap[i] + k] = a->scale[3 * i + k] - log_s;
         meshopt_encodeFilterExp(buf, n, 12, 12, tmp);
         acc[1] = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, buf, n, 12, "EXPONENTIAL"), ASP__GL_FLOAT, n,
                                     "VEC3", 0, NULL, NULL);
