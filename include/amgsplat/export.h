@@ -24,8 +24,11 @@ enum asp_gltf_flags {
     ASP_GLTF_LIT = 1 << 0,           /* primitives: metallic-roughness material instead of KHR_materials_unlit */
     ASP_GLTF_NO_NORMAL_MAP = 1 << 1, /* primitives: leave the level's normal map out */
     ASP_GLTF_NO_SPLATS = 1 << 2,     /* points: plain POINTS, no KHR_gaussian_splatting attributes */
-    ASP_GLTF_PLAIN = 1 << 3          /* points: float attributes, uncompressed (no KHR_mesh_quantization,
+    ASP_GLTF_PLAIN = 1 << 3,         /* points: float attributes, uncompressed (no KHR_mesh_quantization,
                                         no EXT_meshopt_compression), in input order */
+    ASP_GLTF_SPZ = 1 << 4            /* points: the splats as one SPZ stream (KHR_gaussian_splatting_
+                                        compression_spz_2, required; what CesiumJS draws); not with
+                                        ASP_GLTF_PLAIN or ASP_GLTF_NO_SPLATS (ASP_EINVAL) */
 };
 
 /** Options; the zero value means the defaults. */

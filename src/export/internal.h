@@ -117,4 +117,23 @@ int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n,
  */
 cJSON *asp__gltf_crs(const asp_las_meta *las);
 
+/* n Gaussians for asp__spz_encode, in the glTF node's local frame (gltf_spz.c) */
+typedef struct asp__spz_splats {
+    const float *positions;  /* xyz */
+    const float *rotations;  /* unit quaternions x, y, z, w */
+    const float *log_scales; /* ln sigma, 3 a splat */
+    const float *opacities;  /* in [0, 1] */
+    const float *sh0;        /* SH DC, 3 a splat (colour = 0.5 + 0.2820948 sh0) */
+    int fractional_bits;     /* of the 24-bit fixed-point positions, 0..23 (|x| < 2^(23 - bits)) */
+} asp__spz_splats;
+/*
+ * The gzipped SPZ version 2 stream of n splats (KHR_gaussian_splatting_compression_spz_2) in
+ * *dst (asp_alloc'd, asp_free) of *dst_size bytes. Errors: ASP_EINVAL (n = 0 or too many), ASP_ENOMEM.
+ */
+int asp__spz_encode(const asp__spz_splats *s, size_t n, uint8_t **dst, size_t *dst_size, asp_error *err);
+/* What a tileset of tiles written with flags (asp_gltf_flags) adds to tileset.json's root: the
+ * glTF extensions a client needs (3DTILES_content_gltf; CesiumJS draws Gaussian splats only where
+ * it lists KHR_gaussian_splatting_compression_spz_2 as required). */
+void asp__gltf_tileset_extensions(cJSON *tileset, unsigned flags);
+
 #endif

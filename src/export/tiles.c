@@ -256,6 +256,7 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
     // the error of showing nothing: the whole model as one pixel-sized dot
     cJSON_AddNumberToObject(root, "geometricError", sqrt(diag));
     cJSON_AddItemToObject(root, "root", root_tile);
+    asp__gltf_tileset_extensions(root, d->gltf.flags);
     cJSON *extras = asp__gltf_extras("tileset", NULL, origin, frame);
     cJSON *a = cJSON_GetObjectItemCaseSensitive(extras, "amgsplat");
     cJSON_AddNumberToObject(a, "points", (double)asp_hier_point_count(hier));
