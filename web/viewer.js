@@ -13,6 +13,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 // three ships (meshoptimizer's WebAssembly decoder, filters included)
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { TileStream } from './tiles.js';
+import { spzToPlainGlb } from './spz.js';
 
 const status = { ready: false, error: null, info: null };
 window.amgsplatViewer = status;
@@ -278,6 +279,8 @@ class Viewer {
   async open(buffer, name, resourcePath = '') {
     const loader = new GLTFLoader();
     loader.setMeshoptDecoder(MeshoptDecoder);
+    // SPZ splats (export --splat-codec spz, for CesiumJS) decoded to the float attributes three reads
+    if (buffer instanceof ArrayBuffer) buffer = await spzToPlainGlb(buffer);
     const gltf = await loader.parseAsync(buffer, resourcePath);
     this.gltf = gltf;
     // an unlit material (KHR_materials_unlit) becomes a MeshBasicMaterial, which drops the

@@ -57,11 +57,24 @@ int asp__spz_encode(const asp__spz_splats *s, size_t n, uint8_t **dst, size_t *d
             scale[3 * i + k] = to_u8((s->log_scales[3 * i + k] + 10.0) * 16.0);
         }
         alpha[i] = to_u8(s->opacities[i] * 255.0);
-        const float *q = s->rotations + 4 * i; // x, y, z, w
-        double len = sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3]);
-        double sign = q[3] < 0 ? -1.0 : 1.0; // q and -q are one rotation: the one with w >= 0
+        // A Gaussian is unchanged by a half turn about any of its own axes: q, q i, q j and q k
+        // (x, y, z, w) = (x, y, z, w), (w, z, -y, -x), (-z, w, x, -y), (y, -x, w, -z) are one
+        // splat. The one with the largest |w| keeps the rebuilt w = sqrt(1 - x^2 - y^2 - z^2) away
+        // from 0, where 8-bit x, y, z tilt the splat by up to 10 degrees (3 at |w| >= 0.5).
+        const float *q = s->rotations + 4 * i;
+        const double c[4][4] = {{q[0], q[1], q[2], q[3]},
+                                {q[3], q[2], -q[1], -q[0]},
+                                {-q[2], q[3], q[0], -q[1]},
+                                {q[1], -q[0], q[3], -q[2]}};
+        int best = 0;
+        for (int j = 1; j < 4; j++)
+            if (fabs(c[j][3]) > fabs(c[best][3]))
+                best = j;
+        const double *b = c[best];
+        double len = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);
+        double sign = b[3] < 0 ? -1.0 : 1.0; // q and -q are one rotation: the one with w >= 0
         for (int k = 0; k < 3; k++)
-            rot[3 * i + k] = len > 0 ? to_u8(sign * q[k] / len * 127.5 + 127.5) : 128;
+            rot[3 * i + k] = len > 0 ? to_u8(sign * b[k] / len * 127.5 + 127.5) : 128;
     }
     // gzip (RFC 1952) through zlib: window bits 15 + 16 asks deflate for the gzip wrapper
     z_stream z;
