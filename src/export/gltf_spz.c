@@ -76,7 +76,8 @@ int asp__spz_encode(const asp__spz_splats *s, size_t n, uint8_t **dst, size_t *d
         for (int k = 0; k < 3; k++)
             rot[3 * i + k] = len > 0 ? to_u8(sign * b[k] / len * 127.5 + 127.5) : 128;
     }
-    // gzip (RFC 1952) through zlib: window bits 15 + 16 asks deflate for the gzip wrapper
+    // gzip (RFC 1952) through zlib: window bits 15 + 16 asks deflate for the gzip wrapper. Level 9:
+    // the 1M bunny 8.80 bytes a point in 6.1 s, level 6 8.89 in 3.9 s (one run, loaded machine)
     z_stream z;
     memset(&z, 0, sizeof z);
     int rc = 0;
