@@ -220,8 +220,8 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
         {"no-splats", 0, CLI_FLAG, &o.no_splats, NULL, "points: plain POINTS without the KHR_gaussian_splatting ellipses"},
         {"plain", 0, CLI_FLAG, &o.plain, NULL, "points: float attributes, uncompressed, in input order (default: "
                                                 "quantised, meshopt-compressed)"},
-        {"splat-codec", 0, CLI_STRING, &o.splat_codec, "C", "points: meshopt (default; the web page) or spz "
-                                                               "(KHR_gaussian_splatting_compression_spz_2: CesiumJS)"},
+        {"splat-codec", 0, CLI_STRING, &o.splat_codec, "C", "points: meshopt (default) or spz (KHR_gaussian_"
+                                                               "splatting_compression_spz_2, what CesiumJS draws)"},
         {"tiles", 0, CLI_FLAG, &o.tiles, NULL, "points: a 3D Tiles 1.1 tileset in directory OUT (tileset.json, tiles/*.glb)"},
         {"tile-points", 0, CLI_SIZE, &o.tile_points, "N", "--tiles: most splats in a tile (default 32768)"},
         {0},
