@@ -21,6 +21,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { TilesRenderer } from '3d-tiles-renderer/three';
 import { splatDepthFragment, splatAccumFragment } from './viewer.js';
+import { spzToPlainGlb } from './spz.js';
 
 const STILL_MS = 300; // the camera counts as moving until this long after its last change
 const SETTLE_FRAMES = 20; // frames without loads or visibility changes before `settled`
@@ -115,7 +116,10 @@ export class TileStream {
       const body = await res.arrayBuffer();
       this.bytes += body.byteLength;
       this.requests++;
-      return new Response(body, { status: res.status, statusText: res.statusText, headers: res.headers });
+      // SPZ tiles (export --tiles --splat-codec spz, for CesiumJS) become the float Gaussians three
+      // reads (spz.js), so one tileset serves Cesium and this page
+      const out = res.ok && /\.glb$/.test(new URL(url, location.href).pathname) ? await spzToPlainGlb(body) : body;
+      return new Response(out, { status: res.status, statusText: res.statusText, headers: res.headers });
     };
     tiles.registerPlugin({ name: 'amgsplat-splats', processTileModel: (scene) => this.prepare(scene) });
     tiles.maxDepth = 1; // coarse first: the root alone until it is shown

@@ -13,6 +13,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 // three ships (meshoptimizer's WebAssembly decoder, filters included)
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { TileStream } from './tiles.js';
+import { spzToPlainGlb } from './spz.js';
 
 const status = { ready: false, error: null, info: null };
 window.amgsplatViewer = status;
@@ -281,6 +282,8 @@ class Viewer {
   async open(buffer, name, resourcePath = '') {
     const loader = new GLTFLoader();
     loader.setMeshoptDecoder(MeshoptDecoder);
+    // SPZ splats (export --splat-codec spz, for CesiumJS) decoded to the float attributes three reads
+    if (buffer instanceof ArrayBuffer) buffer = await spzToPlainGlb(buffer);
     const gltf = await loader.parseAsync(buffer, resourcePath);
     this.gltf = gltf;
     // an unlit material (KHR_materials_unlit) becomes a MeshBasicMaterial, which drops the
@@ -398,14 +401,16 @@ class Viewer {
 
   // The splats of a points node: per point its ellipse axes u a, v b from the Gaussian
   // (rotation columns x, y; semi-axes 2 sigma, export.md), colour (linear), normal. Attributes are
-  // read through getX.. (which undo KHR_mesh_quantization's normalized integers); the centres get
-  // the node's transform here (translation, and the scale that undoes the 16-bit positions), as
-  // the splat shader works in the scene's frame without a model matrix.
+  // read through getX.. (which undo KHR_mesh_quantization's normalized integers); the centres and
+  // the axes get the node's transform here (translation, and the scale that undoes the 16-bit
+  // positions: SCALE is in the node's units, as every glTF attribute), as the splat shader works
+  // in the scene's frame without a model matrix.
   splatPasses(points) {
     const g = points.geometry, n = g.attributes.position.count;
     const rot = g.attributes['khr_gaussian_splatting:rotation'], scale = g.attributes['khr_gaussian_splatting:scale'];
     const P = g.attributes.position, N = g.attributes.normal, at = new THREE.Vector3();
     points.updateMatrix();
+    const linear = new THREE.Matrix3().setFromMatrix4(points.matrix), axis = new THREE.Vector3();
     const U = new Float32Array(3 * n), V = new Float32Array(3 * n), C = new Float32Array(4 * n);
     const centers = new Float32Array(3 * n), normals = new Float32Array(3 * n);
     for (let i = 0; i < n; i++) {
@@ -413,8 +418,10 @@ class Viewer {
       if (N) normals.set([N.getX(i), N.getY(i), N.getZ(i)], 3 * i);
       const x = rot.getX(i), y = rot.getY(i), z = rot.getZ(i), w = rot.getW(i);
       const a = 2 * Math.exp(scale.getX(i)), b = 2 * Math.exp(scale.getY(i));
-      U.set([(1 - 2 * (y * y + z * z)) * a, 2 * (x * y + w * z) * a, 2 * (x * z - w * y) * a], 3 * i);
-      V.set([2 * (x * y - w * z) * b, (1 - 2 * (x * x + z * z)) * b, 2 * (y * z + w * x) * b], 3 * i);
+      axis.set((1 - 2 * (y * y + z * z)) * a, 2 * (x * y + w * z) * a, 2 * (x * z - w * y) * a);
+      U.set(axis.applyMatrix3(linear).toArray(), 3 * i);
+      axis.set(2 * (x * y - w * z) * b, (1 - 2 * (x * x + z * z)) * b, 2 * (y * z + w * x) * b);
+      V.set(axis.applyMatrix3(linear).toArray(), 3 * i);
       const c = g.attributes.color;
       C.set(c ? [c.getX(i), c.getY(i), c.getZ(i), 1] : [0.578, 0.578, 0.578, 1], 4 * i);
     }

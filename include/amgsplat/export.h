@@ -25,8 +25,11 @@ enum asp_gltf_flags {
     ASP_GLTF_LIT = 1 << 0,           /* primitives: metallic-roughness material instead of KHR_materials_unlit */
     ASP_GLTF_NO_NORMAL_MAP = 1 << 1, /* primitives: leave the level's normal map out */
     ASP_GLTF_NO_SPLATS = 1 << 2,     /* points: plain POINTS, no KHR_gaussian_splatting attributes */
-    ASP_GLTF_PLAIN = 1 << 3          /* points: float attributes, uncompressed (no KHR_mesh_quantization,
+    ASP_GLTF_PLAIN = 1 << 3,         /* points: float attributes, uncompressed (no KHR_mesh_quantization,
                                         no EXT_meshopt_compression), in input order */
+    ASP_GLTF_SPZ = 1 << 4            /* points: the splats as one SPZ stream (KHR_gaussian_splatting_
+                                        compression_spz_2, required; what CesiumJS draws); not with
+                                        ASP_GLTF_PLAIN or ASP_GLTF_NO_SPLATS (ASP_EINVAL) */
 };
 
 /** Options; the zero value means the defaults. */
@@ -79,10 +82,11 @@ int asp_gltf_export_dps(const asp_dps *dps, const char *path, const asp_gltf_des
  * ellipses of seed 001 as a KHR_gaussian_splatting primitive
  * (asp_gltf_gaussian_from_ellipse): ROTATION, SCALE, OPACITY and
  * SH_DEGREE_0_COEF_0, that extension in extensionsUsed only. By default the
- * attributes are quantised (KHR_mesh_quantization: positions 16-bit in the
+ * attributes are quantised (KHR_mesh_quantization: positions 16-bit normalized in the
  * points' box, which the node's translation and uniform scale undo; normals
  * octahedral 8-bit; colours and opacity 8-bit; rotations 12-bit quaternions;
- * scales and SH exponential-filtered floats) and compressed with
+ * scales and SH exponential-filtered floats, scales as ln(sigma / s) in
+ * the node's units, s its scale) and compressed with
  * meshoptimizer's vertex codec (EXT_meshopt_compression), points in
  * meshopt_spatialSortRemap order; both extensions are required.
  * ASP_GLTF_PLAIN writes float attributes in input order, as glTF core.

@@ -6,8 +6,9 @@
 static const char usage[] =
     "usage: amgsplat export IN -o OUT.glb|OUT.gltf [--level L[,L...]|all] [--alpha-mode blend|mask]\n"
     "                       [--alpha-cutoff X] [--lit] [--no-normal-map] [--no-splats] [--plain]\n"
-    "                       [--json]\n"
+    "                       [--splat-codec meshopt|spz] [--json]\n"
     "       amgsplat export IN -o DIR --tiles [--tile-points N] [--memory SIZE] [--no-splats] [--plain]\n"
+    "                       [--splat-codec meshopt|spz]\n"
     "\n"
     "Writes glTF 2.0: one binary .glb, or a .gltf with OUT.bin and OUT_<image>.png beside it.\n"
     "A .dps becomes one textured quad per domain primitive (its support rectangle, as amgsplat\n"
@@ -16,6 +17,8 @@ static const char usage[] =
     "a node and a scene named by level. A point set (.ply, .xyz, ...) or .hier becomes POINTS with\n"
     "POSITION, NORMAL, COLOR_0 and seed 001's splat ellipses as KHR_gaussian_splatting Gaussians,\n"
     "quantised (KHR_mesh_quantization) and compressed (EXT_meshopt_compression) unless --plain.\n"
+    "--splat-codec spz writes the splats as one SPZ stream (KHR_gaussian_splatting_compression_spz_2),\n"
+    "what CesiumJS draws as Gaussian splats.\n"
     "Positions are relative to the model's origin, kept in the node translation.\n"
     "--tiles writes a point set or .hier as a streamed 3D Tiles 1.1 tileset: DIR/tileset.json and\n"
     "one GLB a tile under DIR/tiles/ (docs/web.md). A point file is converted first to a streamed\n"
@@ -32,7 +35,7 @@ static const char usage[] =
 #include "util/banned.h"
 
 struct export_opts {
-    const char *output, *level, *alpha_mode, *memory;
+    const char *output, *level, *alpha_mode, *memory, *splat_codec;
     double alpha_cutoff;
     int lit, no_normal_map, no_splats, plain, tiles;
     size_t tile_points;
@@ -104,6 +107,8 @@ static int print_result(const struct cli_env *env, const char *in, const char *o
         } else {
             cJSON_AddBoolToObject(j, "gaussian_splats", !(d->flags & ASP_GLTF_NO_SPLATS));
             cJSON_AddBoolToObject(j, "compressed", !(d->flags & ASP_GLTF_PLAIN));
+            if (!(d->flags & (ASP_GLTF_PLAIN | ASP_GLTF_NO_SPLATS)))
+                cJSON_AddStringToObject(j, "splat_codec", (d->flags & ASP_GLTF_SPZ) ? "spz" : "meshopt");
         }
         return cli_json_print(env, j);
     }
@@ -142,6 +147,13 @@ static int check_options(struct cli_env *env, const struct export_opts *o, asp_g
     d->alpha_cutoff = (float)o->alpha_cutoff;
     d->flags = (o->lit ? ASP_GLTF_LIT : 0u) | (o->no_normal_map ? ASP_GLTF_NO_NORMAL_MAP : 0u) |
                (o->no_splats ? ASP_GLTF_NO_SPLATS : 0u) | (o->plain ? ASP_GLTF_PLAIN : 0u);
+    if (o->splat_codec && strcmp(o->splat_codec, "spz") == 0) {
+        if (o->plain || o->no_splats)
+            return cli_usage_error(env, "--splat-codec spz writes compressed splats: not with %s",
+                                   o->plain ? "--plain" : "--no-splats");
+        d->flags |= ASP_GLTF_SPZ;
+    } else if (o->splat_codec && strcmp(o->splat_codec, "meshopt") != 0)
+        return cli_usage_error(env, "--splat-codec expects meshopt or spz, got '%s'", o->splat_codec);
     return 0;
 }
 
@@ -210,6 +222,8 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
         {"no-splats", 0, CLI_FLAG, &o.no_splats, NULL, "points: plain POINTS without the KHR_gaussian_splatting ellipses"},
         {"plain", 0, CLI_FLAG, &o.plain, NULL, "points: float attributes, uncompressed, in input order (default: "
                                                 "quantised, meshopt-compressed)"},
+        {"splat-codec", 0, CLI_STRING, &o.splat_codec, "C", "points: meshopt (default) or spz (KHR_gaussian_"
+                                                               "splatting_compression_spz_2, what CesiumJS draws)"},
         {"tiles", 0, CLI_FLAG, &o.tiles, NULL, "points: a 3D Tiles 1.1 tileset in directory OUT (tileset.json, tiles/*.glb)"},
         {"tile-points", 0, CLI_SIZE, &o.tile_points, "N", "--tiles: most splats in a tile (default 32768; a point "
                                                            "file: most points in a leaf node)"},
@@ -244,6 +258,8 @@ int cmd_export(int argc, char **argv, struct cli_env *env)
                                     "inputs");
     if (is_dps && o.no_splats)
         return cli_usage_error(env, "--no-splats is for point inputs");
+    if (is_dps && o.splat_codec)
+        return cli_usage_error(env, "--splat-codec is for point inputs");
     if (is_dps && o.plain)
         return cli_usage_error(env, "--plain is for point inputs (primitive levels are always written plain)");
     if ((o.tile_points || o.memory) && !o.tiles)

@@ -65,13 +65,23 @@ int export_tiles(struct cli_env *env, const char *in, asp_file_kind kind, const 
     unsigned flags = gd->flags;
     int hier_file = kind == ASP_FILE_HIER;
     int streamed = hier_file && asp_ooc_probe(in) == 1;
+    // Gaussian splats (--splat-codec spz, what CesiumJS draws) need seed 001's ellipses, which only
+    // the in-memory hierarchy computes: a point file is then built into one in memory, not streamed
+    int gaussians = (flags & ASP_GLTF_SPZ) != 0;
+    int in_memory = kind != ASP_FILE_DPS && ((hier_file && !streamed) || (!hier_file && gaussians));
+    if (streamed && gaussians)
+        return cli_usage_error(env, "--splat-codec spz: the tiles of the streamed hierarchy '%s' are round discs "
+                                    "without Gaussians; tile its point file instead", in);
+    if (!hier_file && gaussians && memory)
+        return cli_usage_error(env, "--memory: a tileset of Gaussian splats (--splat-codec spz) is built in memory, "
+                                    "not converted");
     size_t budget = 0;
     if (memory && hier_file)
         return cli_usage_error(env, "--memory is the budget of converting a point file; '%s' is a hierarchy already",
                                in);
     if (memory && cli_memory_option(env, memory, &budget))
         return 2;
-    if (!hier_file && tile_points && (tile_points < 64 || tile_points > 1000000))
+    if (!hier_file && !in_memory && tile_points && (tile_points < 64 || tile_points > 1000000))
         return cli_usage_error(env, "--tile-points %zu: a point file's leaf nodes hold 64 to 1000000 points",
                                tile_points);
     if (streamed && tile_points)
@@ -86,10 +96,18 @@ int export_tiles(struct cli_env *env, const char *in, asp_file_kind kind, const 
         if (!rc)
             rc = asp_tiles_export_dps(dps, dir, &d, &st, &err);
         asp_dps_destroy(dps);
-    } else if (!hier_file || streamed)
+    } else if (!in_memory)
         rc = tiles_streamed(env, in, !hier_file, dir, tile_points, budget, flags, &st, &err);
     else {
-        rc = asp_hier_load(in, &env->ctx, &h, &err);
+        if (hier_file)
+            rc = asp_hier_load(in, &env->ctx, &h, &err);
+        else { // the ellipses of seed 001, built in memory (asp_hier_build)
+            asp_cloud *c = NULL;
+            rc = asp_cloud_load(in, &env->ctx, &c, &err);
+            if (!rc)
+                rc = asp_hier_build(c, NULL, &env->ctx, &h, &err);
+            asp_cloud_destroy(c); // the hierarchy holds what the tiles need
+        }
         const asp_tiles_desc d = {.gltf = {.flags = flags}, .tile_points = tile_points};
         if (!rc)
             rc = asp_tiles_export_hier(h, dir, &d, &st, &err);
@@ -98,7 +116,7 @@ int export_tiles(struct cli_env *env, const char *in, asp_file_kind kind, const 
     if (rc)
         return cli_fail(env, &err);
     cli_progress_end(env);
-    const char *refine = (hier_file && !streamed) || kind == ASP_FILE_DPS ? "REPLACE" : "ADD";
+    const char *refine = in_memory || kind == ASP_FILE_DPS ? "REPLACE" : "ADD";
     if (env->json) {
         cJSON *j = cJSON_CreateObject();
         cJSON_AddStringToObject(j, "input", in);
@@ -115,7 +133,7 @@ int export_tiles(struct cli_env *env, const char *in, asp_file_kind kind, const 
         cJSON_AddNumberToObject(j, "json_bytes", (double)st.json_bytes);
         cJSON_AddNumberToObject(j, "bytes", (double)st.file_bytes);
         // streamed tiles are round discs (no normals to orient an ellipse)
-        cJSON_AddBoolToObject(j, "gaussian_splats", !(flags & ASP_GLTF_NO_SPLATS) && hier_file && !streamed);
+        cJSON_AddBoolToObject(j, "gaussian_splats", !(flags & ASP_GLTF_NO_SPLATS) && in_memory);
         if (kind == ASP_FILE_DPS)
             cJSON_AddNumberToObject(j, "primitives", (double)st.splats);
         cJSON_AddBoolToObject(j, "compressed", !(flags & ASP_GLTF_PLAIN));

@@ -179,7 +179,7 @@ static int add_points_mesh(asp__gltf *g, const point_arrays *a, size_t n, int sp
     return ok && m >= 0 ? m : -1;
 }
 
-/* The compact points' node transform: world offset = translation + scale * q (q: 16-bit position). */
+/* The compact points' node transform: world offset = translation + scale * q / 65535 (q: 16-bit position). */
 typedef struct compact_node {
     double translation[3], scale;
 } compact_node;
@@ -187,13 +187,16 @@ typedef struct compact_node {
 /*
  * The compact form (issue 32, the encodings of gltfpack): points in meshopt_spatialSortRemap order
  * (neighbours next to each other is what the vertex codec's byte deltas compress), then
- *  POSITION  VEC3 unsigned short (stride 8): q = round((p - lo) / s), s = the box's longest side / 65535,
- *            the same s on all axes so that the node's scale leaves normals and splat shapes unskewed;
+ *  POSITION  VEC3 unsigned short normalized (stride 8): q = round((p - lo) / s * 65535), s = the box's
+ *            longest side, the node's scale: the same s on all axes so that it leaves normals and
+ *            splat shapes unskewed, and the box's side so that the splats' local sizes do not
+ *            depend on the model's units (SCALE below);
  *  NORMAL    VEC3 byte normalized (stride 4) through the OCTAHEDRAL filter (8 bits): three.js's
  *            MeshoptDecoder undoes the filter, so the page sees plain int8 xyz (KHR_mesh_quantization);
  *  COLOR_0   VEC4 unsigned byte normalized, linear (8 bits, gltfpack's choice);
  *  ROTATION  VEC4 short normalized (stride 8) through the QUATERNION filter (12 bits);
- *  SCALE     VEC3 float, EXPONENTIAL filter (12-bit mantissa: ln sigma to ~0.1 %);
+ *  SCALE     VEC3 float, EXPONENTIAL filter (12-bit mantissa: ln sigma to ~0.1 %), ln(sigma / s): in the
+ *            node's local units like the positions, so the node's scale gives world sigma back;
  *  OPACITY   unsigned byte normalized (stride 4: vertex attributes are 4-byte aligned);
  *  SH0       VEC3 float, EXPONENTIAL filter (10-bit mantissa: below half an 8-bit colour step).
  * Each view is one vertex stream of EXT_meshopt_compression (mode ATTRIBUTES).
@@ -215,22 +218,22 @@ static int add_points_compact(asp__gltf *g, const point_arrays *a, size_t n, int
         side = fmax(side, (double)a->hi[k] - a->lo[k]);
         node->translation[k] = origin[k] + a->lo[k];
     }
-    double s = side > 0 ? side / 65535.0 : 1.0;
+    double s = side > 0 ? side : 1.0;
     node->scale = s;
     uint16_t *q = (uint16_t *)buf;
     float qmin[3] = {65535, 65535, 65535}, qmax[3] = {0, 0, 0};
     for (size_t i = 0; i < n; i++) {
         uint16_t *o = q + 4 * (size_t)remap[i];
         for (int k = 0; k < 3; k++) {
-            double v = fmin(fmax(rint(((double)a->pos[3 * i + k] - a->lo[k]) / s), 0.0), 65535.0);
+            double v = fmin(fmax(rint(((double)a->pos[3 * i + k] - a->lo[k]) / s * 65535.0), 0.0), 65535.0);
             o[k] = (uint16_t)v;
-            qmin[k] = fminf(qmin[k], (float)v);
+            qmin[k] = fminf(qmin[k], (float)v); // bounds in the stored integers (glTF 3.6.2.5)
             qmax[k] = fmaxf(qmax[k], (float)v);
         }
         o[3] = 0;
     }
     int pos = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, q, n, 8, "NONE"), ASP__GL_UNSIGNED_SHORT, n, "VEC3",
-                                 0, qmin, qmax);
+                                 1, qmin, qmax);
     for (size_t i = 0; i < n; i++) {
         float *o = tmp + 4 * (size_t)remap[i];
         memcpy(o, a->nrm + 3 * i, 12);
@@ -256,8 +259,15 @@ static int add_points_compact(asp__gltf *g, const point_arrays *a, size_t n, int
         meshopt_encodeFilterQuat(buf, n, 8, 12, tmp);
         acc[0] = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, buf, n, 8, "QUATERNION"), ASP__GL_SHORT, n, "VEC4",
                                     1, NULL, NULL);
+        // glTF attributes live in the node's local space, which the node's scale s takes to the
+        // world (and viewers apply it to the Gaussian, as KHR_gaussian_splatting says): ln(sigma / s).
+        // With s the box's side, ln(sigma / s) lies near -7 (tangent) and -12 (normal) for
+        // 10^3..10^8 points of any unit: the filter's shared exponent (of the largest) stays put,
+        // which the codec's byte deltas need (s = side / 65535 put it on 4 for the 1M bunny: +1.5 B)
+        const float log_s = (float)log(s);
         for (size_t i = 0; i < n; i++)
-            memcpy(tmp + 3 * (size_t)remap[i], a->scale + 3 * i, 12);
+            for (int k = 0; k < 3; k++)
+                tmp[3 * (size_t)remap[i] + k] = a->scale[3 * i + k] - log_s;
         meshopt_encodeFilterExp(buf, n, 12, 12, tmp);
         acc[1] = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, buf, n, 12, "EXPONENTIAL"), ASP__GL_FLOAT, n,
                                     "VEC3", 0, NULL, NULL);
@@ -290,12 +300,145 @@ done:
     return mesh;
 }
 
+/* An accessor without a bufferView: an extension supplies its data (count and type say what decodes). */
+static int accessor_no_view(asp__gltf *g, int component_type, size_t n, const char *type, int normalized,
+                            const double *min, const double *max)
+{
+    cJSON *acc = cJSON_CreateObject();
+    cJSON_AddNumberToObject(acc, "componentType", component_type);
+    cJSON_AddNumberToObject(acc, "count", (double)n);
+    cJSON_AddStringToObject(acc, "type", type);
+    if (normalized)
+        cJSON_AddBoolToObject(acc, "normalized", 1);
+    if (min && max) {
+        cJSON_AddItemToObject(acc, "min", asp__gltf_numbers(min, 3));
+        cJSON_AddItemToObject(acc, "max", asp__gltf_numbers(max, 3));
+    }
+    return asp__gltf_append(g, g->accessors, acc);
+}
+
+/* SPZ's local frame: the box's longest side spans this many units (see add_points_spz) */
+#define SPZ_SIDE 256.0
+/* fractional bits of SPZ's 24-bit positions: 1/256 of a unit, 1/65536 of the side (the meshopt form's 16 bits) */
+#define SPZ_FRACTION_BITS 8
+
+/*
+ * The splats as KHR_gaussian_splatting_compression_spz_2 (issue 32; what CesiumJS draws): one
+ * gzipped SPZ version 2 stream (gltf_spz.c) in a buffer view named by the extension, and the
+ * accessors the extension maps it to (POSITION, COLOR_0 = colour and opacity,
+ * KHR_gaussian_splatting:SCALE and :ROTATION) without views of their own. No NORMAL (the normal
+ * is the rotation's third axis) and no OPACITY / SH_DEGREE_0 attributes: SPZ's colours and alphas
+ * are COLOR_0 (the extension's attribute mapping).
+ * The frame: points in meshopt_spatialSortRemap order (gzip finds the like bytes of neighbours);
+ * the node's translation (origin + the box centre) and uniform scale s = side / 256 take SPZ's
+ * coordinates to the world, so that SPZ's fixed ranges fit any model's units: positions within
+ * +-128 in 24-bit fixed point with 8 fractional bits, ln sigma - ln s within SPZ's [-10, 5.9]
+ * (sigma from 2e-7 to 1.5 times the side). The coordinates are glTF's own, not converted to SPZ's
+ * RUB: CesiumJS unpacks the stream unconverted (coordinateSystem UNSPECIFIED) and puts the splats
+ * where glTF's axes say.
+ */
+static int add_points_spz(asp__gltf *g, const point_arrays *a, size_t n, const double origin[3], compact_node *node)
+{
+    unsigned *remap = asp_alloc(NULL, n * sizeof *remap);
+    float *f = asp_alloc(NULL, n * 14 * sizeof *f);
+    uint8_t *spz = NULL;
+    size_t spz_size = 0;
+    int mesh = -1;
+    if (!remap || !f) {
+        g->failed = 1;
+        goto done;
+    }
+    meshopt_spatialSortRemap(remap, a->pos, n, 12); // remap[input index] = output index
+    double side = 0, centre[3];
+    for (int k = 0; k < 3; k++) {
+        side = fmax(side, (double)a->hi[k] - a->lo[k]);
+        centre[k] = 0.5 * ((double)a->lo[k] + a->hi[k]);
+        node->translation[k] = origin[k] + centre[k];
+    }
+    double s = side > 0 ? side / SPZ_SIDE : 1.0, log_s = log(s);
+    node->scale = s;
+    float *pos = f, *rot = pos + 3 * n, *ls = rot + 4 * n, *op = ls + 3 * n, *sh = op + n;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < n; i++) {
+        size_t o = remap[i];
+        for (int k = 0; k < 3; k++) {
+            // the decoded position (what the POSITION bounds must hold): SPZ's fixed point
+            double x = rint(((double)a->pos[3 * i + k] - centre[k]) / s * (1 << SPZ_FRACTION_BITS));
+            x /= (1 << SPZ_FRACTION_BITS);
+            pos[3 * o + k] = (float)x;
+            lo[k] = fmin(lo[k], x);
+            hi[k] = fmax(hi[k], x);
+            ls[3 * o + k] = (float)(a->scale[3 * i + k] - log_s);
+            sh[3 * o + k] = a->sh0[3 * i + k];
+        }
+        memcpy(rot + 4 * o, a->rot + 4 * i, 16);
+        op[o] = a->opacity[i];
+    }
+    asp__spz_splats in = {pos, rot, ls, op, sh, SPZ_FRACTION_BITS};
+    if (asp__spz_encode(&in, n, &spz, &spz_size, NULL)) {
+        g->failed = 1;
+        goto done;
+    }
+    int view = asp__gltf_view(g, spz, spz_size, 0);
+    int acc[4] = {accessor_no_view(g, ASP__GL_FLOAT, n, "VEC3", 0, lo, hi),
+                  accessor_no_view(g, ASP__GL_UNSIGNED_BYTE, n, "VEC4", 1, NULL, NULL),
+                  accessor_no_view(g, ASP__GL_FLOAT, n, "VEC3", 0, NULL, NULL),
+                  accessor_no_view(g, ASP__GL_FLOAT, n, "VEC4", 0, NULL, NULL)};
+    cJSON *attrs = cJSON_CreateObject(), *pr = cJSON_CreateObject();
+    cJSON_AddNumberToObject(attrs, "POSITION", acc[0]);
+    cJSON_AddNumberToObject(attrs, "COLOR_0", acc[1]);
+    cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:SCALE", acc[2]);
+    cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:ROTATION", acc[3]);
+    cJSON_AddItemToObject(pr, "attributes", attrs);
+    cJSON_AddNumberToObject(pr, "mode", 0); // POINTS
+    cJSON *ext = cJSON_AddObjectToObject(pr, "extensions");
+    cJSON *k = cJSON_AddObjectToObject(ext, "KHR_gaussian_splatting");
+    cJSON_AddStringToObject(k, "kernel", "ellipse");
+    cJSON_AddStringToObject(k, "colorSpace", "srgb_rec709_display");
+    cJSON_AddStringToObject(k, "projection", "perspective");
+    cJSON_AddStringToObject(k, "sortingMethod", "cameraDistance");
+    cJSON *kx = cJSON_AddObjectToObject(cJSON_AddObjectToObject(k, "extensions"), "KHR_gaussian_splatting_compression_spz_2");
+    cJSON_AddNumberToObject(kx, "bufferView", view);
+    // the accessors have no data without the SPZ stream: a viewer must decode it
+    asp__gltf_require_extension(g, "KHR_gaussian_splatting");
+    asp__gltf_require_extension(g, "KHR_gaussian_splatting_compression_spz_2");
+    cJSON *m = cJSON_CreateObject();
+    cJSON_AddItemToArray(cJSON_AddArrayToObject(m, "primitives"), pr);
+    cJSON_AddStringToObject(m, "name", "points");
+    mesh = asp__gltf_append(g, g->meshes, m);
+    if (view < 0 || acc[0] < 0 || acc[1] < 0 || acc[2] < 0 || acc[3] < 0)
+        mesh = -1;
+done:
+    asp_free(NULL, remap);
+    asp_free(NULL, f);
+    asp_free(NULL, spz);
+    return mesh;
+}
+
+void asp__gltf_tileset_extensions(cJSON *tileset, unsigned flags)
+{
+    if (!(flags & ASP_GLTF_SPZ) || (flags & ASP_GLTF_NO_SPLATS))
+        return;
+    // 3D Tiles 1.1 reads glTF content without it; CesiumJS asks it which glTF extensions the tiles
+    // require (Cesium3DTileset.isGltfExtensionRequired) and draws splats only where both are
+    cJSON_AddItemToArray(cJSON_AddArrayToObject(tileset, "extensionsUsed"), cJSON_CreateString("3DTILES_content_gltf"));
+    cJSON *c = cJSON_AddObjectToObject(cJSON_AddObjectToObject(tileset, "extensions"), "3DTILES_content_gltf");
+    const char *names[2] = {"KHR_gaussian_splatting", "KHR_gaussian_splatting_compression_spz_2"};
+    cJSON_AddItemToObject(c, "extensionsUsed", cJSON_CreateStringArray(names, 2));
+    cJSON_AddItemToObject(c, "extensionsRequired", cJSON_CreateStringArray(names, 2));
+}
+
 int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n, const double origin[3], cJSON *crs,
                            const char *path, const asp_gltf_desc *desc, asp_gltf_stats *stats, asp_error *err)
 {
     static const asp_gltf_desc zero;
     const asp_gltf_desc *d = desc ? desc : &zero;
-    int splats = !(d->flags & ASP_GLTF_NO_SPLATS);
+    int splats = !(d->flags & ASP_GLTF_NO_SPLATS), spz = (d->flags & ASP_GLTF_SPZ) != 0;
+    if (spz && (d->flags & (ASP_GLTF_NO_SPLATS | ASP_GLTF_PLAIN))) {
+        cJSON_Delete(crs);
+        return asp_error_set(err, ASP_EINVAL, "SPZ holds Gaussian splats, compressed: not with %s",
+                             (d->flags & ASP_GLTF_PLAIN) ? "plain (float) attributes" : "no splats");
+    }
     if (n == 0) {
         cJSON_Delete(crs);
         return asp_error_set(err, ASP_EDEGENERATE, "no points to export");
@@ -303,7 +446,9 @@ int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n,
     asp_gltf_stats st = {0};
     asp__gltf_turn_up(asp_hier_frame(hier)->up, origin, st.origin); // the node translation, y-up
     asp__gltf g;
-    int rc = asp__gltf_init(&g, path, splats ? "(points, KHR_gaussian_splatting)" : "(points)", NULL, err);
+    int rc = asp__gltf_init(&g, path, spz      ? "(points, KHR_gaussian_splatting, SPZ)"
+                               : splats ? "(points, KHR_gaussian_splatting)"
+                                        : "(points)", NULL, err);
     if (rc) {
         cJSON_Delete(crs);
         return rc;
@@ -332,14 +477,23 @@ int asp__gltf_points_write(const asp_hier *hier, const asp_index *ids, size_t n,
     fill_points(hier, ids, n, &a, splats);
     int plain = (d->flags & ASP_GLTF_PLAIN) != 0;
     compact_node cn = {{0, 0, 0}, 1};
-    int mesh = plain ? add_points_mesh(&g, &a, n, splats) : add_points_compact(&g, &a, n, splats, st.origin, &cn);
+    int mesh = plain ? add_points_mesh(&g, &a, n, splats)
+               : spz ? add_points_spz(&g, &a, n, st.origin, &cn)
+                     : add_points_compact(&g, &a, n, splats, st.origin, &cn);
     char name[64];
     snprintf(name, sizeof name, "points (%zu)", n);
     cJSON *node = cJSON_CreateObject();
     cJSON_AddStringToObject(node, "name", name);
     cJSON_AddNumberToObject(node, "mesh", mesh);
-    cJSON_AddItemToObject(node, "translation", asp__gltf_numbers(plain ? st.origin : cn.translation, 3));
-    if (!plain) {
+    if (spz) {
+        // as a matrix, not TRS: CesiumJS's splat tiles take the node's transform from node.matrix
+        // only (GaussianSplat3DTileContent: scene.nodes[0].matrix), undefined for TRS nodes
+        double m[16] = {cn.scale, 0, 0, 0, 0, cn.scale, 0, 0, 0, 0, cn.scale, 0, 0, 0, 0, 1};
+        memcpy(m + 12, cn.translation, sizeof cn.translation);
+        cJSON_AddItemToObject(node, "matrix", asp__gltf_numbers(m, 16));
+    } else
+        cJSON_AddItemToObject(node, "translation", asp__gltf_numbers(plain ? st.origin : cn.translation, 3));
+    if (!plain && !spz) {
         double sc[3] = {cn.scale, cn.scale, cn.scale};
         cJSON_AddItemToObject(node, "scale", asp__gltf_numbers(sc, 3));
     }

@@ -137,10 +137,31 @@ cJSON *asp__tiles_box(const double box[6]);
 /*
  * Writes dir/tileset.json atomically around root_tile (taken over): refine on the root, the root
  * transform to origin (y-up, as the GLBs' frame: turned to z-up here), the tileset's
- * geometricError from box (y-up), extras.amgsplat with frame and st's counts. Adds the JSON's
+ * geometricError from box (y-up), the glTF extensions tiles written with gltf_flags need
+ * (asp__gltf_tileset_extensions), extras.amgsplat with frame and st's counts. Adds the JSON's
  * bytes to st and fills st->json_bytes, root_error and origin.
  */
 int asp__tiles_write_tileset(const char *dir, cJSON *root_tile, const char *refine, const double box[6],
-                             const double origin[3], const asp_frame *frame, asp_tiles_stats *st, asp_error *err);
+                             const double origin[3], const asp_frame *frame, unsigned gltf_flags,
+                             asp_tiles_stats *st, asp_error *err);
+
+/* n Gaussians for asp__spz_encode, in the glTF node's local frame (gltf_spz.c) */
+typedef struct asp__spz_splats {
+    const float *positions;  /* xyz */
+    const float *rotations;  /* unit quaternions x, y, z, w */
+    const float *log_scales; /* ln sigma, 3 a splat */
+    const float *opacities;  /* in [0, 1] */
+    const float *sh0;        /* SH DC, 3 a splat (colour = 0.5 + 0.2820948 sh0) */
+    int fractional_bits;     /* of the 24-bit fixed-point positions, 0..23 (|x| < 2^(23 - bits)) */
+} asp__spz_splats;
+/*
+ * The gzipped SPZ version 2 stream of n splats (KHR_gaussian_splatting_compression_spz_2) in
+ * *dst (asp_alloc'd, asp_free) of *dst_size bytes. Errors: ASP_EINVAL (n = 0 or too many), ASP_ENOMEM.
+ */
+int asp__spz_encode(const asp__spz_splats *s, size_t n, uint8_t **dst, size_t *dst_size, asp_error *err);
+/* What a tileset of tiles written with flags (asp_gltf_flags) adds to tileset.json's root: the
+ * glTF extensions a client needs (3DTILES_content_gltf; CesiumJS draws Gaussian splats only where
+ * it lists KHR_gaussian_splatting_compression_spz_2 as required). */
+void asp__gltf_tileset_extensions(cJSON *tileset, unsigned flags);
 
 #endif

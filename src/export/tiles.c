@@ -215,7 +215,8 @@ int asp__tiles_dirs(const char *dir, asp_error *err)
 }
 
 int asp__tiles_write_tileset(const char *dir, cJSON *root_tile, const char *refine, const double box[6],
-                             const double origin[3], const asp_frame *frame, asp_tiles_stats *st, asp_error *err)
+                             const double origin[3], const asp_frame *frame, unsigned gltf_flags,
+                             asp_tiles_stats *st, asp_error *err)
 {
     cJSON_AddStringToObject(root_tile, "refine", refine);
     if (origin[0] != 0 || origin[1] != 0 || origin[2] != 0) {
@@ -232,6 +233,7 @@ int asp__tiles_write_tileset(const char *dir, cJSON *root_tile, const char *refi
     // the error of showing nothing: the whole model as one pixel-sized dot
     cJSON_AddNumberToObject(root, "geometricError", sqrt(diag));
     cJSON_AddItemToObject(root, "root", root_tile);
+    asp__gltf_tileset_extensions(root, gltf_flags);
     cJSON *extras = asp__gltf_extras("tileset", NULL, origin, frame);
     cJSON *a = cJSON_GetObjectItemCaseSensitive(extras, "amgsplat");
     cJSON_AddNumberToObject(a, "points", (double)st->points);
@@ -297,7 +299,8 @@ int asp_tiles_export_hier(const asp_hier *hier, const char *dir, const asp_tiles
     // 3D Tiles turns it back to z-up below)
     asp__gltf_turn_up(asp_hier_frame(hier)->up, origin, origin);
     t.st.points = asp_hier_point_count(hier);
-    rc = asp__tiles_write_tileset(dir, root_tile, "REPLACE", box, origin, asp_hier_frame(hier), &t.st, err);
+    rc = asp__tiles_write_tileset(dir, root_tile, "REPLACE", box, origin, asp_hier_frame(hier), d->gltf.flags, &t.st,
+                                  err);
     if (rc)
         return rc;
     if (stats)

@@ -151,7 +151,7 @@ int asp_tiles_export_dps(const asp_dps *dps, const char *dir, const asp_tiles_de
     }
     st.depth = (uint32_t)(n - 1);
     st.points = dps->source_points;
-    rc = asp__tiles_write_tileset(dir, tiles[0], "REPLACE", boxes, origin, &dps->frame, &st, err);
+    rc = asp__tiles_write_tileset(dir, tiles[0], "REPLACE", boxes, origin, &dps->frame, 0, &st, err); // no splats
     tiles[0] = NULL; // taken over
     if (!rc && stats)
         *stats = st;

@@ -303,7 +303,8 @@ int asp_tiles_export_ooc(asp_ooc *ooc, const char *dir, const asp_tiles_desc *de
         asp_ooc_origin(ooc, origin);
         asp__gltf_turn_up(r.up, origin, origin); // as the GLBs' content (tiles.c)
         r.st.points = (size_t)asp_ooc_point_count(ooc);
-        rc = asp__tiles_write_tileset(dir, root_tile, "ADD", r.boxes, origin, asp_ooc_frame(ooc), &r.st, err);
+        rc = asp__tiles_write_tileset(dir, root_tile, "ADD", r.boxes, origin, asp_ooc_frame(ooc), 0 /* round discs, no splats */,
+                                      &r.st, err);
     }
     // the tiles written before an error stay; without tileset.json they are no tileset
     asp_free(NULL, r.boxes);

@@ -46,8 +46,8 @@ assert abs(acc['max'][0] - acc['min'][0] - 0.19) < 1e-6, acc
 assert g['extensionsUsed'] == ['KHR_gaussian_splatting'] and 'extensionsRequired' not in g, g.get('extensionsUsed')
 " "$T/utm.json" "$T/utm.gltf.json" || fail "UTM export: $(cat "$T/utm.json")"
 validate "$T/utm.glb"
-# the default (issue 32): 16-bit positions in the points' box, which the node's translation (origin + box
-# minimum) and uniform scale (longest side / 65535) undo; meshopt-compressed views in buffer 0 whose
+# the default (issue 32): 16-bit normalized positions in the points' box, which the node's translation
+# (origin + box minimum) and uniform scale (longest side) undo; meshopt-compressed views in buffer 0 whose
 # decoded form lives in the data-less fallback buffer 1; both extensions required
 "$AMGSPLAT" export "$T/utm.ply" -o "$T/utmc.glb" --json >"$T/utmc.json"
 glb_json "$T/utmc.glb" >"$T/utmc.gltf.json"
@@ -56,12 +56,12 @@ import json, sys
 r = json.load(open(sys.argv[1])); g = json.load(open(sys.argv[2]))
 assert r['points'] == 400 and r['compressed'] and r['gaussian_splats'], r
 n = g['nodes'][0]; t = n['translation']; s = n['scale']
-assert s[0] == s[1] == s[2] and abs(s[0] - 0.19 / 65535) < 1e-9, s
+assert s[0] == s[1] == s[2] and abs(s[0] - 0.19) < 1e-7, s  # float positions: 0.19 to 4e-9
 acc = g['accessors'][g['meshes'][0]['primitives'][0]['attributes']['POSITION']]
-assert acc['componentType'] == 5123 and acc['min'] == [0, 0, 0] and acc['max'][0] == 65535, acc
-# world = translation + scale * q: the box's corners are the first and last point to a micrometre
+assert acc['componentType'] == 5123 and acc['normalized'] and acc['min'] == [0, 0, 0] and acc['max'][0] == 65535, acc
+# world = translation + scale * q / 65535: the box's corners are the first and last point to a micrometre
 assert abs(t[0] - 500000.003) < 1e-6 and abs(t[1] - 5000000.001) < 1e-6 and abs(t[2] - 312.125) < 1e-6, t
-assert abs(t[0] + s[0] * acc['max'][0] - 500000.193) < 1e-6 and abs(t[1] + s[1] * acc['max'][1] - 5000000.191) < 3e-6, (t, acc)
+assert abs(t[0] + s[0] * acc['max'][0] / 65535 - 500000.193) < 1e-6 and abs(t[1] + s[1] * acc['max'][1] / 65535 - 5000000.191) < 3e-6, (t, acc)
 assert sorted(g['extensionsRequired']) == ['EXT_meshopt_compression', 'KHR_mesh_quantization'], g['extensionsRequired']
 assert 'KHR_gaussian_splatting' in g['extensionsUsed']
 fb = g['buffers'][1]

@@ -116,6 +116,11 @@ ssim "$T/web_points.png" "$T/web_points_plain.png" 0.95
 python3 -c "import json, sys; d = json.load(open(sys.argv[1])); assert d['ssim'] < 0.95, d" "$T/diff.json" ||
   fail "splats of the compact file match plain points of another view: $(cat "$T/diff.json")"
 
+# the splats' world size as any glTF viewer takes it (exp(SCALE) times the node's scale, which in the
+# compact file undoes the 16-bit positions) is the plain file's, splat by splat
+node "$web/test/splat_scale.mjs" "$T/points.glb" "$T/points_plain.glb" >>"$T/shots.log" ||
+  fail "compact splat sizes differ from the plain file's: $(tail -1 "$T/shots.log")"
+
 # a billboard cloud (issue 30) is drawn by its MASK material whatever the method: the page at its
 # default method matches `amgsplat render` of the same .dps (which draws billboard levels no-blend)
 "$AMGSPLAT" simplify "$ASP_TEST_DATA/stanford-bunny.obj" --billboards --error 0.04 -o "$T/bb.dps" -q >/dev/null

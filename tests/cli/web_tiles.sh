@@ -17,9 +17,11 @@
 #    azimuth does not pass;
 #  - a point budget holds: with point-budget 20000 the settled view shows at most that many splats;
 #  - CesiumJS (web/test/cesium.mjs) loads the tileset without errors. Cesium 1.145 cannot draw
-#    KHR_gaussian_splatting without its SPZ compression (it names GLSL variables after the
-#    attributes, "khr_gaussian_splatting:opacity"), so that check reads the --no-splats tileset,
-#    the form for generic 3D Tiles clients (docs/web.md).
+#    meshopt-compressed KHR_gaussian_splatting (it names GLSL variables after the attributes,
+#    "khr_gaussian_splatting:opacity"), so for an in-memory .hier that check reads the --no-splats
+#    tileset; Gaussian splats in Cesium are --splat-codec spz, checked by web_cesium.sh.
+#  - a .dps tileset (one tile a level) streams from the coarsest level to the finest, which matches
+#    `amgsplat render` of that level (SSIM >= 0.95), and CesiumJS loads it.
 # Skips (77) without node, web/node_modules or Chromium.
 source "$(dirname "$0")/common.sh"
 

@@ -415,7 +415,7 @@ static void test_points_compact(void)
     for (size_t j = 0; !bad && j < N; j++) {
         double w[3];
         for (int k = 0; k < 3; k++)
-            w[k] = cJSON_GetArrayItem(t, k)->valuedouble + s * q[4 * j + k] - c->origin[k];
+            w[k] = cJSON_GetArrayItem(t, k)->valuedouble + s * (q[4 * j + k] / 65535.0) - c->origin[k];
         // which input point: the grid cell (positions are exact to s / 2 = 2 micrometres)
         long ix = lround(w[0] / 0.01), iy = lround(w[1] / 0.01);
         if (ix < 0 || ix >= 20 || iy < 0 || iy >= 20 || seen[iy * 20 + ix]++)
@@ -426,7 +426,8 @@ static void test_points_compact(void)
         for (int k = 0; k < 3; k++) {
             worst_pos = fmax(worst_pos, fabs(w[k] - ppos[3 * i + k]));
             worst_nrm = fmax(worst_nrm, fabs(fmax(nrm[4 * j + k] / 127.0, -1.0) - plain[0][3 * i + k]));
-            worst_scale = fmax(worst_scale, fabs(scale[3 * j + k] - plain[2][3 * i + k]));
+            // SCALE is in the node's units (ln(sigma / s)): the node's scale gives world sigma back
+            worst_scale = fmax(worst_scale, fabs(scale[3 * j + k] + log(s) - plain[2][3 * i + k]));
             worst_sh = fmax(worst_sh, fabs(sh[3 * j + k] - plain[4][3 * i + k]));
             // linear colour: 8 bits of the 16-bit plain value
             int want = (int)lrint(srgb_to_linear_ref(c->colors[4 * i + k]) * 255.0);
@@ -440,7 +441,7 @@ static void test_points_compact(void)
         CHECK(fabs(op[4 * j] / 255.0 - plain[3][i]) < 1e-6);
     }
     CHECK_MSG(matched == N, "%d of %d compact points matched a grid point", matched, N);
-    CHECK_MSG(worst_pos <= 0.51 * s + 1e-9, "position error %g (step %g)", worst_pos, s);
+    CHECK_MSG(worst_pos <= 0.51 * s / 65535 + 1e-9, "position error %g (step %g)", worst_pos, s / 65535);
     CHECK_MSG(worst_nrm < 0.02, "normal error %g (8-bit octahedral)", worst_nrm);
     CHECK_MSG(worst_col <= 1, "colour error %d of 255", worst_col);
     CHECK_MSG(worst_rot < 1e-5, "rotation 1 - |q.q'| = %g (12-bit quaternion)", worst_rot);
