@@ -20,7 +20,7 @@ import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { TilesRenderer } from '3d-tiles-renderer/three';
-import { splatDepthFragment, splatAccumFragment } from './viewer.js';
+import { splatMaterials } from './viewer.js';
 import { spzToPlainGlb } from './spz.js';
 
 const STILL_MS = 300; // the camera counts as moving until this long after its last change
@@ -75,14 +75,7 @@ function discPasses(viewer, points, radius, cube) {
   geo.instanceCount = n;
   const uniforms = { uEpsilon: { value: 1 }, uLit: { value: 0 }, uRadii: { value: new Array(8).fill(radius) },
     uCube: { value: new THREE.Vector3(...(cube || [0, 0, 0])) }, frontDepth: { value: viewer.front.depthTexture } };
-  const common = { glslVersion: THREE.GLSL3, vertexShader: discVertex, side: THREE.DoubleSide };
-  const depth = new THREE.RawShaderMaterial({ ...common, fragmentShader: splatDepthFragment, uniforms });
-  const accum = new THREE.RawShaderMaterial({
-    ...common, fragmentShader: splatAccumFragment, uniforms,
-    blending: THREE.CustomBlending, blendEquation: THREE.AddEquation, blendSrc: THREE.OneFactor,
-    blendDst: THREE.OneFactor, blendSrcAlpha: THREE.OneFactor, blendDstAlpha: THREE.OneFactor,
-    depthTest: false, depthWrite: false,
-  });
+  const { depth, accum } = splatMaterials(discVertex, uniforms);
   const mesh = new THREE.Mesh(geo, depth);
   mesh.frustumCulled = false;
   return { mesh, points, depth, accum, uniforms };

@@ -232,7 +232,20 @@ void main() {
 }`;
 
 // the streamed tiles' discs blend with the splats' passes (tiles.js)
-export { splatDepthFragment, splatAccumFragment };
+// The two splat passes over one instanced mesh (render's splat renderer, seed 001 sections 4-5):
+// pass 1 writes the front depth pushed back by uEpsilon, pass 2 adds (psi c, psi) without depth
+// test; vertexShader places each splat (its ellipse here, a disc facing the eye in tiles.js).
+export function splatMaterials(vertexShader, uniforms) {
+  const common = { glslVersion: THREE.GLSL3, vertexShader, side: THREE.DoubleSide };
+  const depth = new THREE.RawShaderMaterial({ ...common, fragmentShader: splatDepthFragment, uniforms });
+  const accum = new THREE.RawShaderMaterial({
+    ...common, fragmentShader: splatAccumFragment, uniforms,
+    blending: THREE.CustomBlending, blendEquation: THREE.AddEquation, blendSrc: THREE.OneFactor,
+    blendDst: THREE.OneFactor, blendSrcAlpha: THREE.OneFactor, blendDstAlpha: THREE.OneFactor,
+    depthTest: false, depthWrite: false,
+  });
+  return { depth, accum };
+}
 
 function srgbToLinear(c) {
   const x = c / 255;
@@ -436,14 +449,7 @@ class Viewer {
     geo.instanceCount = n;
     const uniforms = { uEpsilon: { value: 1 }, uLit: { value: 0 },
       frontDepth: { value: this.front.depthTexture } };
-    const common = { glslVersion: THREE.GLSL3, vertexShader: splatVertex, side: THREE.DoubleSide };
-    const depth = new THREE.RawShaderMaterial({ ...common, fragmentShader: splatDepthFragment, uniforms });
-    const accum = new THREE.RawShaderMaterial({
-      ...common, fragmentShader: splatAccumFragment, uniforms,
-      blending: THREE.CustomBlending, blendEquation: THREE.AddEquation, blendSrc: THREE.OneFactor,
-      blendDst: THREE.OneFactor, blendSrcAlpha: THREE.OneFactor, blendDstAlpha: THREE.OneFactor,
-      depthTest: false, depthWrite: false,
-    });
+    const { depth, accum } = splatMaterials(splatVertex, uniforms);
     const mesh = new THREE.Mesh(geo, depth);
     mesh.frustumCulled = false;
     // at the identity: the centres already hold the node's transform (the shader takes the model matrix of
