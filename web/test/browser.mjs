@@ -1,4 +1,4 @@
-// What the page tests (screenshot.mjs, tiles.mjs, cesium.mjs) share: their command line and headless
+// What the page tests (screenshot.mjs, tiles.mjs, cesium.mjs, cesium_splats.mjs) share: their command line and headless
 // Chromium started as this machine runs it (no sandbox as root, no GPU: WebGL through SwiftShader,
 // no background networking on a closed network).
 import fs from 'node:fs';
@@ -35,4 +35,18 @@ export async function launchChromium(executablePath, timeoutSeconds) {
       '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
   });
   return { browser, userDir };
+}
+
+// The errors a page shows (console errors, uncaught exceptions, failed requests, HTTP >= 400) into
+// errors, every console line into logs: the Cesium checks fail on any of the first.
+export function watchPage(page, errors, logs) {
+  page.on('console', (m) => {
+    logs.push(`${m.type()}: ${m.text()}`);
+    if (m.type() === 'error') errors.push(`console: ${m.text()}`);
+  });
+  page.on('pageerror', (e) => errors.push(`pageerror: ${e.message}`));
+  page.on('requestfailed', (r) => errors.push(`request failed: ${r.url()}: ${r.failure()?.errorText}`));
+  page.on('response', (r) => {
+    if (r.status() >= 400) errors.push(`HTTP ${r.status()}: ${r.url()}`);
+  });
 }

@@ -6,7 +6,7 @@
 // Prints one JSON line {loaded, failed, ...}. Exit 1 on an error, 2 on usage errors.
 import fs from 'node:fs';
 import path from 'node:path';
-import { launchChromium, parseArgs } from './browser.mjs';
+import { launchChromium, parseArgs, watchPage } from './browser.mjs';
 import { serve } from '../serve.mjs';
 
 const usage = 'usage: node web/test/cesium.mjs DIR [--size WxH] [--sse PX] [--png OUT.png] [--timeout S] [--chromium PATH]';
@@ -31,16 +31,7 @@ async function main() {
   const errors = [], logs = [];
   try {
     const page = await browser.newPage();
-    page.on('console', (m) => {
-      logs.push(`${m.type()}: ${m.text()}`);
-      // swiftshader's performance notes are not errors of the tileset
-      if (m.type() === 'error') errors.push(`console: ${m.text()}`);
-    });
-    page.on('pageerror', (e) => errors.push(`pageerror: ${e.message}`));
-    page.on('requestfailed', (r) => errors.push(`request failed: ${r.url()}: ${r.failure()?.errorText}`));
-    page.on('response', (r) => {
-      if (r.status() >= 400) errors.push(`HTTP ${r.status()}: ${r.url()}`);
-    });
+    watchPage(page, errors, logs);
     await page.setViewport({ width: w, height: h, deviceScaleFactor: 1 });
     const { port } = server.address();
     const q = new URLSearchParams({ tileset: '/model/tileset.json', sse: o.sse });

@@ -10,7 +10,7 @@
 // background. Exit 1 on an error or fg < min-fg (default 0.02), 2 on usage errors.
 import fs from 'node:fs';
 import path from 'node:path';
-import { launchChromium, parseArgs } from './browser.mjs';
+import { launchChromium, parseArgs, watchPage } from './browser.mjs';
 import { serve } from '../serve.mjs';
 
 const usage = 'usage: node web/test/cesium_splats.mjs DIR OUT.png [--view AZ,EL] [--size WxH] [--bg R,G,B] ' +
@@ -37,15 +37,7 @@ async function main() {
   const errors = [], logs = [];
   try {
     const page = await browser.newPage();
-    page.on('console', (m) => {
-      logs.push(`${m.type()}: ${m.text()}`);
-      if (m.type() === 'error') errors.push(`console: ${m.text()}`);
-    });
-    page.on('pageerror', (e) => errors.push(`pageerror: ${e.message}`));
-    page.on('requestfailed', (r) => errors.push(`request failed: ${r.url()}: ${r.failure()?.errorText}`));
-    page.on('response', (r) => {
-      if (r.status() >= 400) errors.push(`HTTP ${r.status()}: ${r.url()}`);
-    });
+    watchPage(page, errors, logs);
     await page.setViewport({ width: w, height: h, deviceScaleFactor: 1 });
     const { port } = server.address();
     const q = new URLSearchParams({ tileset: '/model/tileset.json', view: o.view, bg: o.bg });
