@@ -129,18 +129,24 @@ static void fill_points(const asp_hier *hier, const asp_index *ids, size_t n, po
     }
 }
 
+/* The primitive's KHR_gaussian_splatting object (seed 001's ellipses as Gaussians), for both codecs. */
+static cJSON *gaussian_extension(cJSON *pr)
+{
+    cJSON *k = cJSON_AddObjectToObject(cJSON_AddObjectToObject(pr, "extensions"), "KHR_gaussian_splatting");
+    cJSON_AddStringToObject(k, "kernel", "ellipse");
+    cJSON_AddStringToObject(k, "colorSpace", "srgb_rec709_display");
+    cJSON_AddStringToObject(k, "projection", "perspective");
+    cJSON_AddStringToObject(k, "sortingMethod", "cameraDistance");
+    return k;
+}
+
 static void splat_extension(asp__gltf *g, cJSON *attrs, cJSON *pr, const int acc[4])
 {
     cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:ROTATION", acc[0]);
     cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:SCALE", acc[1]);
     cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:OPACITY", acc[2]);
     cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:SH_DEGREE_0_COEF_0", acc[3]);
-    cJSON *ext = cJSON_AddObjectToObject(pr, "extensions");
-    cJSON *k = cJSON_AddObjectToObject(ext, "KHR_gaussian_splatting");
-    cJSON_AddStringToObject(k, "kernel", "ellipse");
-    cJSON_AddStringToObject(k, "colorSpace", "srgb_rec709_display");
-    cJSON_AddStringToObject(k, "projection", "perspective");
-    cJSON_AddStringToObject(k, "sortingMethod", "cameraDistance");
+    gaussian_extension(pr);
     asp__gltf_use_extension(g, "KHR_gaussian_splatting");
 }
 
@@ -391,12 +397,7 @@ static int add_points_spz(asp__gltf *g, const point_arrays *a, size_t n, const d
     cJSON_AddNumberToObject(attrs, "KHR_gaussian_splatting:ROTATION", acc[3]);
     cJSON_AddItemToObject(pr, "attributes", attrs);
     cJSON_AddNumberToObject(pr, "mode", 0); // POINTS
-    cJSON *ext = cJSON_AddObjectToObject(pr, "extensions");
-    cJSON *k = cJSON_AddObjectToObject(ext, "KHR_gaussian_splatting");
-    cJSON_AddStringToObject(k, "kernel", "ellipse");
-    cJSON_AddStringToObject(k, "colorSpace", "srgb_rec709_display");
-    cJSON_AddStringToObject(k, "projection", "perspective");
-    cJSON_AddStringToObject(k, "sortingMethod", "cameraDistance");
+    cJSON *k = gaussian_extension(pr);
     cJSON *kx = cJSON_AddObjectToObject(cJSON_AddObjectToObject(k, "extensions"), "KHR_gaussian_splatting_compression_spz_2");
     cJSON_AddNumberToObject(kx, "bufferView", view);
     // the accessors have no data without the SPZ stream: a viewer must decode it
