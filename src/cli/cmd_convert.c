@@ -16,7 +16,10 @@ static const char usage[] =
     "\n"
     "OUT.hier builds the streamed (out-of-core) point hierarchy from a binary PLY or LAS file of any\n"
     "size with a working set of about --memory (default 2G): a counting sort into chunks, one octree\n"
-    "per chunk, then the top (docs/hier.md). render draws it, loading only the nodes a view needs.";
+    "per chunk, then the top (docs/hier.md). render draws it, loading only the nodes a view needs.\n"
+    "With --in-memory, OUT.hier is the in-memory hierarchy instead: every node's splat ellipse\n"
+    "(seed 001), what the splat renderer draws and export --tiles writes as Gaussian splats; the\n"
+    "points must fit in memory.";
 
 #include <stdio.h>
 #include <string.h>
@@ -126,9 +129,43 @@ static int convert_hier(struct cli_env *env, const char *in, const char *out, co
     return 0;
 }
 
+/* Point file -> in-memory hierarchy with seed 001's ellipses (asp_hier_build, asp_hier_save). */
+static int convert_hier_in_memory(struct cli_env *env, const char *in, const char *out)
+{
+    asp_error err = {0};
+    asp_cloud *c = NULL;
+    asp_hier *h = NULL;
+    double t0 = asp_time_now();
+    int rc = asp_cloud_load(in, &env->ctx, &c, &err);
+    if (!rc)
+        rc = asp_hier_build(c, NULL, &env->ctx, &h, &err);
+    asp_cloud_destroy(c);
+    if (!rc)
+        rc = asp_hier_save(h, out, &err);
+    double s = asp_time_now() - t0;
+    size_t nodes = h ? asp_hier_node_count(h) : 0, points = h ? asp_hier_point_count(h) : 0;
+    asp_hier_destroy(h);
+    if (rc)
+        return cli_fail(env, &err);
+    cli_progress_end(env);
+    if (env->json) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "input", in);
+        cJSON_AddStringToObject(o, "output", out);
+        cJSON_AddStringToObject(o, "encoding", "hier");
+        cJSON_AddNumberToObject(o, "points", (double)points);
+        cJSON_AddNumberToObject(o, "nodes", (double)nodes);
+        cJSON_AddItemToObject(o, "seconds", cli_json_number("%.3f", s));
+        return cli_json_print(env, o);
+    }
+    if (!env->quiet)
+        printf("converted '%s' -> '%s' (in-memory hierarchy): %zu points, %zu nodes, %.2f s\n", in, out, points, nodes, s);
+    return 0;
+}
+
 int cmd_convert(int argc, char **argv, struct cli_env *env)
 {
-    int ascii = 0, big_endian = 0, npos = 0, las_format = -1;
+    int ascii = 0, big_endian = 0, npos = 0, las_format = -1, in_memory = 0;
     double las_scale = 0;
     const char *output = NULL, *memory = NULL, *temp_dir = NULL;
     size_t node_points = 0;
@@ -141,6 +178,7 @@ int cmd_convert(int argc, char **argv, struct cli_env *env)
         {"memory", 0, CLI_STRING, &memory, "SIZE", ".hier output: working-set budget, e.g. 512M, 2G (default 2G)"},
         {"node-points", 0, CLI_SIZE, &node_points, "N", ".hier output: most points in a leaf node (default 32768)"},
         {"temp-dir", 0, CLI_STRING, &temp_dir, "DIR", ".hier output: directory for the chunk files (default: next to OUT)"},
+        {"in-memory", 0, CLI_FLAG, &in_memory, NULL, ".hier output: the in-memory hierarchy with splat ellipses (the points must fit in memory)"},
         {0},
     };
     int rc = cli_parse(argc, argv, opts, usage, env, &npos);
@@ -159,7 +197,14 @@ int cmd_convert(int argc, char **argv, struct cli_env *env)
     if (cli_check_output(env, out, NULL, 0, (const char *const[]){in}, 1))
         return 2;
     asp_file_type out_type;
-    if (asp_file_type_of_name(out, &out_type, NULL) == 0 && out_type.kind == ASP_FILE_HIER)
+    int hier_out = asp_file_type_of_name(out, &out_type, NULL) == 0 && out_type.kind == ASP_FILE_HIER;
+    if (in_memory && !hier_out)
+        return cli_usage_error(env, "--in-memory applies to .hier output only, not '%s'", out);
+    if (in_memory && (memory || node_points || temp_dir))
+        return cli_usage_error(env, "--memory, --node-points and --temp-dir are for the streamed layout, not --in-memory");
+    if (in_memory)
+        return convert_hier_in_memory(env, in, out);
+    if (hier_out)
         return convert_hier(env, in, out, memory, node_points, temp_dir);
     if (memory || node_points || temp_dir)
         return cli_usage_error(env, "--memory, --node-points and --temp-dir apply to .hier output only, not '%s'", out);

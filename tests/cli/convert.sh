@@ -77,4 +77,27 @@ set -e
 [ $rc2 -eq 1 ] && grep -q "unknown point format '.abc'" "$T/err2.txt" || fail "unknown extension: $rc2"
 [ $rc3 -eq 2 ] && [ $rc4 -eq 2 ] && [ $rc5 -eq 2 ] && [ $rc6 -eq 2 ] || fail "usage errors: $rc3 $rc4 $rc5 $rc6"
 "$AMGSPLAT" convert -h | grep "usage: amgsplat convert" >/dev/null || fail "-h"
+
+# --in-memory: the hierarchy with splat ellipses, in the in-memory layout (info shows no streamed
+# layout), which render's splat renderer draws and export --tiles writes as Gaussian splats
+"$AMGSPLAT" synth torus -o "$T/torus.ply" --points 20000 -q
+"$AMGSPLAT" convert "$T/torus.ply" -o "$T/torus.hier" --in-memory --json >"$T/mem.json" || fail "convert --in-memory"
+"$AMGSPLAT" info "$T/torus.hier" --json >"$T/mem_info.json"
+python3 - "$T/mem.json" "$T/mem_info.json" <<'PY' || fail "--in-memory: $(cat "$T/mem.json" "$T/mem_info.json")"
+import json, sys
+c, i = (json.load(open(p)) for p in sys.argv[1:3])
+assert c['encoding'] == 'hier' and c['points'] == 20000 and c['nodes'] > 1, c
+assert i['kind'] == 'hier' and i['points'] == 20000 and i['nodes'] == c['nodes'] and i.get('layout') != 'streamed', i
+PY
+"$AMGSPLAT" render "$T/torus.hier" -o "$T/mem.png" --size 96x96 -q || fail "render of the in-memory .hier"
+"$AMGSPLAT" export "$T/torus.hier" -o "$T/mem_tiles" --tiles --json >"$T/mem_tiles.json" || fail "tiles"
+python3 -c "
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j['refine'] == 'REPLACE' and j['gaussian_splats'] and j['points'] == 20000, j" "$T/mem_tiles.json" ||
+  fail "tiles of the in-memory .hier: $(cat "$T/mem_tiles.json")"
+rc=0; "$AMGSPLAT" convert "$T/torus.ply" -o "$T/x.ply" --in-memory 2>"$T/e1" || rc=$?
+[[ $rc == 2 ]] && grep -q -- "--in-memory applies to .hier output" "$T/e1" || fail "--in-memory on a PLY: $rc $(cat "$T/e1")"
+rc=0; "$AMGSPLAT" convert "$T/torus.ply" -o "$T/x.hier" --in-memory --node-points 100 2>"$T/e2" || rc=$?
+[[ $rc == 2 && ! -e "$T/x.hier" ]] || fail "--in-memory --node-points: $rc $(cat "$T/e2")"
 echo "convert: ok"
