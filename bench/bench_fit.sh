@@ -35,7 +35,7 @@ nflag=()
 [ "$normals" = 1 ] && nflag=(--normals)
 poisson=${POISSON:-1}
 if [ "$poisson" = 1 ] && ! "$py" -c 'import open3d' 2>/dev/null; then
-  echo "bench_fit.sh: no python3-open3d (scripts/bootstrap.sh installs it): Poisson column skipped" >&2
+  echo "bench_fit.sh: no python3-open3d (scripts/bootstrap.sh --bench installs it): Poisson column skipped" >&2
   poisson=0
 fi
 prims_of() { # the primitive count of a .dps's one level

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs every build, test and demo dependency from Debian packages (apt-get
 # only). Idempotent: installs nothing when everything is already present.
-# Usage: scripts/bootstrap.sh   (--fuzz is still accepted; clang is always installed now, since
-# scripts/test.sh compiles once with clang and runs the libFuzzer targets)
+# Usage: scripts/bootstrap.sh [--bench]   (--fuzz is still accepted; clang is always installed now,
+# since scripts/test.sh compiles once with clang and runs the libFuzzer targets)
+#   --bench  also the benchmark-only peers that no build or test needs: python3-open3d (screened
+#            Poisson for bench/bench_fit.sh; large, so the README's two commands leave it out)
 set -euo pipefail
 
 packages=(
@@ -16,7 +18,6 @@ packages=(
   libstb-dev                       # PNG/JPEG read and write
   zlib1g-dev                       # CRC-32 of the .amg and .dps files
   libflann-dev                     # k-NN baseline for bench/bench_knn.c
-  python3-open3d                   # screened Poisson + quadric decimation peer for bench/bench_fit.sh (bench only)
   xvfb xauth                       # viewer test under a virtual display
   glmark2-data                     # ships the Stanford bunny (demo model)
   clang libclang-rt-14-dev         # the clang build and the libFuzzer targets (scripts/test.sh)
@@ -32,6 +33,14 @@ packages=(
 if ! command -v npm >/dev/null 2>&1; then
   packages+=(nodejs npm)
 fi
+
+for arg in "$@"; do
+  case "$arg" in
+  --bench) packages+=(python3-open3d) ;; # screened Poisson + quadric decimation peer of bench/bench_fit.sh
+  --fuzz) ;;
+  *) echo "bootstrap: unknown option '$arg' (expected --bench)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do
