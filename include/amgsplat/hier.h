@@ -177,6 +177,15 @@ typedef struct asp_hier_view {
     uint32_t depth_limit;   /* 0 = none; else only splats of depth < depth_limit (seed 004 Fig. 3.5) */
 } asp_hier_view;
 
+struct asp_camera;
+/**
+ * The view of cam (asp_camera, camera.h: its view and projection matrices and eye) for a
+ * width x height viewport and tolerance tau; culling flags and depth limit off. out is
+ * hierarchy-local when cam is (the renderers' local frame).
+ */
+void asp_hier_view_of_camera(const struct asp_camera *cam, uint32_t width, uint32_t height, float tau,
+                             asp_hier_view *out);
+
 /** Capacity that always suffices for a selection: the point count. */
 size_t asp_hier_select_bound(const asp_hier *hier);
 

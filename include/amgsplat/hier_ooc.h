@@ -126,6 +126,14 @@ int asp_ooc_select(const asp_ooc *ooc, const asp_hier_view *view, uint64_t max_p
                    uint64_t *points, asp_error *err);
 
 /**
+ * The points of a cut that memory bytes hold while it is drawn: 64 bytes a point (the cloud's
+ * position, colour and radius, 20, the renderer's copies in GL buffers, 20 on llvmpipe where
+ * buffers are host memory, and the driver's staging); memory 0 = 2 GiB. The budget render and
+ * view give asp_ooc_select for --memory.
+ */
+uint64_t asp_ooc_budget_points(size_t memory);
+
+/**
  * Loads the points of the given nodes (a cut from asp_ooc_select: closed
  * under parents) into a new cloud with positions (hierarchy-local, origin
  * set), colours and radii. A point whose deepest listed node (holding it) is

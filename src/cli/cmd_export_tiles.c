@@ -1,14 +1,16 @@
 /*
- * amgsplat export IN -o DIR --tiles: a point set or .hier as a streamed 3D Tiles 1.1 tileset
- * (issue 32), for the web page's streaming mode and any 3D Tiles client. docs/web.md says how to
- * serve it. Three routes:
+ * amgsplat export IN -o DIR --tiles: a point set, .hier or .dps as a streamed 3D Tiles 1.1
+ * tileset (issue 32), for the web page's streaming mode and any 3D Tiles client. docs/web.md says
+ * how to serve it. Four routes:
  *  - a streamed .hier (amgsplat convert): one tile a node, refine ADD (asp_tiles_export_ooc),
  *    memory bounded by the largest node;
  *  - a point file: converted first to a temporary streamed .hier next to DIR within --memory
  *    (asp_ooc_build, as PotreeConverter does), then as above, so a scan of any size tiles in
  *    bounded memory; the temporary file is removed;
- *  - an in-memory .hier (amgsplat hier): its elliptical splats, refine REPLACE
- *    (asp_tiles_export_hier).
+ *  - an in-memory .hier (amgsplat convert --in-memory), or a point file with --splat-codec spz
+ *    (Gaussians need its ellipses, so it is built in memory): elliptical splats, refine REPLACE
+ *    (asp_tiles_export_hier);
+ *  - a .dps: one tile a level, coarsest first, refine REPLACE (asp_tiles_export_dps).
  */
 #include <stdio.h>
 #include <string.h>

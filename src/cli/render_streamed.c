@@ -13,12 +13,6 @@
 #include "cli/cli.h"
 #include "util/banned.h"
 
-/*
- * Bytes a loaded point costs while it is drawn: the cloud's position, colour
- * and radius (20), the renderer's copies in GL buffers (20 on llvmpipe, where
- * buffers are host memory) and slack for the driver's staging.
- */
-enum { BYTES_PER_POINT = 64 };
 
 int cli_render_streamed(const char *path, const struct cli_streamed_view *v, const asp_context *ctx, asp_scene *s,
                         struct cli_streamed_stats *st, asp_error *err)
@@ -31,7 +25,7 @@ int cli_render_streamed(const char *path, const struct cli_streamed_view *v, con
     uint32_t *cut = malloc(nn * sizeof *cut), *all = malloc(nn * sizeof *all);
     uint8_t *mark = calloc(nn, 1);
     size_t nall = 0;
-    uint64_t budget = (v->memory ? v->memory : (size_t)2 << 30) / BYTES_PER_POINT;
+    uint64_t budget = asp_ooc_budget_points(v->memory);
     uint64_t per_view = budget / (v->views ? v->views : 1);
     double origin[3];
     asp_ooc_origin(ooc, origin);
@@ -46,13 +40,7 @@ int cli_render_streamed(const char *path, const struct cli_streamed_view *v, con
         cam.elevation = (float)(i % 2 ? -v->el : v->el);
         asp_camera_frame(&cam, asp_ooc_frame(ooc), origin, (float)v->width / (float)v->height, (float)v->dist);
         asp_hier_view hv;
-        memset(&hv, 0, sizeof hv);
-        asp_camera_view_matrix(&cam, hv.view);
-        asp_camera_projection_matrix(&cam, hv.proj);
-        asp_camera_eye(&cam, hv.eye);
-        hv.width = v->width;
-        hv.height = v->height;
-        hv.tau = (float)v->tau;
+        asp_hier_view_of_camera(&cam, v->width, v->height, (float)v->tau, &hv);
         size_t n = 0;
         uint64_t pts = 0;
         if ((rc = asp_ooc_select(ooc, &hv, per_view, cut, &n, &pts, err)) != 0)

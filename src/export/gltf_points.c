@@ -64,7 +64,7 @@ void asp_gltf_gaussian_from_ellipse(const float u[3], const float v[3], float a,
     log_scale[2] = (float)log(sn);
 }
 
-static float srgb_to_linear(uint8_t c)
+float asp__gltf_srgb_to_linear(uint8_t c)
 {
     double x = c / 255.0;
     return (float)(x <= 0.04045 ? x / 12.92 : pow((x + 0.055) / 1.055, 2.4));
@@ -117,7 +117,7 @@ static void fill_points(const asp_hier *hier, const asp_index *ids, size_t n, po
         if (colored)
             memcpy(rgba, s->color, 4);
         for (int k = 0; k < 3; k++)
-            a->color[4 * i + k] = (uint16_t)lrintf(srgb_to_linear(rgba[k]) * 65535.0f); // glTF colours are linear
+            a->color[4 * i + k] = (uint16_t)lrintf(asp__gltf_srgb_to_linear(rgba[k]) * 65535.0f); // glTF colours are linear
         a->color[4 * i + 3] = (uint16_t)(rgba[3] * 257u);
         if (!splats)
             continue;
@@ -185,6 +185,34 @@ static int add_points_mesh(asp__gltf *g, const point_arrays *a, size_t n, int sp
     return ok && m >= 0 ? m : -1;
 }
 
+int asp__gltf_compact_positions(asp__gltf *g, const float *pos, size_t n, const float lo[3], const float hi[3],
+                                const unsigned *remap, int normalized, uint8_t *buf, double translation[3],
+                                double *scale)
+{
+    double side = 0;
+    for (int k = 0; k < 3; k++) {
+        side = fmax(side, (double)hi[k] - lo[k]);
+        translation[k] = lo[k];
+    }
+    side = side > 0 ? side : 1.0;
+    // normalized: the node's scale is the side (stored q / 65535); else one 16-bit step (stored q)
+    *scale = normalized ? side : side / 65535.0;
+    uint16_t *q = (uint16_t *)buf;
+    float qmin[3] = {65535, 65535, 65535}, qmax[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        uint16_t *o = q + 4 * (size_t)remap[i];
+        for (int k = 0; k < 3; k++) {
+            double v = fmin(fmax(rint(((double)pos[3 * i + k] - lo[k]) / side * 65535.0), 0.0), 65535.0);
+            o[k] = (uint16_t)v;
+            qmin[k] = fminf(qmin[k], (float)v); // bounds in the stored integers (glTF 3.6.2.5)
+            qmax[k] = fmaxf(qmax[k], (float)v);
+        }
+        o[3] = 0;
+    }
+    return asp__gltf_accessor(g, asp__gltf_view_meshopt(g, q, n, 8, "NONE"), ASP__GL_UNSIGNED_SHORT, n, "VEC3",
+                              normalized, qmin, qmax);
+}
+
 /* The compact points' node transform: world offset = translation + scale * q / 65535 (q: 16-bit position). */
 typedef struct compact_node {
     double translation[3], scale;
@@ -219,27 +247,11 @@ static int add_points_compact(asp__gltf *g, const point_arrays *a, size_t n, int
         goto done;
     }
     meshopt_spatialSortRemap(remap, a->pos, n, 12); // remap[input index] = output index
-    double side = 0;
-    for (int k = 0; k < 3; k++) {
-        side = fmax(side, (double)a->hi[k] - a->lo[k]);
-        node->translation[k] = origin[k] + a->lo[k];
-    }
-    double s = side > 0 ? side : 1.0;
+    double s;
+    int pos = asp__gltf_compact_positions(g, a->pos, n, a->lo, a->hi, remap, 1, buf, node->translation, &s);
+    for (int k = 0; k < 3; k++)
+        node->translation[k] += origin[k];
     node->scale = s;
-    uint16_t *q = (uint16_t *)buf;
-    float qmin[3] = {65535, 65535, 65535}, qmax[3] = {0, 0, 0};
-    for (size_t i = 0; i < n; i++) {
-        uint16_t *o = q + 4 * (size_t)remap[i];
-        for (int k = 0; k < 3; k++) {
-            double v = fmin(fmax(rint(((double)a->pos[3 * i + k] - a->lo[k]) / s * 65535.0), 0.0), 65535.0);
-            o[k] = (uint16_t)v;
-            qmin[k] = fminf(qmin[k], (float)v); // bounds in the stored integers (glTF 3.6.2.5)
-            qmax[k] = fmaxf(qmax[k], (float)v);
-        }
-        o[3] = 0;
-    }
-    int pos = asp__gltf_accessor(g, asp__gltf_view_meshopt(g, q, n, 8, "NONE"), ASP__GL_UNSIGNED_SHORT, n, "VEC3",
-                                 1, qmin, qmax);
     for (size_t i = 0; i < n; i++) {
         float *o = tmp + 4 * (size_t)remap[i];
         memcpy(o, a->nrm + 3 * i, 12);

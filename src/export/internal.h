@@ -125,6 +125,21 @@ cJSON *asp__gltf_crs(const asp_las_meta *las);
 int asp__gltf_prims_tile(const asp_dps *dps, size_t level, const char *path, const asp_gltf_desc *desc,
                          asp_gltf_stats *stats, asp_error *err);
 
+/*
+ * Positions pos (n xyz in lo..hi) as a compact POSITION accessor (an EXT_meshopt_compression view;
+ * the caller requires KHR_mesh_quantization): unsigned short VEC3 (stride 8) written in remap order,
+ * q = round((p - lo) / side x 65535), side = the box's longest side (one step on every axis, so
+ * one uniform node scale undoes it). normalized: stored normalized, the node's scale is side; else
+ * plain integers, the node's scale is side / 65535. translation = lo. buf: 8 n bytes. Returns the
+ * accessor (< 0 on failure).
+ */
+int asp__gltf_compact_positions(asp__gltf *g, const float *pos, size_t n, const float lo[3], const float hi[3],
+                                const unsigned *remap, int normalized, uint8_t *buf, double translation[3],
+                                double *scale);
+
+/* An sRGB byte in linear light, 0..1 (glTF's COLOR_0 is linear; gltf_points.c). */
+float asp__gltf_srgb_to_linear(uint8_t c);
+
 /* ---- tilesets (tiles.c, shared by tiles_ooc.c and tiles_dps.c) ---- */
 
 /* Creates dir and dir/tiles. Returns 0, ASP_EINVAL (name too long), ASP_EIO. */

@@ -105,27 +105,8 @@ static int write_glb(const ooc_run *r, uint32_t id, const scratch *s, size_t n, 
     } else {
         // neighbours next to each other: what the vertex codec's byte deltas compress
         meshopt_spatialSortRemap(s->remap, s->pos, n, 12);
-        double side = 0;
-        for (int k = 0; k < 3; k++) {
-            side = fmax(side, (double)hi[k] - lo[k]);
-            translation[k] = lo[k];
-        }
-        // one step on every axis, so the node's uniform scale undoes it (asp__gltf_points_write's form)
-        scale = side > 0 ? side / 65535.0 : 1.0;
-        uint16_t *q = (uint16_t *)s->buf;
-        float qmin[3] = {65535, 65535, 65535}, qmax[3] = {0, 0, 0};
-        for (size_t i = 0; i < n; i++) {
-            uint16_t *o = q + 4 * (size_t)s->remap[i];
-            for (int k = 0; k < 3; k++) {
-                double v = fmin(fmax(rint(((double)s->pos[3 * i + k] - lo[k]) / scale), 0.0), 65535.0);
-                o[k] = (uint16_t)v;
-                qmin[k] = fminf(qmin[k], (float)v);
-                qmax[k] = fmaxf(qmax[k], (float)v);
-            }
-            o[3] = 0;
-        }
-        pos = asp__gltf_accessor(&g, asp__gltf_view_meshopt(&g, q, n, 8, "NONE"), ASP__GL_UNSIGNED_SHORT, n, "VEC3",
-                                 0, qmin, qmax);
+        // plain 16-bit integers under a node scale of one step (not normalized: the streamed tiles' form)
+        pos = asp__gltf_compact_positions(&g, s->pos, n, lo, hi, s->remap, 0, s->buf, translation, &scale);
         for (size_t i = 0; i < n; i++)
             for (int k = 0; k < 4; k++)
                 s->buf[4 * (size_t)s->remap[i] + k] = k < 3 ? r->lut[s->rec[i].color[k]] : s->rec[i].color[3];
@@ -228,10 +209,8 @@ int asp_tiles_export_ooc(asp_ooc *ooc, const char *dir, const asp_tiles_desc *de
                  .node_count = asp_ooc_node_count(ooc),
                  .plain = (d->gltf.flags & ASP_GLTF_PLAIN) != 0,
                  .up = asp_ooc_frame(ooc)->up};
-    for (int c = 0; c < 256; c++) {
-        double x = c / 255.0;
-        r.lut[c] = (uint8_t)lrint(255.0 * (x <= 0.04045 ? x / 12.92 : pow((x + 0.055) / 1.055, 2.4)));
-    }
+    for (int c = 0; c < 256; c++)
+        r.lut[c] = (uint8_t)lrintf(255.0f * asp__gltf_srgb_to_linear((uint8_t)c));
     size_t largest = 0;
     for (size_t i = 0; i < r.node_count; i++)
         largest = r.nodes[i].point_count > largest ? r.nodes[i].point_count : largest;

@@ -410,6 +410,11 @@ int asp_ooc_read_points(asp_ooc *o, uint32_t node, asp_ooc_point *dst, asp_error
     return 0;
 }
 
+uint64_t asp_ooc_budget_points(size_t memory)
+{
+    return (uint64_t)(memory ? memory : (size_t)2 << 30) / 64u;
+}
+
 float asp_ooc_disc_radius(const asp_ooc *o, uint32_t node)
 {
     ASP_ASSERT(o && node < o->node_count);

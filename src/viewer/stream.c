@@ -19,14 +19,11 @@
 #include "viewer/internal.h"
 #include "util/banned.h"
 
-/* Bytes a drawn point costs (cloud, GL buffers, staging): the same figure render's loader uses. */
-enum { BYTES_PER_POINT = 64 };
 /* How long the camera must rest before the cut is chosen again: shorter re-reads mid-gesture. */
 #define REST_SECONDS 0.25
 
 struct asp__viewer_stream {
     asp_ooc *ooc;
-    asp_context ctx;
     uint64_t budget;         /* points of one view's cut */
     float tau;               /* pixels of projected spacing the cut refines to (0 = 1) */
     int scripted;
@@ -59,13 +56,7 @@ static int select_cut(asp__viewer_stream *s, const asp_camera *cam, uint32_t w, 
                       asp_error *err)
 {
     asp_hier_view hv;
-    memset(&hv, 0, sizeof hv);
-    asp_camera_view_matrix(cam, hv.view);
-    asp_camera_projection_matrix(cam, hv.proj);
-    asp_camera_eye(cam, hv.eye);
-    hv.width = w ? w : 1;
-    hv.height = h ? h : 1;
-    hv.tau = s->tau;
+    asp_hier_view_of_camera(cam, w ? w : 1, h ? h : 1, s->tau, &hv);
     uint64_t points = 0;
     int rc = asp_ooc_select(s->ooc, &hv, s->budget, s->scratch, n, &points, err);
     if (!rc)
@@ -79,8 +70,6 @@ int asp__viewer_stream_open(const char *path, size_t memory, float tau, int scri
     asp__viewer_stream *s = calloc(1, sizeof *s);
     if (!s)
         return asp_error_set(err, ASP_ENOMEM, "out of memory for the stream of '%s'", path);
-    if (ctx)
-        s->ctx = *ctx;
     int rc = asp_ooc_open(path, ctx, &s->ooc, err);
     if (!rc) {
         size_t nn = asp_ooc_node_count(s->ooc);
@@ -94,7 +83,7 @@ int asp__viewer_stream_open(const char *path, size_t memory, float tau, int scri
         asp__viewer_stream_close(s);
         return rc;
     }
-    s->budget = (memory ? memory : (size_t)2 << 30) / BYTES_PER_POINT;
+    s->budget = asp_ooc_budget_points(memory);
     s->tau = tau;
     s->scripted = scripted;
     atomic_init(&s->done, 0);
